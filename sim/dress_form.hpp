@@ -1,0 +1,116 @@
+// The dress form as the study's section model: horizontal sections at uniform heights, each
+// with 256 radii r(section j, angle n) around its own centre, plus reference lines.
+//
+// Frame (stage space): y up, floor at y = 0, the form stands at the origin and its centre
+// front faces +z. The section angle theta is measured from centre front (+z) toward the form's
+// LEFT side (+x): the surface point of angle theta is centre + r * (sin theta, 0, cos theta).
+// So theta = 0 centre front, pi/2 left side line, pi centre back, 3pi/2 right side line
+// (the form's own left/right, as a person wearing it).
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "sim/types.hpp"
+
+namespace drape::sim {
+
+struct TriMesh;  // sim/mesh_io.hpp
+
+// Body measurements for a parametric form (metres). Girths are tape measures around the section.
+struct FormMeasurements {
+  std::string size = "9AR";
+  double bust_girth = 0.83;
+  double waist_girth = 0.64;
+  double hip_girth = 0.91;
+  double height = 1.58;        // the person's height
+  double bust_height = 1.15;   // above the floor
+  double waist_height = 0.97;
+  double hip_height = 0.78;    // waist - 0.19
+  double neck_height = 1.34;   // base of the neck (top of the torso)
+  double bottom_height = 0.60; // bottom of the form (upper thigh)
+  // Width/depth of the sections (method digest: ~1.3 at bust and waist, 1.4 at hip).
+  double bust_aspect = 1.3, waist_aspect = 1.3, hip_aspect = 1.4;
+};
+
+// The measurements of a standard size ("7AR", "9AR", "11AR", "13AR"; assets/forms/).
+Result<FormMeasurements> measurements_for_size(const std::string& size);
+// Measurements from a JSON file (fields as above, in metres); errors name the file and field.
+Result<FormMeasurements> load_measurements(const std::string& path);
+
+// How to read a scanned or modelled form from a mesh file.
+struct MeshImportOptions {
+  enum class Units { kAuto, kMetres, kCentimetres, kMillimetres, kInches };
+  enum class UpAxis { kAuto, kY, kZ, kX, kNegY, kNegZ, kNegX };
+  Units units = Units::kAuto;
+  UpAxis up = UpAxis::kAuto;
+  bool front_auto = true;     // detect centre front (bust protrudes); else front_axis is used
+  Vec3 front_axis{0, 0, 1};   // in the file's frame after the up-axis change
+  double section_spacing = 0.0025;  // m between sections
+};
+
+// Where the reference lines and landmarks are.
+struct FormLandmarks {
+  double bottom_y = 0, top_y = 0;             // extent of the section model
+  double hip_y = 0, waist_y = 0, bust_y = 0;  // heights of the horizontal reference lines
+  double neck_y = 0;
+  double centre_front_theta = 0.0;            // always 0 by construction
+  double centre_back_theta = 3.14159265358979323846;
+  double left_side_theta = 3.14159265358979323846 / 2;   // side lines (may differ from pi/2
+  double right_side_theta = 3 * 3.14159265358979323846 / 2;  // on an asymmetric scan)
+};
+
+class DressForm {
+ public:
+  static constexpr int kAngles = 256;
+
+  DressForm() = default;
+  // Builds a form from radii: radii[j * kAngles + n]; section j at height y0 + j * dy.
+  DressForm(double y0, double dy, std::vector<Vec2> centres, std::vector<double> radii,
+            FormLandmarks landmarks);
+
+  static Result<DressForm> from_measurements(const FormMeasurements& m,
+                                             double section_spacing = 0.0025);
+  static Result<DressForm> from_mesh(const std::string& path, const MeshImportOptions& opt = {});
+
+  int num_sections() const { return num_sections_; }
+  double section_y(int j) const { return y0_ + dy_ * j; }
+  double section_spacing() const { return dy_; }
+  const Vec2& centre(int j) const { return centres_[j]; }  // (x, z) of the section centre
+  double radius(int j, int n) const { return radii_[static_cast<size_t>(j) * kAngles + n]; }
+  static double theta(int n) { return 2.0 * 3.14159265358979323846 * n / kAngles; }
+  static Vec3 direction(double theta);  // (sin theta, 0, cos theta)
+  Vec3 point(int j, int n) const;       // surface sample of section j, angle n
+
+  double min_y() const { return y0_; }
+  double max_y() const { return y0_ + dy_ * (num_sections_ - 1); }
+  const FormLandmarks& landmarks() const { return landmarks_; }
+
+  // Continuous surface: bilinear in (height, angle) between the four nearest samples
+  // (method 2.2). Heights outside [min_y, max_y] clamp to the end sections.
+  double radius_at(double y, double theta) const;
+  Vec2 centre_at(double y) const;
+  Vec3 surface_at(double y, double theta) const;
+  // Tape-measure girth at height y: perimeter of the interpolated section.
+  double girth_at(double y) const;
+
+  // O(1) collision by section lookup: if p is closer to its section centre than the surface
+  // plus `offset`, moves it radially to surface + offset and returns the penetration depth
+  // (> 0); else returns 0 and leaves p. Points outside the form's height range are untouched.
+  double push_outside(Vec3& p, double offset) const;
+  // Signed radial distance of p from the surface (< 0 inside); +inf outside the height range.
+  double signed_distance(const Vec3& p) const;
+
+  // The form as a closed triangle mesh (sections x angles, capped), for rendering and export.
+  TriMesh to_mesh() const;
+
+ private:
+  double y0_ = 0, dy_ = 0;
+  int num_sections_ = 0;
+  std::vector<Vec2> centres_;
+  std::vector<double> radii_;
+  FormLandmarks landmarks_;
+};
+
+}  // namespace drape::sim

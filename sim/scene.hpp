@@ -1,0 +1,56 @@
+// Rigid objects of a draping scene (the study's plate and cube, spheres for tests) and the
+// hand proxies operations act with. All analytic; the dress form is in dress_form.hpp.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <vector>
+
+#include "sim/types.hpp"
+
+namespace drape::sim {
+
+class DressForm;
+
+// Horizontal square plate (the study's table): top face at centre.y, half extents in x and z.
+struct Plate {
+  Vec3 centre{0, 0.8, 0};
+  double half_x = 0.3, half_z = 0.3;
+  double thickness = 0.01;
+};
+
+// Axis-aligned box (the study's cube).
+struct Box {
+  Vec3 centre{0, 0.9, 0};
+  Vec3 half{0.1, 0.1, 0.1};
+};
+
+struct Sphere {
+  Vec3 centre{0, 1, 0};
+  double radius = 0.2;
+};
+
+// A hand as the simulation sees it: no device, only a pose and a size. `id` is 0 (left) or
+// 1 (right); a capsule from palm to fingertip when `tip` differs from `position`.
+struct HandProxy {
+  int id = 0;
+  bool tracked = false;
+  Vec3 position{0, 0, 0};                                  // palm or pinch point (m)
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  Vec3 tip{0, 0, 0};                                       // capsule end (= position: a sphere)
+  double radius = 0.04;                                    // collision radius (m)
+  bool collides = false;                                   // push cloth away (hand as obstacle)
+};
+
+// Everything the cloth can touch.
+struct SceneObjects {
+  std::shared_ptr<const DressForm> form;  // may be null
+  std::vector<Plate> plates;
+  std::vector<Box> boxes;
+  std::vector<Sphere> spheres;
+  std::vector<HandProxy> hands;
+  bool floor = true;       // the stage floor y = 0
+  double offset = 0.002;   // cloth thickness / collision offset (m): kept-out distance
+};
+
+}  // namespace drape::sim
