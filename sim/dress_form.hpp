@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,9 @@ struct FormMeasurements {
 Result<FormMeasurements> measurements_for_size(const std::string& size);
 // Measurements from a JSON file (fields as above, in metres); errors name the file and field.
 Result<FormMeasurements> load_measurements(const std::string& path);
+// The same from JSON text; `source` names the origin in error messages.
+Result<FormMeasurements> parse_measurements(const std::string& json_text,
+                                            const std::string& source);
 
 // How to read a scanned or modelled form from a mesh file.
 struct MeshImportOptions {
@@ -48,6 +52,24 @@ struct MeshImportOptions {
   bool front_auto = true;     // detect centre front (bust protrudes); else front_axis is used
   Vec3 front_axis{0, 0, 1};   // in the file's frame after the up-axis change
   double section_spacing = 0.0025;  // m between sections
+  // Height of the form's bottom in stage space (m). NaN (default): keep the file's height
+  // (after units and up axis) when the whole form is above the floor, else put the bottom at
+  // 0.60 m (the standard forms' bottom height). docs/dress-form.md.
+  double bottom_y = std::numeric_limits<double>::quiet_NaN();
+  // Move the form horizontally so its mean section centre is on the vertical axis (x = z = 0).
+  bool centre_on_axis = true;
+};
+
+// What from_mesh detected (for reports).
+struct MeshImportInfo {
+  double scale = 1.0;                 // file units -> metres
+  std::string units;                  // "m", "cm", "mm", "in"
+  std::string up;                     // "+y", "+z", ... (the file's axis that became +y)
+  bool units_detected = false, up_detected = false, front_detected = false;
+  double front_angle = 0.0;           // rotation about +y applied to bring centre front to +z
+  double lift = 0.0;                  // vertical translation applied (m)
+  int triangles = 0;
+  int filled_rays = 0;                // rays that missed and were filled from neighbours
 };
 
 // Where the reference lines and landmarks are.
@@ -73,6 +95,11 @@ class DressForm {
   static Result<DressForm> from_measurements(const FormMeasurements& m,
                                              double section_spacing = 0.0025);
   static Result<DressForm> from_mesh(const std::string& path, const MeshImportOptions& opt = {});
+  // The same from a mesh already in memory (`name` appears in errors); `info` (optional)
+  // receives what was detected.
+  static Result<DressForm> from_triangles(const TriMesh& mesh, const MeshImportOptions& opt,
+                                          const std::string& name,
+                                          MeshImportInfo* info = nullptr);
 
   int num_sections() const { return num_sections_; }
   double section_y(int j) const { return y0_ + dy_ * j; }

@@ -48,6 +48,10 @@ struct SceneSnapshot {
   std::array<int32_t, 2> candidate_vertex{-1, -1};  // per hand: the particle an op would take
   std::array<Vec3f, 2> candidate_point{Vec3f::Zero(), Vec3f::Zero()};  // or form point (pin)
   std::array<bool, 2> candidate_is_form{false, false};
+  // Per hand: every particle an operation could take, best first (layers under the hand), and
+  // the fixed particle release would free (-1: none). Filled by the operations.
+  std::array<std::vector<int32_t>, 2> candidate_alternatives;
+  std::array<int32_t, 2> release_candidate{-1, -1};
   std::vector<Vec3f> pins;                           // pinned particle positions
   std::vector<std::vector<Vec3f>> cut_strokes;       // smoothed strokes (display)
   std::vector<std::vector<Vec2f>> pattern_outlines;  // flattened pattern pieces (m)

@@ -1,0 +1,85 @@
+// CPU-side geometry of a frame: every object of a SceneSnapshot becomes world-space triangles in
+// one vertex format (render/shaders/scene.vert), so the whole scene is one pipeline and two draws
+// (the static form, the per-frame rest). Pure functions: testable without a GPU.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "sim/snapshot.hpp"
+
+namespace drape::sim {
+class DressForm;
+}
+
+namespace drape::render {
+
+enum class ShadeMode : int { kLit = 0, kForm = 1, kCloth = 2, kUnlit = 3, kFloor = 4 };
+enum class ColourMap : int { kNone = 0, kStrain = 1, kEase = 2 };
+
+struct Vertex {
+  float pos[3];
+  float normal[3];
+  float uv[2];     // cloth: material coordinates (m)
+  float color[4];  // linear RGB
+  float aux[4];    // mode, section centre x, section centre z, colour-map scalar
+};
+static_assert(sizeof(Vertex) == 16 * sizeof(float));
+
+struct Mesh {
+  std::vector<Vertex> vertices;
+  std::vector<uint32_t> indices;
+  void clear() {
+    vertices.clear();
+    indices.clear();
+  }
+};
+
+// What to draw and how; everything has a sensible default.
+struct DrawOptions {
+  ColourMap colour_map = ColourMap::kNone;
+  float strain_range = 0.05f;  // |strain| mapped to full colour
+  float ease_range = 0.05f;    // ease (m) mapped to the loose end of the ramp
+  bool grain = true;           // warp/weft check on the cloth
+  float grain_spacing = 0.02f; // m between grain lines (every 5th warp line is stronger)
+  bool floor_grid = true;
+  bool pattern_panel = true;
+  Eigen::Vector3f panel_centre{0.72f, 1.25f, 0.15f};  // floating pattern panel (stage space)
+  float panel_yaw = -0.45f;    // rotation about +y; 0 faces +z (like the form's front)
+  float panel_size = 0.5f;     // edge length of the square panel (m)
+  float line_half_width = 0.0025f;  // reference lines on the form (m)
+  std::array<float, 4> background{0.55f, 0.60f, 0.68f, 1.0f};  // linear RGB
+  std::array<float, 3> cloth_colour{0.92f, 0.89f, 0.80f};      // unbleached muslin
+  std::array<float, 3> form_colour{0.62f, 0.52f, 0.40f};       // linen-covered form
+  float form_section_spacing = 0.008f;  // decimation of the form's sections for drawing (m)
+};
+
+// The dress form as a smooth grid of its sections (normals from the grid), capped, in form mode.
+void append_form(const sim::DressForm& form, float max_section_spacing, const DrawOptions& opt,
+                 Mesh& out);
+// The cloth (two-sided in the shader) with the snapshot's normals (recomputed here when the
+// snapshot has none) and the colour-map scalar per vertex.
+void append_cloth(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& out);
+// Plates, boxes, spheres, hands, pins, candidates, cut strokes, pattern panel.
+void append_decorations(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& out);
+// The floor quad (grid in the shader).
+void append_floor(Mesh& out);
+
+// Signed radial distance of p from the form surface (< 0 inside), from the section model only
+// (bilinear in height and angle, like sim::DressForm::radius_at); +inf outside its height range.
+float form_distance(const sim::DressForm& form, const Eigen::Vector3f& p);
+// Area-weighted vertex normals of a triangle mesh.
+void vertex_normals(const std::vector<sim::Vec3f>& pos, const std::vector<uint32_t>& idx,
+                    std::vector<sim::Vec3f>& normals);
+
+// Primitive builders (world space), used above and by tests.
+void append_sphere(Mesh& out, const Eigen::Vector3f& c, float r, const std::array<float, 3>& rgb,
+                   ShadeMode mode, int slices = 12, int stacks = 8);
+void append_box(Mesh& out, const Eigen::Vector3f& c, const Eigen::Vector3f& half,
+                const std::array<float, 3>& rgb);
+void append_tube(Mesh& out, const Eigen::Vector3f& a, const Eigen::Vector3f& b, float r,
+                 const std::array<float, 3>& rgb, ShadeMode mode, int sides = 8);
+
+}  // namespace drape::render

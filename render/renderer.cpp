@@ -1,0 +1,730 @@
+// Vulkan side of the renderer (render/renderer.hpp). Resources are managed simply: every buffer
+// is host-visible, coherent and persistently mapped (one allocation each, grown by doubling);
+// images are device-local with one allocation each; a frame is recorded into one command buffer
+// and the call waits on one fence, so nothing is in flight when it returns.
+#include "render/renderer.hpp"
+
+#include <time.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <tuple>
+
+#include "scene_frag.spv.h"
+#include "scene_vert.spv.h"
+#include "sim/dress_form.hpp"
+
+namespace drape::render {
+namespace {
+
+struct PushConstants {
+  float view_proj[16];
+  float eye[4];
+  float heights[4];
+  float angles[4];
+  int32_t flags[4];
+};
+static_assert(sizeof(PushConstants) == 128, "push constants must fit the guaranteed 128 bytes");
+
+struct Buffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  void* mapped = nullptr;
+  VkDeviceSize size = 0;
+};
+
+struct Attachment {
+  VkImage image = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+};
+
+struct TargetKey {
+  VkImage image;
+  uint32_t layer, width, height;
+  VkFormat format;
+  int samples;
+  VkImageLayout final_layout;
+  auto tie() const { return std::tie(image, layer, width, height, format, samples, final_layout); }
+  bool operator<(const TargetKey& o) const { return tie() < o.tie(); }
+};
+
+struct TargetFb {
+  VkImageView view = VK_NULL_HANDLE;
+  VkFramebuffer framebuffer = VK_NULL_HANDLE;
+};
+
+bool is_srgb(VkFormat f) {
+  switch (f) {
+    case VK_FORMAT_R8G8B8A8_SRGB:
+    case VK_FORMAT_B8G8R8A8_SRGB:
+    case VK_FORMAT_A8B8G8R8_SRGB_PACK32:
+    case VK_FORMAT_R8G8B8_SRGB:
+    case VK_FORMAT_B8G8R8_SRGB:
+      return true;
+    default:
+      return false;
+  }
+}
+
+// Formats holding linear values with more than 8 bits need no encoding either.
+bool needs_shader_encode(VkFormat f) {
+  switch (f) {
+    case VK_FORMAT_R8G8B8A8_UNORM:
+    case VK_FORMAT_B8G8R8A8_UNORM:
+    case VK_FORMAT_A8B8G8R8_UNORM_PACK32:
+    case VK_FORMAT_A2B10G10R10_UNORM_PACK32:
+    case VK_FORMAT_A2R10G10B10_UNORM_PACK32:
+      return true;
+    default:
+      return false;
+  }
+}
+
+float srgb_encode(float c) {
+  c = std::clamp(c, 0.0f, 1.0f);
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  std::unique_ptr<VulkanContext> ctx;
+  int samples = 1;
+  bool lost = false;
+  FrameStats stats;
+
+  VkCommandPool pool = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  VkShaderModule vs = VK_NULL_HANDLE, fs = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  std::map<std::tuple<VkFormat, int, VkImageLayout>, VkRenderPass> passes;
+  std::map<std::pair<VkFormat, int>, VkPipeline> pipelines;
+  std::map<std::tuple<uint32_t, uint32_t, VkFormat, int>, std::pair<Attachment, Attachment>>
+      attachments;  // (depth, msaa colour) per size/format/samples
+  std::map<TargetKey, TargetFb> targets;
+
+  // Offscreen target + readback.
+  Attachment offscreen;
+  uint32_t off_w = 0, off_h = 0;
+  Buffer readback;
+
+  // Geometry: the static part (form, floor) is rebuilt only when the form or options change.
+  Buffer static_vb, static_ib, dyn_vb, dyn_ib;
+  uint32_t static_count = 0;
+  const sim::DressForm* cached_form = nullptr;
+  std::shared_ptr<const sim::DressForm> form_ref;  // keeps the cached form alive
+  bool cached_floor = false;
+  float cached_spacing = -1;
+  std::array<float, 3> cached_colour{-1, -1, -1};
+  Mesh mesh;
+
+  ~Impl() { destroy(); }
+
+  VkDevice dev() const { return ctx->device; }
+
+  Status fail(const std::string& what, VkResult r) {
+    if (r == VK_ERROR_DEVICE_LOST) lost = true;
+    return Status{"vulkan: " + what + " failed: " + vk_result_name(r) +
+                  (r == VK_ERROR_DEVICE_LOST ? " (device lost: recreate the renderer)" : "")};
+  }
+
+  sim::Result<uint32_t> memory_type(uint32_t bits, VkMemoryPropertyFlags want) const {
+    for (uint32_t i = 0; i < ctx->memory.memoryTypeCount; ++i)
+      if ((bits & (1u << i)) && (ctx->memory.memoryTypes[i].propertyFlags & want) == want) return i;
+    return sim::Error{"vulkan: no memory type with the required properties"};
+  }
+
+  void destroy_buffer(Buffer& b) {
+    if (b.buffer) vkDestroyBuffer(dev(), b.buffer, nullptr);
+    if (b.memory) vkFreeMemory(dev(), b.memory, nullptr);
+    b = Buffer{};
+  }
+  void destroy_attachment(Attachment& a) {
+    if (a.view) vkDestroyImageView(dev(), a.view, nullptr);
+    if (a.image) vkDestroyImage(dev(), a.image, nullptr);
+    if (a.memory) vkFreeMemory(dev(), a.memory, nullptr);
+    a = Attachment{};
+  }
+
+  Status ensure_buffer(Buffer& b, VkDeviceSize size, VkBufferUsageFlags usage) {
+    if (b.size >= size && b.buffer) return {};
+    destroy_buffer(b);
+    VkDeviceSize cap = 4096;
+    while (cap < size) cap *= 2;
+    VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    bi.size = cap;
+    bi.usage = usage;
+    bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    if (VkResult r = vkCreateBuffer(dev(), &bi, nullptr, &b.buffer); r != VK_SUCCESS)
+      return fail("vkCreateBuffer", r);
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(dev(), b.buffer, &req);
+    auto type = memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                                    VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    if (!type) return Status{type.error()};
+    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = req.size;
+    ai.memoryTypeIndex = *type;
+    if (VkResult r = vkAllocateMemory(dev(), &ai, nullptr, &b.memory); r != VK_SUCCESS)
+      return fail("vkAllocateMemory", r);
+    vkBindBufferMemory(dev(), b.buffer, b.memory, 0);
+    if (VkResult r = vkMapMemory(dev(), b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped); r != VK_SUCCESS)
+      return fail("vkMapMemory", r);
+    b.size = cap;
+    return {};
+  }
+
+  Status make_image(Attachment& a, uint32_t w, uint32_t h, VkFormat fmt, VkImageUsageFlags usage,
+                    VkImageAspectFlags aspect, int nsamples) {
+    VkImageCreateInfo ii{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    ii.imageType = VK_IMAGE_TYPE_2D;
+    ii.format = fmt;
+    ii.extent = {w, h, 1};
+    ii.mipLevels = 1;
+    ii.arrayLayers = 1;
+    ii.samples = static_cast<VkSampleCountFlagBits>(nsamples);
+    ii.tiling = VK_IMAGE_TILING_OPTIMAL;
+    ii.usage = usage;
+    ii.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    if (VkResult r = vkCreateImage(dev(), &ii, nullptr, &a.image); r != VK_SUCCESS)
+      return fail("vkCreateImage", r);
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(dev(), a.image, &req);
+    auto type = memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    if (!type) type = memory_type(req.memoryTypeBits, 0);
+    if (!type) return Status{type.error()};
+    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = req.size;
+    ai.memoryTypeIndex = *type;
+    if (VkResult r = vkAllocateMemory(dev(), &ai, nullptr, &a.memory); r != VK_SUCCESS)
+      return fail("vkAllocateMemory", r);
+    vkBindImageMemory(dev(), a.image, a.memory, 0);
+    VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    vi.image = a.image;
+    vi.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    vi.format = fmt;
+    vi.subresourceRange = {aspect, 0, 1, 0, 1};
+    if (VkResult r = vkCreateImageView(dev(), &vi, nullptr, &a.view); r != VK_SUCCESS)
+      return fail("vkCreateImageView", r);
+    return {};
+  }
+
+  Status init(int want_samples) {
+    VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pi.queueFamilyIndex = ctx->queue_family;
+    if (VkResult r = vkCreateCommandPool(dev(), &pi, nullptr, &pool); r != VK_SUCCESS)
+      return fail("vkCreateCommandPool", r);
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = pool;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    if (VkResult r = vkAllocateCommandBuffers(dev(), &ai, &cmd); r != VK_SUCCESS)
+      return fail("vkAllocateCommandBuffers", r);
+    VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    if (VkResult r = vkCreateFence(dev(), &fi, nullptr, &fence); r != VK_SUCCESS)
+      return fail("vkCreateFence", r);
+    VkShaderModuleCreateInfo si{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    si.codeSize = sizeof(k_scene_vert_spv);
+    si.pCode = k_scene_vert_spv;
+    if (VkResult r = vkCreateShaderModule(dev(), &si, nullptr, &vs); r != VK_SUCCESS)
+      return fail("vkCreateShaderModule", r);
+    si.codeSize = sizeof(k_scene_frag_spv);
+    si.pCode = k_scene_frag_spv;
+    if (VkResult r = vkCreateShaderModule(dev(), &si, nullptr, &fs); r != VK_SUCCESS)
+      return fail("vkCreateShaderModule", r);
+    VkPushConstantRange pc{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                           sizeof(PushConstants)};
+    VkPipelineLayoutCreateInfo li{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    li.pushConstantRangeCount = 1;
+    li.pPushConstantRanges = &pc;
+    if (VkResult r = vkCreatePipelineLayout(dev(), &li, nullptr, &layout); r != VK_SUCCESS)
+      return fail("vkCreatePipelineLayout", r);
+    // MSAA: the largest supported count not above the request.
+    VkPhysicalDeviceProperties props;
+    vkGetPhysicalDeviceProperties(ctx->physical, &props);
+    const VkSampleCountFlags ok = props.limits.framebufferColorSampleCounts &
+                                  props.limits.framebufferDepthSampleCounts;
+    samples = 1;
+    for (int s : {8, 4, 2})
+      if (s <= want_samples && (ok & static_cast<VkSampleCountFlags>(s))) {
+        samples = s;
+        break;
+      }
+    return {};
+  }
+
+  void destroy() {
+    if (!ctx || !ctx->device) return;
+    vkDeviceWaitIdle(dev());
+    forget_targets();
+    for (auto& [k, a] : attachments) {
+      destroy_attachment(a.first);
+      destroy_attachment(a.second);
+    }
+    attachments.clear();
+    destroy_attachment(offscreen);
+    for (Buffer* b : {&readback, &static_vb, &static_ib, &dyn_vb, &dyn_ib}) destroy_buffer(*b);
+    for (auto& [k, p] : pipelines) vkDestroyPipeline(dev(), p, nullptr);
+    pipelines.clear();
+    for (auto& [k, p] : passes) vkDestroyRenderPass(dev(), p, nullptr);
+    passes.clear();
+    if (layout) vkDestroyPipelineLayout(dev(), layout, nullptr);
+    if (vs) vkDestroyShaderModule(dev(), vs, nullptr);
+    if (fs) vkDestroyShaderModule(dev(), fs, nullptr);
+    if (fence) vkDestroyFence(dev(), fence, nullptr);
+    if (pool) vkDestroyCommandPool(dev(), pool, nullptr);
+    layout = VK_NULL_HANDLE;
+    vs = fs = VK_NULL_HANDLE;
+    fence = VK_NULL_HANDLE;
+    pool = VK_NULL_HANDLE;
+  }
+
+  void forget_targets() {
+    for (auto& [k, t] : targets) {
+      if (t.framebuffer) vkDestroyFramebuffer(dev(), t.framebuffer, nullptr);
+      if (t.view) vkDestroyImageView(dev(), t.view, nullptr);
+    }
+    targets.clear();
+  }
+
+  sim::Result<VkRenderPass> pass_for(VkFormat fmt, VkImageLayout final_layout) {
+    const auto key = std::make_tuple(fmt, samples, final_layout);
+    if (auto it = passes.find(key); it != passes.end()) return it->second;
+    const auto s = static_cast<VkSampleCountFlagBits>(samples);
+    std::vector<VkAttachmentDescription> att;
+    VkAttachmentDescription color{};
+    color.format = fmt;
+    color.samples = s;
+    color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    color.storeOp = samples > 1 ? VK_ATTACHMENT_STORE_OP_DONT_CARE : VK_ATTACHMENT_STORE_OP_STORE;
+    color.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+    color.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    color.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    color.finalLayout = samples > 1 ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : final_layout;
+    att.push_back(color);
+    VkAttachmentDescription depth = color;
+    depth.format = VK_FORMAT_D32_SFLOAT;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    depth.finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    att.push_back(depth);
+    if (samples > 1) {
+      VkAttachmentDescription resolve = color;
+      resolve.samples = VK_SAMPLE_COUNT_1_BIT;
+      resolve.loadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+      resolve.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+      resolve.finalLayout = final_layout;
+      att.push_back(resolve);
+    }
+    VkAttachmentReference cref{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+    VkAttachmentReference dref{1, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+    VkAttachmentReference rref{2, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+    VkSubpassDescription sub{};
+    sub.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    sub.colorAttachmentCount = 1;
+    sub.pColorAttachments = &cref;
+    sub.pDepthStencilAttachment = &dref;
+    if (samples > 1) sub.pResolveAttachments = &rref;
+    VkSubpassDependency deps[2]{};
+    deps[0].srcSubpass = VK_SUBPASS_EXTERNAL;
+    deps[0].dstSubpass = 0;
+    deps[0].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+                           VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+    deps[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+                           VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT;
+    deps[0].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
+                            VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+                            VK_ACCESS_TRANSFER_READ_BIT;
+    deps[0].dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
+                            VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+    deps[1].srcSubpass = 0;
+    deps[1].dstSubpass = VK_SUBPASS_EXTERNAL;
+    deps[1].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+    deps[1].dstStageMask = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    deps[1].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+    deps[1].dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+    VkRenderPassCreateInfo ri{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+    ri.attachmentCount = static_cast<uint32_t>(att.size());
+    ri.pAttachments = att.data();
+    ri.subpassCount = 1;
+    ri.pSubpasses = &sub;
+    ri.dependencyCount = 2;
+    ri.pDependencies = deps;
+    VkRenderPass rp = VK_NULL_HANDLE;
+    if (VkResult r = vkCreateRenderPass(dev(), &ri, nullptr, &rp); r != VK_SUCCESS)
+      return sim::Error{fail("vkCreateRenderPass", r).error};
+    passes[key] = rp;
+    return rp;
+  }
+
+  sim::Result<VkPipeline> pipeline_for(VkFormat fmt, VkRenderPass rp) {
+    const auto key = std::make_pair(fmt, samples);
+    if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
+    VkPipelineShaderStageCreateInfo stages[2]{};
+    stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stages[0].module = vs;
+    stages[0].pName = "main";
+    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+    stages[1].module = fs;
+    stages[1].pName = "main";
+    VkVertexInputBindingDescription binding{0, sizeof(Vertex), VK_VERTEX_INPUT_RATE_VERTEX};
+    VkVertexInputAttributeDescription attrs[5] = {
+        {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, pos)},
+        {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal)},
+        {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)},
+        {3, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(Vertex, color)},
+        {4, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(Vertex, aux)}};
+    VkPipelineVertexInputStateCreateInfo vin{
+        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    vin.vertexBindingDescriptionCount = 1;
+    vin.pVertexBindingDescriptions = &binding;
+    vin.vertexAttributeDescriptionCount = 5;
+    vin.pVertexAttributeDescriptions = attrs;
+    VkPipelineInputAssemblyStateCreateInfo ia{
+        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    vp.viewportCount = 1;
+    vp.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo rs{
+        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    rs.polygonMode = VK_POLYGON_MODE_FILL;
+    rs.cullMode = VK_CULL_MODE_NONE;  // cloth is two-sided; everything else is cheap enough
+    rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    rs.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo ms{
+        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    ms.rasterizationSamples = static_cast<VkSampleCountFlagBits>(samples);
+    VkPipelineDepthStencilStateCreateInfo ds{
+        VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    ds.depthTestEnable = VK_TRUE;
+    ds.depthWriteEnable = VK_TRUE;
+    ds.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
+    VkPipelineColorBlendAttachmentState cba{};
+    cba.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                         VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+    VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    cb.attachmentCount = 1;
+    cb.pAttachments = &cba;
+    VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dsi{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dsi.dynamicStateCount = 2;
+    dsi.pDynamicStates = dyn;
+    VkGraphicsPipelineCreateInfo gi{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    gi.stageCount = 2;
+    gi.pStages = stages;
+    gi.pVertexInputState = &vin;
+    gi.pInputAssemblyState = &ia;
+    gi.pViewportState = &vp;
+    gi.pRasterizationState = &rs;
+    gi.pMultisampleState = &ms;
+    gi.pDepthStencilState = &ds;
+    gi.pColorBlendState = &cb;
+    gi.pDynamicState = &dsi;
+    gi.layout = layout;
+    gi.renderPass = rp;
+    VkPipeline p = VK_NULL_HANDLE;
+    if (VkResult r = vkCreateGraphicsPipelines(dev(), VK_NULL_HANDLE, 1, &gi, nullptr, &p);
+        r != VK_SUCCESS)
+      return sim::Error{fail("vkCreateGraphicsPipelines", r).error};
+    pipelines[key] = p;
+    return p;
+  }
+
+  sim::Result<std::pair<Attachment, Attachment>*> attachments_for(uint32_t w, uint32_t h,
+                                                                  VkFormat fmt) {
+    const auto key = std::make_tuple(w, h, fmt, samples);
+    if (auto it = attachments.find(key); it != attachments.end()) return &it->second;
+    std::pair<Attachment, Attachment> a;
+    Status st = make_image(a.first, w, h, VK_FORMAT_D32_SFLOAT,
+                           VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
+                           samples);
+    if (st && samples > 1)
+      st = make_image(a.second, w, h, fmt,
+                      VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
+                      VK_IMAGE_ASPECT_COLOR_BIT, samples);
+    if (!st) {
+      destroy_attachment(a.first);
+      destroy_attachment(a.second);
+      return sim::Error{st.error};
+    }
+    return &(attachments[key] = a);
+  }
+
+  sim::Result<VkFramebuffer> framebuffer_for(const ColorTarget& t, VkRenderPass rp) {
+    const TargetKey key{t.image, t.array_layer, t.width, t.height, t.format, samples, t.final_layout};
+    if (auto it = targets.find(key); it != targets.end()) return it->second.framebuffer;
+    auto att = attachments_for(t.width, t.height, t.format);
+    if (!att) return sim::Error{att.error()};
+    TargetFb fb;
+    VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    vi.image = t.image;
+    vi.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    vi.format = t.format;
+    vi.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, t.array_layer, 1};
+    if (VkResult r = vkCreateImageView(dev(), &vi, nullptr, &fb.view); r != VK_SUCCESS)
+      return sim::Error{fail("vkCreateImageView (target)", r).error};
+    std::vector<VkImageView> views;
+    if (samples > 1)
+      views = {(*att)->second.view, (*att)->first.view, fb.view};
+    else
+      views = {fb.view, (*att)->first.view};
+    VkFramebufferCreateInfo fi{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+    fi.renderPass = rp;
+    fi.attachmentCount = static_cast<uint32_t>(views.size());
+    fi.pAttachments = views.data();
+    fi.width = t.width;
+    fi.height = t.height;
+    fi.layers = 1;
+    if (VkResult r = vkCreateFramebuffer(dev(), &fi, nullptr, &fb.framebuffer); r != VK_SUCCESS) {
+      vkDestroyImageView(dev(), fb.view, nullptr);
+      return sim::Error{fail("vkCreateFramebuffer", r).error};
+    }
+    targets[key] = fb;
+    return fb.framebuffer;
+  }
+
+  Status upload(const Mesh& m, Buffer& vb, Buffer& ib) {
+    const VkDeviceSize vbytes = std::max<size_t>(m.vertices.size(), 1) * sizeof(Vertex);
+    const VkDeviceSize ibytes = std::max<size_t>(m.indices.size(), 1) * sizeof(uint32_t);
+    if (Status s = ensure_buffer(vb, vbytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT); !s) return s;
+    if (Status s = ensure_buffer(ib, ibytes, VK_BUFFER_USAGE_INDEX_BUFFER_BIT); !s) return s;
+    if (!m.vertices.empty()) std::memcpy(vb.mapped, m.vertices.data(), m.vertices.size() * sizeof(Vertex));
+    if (!m.indices.empty()) std::memcpy(ib.mapped, m.indices.data(), m.indices.size() * sizeof(uint32_t));
+    return {};
+  }
+
+  Status prepare_static(const sim::SceneSnapshot& snap, const DrawOptions& opt) {
+    if (static_vb.buffer && cached_form == snap.form.get() && cached_floor == opt.floor_grid &&
+        cached_spacing == opt.form_section_spacing && cached_colour == opt.form_colour)
+      return {};
+    mesh.clear();
+    if (snap.form) append_form(*snap.form, opt.form_section_spacing, opt, mesh);
+    if (opt.floor_grid) append_floor(mesh);
+    if (Status s = upload(mesh, static_vb, static_ib); !s) return s;
+    static_count = static_cast<uint32_t>(mesh.indices.size());
+    cached_form = snap.form.get();
+    form_ref = snap.form;
+    cached_floor = opt.floor_grid;
+    cached_spacing = opt.form_section_spacing;
+    cached_colour = opt.form_colour;
+    return {};
+  }
+
+  // Records and submits one frame into `t`; when `copy_to` is set, also copies the result into
+  // the readback buffer. Waits for completion.
+  Status draw(const sim::SceneSnapshot& snap, const View& view, const ColorTarget& t,
+              const DrawOptions& opt, bool readback_copy) {
+    if (lost) return Status{"vulkan: the device was lost earlier; recreate the renderer"};
+    if (!t.image || t.width == 0 || t.height == 0)
+      return Status{"render: target image is null or has zero size"};
+    const double cpu0 = thread_cpu_ms();
+    auto t0 = Clock::now();
+    if (Status s = prepare_static(snap, opt); !s) return s;
+    mesh.clear();
+    append_cloth(snap, opt, mesh);
+    append_decorations(snap, opt, mesh);
+    const auto dyn_count = static_cast<uint32_t>(mesh.indices.size());
+    stats.triangles = (static_count + dyn_count) / 3;
+    stats.build_ms = ms_since(t0);
+    t0 = Clock::now();
+    if (Status s = upload(mesh, dyn_vb, dyn_ib); !s) return s;
+
+    auto rp = pass_for(t.format, t.final_layout);
+    if (!rp) return Status{rp.error()};
+    auto pipe = pipeline_for(t.format, *rp);
+    if (!pipe) return Status{pipe.error()};
+    auto fb = framebuffer_for(t, *rp);
+    if (!fb) return Status{fb.error()};
+
+    PushConstants pc{};
+    const Mat4f vp = view.view_proj();
+    std::memcpy(pc.view_proj, vp.data(), sizeof(pc.view_proj));
+    pc.eye[0] = view.eye.x();
+    pc.eye[1] = view.eye.y();
+    pc.eye[2] = view.eye.z();
+    pc.eye[3] = opt.grain_spacing;
+    if (snap.form) {
+      const auto& lm = snap.form->landmarks();
+      pc.heights[0] = static_cast<float>(lm.waist_y);
+      pc.heights[1] = static_cast<float>(lm.hip_y);
+      pc.heights[2] = static_cast<float>(lm.bust_y);
+      pc.angles[0] = static_cast<float>(lm.centre_front_theta);
+      pc.angles[1] = static_cast<float>(lm.centre_back_theta);
+      pc.angles[2] = static_cast<float>(lm.left_side_theta);
+      pc.angles[3] = static_cast<float>(lm.right_side_theta);
+    }
+    pc.heights[3] = opt.line_half_width;
+    pc.flags[0] = static_cast<int32_t>(opt.colour_map);
+    pc.flags[1] = needs_shader_encode(t.format) ? 1 : 0;
+    pc.flags[2] = opt.grain ? 1 : 0;
+
+    vkResetCommandBuffer(cmd, 0);
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    if (VkResult r = vkBeginCommandBuffer(cmd, &bi); r != VK_SUCCESS)
+      return fail("vkBeginCommandBuffer", r);
+    VkClearValue clears[3]{};
+    for (int i = 0; i < 3; ++i)
+      clears[0].color.float32[i] = pc.flags[1] ? srgb_encode(opt.background[i]) : opt.background[i];
+    clears[0].color.float32[3] = 1.0f;
+    clears[1].depthStencil = {1.0f, 0};
+    clears[2] = clears[0];
+    VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+    rbi.renderPass = *rp;
+    rbi.framebuffer = *fb;
+    rbi.renderArea = {{0, 0}, {t.width, t.height}};
+    rbi.clearValueCount = samples > 1 ? 3 : 2;
+    rbi.pClearValues = clears;
+    vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, *pipe);
+    VkViewport viewport{0, 0, static_cast<float>(t.width), static_cast<float>(t.height), 0, 1};
+    VkRect2D scissor{{0, 0}, {t.width, t.height}};
+    vkCmdSetViewport(cmd, 0, 1, &viewport);
+    vkCmdSetScissor(cmd, 0, 1, &scissor);
+    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                       sizeof(pc), &pc);
+    const VkDeviceSize zero = 0;
+    if (static_count) {
+      vkCmdBindVertexBuffers(cmd, 0, 1, &static_vb.buffer, &zero);
+      vkCmdBindIndexBuffer(cmd, static_ib.buffer, 0, VK_INDEX_TYPE_UINT32);
+      vkCmdDrawIndexed(cmd, static_count, 1, 0, 0, 0);
+    }
+    if (dyn_count) {
+      vkCmdBindVertexBuffers(cmd, 0, 1, &dyn_vb.buffer, &zero);
+      vkCmdBindIndexBuffer(cmd, dyn_ib.buffer, 0, VK_INDEX_TYPE_UINT32);
+      vkCmdDrawIndexed(cmd, dyn_count, 1, 0, 0, 0);
+    }
+    vkCmdEndRenderPass(cmd);
+    if (readback_copy) {
+      VkBufferImageCopy region{};
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, t.array_layer, 1};
+      region.imageExtent = {t.width, t.height, 1};
+      vkCmdCopyImageToBuffer(cmd, t.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1,
+                             &region);
+      VkBufferMemoryBarrier bar{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+      bar.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+      bar.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+      bar.srcQueueFamilyIndex = bar.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+      bar.buffer = readback.buffer;
+      bar.size = VK_WHOLE_SIZE;
+      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
+                           nullptr, 1, &bar, 0, nullptr);
+    }
+    if (VkResult r = vkEndCommandBuffer(cmd); r != VK_SUCCESS) return fail("vkEndCommandBuffer", r);
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cmd;
+    vkResetFences(dev(), 1, &fence);
+    if (VkResult r = vkQueueSubmit(ctx->queue, 1, &si, fence); r != VK_SUCCESS)
+      return fail("vkQueueSubmit", r);
+    stats.submit_ms = ms_since(t0);
+    t0 = Clock::now();
+    constexpr uint64_t kTimeoutNs = 60ull * 1000 * 1000 * 1000;
+    VkResult r = vkWaitForFences(dev(), 1, &fence, VK_TRUE, kTimeoutNs);
+    stats.wait_ms = ms_since(t0);
+    stats.thread_cpu_ms = thread_cpu_ms() - cpu0;
+    if (r == VK_TIMEOUT) {
+      lost = true;  // the command buffer may still be pending: nothing can be reused safely
+      return Status{"vulkan: frame did not finish within 60 s (treated as a lost device)"};
+    }
+    if (r != VK_SUCCESS) return fail("vkWaitForFences", r);
+    return {};
+  }
+
+  sim::Result<Image> draw_offscreen(const sim::SceneSnapshot& snap, const View& view, int w, int h,
+                                    const DrawOptions& opt) {
+    if (lost) return sim::Error{"vulkan: the device was lost earlier; recreate the renderer"};
+    if (w <= 0 || h <= 0 || w > 16384 || h > 16384)
+      return sim::Error{"render: image size " + std::to_string(w) + "x" + std::to_string(h) +
+                        " out of range (1..16384)"};
+    const auto uw = static_cast<uint32_t>(w), uh = static_cast<uint32_t>(h);
+    constexpr VkFormat kFormat = VK_FORMAT_R8G8B8A8_SRGB;
+    if (uw != off_w || uh != off_h || !offscreen.image) {
+      forget_targets();
+      destroy_attachment(offscreen);
+      if (Status s = make_image(offscreen, uw, uh, kFormat,
+                                VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
+                                    VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                VK_IMAGE_ASPECT_COLOR_BIT, 1);
+          !s)
+        return sim::Error{s.error};
+      off_w = uw;
+      off_h = uh;
+    }
+    if (Status s = ensure_buffer(readback, VkDeviceSize(uw) * uh * 4,
+                                 VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+        !s)
+      return sim::Error{s.error};
+    ColorTarget t{offscreen.image, kFormat, uw, uh, 0, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+    if (Status s = draw(snap, view, t, opt, true); !s) return sim::Error{s.error};
+    Image img;
+    img.width = w;
+    img.height = h;
+    img.rgba.resize(static_cast<size_t>(w) * h * 4);
+    std::memcpy(img.rgba.data(), readback.mapped, img.rgba.size());
+    return img;
+  }
+};
+
+Renderer::Renderer() : impl_(std::make_unique<Impl>()) {}
+Renderer::~Renderer() = default;
+
+sim::Result<std::unique_ptr<Renderer>> Renderer::create(const RendererOptions& opt) {
+  auto ctx = VulkanContext::create(opt.context);
+  if (!ctx) return sim::Error{ctx.error()};
+  std::unique_ptr<Renderer> r(new Renderer());
+  r->impl_->ctx = std::move(*ctx);
+  if (Status s = r->impl_->init(opt.samples); !s) return sim::Error{s.error};
+  return r;
+}
+
+sim::Result<std::unique_ptr<Renderer>> Renderer::create_on(const ExternalDevice& dev,
+                                                           const RendererOptions& opt) {
+  auto ctx = VulkanContext::adopt(dev);
+  if (!ctx) return sim::Error{ctx.error()};
+  std::unique_ptr<Renderer> r(new Renderer());
+  r->impl_->ctx = std::move(*ctx);
+  if (Status s = r->impl_->init(opt.samples); !s) return sim::Error{s.error};
+  return r;
+}
+
+Status Renderer::render(const sim::SceneSnapshot& snap, const View& view, const ColorTarget& t,
+                        const DrawOptions& opt) {
+  return impl_->draw(snap, view, t, opt, false);
+}
+
+sim::Result<Image> Renderer::render_offscreen(const sim::SceneSnapshot& snap, const View& view,
+                                              int width, int height, const DrawOptions& opt) {
+  return impl_->draw_offscreen(snap, view, width, height, opt);
+}
+
+void Renderer::forget_targets() {
+  if (!impl_->lost) vkDeviceWaitIdle(impl_->dev());
+  impl_->forget_targets();
+}
+ValidationCounts Renderer::validation() const { return impl_->ctx->validation(); }
+const std::string& Renderer::device_name() const { return impl_->ctx->device_name; }
+bool Renderer::is_cpu_device() const { return impl_->ctx->is_cpu; }
+bool Renderer::device_lost() const { return impl_->lost; }
+const FrameStats& Renderer::last_frame() const { return impl_->stats; }
+VulkanContext& Renderer::context() { return *impl_->ctx; }
+void Renderer::simulate_device_lost() { impl_->lost = true; }
+
+}  // namespace drape::render

@@ -1,0 +1,205 @@
+// The dress form's section model: lookup, interpolation, girth, O(1) collision and export
+// (method 1 and 2.2). Builders live in form_parametric.cpp and form_mesh.cpp.
+#include "sim/dress_form.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sim/mesh_io.hpp"
+
+namespace drape::sim {
+
+namespace {
+constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
+constexpr double kAnglesPerRadian = DressForm::kAngles / kTwoPi;
+}  // namespace
+
+DressForm::DressForm(double y0, double dy, std::vector<Vec2> centres, std::vector<double> radii,
+                     FormLandmarks landmarks)
+    : y0_(y0),
+      dy_(dy),
+      num_sections_(static_cast<int>(centres.size())),
+      centres_(std::move(centres)),
+      radii_(std::move(radii)),
+      landmarks_(landmarks) {
+  if (radii_.size() != static_cast<size_t>(num_sections_) * kAngles) {
+    // A malformed radius array is a programming error; keep the object in a usable empty state.
+    num_sections_ = 0;
+    centres_.clear();
+    radii_.clear();
+  }
+  if (!(dy_ > 0)) dy_ = 1.0;
+}
+
+Vec3 DressForm::direction(double theta) { return Vec3(std::sin(theta), 0.0, std::cos(theta)); }
+
+Vec3 DressForm::point(int j, int n) const {
+  const Vec2& c = centres_[j];
+  const double r = radius(j, n);
+  const double t = theta(n);
+  return Vec3(c.x() + r * std::sin(t), section_y(j), c.y() + r * std::cos(t));
+}
+
+namespace {
+// Section index and fraction for height y, clamped to the model.
+inline void locate(double y, double y0, double dy, int ns, int& j, double& t) {
+  double s = (y - y0) / dy;
+  if (!(s > 0)) s = 0;  // also catches NaN
+  const double smax = ns - 1;
+  if (s >= smax) {
+    j = std::max(ns - 2, 0);
+    t = ns >= 2 ? 1.0 : 0.0;
+    return;
+  }
+  j = static_cast<int>(s);
+  t = s - j;
+}
+// Angle index and fraction for theta (any real).
+inline void locate_angle(double theta, int& n, double& u) {
+  double a = theta * kAnglesPerRadian;
+  a -= DressForm::kAngles * std::floor(a / DressForm::kAngles);
+  n = static_cast<int>(a);
+  if (n >= DressForm::kAngles) n = 0, a = 0;
+  u = a - n;
+}
+}  // namespace
+
+double DressForm::radius_at(double y, double th) const {
+  if (num_sections_ == 0) return 0.0;
+  int j, n;
+  double t, u;
+  locate(y, y0_, dy_, num_sections_, j, t);
+  locate_angle(th, n, u);
+  const int n1 = (n + 1) & (kAngles - 1);
+  const int j1 = std::min(j + 1, num_sections_ - 1);
+  const double* r0 = &radii_[static_cast<size_t>(j) * kAngles];
+  const double* r1 = &radii_[static_cast<size_t>(j1) * kAngles];
+  const double a = r0[n] + (r0[n1] - r0[n]) * u;
+  const double b = r1[n] + (r1[n1] - r1[n]) * u;
+  return a + (b - a) * t;
+}
+
+Vec2 DressForm::centre_at(double y) const {
+  if (num_sections_ == 0) return Vec2::Zero();
+  int j;
+  double t;
+  locate(y, y0_, dy_, num_sections_, j, t);
+  const int j1 = std::min(j + 1, num_sections_ - 1);
+  return centres_[j] + (centres_[j1] - centres_[j]) * t;
+}
+
+Vec3 DressForm::surface_at(double y, double th) const {
+  const Vec2 c = centre_at(y);
+  const double r = radius_at(y, th);
+  return Vec3(c.x() + r * std::sin(th), y, c.y() + r * std::cos(th));
+}
+
+double DressForm::girth_at(double y) const {
+  if (num_sections_ == 0) return 0.0;
+  int j;
+  double t;
+  locate(y, y0_, dy_, num_sections_, j, t);
+  const int j1 = std::min(j + 1, num_sections_ - 1);
+  const double* r0 = &radii_[static_cast<size_t>(j) * kAngles];
+  const double* r1 = &radii_[static_cast<size_t>(j1) * kAngles];
+  // Precomputed unit directions: the polygon of the 256 interpolated samples.
+  static const std::array<Vec2, kAngles> dirs = [] {
+    std::array<Vec2, kAngles> d;
+    for (int n = 0; n < kAngles; ++n) d[n] = Vec2(std::sin(theta(n)), std::cos(theta(n)));
+    return d;
+  }();
+  double perimeter = 0.0;
+  Vec2 first = dirs[0] * (r0[0] + (r1[0] - r0[0]) * t);
+  Vec2 prev = first;
+  for (int n = 1; n < kAngles; ++n) {
+    const Vec2 p = dirs[n] * (r0[n] + (r1[n] - r0[n]) * t);
+    perimeter += (p - prev).norm();
+    prev = p;
+  }
+  perimeter += (first - prev).norm();
+  return perimeter;
+}
+
+double DressForm::push_outside(Vec3& p, double offset) const {
+  if (num_sections_ == 0) return 0.0;
+  const double s = (p.y() - y0_) / dy_;
+  if (!(s >= 0.0) || s > num_sections_ - 1) return 0.0;  // outside the height range (or NaN)
+  int j = static_cast<int>(s);
+  double t = s - j;
+  if (j >= num_sections_ - 1) j = std::max(num_sections_ - 2, 0), t = num_sections_ >= 2 ? 1 : 0;
+  const int j1 = std::min(j + 1, num_sections_ - 1);
+  const Vec2 c = centres_[j] + (centres_[j1] - centres_[j]) * t;
+  const double dx = p.x() - c.x(), dz = p.z() - c.y();
+  const double d2 = dx * dx + dz * dz;
+  double th = std::atan2(dx, dz);  // 0 at +z (centre front), +pi/2 at +x (left side)
+  int n;
+  double u;
+  locate_angle(th, n, u);
+  const int n1 = (n + 1) & (kAngles - 1);
+  const double* r0 = &radii_[static_cast<size_t>(j) * kAngles];
+  const double* r1 = &radii_[static_cast<size_t>(j1) * kAngles];
+  const double a = r0[n] + (r0[n1] - r0[n]) * u;
+  const double b = r1[n] + (r1[n1] - r1[n]) * u;
+  const double target = a + (b - a) * t + offset;
+  if (d2 >= target * target) return 0.0;
+  const double d = std::sqrt(d2);
+  double ux, uz;
+  if (d > 1e-12) {
+    ux = dx / d, uz = dz / d;
+  } else {  // on the axis: push toward centre front
+    ux = 0.0, uz = 1.0;
+  }
+  p.x() = c.x() + ux * target;
+  p.z() = c.y() + uz * target;
+  return target - d;
+}
+
+double DressForm::signed_distance(const Vec3& p) const {
+  if (num_sections_ == 0) return std::numeric_limits<double>::infinity();
+  const double s = (p.y() - y0_) / dy_;
+  if (!(s >= 0.0) || s > num_sections_ - 1) return std::numeric_limits<double>::infinity();
+  const Vec2 c = centre_at(p.y());
+  const double dx = p.x() - c.x(), dz = p.z() - c.y();
+  return std::sqrt(dx * dx + dz * dz) - radius_at(p.y(), std::atan2(dx, dz));
+}
+
+TriMesh DressForm::to_mesh() const {
+  TriMesh m;
+  m.name = "dress_form";
+  if (num_sections_ < 2) return m;
+  const int ns = num_sections_;
+  m.vertices.reserve(static_cast<size_t>(ns) * kAngles + 2);
+  m.uv.reserve(static_cast<size_t>(ns) * kAngles + 2);
+  for (int j = 0; j < ns; ++j) {
+    for (int n = 0; n < kAngles; ++n) {
+      m.vertices.push_back(point(j, n));
+      // uv: arc-angle around (0 at centre front) and height: lets a renderer draw the
+      // reference lines (centre front u = 0, side lines u = 0.25 / 0.75, back u = 0.5).
+      m.uv.emplace_back(static_cast<double>(n) / kAngles, section_y(j));
+    }
+  }
+  auto idx = [](int j, int n) { return j * kAngles + (n & (kAngles - 1)); };
+  // Outward-facing (counter-clockwise seen from outside): theta runs from +z toward +x, i.e.
+  // clockwise seen from above, so (j,n) -> (j,n+1) -> (j+1,n) faces outward.
+  for (int j = 0; j + 1 < ns; ++j) {
+    for (int n = 0; n < kAngles; ++n) {
+      const int a = idx(j, n), b = idx(j, n + 1), c = idx(j + 1, n), d = idx(j + 1, n + 1);
+      m.triangles.push_back({a, b, d});
+      m.triangles.push_back({a, d, c});
+    }
+  }
+  const int bottom = static_cast<int>(m.vertices.size());
+  m.vertices.emplace_back(centres_[0].x(), section_y(0), centres_[0].y());
+  m.uv.emplace_back(0.0, section_y(0));
+  const int top = bottom + 1;
+  m.vertices.emplace_back(centres_[ns - 1].x(), section_y(ns - 1), centres_[ns - 1].y());
+  m.uv.emplace_back(0.0, section_y(ns - 1));
+  for (int n = 0; n < kAngles; ++n) {
+    m.triangles.push_back({bottom, idx(0, n + 1), idx(0, n)});
+    m.triangles.push_back({top, idx(ns - 1, n), idx(ns - 1, n + 1)});
+  }
+  return m;
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,559 @@
+#include "sim/energy.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "sim/dress_form.hpp"
+
+namespace drape::sim {
+
+namespace {
+
+using Mat32 = Eigen::Matrix<double, 3, 2>;
+
+Eigen::Matrix2d clamp_psd(const Eigen::Matrix2d& S) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(S);
+  Eigen::Vector2d ev = es.eigenvalues().cwiseMax(0.0);
+  return es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+}
+
+}  // namespace
+
+void lump_masses(Cloth& cloth) {
+  auto& st = cloth.state;
+  const int n = cloth.num_vertices();
+  st.mass.assign(n, 0.0);
+  for (const auto& t : cloth.topo.triangles) {
+    const Vec2& a = cloth.topo.material[t[0]];
+    const Vec2& b = cloth.topo.material[t[1]];
+    const Vec2& c = cloth.topo.material[t[2]];
+    const double area = 0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+    for (int k = 0; k < 3; ++k) st.mass[t[k]] += cloth.fabric.areal_density * area / 3.0;
+  }
+  st.inv_mass.assign(n, 0.0);
+  for (int i = 0; i < n; ++i) {
+    if (st.mass[i] <= 0) st.mass[i] = 1e-6;
+    st.inv_mass[i] = cloth.is_free(i) ? 1.0 / st.mass[i] : 0.0;
+  }
+}
+
+void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
+  opt_ = opt;
+  num_vertices_ = cloth.num_vertices();
+  built_version_ = cloth.topology_version;
+  const auto& topo = cloth.topo;
+  const FabricParams& fab = cloth.fabric;
+  ku_ = fab.stretch_weft;
+  kv_ = fab.stretch_warp;
+  kshear_ = fab.shear;
+  tri_v_.clear();
+  tri_D_.clear();
+  tri_area_.clear();
+  hinge_v_.clear();
+  hinge_k_.clear();
+  hinge_w_.clear();
+  // Springs added by add_spring() before build are kept only for the springs model rebuild.
+  spring_v_.clear();
+  spring_rest_.clear();
+  spring_k_.clear();
+  vertex_area_.assign(num_vertices_, 0.0);
+
+  const auto& M = topo.material;
+  if (opt_.model == EnergyOptions::Model::kFem) {
+    for (const auto& t : topo.triangles) {
+      Eigen::Matrix2d Dm;
+      Dm.col(0) = M[t[1]] - M[t[0]];
+      Dm.col(1) = M[t[2]] - M[t[0]];
+      const double det = Dm.determinant();
+      if (std::abs(det) < 1e-16) continue;  // degenerate in material space: no stiffness
+      Eigen::Matrix<double, 3, 2> B;
+      B << -1, -1, 1, 0, 0, 1;
+      tri_v_.push_back(t);
+      tri_D_.push_back(B * Dm.inverse());
+      tri_area_.push_back(0.5 * std::abs(det));
+    }
+    // Hinges: interior edges shared by exactly two triangles.
+    if (opt_.bending) {
+      std::map<std::pair<int, int>, std::pair<int, int>> edge_tris;  // edge -> (tri, opposite)
+      for (int ti = 0; ti < static_cast<int>(tri_v_.size()); ++ti) {
+        const auto& t = tri_v_[ti];
+        for (int k = 0; k < 3; ++k) {
+          int a = t[k], b = t[(k + 1) % 3], o = t[(k + 2) % 3];
+          auto key = std::make_pair(std::min(a, b), std::max(a, b));
+          auto it = edge_tris.find(key);
+          if (it == edge_tris.end()) {
+            edge_tris.emplace(key, std::make_pair(ti, o));
+          } else if (it->second.first >= 0) {
+            const int oa = it->second.second;
+            const int e0 = key.first, e1 = key.second;
+            const Vec2 d = M[e1] - M[e0];
+            const double len = d.norm();
+            if (len < 1e-12) continue;
+            const Vec2 dir = d / len;
+            auto foot = [&](int ov, double& s, double& h) {
+              const Vec2 r = M[ov] - M[e0];
+              s = r.dot(dir) / len;
+              h = std::abs(dir.x() * r.y() - dir.y() * r.x());
+            };
+            double sa, ha, sb, hb;
+            foot(oa, sa, ha);
+            foot(o, sb, hb);
+            if (ha < 1e-12 || hb < 1e-12) continue;
+            std::array<double, 4> K{-(1 - sa) / ha - (1 - sb) / hb, -sa / ha - sb / hb, 1 / ha,
+                                    1 / hb};
+            const double area = tri_area_[it->second.first] + tri_area_[ti];
+            // In-plane normal of the edge (direction of curvature the hinge resists).
+            const double nu = -dir.y(), nv = dir.x();
+            const double B = fab.bending_warp * nv * nv + fab.bending_weft * nu * nu;
+            hinge_v_.push_back({e0, e1, oa, o});
+            hinge_k_.push_back(K);
+            hinge_w_.push_back(B * len * len / area);
+            it->second.first = -1;  // a third triangle on this edge makes no further hinge
+          }
+        }
+      }
+    }
+  } else {
+    // The study's 8-neighbour springs: structural springs along grid rows/columns and both
+    // diagonals of every cell (grid panels), else along triangle edges.
+    const double h = topo.spacing > 0 ? topo.spacing : 0.01;
+    const double ks_u = opt_.spring_k_struct > 0 ? opt_.spring_k_struct : fab.stretch_weft;
+    const double ks_v = opt_.spring_k_struct > 0 ? opt_.spring_k_struct : fab.stretch_warp;
+    const double kd = opt_.spring_k_diag > 0 ? opt_.spring_k_diag : fab.shear;
+    (void)h;
+    auto add = [&](int a, int b, double k) {
+      spring_v_.push_back({a, b});
+      spring_rest_.push_back((M[a] - M[b]).norm());
+      spring_k_.push_back(k);
+    };
+    const int nx = topo.grid_nx, ny = topo.grid_ny;
+    if (nx > 0 && ny > 0 && nx * ny == num_vertices_) {
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+          const int v = j * nx + i;
+          if (i + 1 < nx) add(v, v + 1, ks_u);
+          if (j + 1 < ny) add(v, v + nx, ks_v);
+          if (i + 1 < nx && j + 1 < ny) {
+            add(v, v + nx + 1, kd);
+            add(v + 1, v + nx, kd);
+          }
+        }
+    } else {
+      std::map<std::pair<int, int>, int> seen;
+      for (const auto& t : topo.triangles)
+        for (int k = 0; k < 3; ++k) {
+          int a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
+          if (seen.emplace(std::make_pair(a, b), 1).second) {
+            const Vec2 d = M[b] - M[a];
+            const double c2 = d.squaredNorm() > 0 ? d.x() * d.x() / d.squaredNorm() : 0;
+            add(a, b, ks_u * c2 + ks_v * (1 - c2));
+          }
+        }
+    }
+  }
+  for (const auto& t : topo.triangles) {
+    Eigen::Matrix2d Dm;
+    Dm.col(0) = M[t[1]] - M[t[0]];
+    Dm.col(1) = M[t[2]] - M[t[0]];
+    for (int k = 0; k < 3; ++k) vertex_area_[t[k]] += std::abs(Dm.determinant()) / 6.0;
+  }
+  contact_index_.assign(num_vertices_, -1);
+  contacts_.clear();
+  contacts_.reserve(num_vertices_);
+  build_vertex_lists();
+}
+
+void ClothEnergy::add_spring(int a, int b, double k, double rest) {
+  spring_v_.push_back({a, b});
+  spring_rest_.push_back(rest);
+  spring_k_.push_back(k);
+  build_vertex_lists();
+}
+
+void ClothEnergy::build_vertex_lists() {
+  const int n = num_vertices_;
+  auto csr = [n](std::vector<int>& off, std::vector<int>& items, int count, int arity,
+                 auto&& vert) {
+    off.assign(n + 1, 0);
+    for (int e = 0; e < count; ++e)
+      for (int s = 0; s < arity; ++s) ++off[vert(e, s) + 1];
+    for (int i = 0; i < n; ++i) off[i + 1] += off[i];
+    items.assign(off[n], 0);
+    std::vector<int> fill(off.begin(), off.end() - 1);
+    for (int e = 0; e < count; ++e)
+      for (int s = 0; s < arity; ++s) items[fill[vert(e, s)]++] = e * arity + s;
+  };
+  csr(vt_off_, vt_, num_triangles(), 3, [&](int e, int s) { return tri_v_[e][s]; });
+  csr(vh_off_, vh_, num_hinges(), 4, [&](int e, int s) { return hinge_v_[e][s]; });
+  csr(vs_off_, vs_, num_springs(), 2, [&](int e, int s) { return spring_v_[e][s]; });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Membrane: psi = 1/2 ku E_uu^2 + 1/2 kv E_vv^2 + 2 G E_uv^2 per unit rest area (Green strain).
+
+void ClothEnergy::stress(int t, const std::vector<Vec3>& x, Mat32& F, Eigen::Matrix2d& S) const {
+  const auto& v = tri_v_[t];
+  const auto& D = tri_D_[t];
+  F = x[v[0]] * D.row(0) + x[v[1]] * D.row(1) + x[v[2]] * D.row(2);
+  const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
+  S(0, 0) = ku_ * E(0, 0);
+  S(1, 1) = kv_ * E(1, 1);
+  S(0, 1) = S(1, 0) = 2.0 * kshear_ * E(0, 1);
+}
+
+double ClothEnergy::tri_energy(int t, const std::vector<Vec3>& x) const {
+  const auto& v = tri_v_[t];
+  const auto& D = tri_D_[t];
+  const Mat32 F = x[v[0]] * D.row(0) + x[v[1]] * D.row(1) + x[v[2]] * D.row(2);
+  const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
+  return tri_area_[t] * (0.5 * ku_ * E(0, 0) * E(0, 0) + 0.5 * kv_ * E(1, 1) * E(1, 1) +
+                         2.0 * kshear_ * E(0, 1) * E(0, 1));
+}
+
+void ClothEnergy::tri_gradient(int t, const std::vector<Vec3>& x, Vec3 g[3]) const {
+  Mat32 F;
+  Eigen::Matrix2d S;
+  stress(t, x, F, S);
+  const Mat32 P = tri_area_[t] * F * S;
+  for (int k = 0; k < 3; ++k) g[k] = P * tri_D_[t].row(k).transpose();
+}
+
+void ClothEnergy::tri_hessian(int t, const std::vector<Vec3>& x, Mat9& H, bool project) const {
+  Mat32 F;
+  Eigen::Matrix2d S;
+  stress(t, x, F, S);
+  const Eigen::Matrix2d Sp = project ? clamp_psd(S) : S;
+  const auto& D = tri_D_[t];
+  const double A = tri_area_[t];
+  for (int k = 0; k < 3; ++k)
+    for (int c = 0; c < 3; ++c) {
+      Mat32 dF = Mat32::Zero();
+      dF.row(c) = D.row(k);
+      const Eigen::Matrix2d dE = 0.5 * (dF.transpose() * F + F.transpose() * dF);
+      Eigen::Matrix2d dS;
+      dS(0, 0) = ku_ * dE(0, 0);
+      dS(1, 1) = kv_ * dE(1, 1);
+      dS(0, 1) = dS(1, 0) = 2.0 * kshear_ * dE(0, 1);
+      const Mat32 dP = A * (dF * Sp + F * dS);
+      for (int l = 0; l < 3; ++l) H.block<3, 1>(3 * l, 3 * k + c) = dP * D.row(l).transpose();
+    }
+}
+
+void ClothEnergy::tri_vertex_block(int t, int a, const std::vector<Vec3>& x, Vec3& g,
+                                   Mat3& H) const {
+  Mat32 F;
+  Eigen::Matrix2d S;
+  stress(t, x, F, S);
+  const auto& D = tri_D_[t];
+  const double A = tri_area_[t];
+  const Eigen::Vector2d d = D.row(a).transpose();
+  g = A * F * (S * d);
+  // Closed form of the 3x3 block: A [ (d.Sp d) I + sum over strain components of C dE dE ].
+  // dF = e_c d^T, dE = 1/2 (d f_c^T + f_c d^T) with f_c = F^T e_c... computed column-wise.
+  const Eigen::Matrix2d Sp = (S.determinant() >= 0 && S.trace() >= 0) ? S : clamp_psd(S);
+  const double dSd = d.dot(Sp * d);
+  const Eigen::Vector3d fu = F.col(0), fv = F.col(1);
+  // dE_uu = d_u (fu . e_c), dE_vv = d_v (fv . e_c), dE_uv = 1/2 (d_u fv + d_v fu) . e_c
+  const Eigen::Vector3d au = d.x() * fu, av = d.y() * fv, as = 0.5 * (d.x() * fv + d.y() * fu);
+  // d(dP d)/..: H = A [ dSd I + ku au au^T + kv av av^T + 4 G as as^T ]
+  H = A * (dSd * Mat3::Identity() + ku_ * au * au.transpose() + kv_ * av * av.transpose() +
+           4.0 * kshear_ * as * as.transpose());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bending hinges: E = 1/2 w |sum K_k x_k|^2.
+
+double ClothEnergy::hinge_energy(int h, const std::vector<Vec3>& x) const {
+  const auto& v = hinge_v_[h];
+  const auto& K = hinge_k_[h];
+  const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
+  return 0.5 * hinge_w_[h] * s.squaredNorm();
+}
+
+void ClothEnergy::hinge_gradient(int h, const std::vector<Vec3>& x, Vec3 g[4]) const {
+  const auto& v = hinge_v_[h];
+  const auto& K = hinge_k_[h];
+  const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
+  for (int k = 0; k < 4; ++k) g[k] = hinge_w_[h] * K[k] * s;
+}
+
+void ClothEnergy::hinge_hessian(int h, Mat12& H) const {
+  const auto& K = hinge_k_[h];
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      H.block<3, 3>(3 * a, 3 * b) = hinge_w_[h] * K[a] * K[b] * Mat3::Identity();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Springs: E = 1/2 k (|xa - xb| - L)^2.
+
+double ClothEnergy::spring_energy(int s, const std::vector<Vec3>& x) const {
+  const double l = (x[spring_v_[s][0]] - x[spring_v_[s][1]]).norm() - spring_rest_[s];
+  return 0.5 * spring_k_[s] * l * l;
+}
+
+void ClothEnergy::spring_gradient(int s, const std::vector<Vec3>& x, Vec3 g[2]) const {
+  const Vec3 d = x[spring_v_[s][0]] - x[spring_v_[s][1]];
+  const double l = d.norm();
+  const Vec3 f = l > 1e-15 ? Vec3(spring_k_[s] * (l - spring_rest_[s]) * d / l) : Vec3::Zero();
+  g[0] = f;
+  g[1] = -f;
+}
+
+void ClothEnergy::spring_hessian(int s, const std::vector<Vec3>& x, Eigen::Matrix<double, 6, 6>& H,
+                                 bool project) const {
+  const Vec3 d = x[spring_v_[s][0]] - x[spring_v_[s][1]];
+  const double l = std::max(d.norm(), 1e-15);
+  const Vec3 n = d / l;
+  double c = 1.0 - spring_rest_[s] / l;
+  if (project) c = std::max(c, 0.0);
+  const Mat3 B = spring_k_[s] * (n * n.transpose() + c * (Mat3::Identity() - n * n.transpose()));
+  H.block<3, 3>(0, 0) = B;
+  H.block<3, 3>(3, 3) = B;
+  H.block<3, 3>(0, 3) = -B;
+  H.block<3, 3>(3, 0) = -B;
+}
+
+// ---------------------------------------------------------------------------------------------
+// External forces and contact.
+
+Vec3 ClothEnergy::external_force(int i, const Vec3& xi, double mass) const {
+  Vec3 f = opt_.gravity ? Vec3(mass * opt_.g) : Vec3::Zero();
+  if (opt_.pressure > 0 && scene_ && scene_->form) {
+    const DressForm& form = *scene_->form;
+    if (xi.y() >= form.min_y() && xi.y() <= form.max_y()) {
+      const Vec2 c = form.centre_at(xi.y());
+      Vec3 r(xi.x() - c.x(), 0, xi.z() - c.y());
+      const double rn = r.norm();
+      if (rn > 1e-9) f -= opt_.pressure * vertex_area_[i] * r / rn;
+    }
+  }
+  return f;
+}
+
+void ClothEnergy::clear_contacts() {
+  for (const auto& c : contacts_) contact_index_[c.vertex] = -1;
+  contacts_.clear();
+}
+
+double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scene) {
+  clear_contacts();
+  const auto& x = cloth.state.x;
+  const int n = cloth.num_vertices();
+  const double off = scene.offset;
+  const double reach = off + opt_.contact_margin;
+  // Cloth bounds: objects whose bounds do not touch them are skipped entirely.
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max()), hi = -lo;
+  for (int i = 0; i < n; ++i) {
+    lo = lo.cwiseMin(x[i]);
+    hi = hi.cwiseMax(x[i]);
+  }
+  lo.array() -= reach;
+  hi.array() += reach;
+  auto touches = [&](const Vec3& olo, const Vec3& ohi) {
+    if (!opt_.cull_by_bounds) return true;
+    const bool t = (olo.array() <= hi.array()).all() && (ohi.array() >= lo.array()).all();
+    if (!t) ++culled_;
+    return t;
+  };
+  culled_ = 0;
+  double deepest = 0;
+  // Keep, per vertex, the deepest candidate.
+  auto consider = [&](int i, double dist, const Vec3& nrm, const Vec3& surf) {
+    if (dist >= reach) return;
+    const double pen = off - dist;
+    deepest = std::max(deepest, pen);
+    const Vec3 p = surf + off * nrm;
+    int ci = contact_index_[i];
+    if (ci < 0) {
+      contact_index_[i] = static_cast<int>(contacts_.size());
+      contacts_.push_back({i, nrm, p});
+    } else if (nrm.dot(x[i] - p) < contacts_[ci].n.dot(x[i] - contacts_[ci].p)) {
+      contacts_[ci] = {i, nrm, p};
+    }
+  };
+  const bool floor = scene.floor && touches(Vec3(-1e9, -1, -1e9), Vec3(1e9, 0, 1e9));
+  bool form_on = false;
+  if (scene.form) {
+    const DressForm& f = *scene.form;
+    form_on = touches(Vec3(-1, f.min_y(), -1), Vec3(1, f.max_y(), 1));
+  }
+  // Flags per object kind for culling (vectors are small; bool arrays on the stack).
+  for (int i = 0; i < n; ++i) {
+    const uint8_t fl = cloth.state.flags[i];
+    if (fl & (kFlagKinematic | kFlagNoCollide | kFlagPinned | kFlagPinched)) continue;
+    const Vec3& p = x[i];
+    if (floor) consider(i, p.y(), Vec3(0, 1, 0), Vec3(p.x(), 0, p.z()));
+    for (const auto& s : scene.spheres) {
+      const Vec3 d = p - s.centre;
+      const double dn = d.norm();
+      if (dn - s.radius >= reach || dn < 1e-12) continue;
+      const Vec3 nrm = d / dn;
+      consider(i, dn - s.radius, nrm, s.centre + s.radius * nrm);
+    }
+    for (const auto& h : scene.hands) {
+      if (!h.tracked || !h.collides) continue;
+      const Vec3 ab = h.tip - h.position;
+      const double L2 = ab.squaredNorm();
+      const double t = L2 > 0 ? std::clamp((p - h.position).dot(ab) / L2, 0.0, 1.0) : 0.0;
+      const Vec3 c = h.position + t * ab;
+      const Vec3 d = p - c;
+      const double dn = d.norm();
+      if (dn - h.radius >= reach || dn < 1e-12) continue;
+      consider(i, dn - h.radius, d / dn, c + h.radius * d / dn);
+    }
+    for (const auto& pl : scene.plates) {
+      const Vec3 d = p - pl.centre;
+      if (std::abs(d.x()) > pl.half_x || std::abs(d.z()) > pl.half_z) continue;
+      if (d.y() < -pl.thickness) continue;  // below the plate: untouched
+      consider(i, d.y(), Vec3(0, 1, 0), Vec3(p.x(), pl.centre.y(), p.z()));
+    }
+    for (const auto& b : scene.boxes) {
+      const Vec3 d = p - b.centre;
+      const Vec3 q = d.cwiseAbs() - b.half;
+      if (q.maxCoeff() >= reach) continue;
+      if ((q.array() > 0).count() > 1) continue;  // near an edge/corner outside: skip
+      int ax = 0;
+      q.maxCoeff(&ax);
+      Vec3 nrm = Vec3::Zero();
+      nrm[ax] = d[ax] >= 0 ? 1 : -1;
+      Vec3 surf = p;
+      surf[ax] = b.centre[ax] + nrm[ax] * b.half[ax];
+      consider(i, q[ax], nrm, surf);
+    }
+    if (form_on) {
+      const DressForm& f = *scene.form;
+      if (p.y() < f.min_y() || p.y() > f.max_y()) continue;
+      const double sd = f.signed_distance(p);
+      if (!(sd < reach)) continue;
+      const Vec2 c = f.centre_at(p.y());
+      Vec3 r(p.x() - c.x(), 0, p.z() - c.y());
+      const double rn = r.norm();
+      if (rn < 1e-9) continue;
+      const Vec3 nrm = r / rn;
+      consider(i, sd, nrm, p - sd * nrm);
+    }
+  }
+  return deepest;
+}
+
+void ClothEnergy::project_contacts(std::vector<Vec3>& x) const {
+  for (const auto& c : contacts_) {
+    const double d = c.n.dot(x[c.vertex] - c.p);
+    if (d < 0) x[c.vertex] -= d * c.n;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+double ClothEnergy::energy(const std::vector<Vec3>& x, const std::vector<double>& mass) const {
+  double e = 0;
+  for (int t = 0; t < num_triangles(); ++t) e += tri_energy(t, x);
+  for (int h = 0; h < num_hinges(); ++h) e += hinge_energy(h, x);
+  for (int s = 0; s < num_springs(); ++s) e += spring_energy(s, x);
+  for (int i = 0; i < num_vertices_; ++i) {
+    if (opt_.gravity) e -= mass[i] * opt_.g.dot(x[i]);
+    if (opt_.pressure > 0 && scene_ && scene_->form) {
+      const DressForm& form = *scene_->form;
+      if (x[i].y() >= form.min_y() && x[i].y() <= form.max_y()) {
+        const Vec2 c = form.centre_at(x[i].y());
+        e += opt_.pressure * vertex_area_[i] * Vec2(x[i].x() - c.x(), x[i].z() - c.y()).norm();
+      }
+    }
+  }
+  for (const auto& c : contacts_) {
+    const double d = c.n.dot(x[c.vertex] - c.p);
+    if (d < 0) e += 0.5 * k_contact_ * d * d;
+  }
+  return e;
+}
+
+void ClothEnergy::gradient(const std::vector<Vec3>& x, const std::vector<double>& mass,
+                           std::vector<Vec3>& grad) const {
+  grad.resize(num_vertices_);
+  for (int i = 0; i < num_vertices_; ++i) grad[i] = -external_force(i, x[i], mass[i]);
+  Vec3 g[4];
+  for (int t = 0; t < num_triangles(); ++t) {
+    tri_gradient(t, x, g);
+    for (int k = 0; k < 3; ++k) grad[tri_v_[t][k]] += g[k];
+  }
+  for (int h = 0; h < num_hinges(); ++h) {
+    hinge_gradient(h, x, g);
+    for (int k = 0; k < 4; ++k) grad[hinge_v_[h][k]] += g[k];
+  }
+  for (int s = 0; s < num_springs(); ++s) {
+    spring_gradient(s, x, g);
+    grad[spring_v_[s][0]] += g[0];
+    grad[spring_v_[s][1]] += g[1];
+  }
+  for (const auto& c : contacts_) {
+    const double d = c.n.dot(x[c.vertex] - c.p);
+    if (d < 0) grad[c.vertex] += k_contact_ * d * c.n;
+  }
+}
+
+void ClothEnergy::vertex_force_hessian(int i, const std::vector<Vec3>& x, double mass, Vec3& f,
+                                       Mat3& H) const {
+  f = external_force(i, x[i], mass);
+  H.setZero();
+  for (int e = vt_off_[i]; e < vt_off_[i + 1]; ++e) {
+    const int t = vt_[e] / 3, a = vt_[e] % 3;
+    Vec3 g;
+    Mat3 Hb;
+    tri_vertex_block(t, a, x, g, Hb);
+    f -= g;
+    H += Hb;
+  }
+  for (int e = vh_off_[i]; e < vh_off_[i + 1]; ++e) {
+    const int h = vh_[e] / 4, a = vh_[e] % 4;
+    const auto& v = hinge_v_[h];
+    const auto& K = hinge_k_[h];
+    const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
+    f -= hinge_w_[h] * K[a] * s;
+    H.diagonal().array() += hinge_w_[h] * K[a] * K[a];
+  }
+  for (int e = vs_off_[i]; e < vs_off_[i + 1]; ++e) {
+    const int s = vs_[e] / 2, a = vs_[e] % 2;
+    const Vec3 d = x[spring_v_[s][a]] - x[spring_v_[s][1 - a]];
+    const double l = std::max(d.norm(), 1e-15);
+    const Vec3 n = d / l;
+    f -= spring_k_[s] * (l - spring_rest_[s]) * n;
+    const double c = std::max(0.0, 1.0 - spring_rest_[s] / l);
+    H += spring_k_[s] * (n * n.transpose() + c * (Mat3::Identity() - n * n.transpose()));
+  }
+  const int ci = contact_index_[i];
+  if (ci >= 0) {
+    const Contact& c = contacts_[ci];
+    const double d = c.n.dot(x[i] - c.p);
+    if (d < 0) {
+      f -= k_contact_ * d * c.n;
+      H += k_contact_ * c.n * c.n.transpose();
+    }
+  }
+}
+
+void ClothEnergy::vertex_neighbours(std::vector<int>& offsets, std::vector<int>& nbrs) const {
+  std::vector<std::vector<int>> adj(num_vertices_);
+  auto link = [&](const int* v, int k) {
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b)
+        if (a != b) adj[v[a]].push_back(v[b]);
+  };
+  for (const auto& t : tri_v_) link(t.data(), 3);
+  for (const auto& h : hinge_v_) link(h.data(), 4);
+  for (const auto& s : spring_v_) link(s.data(), 2);
+  offsets.assign(num_vertices_ + 1, 0);
+  nbrs.clear();
+  for (int i = 0; i < num_vertices_; ++i) {
+    auto& a = adj[i];
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+    nbrs.insert(nbrs.end(), a.begin(), a.end());
+    offsets[i + 1] = static_cast<int>(nbrs.size());
+  }
+}
+
+}  // namespace drape::sim

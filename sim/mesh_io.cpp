@@ -1,0 +1,238 @@
+// Triangle meshes in and out through assimp.
+#include "sim/mesh_io.hpp"
+
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+#include "sim/cloth.hpp"
+
+namespace drape::sim {
+
+namespace {
+
+constexpr unsigned kImportFlags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                  aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+
+void configure(Assimp::Importer& imp) {
+  // Drop point and line primitives (SortByPType): a form is made of faces.
+  imp.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+}
+
+void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, TriMesh& out,
+             bool& bad_index) {
+  const aiMatrix4x4 m = parent * node->mTransformation;
+  for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+    if (node->mMeshes[k] >= scene->mNumMeshes) {
+      bad_index = true;
+      continue;
+    }
+    const aiMesh* mesh = scene->mMeshes[node->mMeshes[k]];
+    if (!mesh || !mesh->mVertices) continue;
+    const int32_t base = static_cast<int32_t>(out.vertices.size());
+    const bool has_uv = mesh->HasTextureCoords(0);
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D p = m * mesh->mVertices[v];
+      out.vertices.emplace_back(p.x, p.y, p.z);
+      if (has_uv) out.uv.emplace_back(mesh->mTextureCoords[0][v].x, mesh->mTextureCoords[0][v].y);
+      else out.uv.emplace_back(0.0, 0.0);
+    }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      std::array<int32_t, 3> t;
+      for (int c = 0; c < 3; ++c) {
+        if (face.mIndices[c] >= mesh->mNumVertices) {
+          bad_index = true;
+          t[c] = -1;
+        } else {
+          t[c] = base + static_cast<int32_t>(face.mIndices[c]);
+        }
+      }
+      if (t[0] >= 0 && t[1] >= 0 && t[2] >= 0) out.triangles.push_back(t);
+    }
+  }
+  for (unsigned c = 0; c < node->mNumChildren; ++c)
+    if (node->mChildren[c]) collect(scene, node->mChildren[c], m, out, bad_index);
+}
+
+Result<TriMesh> convert(const aiScene* scene, const std::string& name,
+                        const std::string& importer_error) {
+  if (!scene) {
+    std::string why = importer_error.empty() ? "unknown reason" : importer_error;
+    return make_error(name, "cannot be read as a mesh (truncated, corrupt or not a mesh "
+                            "format assimp reads): " + why);
+  }
+  if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
+    return make_error(name, "incomplete scene (no mesh data; not a mesh file?)");
+  if (scene->mNumMeshes == 0 || !scene->mRootNode)
+    return make_error(name, "contains no mesh");
+  TriMesh out;
+  out.name = std::filesystem::path(name).stem().string();
+  bool bad_index = false;
+  collect(scene, scene->mRootNode, aiMatrix4x4(), out, bad_index);
+  if (bad_index) return make_error(name, "corrupt mesh: index out of range");
+  if (out.triangles.empty()) return make_error(name, "contains no triangles");
+  for (size_t i = 0; i < out.vertices.size(); ++i) {
+    if (!out.vertices[i].allFinite()) {
+      std::ostringstream os;
+      os << "vertex " << i << " has a non-finite coordinate (NaN or inf)";
+      return make_error(name, os.str());
+    }
+  }
+  bool any_uv = false;
+  for (const Vec2& t : out.uv) any_uv = any_uv || t != Vec2::Zero();
+  if (!any_uv) out.uv.clear();
+  return out;
+}
+
+}  // namespace
+
+Result<TriMesh> load_mesh(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return make_error(path, "file not found");
+  if (!fs::is_regular_file(path, ec)) return make_error(path, "not a regular file");
+  const auto size = fs::file_size(path, ec);
+  if (ec) return make_error(path, "cannot read file size: " + ec.message());
+  if (size == 0) return make_error(path, "empty file");
+  Assimp::Importer imp;
+  configure(imp);
+  const aiScene* scene = nullptr;
+  try {
+    scene = imp.ReadFile(path, kImportFlags);
+  } catch (const std::exception& e) {  // assimp reports through the return value; be safe
+    return make_error(path, std::string("cannot be read as a mesh: ") + e.what());
+  }
+  return convert(scene, path, scene ? std::string() : imp.GetErrorString());
+}
+
+Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char* hint,
+                                      const std::string& name) {
+  if (!data || size == 0) return make_error(name, "empty file");
+  Assimp::Importer imp;
+  configure(imp);
+  const aiScene* scene = nullptr;
+  try {
+    scene = imp.ReadFileFromMemory(data, size, kImportFlags, hint ? hint : "");
+  } catch (const std::exception& e) {
+    return make_error(name, std::string("cannot be read as a mesh: ") + e.what());
+  }
+  return convert(scene, name, scene ? std::string() : imp.GetErrorString());
+}
+
+std::string write_meshes(const std::string& path, const std::vector<TriMesh>& meshes) {
+  namespace fs = std::filesystem;
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
+    return static_cast<char>(std::tolower(c));
+  });
+  const char* format = ext == ".gltf" ? "gltf2" : ext == ".glb" ? "glb2" : ext == ".obj" ? "obj"
+                                                                                         : nullptr;
+  if (!format) return path + ": unsupported extension (use .gltf, .glb or .obj)";
+  if (meshes.empty()) return path + ": nothing to write (no meshes)";
+  for (const TriMesh& m : meshes) {
+    const auto nv = static_cast<int64_t>(m.vertices.size());
+    if (m.triangles.empty() || nv == 0) return path + ": mesh '" + m.name + "' is empty";
+    for (const auto& t : m.triangles)
+      for (int32_t i : t)
+        if (i < 0 || i >= nv) return path + ": mesh '" + m.name + "' has an index out of range";
+    for (const Vec3& v : m.vertices)
+      if (!v.allFinite()) return path + ": mesh '" + m.name + "' has a non-finite vertex";
+  }
+  std::error_code ec;
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty()) fs::create_directories(parent, ec);
+
+  auto scene = std::make_unique<aiScene>();
+  scene->mNumMaterials = 1;
+  scene->mMaterials = new aiMaterial*[1];
+  scene->mMaterials[0] = new aiMaterial();
+  aiString mat_name("default");
+  scene->mMaterials[0]->AddProperty(&mat_name, AI_MATKEY_NAME);
+  const unsigned n = static_cast<unsigned>(meshes.size());
+  scene->mNumMeshes = n;
+  scene->mMeshes = new aiMesh*[n];
+  scene->mRootNode = new aiNode("root");
+  scene->mRootNode->mNumChildren = n;
+  scene->mRootNode->mChildren = new aiNode*[n];
+  for (unsigned k = 0; k < n; ++k) {
+    const TriMesh& src = meshes[k];
+    const std::string nm = src.name.empty() ? "mesh" + std::to_string(k) : src.name;
+    auto* mesh = new aiMesh();
+    scene->mMeshes[k] = mesh;
+    mesh->mName = aiString(nm);
+    mesh->mMaterialIndex = 0;
+    mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+    const unsigned nv = static_cast<unsigned>(src.vertices.size());
+    mesh->mNumVertices = nv;
+    mesh->mVertices = new aiVector3D[nv];
+    mesh->mNormals = new aiVector3D[nv];
+    std::vector<Vec3> normals(nv, Vec3::Zero());
+    for (const auto& t : src.triangles) {
+      const Vec3 a = src.vertices[t[0]], b = src.vertices[t[1]], c = src.vertices[t[2]];
+      const Vec3 nrm = (b - a).cross(c - a);  // area weighted
+      for (int32_t i : t) normals[i] += nrm;
+    }
+    for (unsigned v = 0; v < nv; ++v) {
+      const Vec3& p = src.vertices[v];
+      mesh->mVertices[v] = aiVector3D(static_cast<ai_real>(p.x()), static_cast<ai_real>(p.y()),
+                                      static_cast<ai_real>(p.z()));
+      const double len = normals[v].norm();
+      const Vec3 nn = len > 0 ? Vec3(normals[v] / len) : Vec3(0, 1, 0);
+      mesh->mNormals[v] = aiVector3D(static_cast<ai_real>(nn.x()), static_cast<ai_real>(nn.y()),
+                                     static_cast<ai_real>(nn.z()));
+    }
+    if (src.uv.size() == nv) {
+      mesh->mTextureCoords[0] = new aiVector3D[nv];
+      mesh->mNumUVComponents[0] = 2;
+      for (unsigned v = 0; v < nv; ++v)
+        mesh->mTextureCoords[0][v] = aiVector3D(static_cast<ai_real>(src.uv[v].x()),
+                                                static_cast<ai_real>(src.uv[v].y()), 0);
+    }
+    const unsigned nf = static_cast<unsigned>(src.triangles.size());
+    mesh->mNumFaces = nf;
+    mesh->mFaces = new aiFace[nf];
+    for (unsigned f = 0; f < nf; ++f) {
+      aiFace& face = mesh->mFaces[f];
+      face.mNumIndices = 3;
+      face.mIndices = new unsigned[3];
+      for (int c = 0; c < 3; ++c) face.mIndices[c] = static_cast<unsigned>(src.triangles[f][c]);
+    }
+    auto* node = new aiNode(nm);
+    node->mParent = scene->mRootNode;
+    node->mNumMeshes = 1;
+    node->mMeshes = new unsigned[1]{k};
+    scene->mRootNode->mChildren[k] = node;
+  }
+  Assimp::Exporter exporter;
+  aiReturn rc;
+  try {
+    rc = exporter.Export(scene.get(), format, path);
+  } catch (const std::exception& e) {
+    return path + ": export failed: " + e.what();
+  }
+  if (rc != aiReturn_SUCCESS) {
+    const char* why = exporter.GetErrorString();
+    return path + ": export failed: " + (why && *why ? why : "unknown error");
+  }
+  return {};
+}
+
+TriMesh cloth_to_mesh(const Cloth& cloth, const std::string& name) {
+  TriMesh m;
+  m.name = name;
+  m.vertices = cloth.state.x;
+  m.triangles = cloth.topo.triangles;
+  if (cloth.topo.material.size() == m.vertices.size()) m.uv = cloth.topo.material;
+  return m;
+}
+
+}  // namespace drape::sim

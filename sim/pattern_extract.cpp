@@ -1,0 +1,395 @@
+// Pattern extraction by rays from the section centres and barycentric coordinates (§2.6).
+#include "sim/pattern_extract.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "sim/dress_form.hpp"
+
+namespace drape::sim {
+namespace {
+constexpr double kPi = 3.141592653589793;
+
+double wrap_pi(double a) {
+  a = std::fmod(a + kPi, 2 * kPi);
+  if (a < 0) a += 2 * kPi;
+  return a - kPi;
+}
+
+// Triangles binned by (height, angle from the centre line) for O(1) ray candidates.
+class RayGrid {
+ public:
+  RayGrid(const Panel& panel, const MappingSurface& surf, const PieceMapping& pm) : pm_(pm) {
+    const auto& x = panel.cloth.state.x;
+    ylo_ = 1e9;
+    double yhi = -1e9;
+    for (const Vec3& p : x) {
+      ylo_ = std::min(ylo_, p.y());
+      yhi = std::max(yhi, p.y());
+    }
+    ylo_ -= 1e-3;
+    ny_ = std::max(1, static_cast<int>((yhi - ylo_) / kDy) + 2);
+    cells_.assign(static_cast<size_t>(ny_) * kNa, {});
+    const auto& tris = panel.cloth.topo.triangles;
+    for (int t = 0; t < static_cast<int>(tris.size()); ++t) {
+      double y0 = 1e9, y1 = -1e9, a0 = 1e9, a1 = -1e9;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3& p = x[tris[t][k]];
+        const Vec2 c = surf.centre(p.y());
+        const double a = angle(std::atan2(p.x() - c.x(), p.z() - c.y()));
+        y0 = std::min(y0, p.y());
+        y1 = std::max(y1, p.y());
+        a0 = std::min(a0, a);
+        a1 = std::max(a1, a);
+      }
+      if (a1 - a0 > kPi) continue;  // degenerate wrap: not on this piece
+      for (int iy = ybin(y0); iy <= ybin(y1); ++iy)
+        for (int ia = abin(a0); ia <= abin(a1); ++ia)
+          cells_[static_cast<size_t>(iy) * kNa + ia].push_back(t);
+    }
+  }
+  double angle(double theta) const { return wrap_pi(pm_.dir * (theta - pm_.theta_centre)); }
+  const std::vector<int>& cell(double y, double theta) const {
+    return cells_[static_cast<size_t>(ybin(y)) * kNa + abin(angle(theta))];
+  }
+
+ private:
+  static constexpr double kDy = 0.01;
+  static constexpr int kNa = 256;
+  int ybin(double y) const { return std::clamp(static_cast<int>((y - ylo_) / kDy), 0, ny_ - 1); }
+  int abin(double a) const {
+    return std::clamp(static_cast<int>((a + kPi) / (2 * kPi) * kNa), 0, kNa - 1);
+  }
+  const PieceMapping& pm_;
+  double ylo_ = 0;
+  int ny_ = 1;
+  std::vector<std::vector<int>> cells_;
+};
+
+struct Hit {
+  bool ok = false;
+  int tri = -1;
+  Vec3 bary;
+  Vec2 flat;
+  Vec3 world;
+};
+
+// Ray from the section centre at height y toward angle theta against the cloth triangles of the
+// allowed zone (-1: any). Tolerant: the least-violating triangle within 1 mm counts as hit.
+Hit cast(const Panel& panel, const MappingSurface& surf, const RayGrid& grid, double y,
+         double theta, int zone) {
+  const auto& x = panel.cloth.state.x;
+  const auto& topo = panel.cloth.topo;
+  const Vec2 c2 = surf.centre(y);
+  const Vec3 o(c2.x(), y, c2.y());
+  const Vec3 d(std::sin(theta), 0, std::cos(theta));
+  Hit best;
+  double best_viol = 1e9;
+  for (int t : grid.cell(y, theta)) {
+    if (zone >= 0 && topo.triangle_zone[t] != zone) continue;
+    const auto& tri = topo.triangles[t];
+    const Vec3 &a = x[tri[0]], &b = x[tri[1]], &cc = x[tri[2]];
+    const Vec3 e1 = b - a, e2 = cc - a;
+    const Vec3 pv = d.cross(e2);
+    const double det = e1.dot(pv);
+    if (std::abs(det) < 1e-14) continue;
+    const Vec3 tv = o - a;
+    const double u = tv.dot(pv) / det;
+    const Vec3 qv = tv.cross(e1);
+    const double v = d.dot(qv) / det;
+    const double tt = e2.dot(qv) / det;  // Moller-Trumbore
+    if (tt <= 0) continue;
+    const Vec3 bc(1 - u - v, u, v);
+    const double viol = std::max(0.0, -bc.minCoeff()) * (e1.norm() + e2.norm());
+    if (viol < best_viol) {
+      best_viol = viol;
+      best.tri = t;
+      best.bary = bc;
+    }
+  }
+  if (best.tri < 0 || best_viol > 1e-3) return best;
+  Vec3 bc = best.bary.cwiseMax(0.0);
+  bc /= bc.sum();
+  const auto& tri = topo.triangles[best.tri];
+  best.ok = true;
+  best.bary = bc;
+  best.flat = bc[0] * topo.material[tri[0]] + bc[1] * topo.material[tri[1]] +
+              bc[2] * topo.material[tri[2]];  // barycentrics do not depend on the deformation
+  best.world = bc[0] * x[tri[0]] + bc[1] * x[tri[1]] + bc[2] * x[tri[2]];
+  return best;
+}
+
+struct RefPoint {
+  double y, theta;
+  int zone;
+};
+
+int steps_for(double len, double step) { return std::max(2, static_cast<int>(std::ceil(len / step))); }
+
+}  // namespace
+
+int PatternPiece::label_index(const std::string& n) const {
+  for (size_t i = 0; i < labels.size(); ++i)
+    if (labels[i] == n) return static_cast<int>(i);
+  return -1;
+}
+
+double PatternPiece::area() const {
+  double a = 0;
+  for (size_t i = 0; i < outline.size(); ++i) {
+    const Vec2 &p = outline[i], &q = outline[(i + 1) % outline.size()];
+    a += p.x() * q.y() - p.y() * q.x();
+  }
+  return 0.5 * a;
+}
+
+double PatternPiece::seam_length(const std::string& label) const {
+  const int li = label_index(label);
+  double s = 0;
+  for (size_t i = 0; i < outline.size(); ++i)
+    if (seg_label[i] == li) s += (outline[(i + 1) % outline.size()] - outline[i]).norm();
+  return s;
+}
+
+double PatternPiece::hip_width() const {
+  double s = 0;
+  for (size_t i = 1; i < hip_line.size(); ++i) s += (hip_line[i] - hip_line[i - 1]).norm();
+  return s;
+}
+
+std::vector<int> PatternPiece::seam_points(const std::string& label) const {
+  const int li = label_index(label);
+  const int n = static_cast<int>(outline.size());
+  std::vector<int> pts;
+  if (li < 0) return pts;
+  // Start at a segment whose predecessor has another label.
+  int start = -1;
+  for (int i = 0; i < n; ++i)
+    if (seg_label[i] == li && seg_label[(i + n - 1) % n] != li) start = i;
+  if (start < 0) return pts;
+  for (int i = start; seg_label[i % n] == li && static_cast<int>(pts.size()) < n; ++i)
+    pts.push_back(i % n);
+  pts.push_back((start + static_cast<int>(pts.size())) % n);
+  return pts;
+}
+
+bool inside_polygon(const std::vector<Vec2>& poly, const Vec2& p) {
+  bool in = false;
+  const size_t n = poly.size();
+  for (size_t i = 0, j = n - 1; i < n; j = i++) {
+    const Vec2 &a = poly[i], &b = poly[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) &&
+        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
+      in = !in;
+  }
+  return in;
+}
+
+Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& surf,
+                                   const PieceMapping& pm, const PieceLines& L,
+                                   const ExtractOptions& opt) {
+  const RayGrid grid(panel, surf, pm);
+  const int nz = panel.num_zones();
+  const double span = std::abs(wrap_pi(pm.dir * (pm.theta_side - pm.theta_centre)));
+  const double r_avg = surf.girth(L.hip_y) / (2 * kPi);
+  const auto theta_at = [&](double f) { return pm.theta_centre + pm.dir * span * f; };
+  PatternPiece piece;
+  struct Run {
+    std::string label;
+    std::vector<RefPoint> pts;
+  };
+  std::vector<Run> runs;
+  const auto vertical = [&](double th, int zone, double y0, double y1) {
+    std::vector<RefPoint> v;
+    const int n = steps_for(std::abs(y1 - y0), opt.step);
+    for (int k = 0; k <= n; ++k) v.push_back({y0 + (y1 - y0) * k / n, th, zone});
+    return v;
+  };
+  const auto horizontal = [&](double y, double f0, double f1, int zone) {
+    std::vector<RefPoint> v;
+    const int n = steps_for(std::abs(f1 - f0) * span * r_avg, opt.step);
+    for (int k = 0; k <= n; ++k) v.push_back({y, theta_at(f0 + (f1 - f0) * k / n), zone});
+    return v;
+  };
+  // Dart lines from the slit ends: the 3D line of each slit's far edge (zone z + 1's boundary).
+  const auto& x = panel.cloth.state.x;
+  std::vector<std::vector<RefPoint>> dart_line(panel.slits.size());
+  std::vector<double> dart_f_waist(panel.slits.size());
+  for (size_t s = 0; s < panel.slits.size(); ++s) {
+    const PanelSlit& ps = panel.slits[s];
+    std::vector<Vec3> edge{x[ps.tip_node]};
+    for (int v : ps.far_nodes) edge.push_back(x[v]);
+    if (edge.front().y() >= L.waist_y || edge.back().y() <= L.waist_y)
+      return Error{"pieces." + piece.name + ".darts[" + std::to_string(s) +
+                   "]: the dart must cross the waist line (slit end below it, top above it)"};
+    const double y_tip = edge.front().y();
+    const int n = steps_for(L.waist_y - y_tip, opt.step);
+    size_t seg = 0;
+    for (int k = 0; k <= n; ++k) {
+      const double y = y_tip + (L.waist_y - y_tip) * k / n;
+      while (seg + 2 < edge.size() && edge[seg + 1].y() < y) ++seg;
+      const double f = std::clamp((y - edge[seg].y()) / (edge[seg + 1].y() - edge[seg].y()), 0.0, 1.0);
+      const Vec3 p = edge[seg] + f * (edge[seg + 1] - edge[seg]);
+      const Vec2 c = surf.centre(y);
+      dart_line[s].push_back({y, std::atan2(p.x() - c.x(), p.z() - c.y()), 0});
+    }
+    dart_f_waist[s] = std::abs(wrap_pi(pm.dir * (dart_line[s].back().theta - pm.theta_centre))) / span;
+  }
+  // Runs in counter-clockwise order for a centre-left panel: hem, side, waist with darts, centre.
+  runs.push_back({"hem", horizontal(L.hem_y, 0, 1, -1)});
+  {
+    Run side{"side", vertical(pm.theta_side, nz - 1, L.hem_y, L.hip_y)};
+    auto up = vertical(pm.theta_side, nz - 1, L.hip_y, L.waist_y);
+    side.pts.insert(side.pts.end(), up.begin() + 1, up.end());
+    runs.push_back(side);
+  }
+  double f_prev = 1.0;
+  for (int z = nz - 1; z >= 0; --z) {
+    const double f_end = z > 0 ? dart_f_waist[z - 1] : 0.0;
+    runs.push_back({"waist", horizontal(L.waist_y, f_prev, f_end, z)});
+    if (z > 0) {
+      const std::string dn = "dart" + std::to_string(z);
+      Run leg2{dn + "_leg2", {}}, leg1{dn + "_leg1", {}};
+      for (auto it = dart_line[z - 1].rbegin(); it != dart_line[z - 1].rend(); ++it)
+        leg2.pts.push_back({it->y, it->theta, z});
+      for (const RefPoint& r : dart_line[z - 1]) leg1.pts.push_back({r.y, r.theta, z - 1});
+      runs.push_back(leg2);
+      runs.push_back(leg1);
+    }
+    f_prev = f_end;
+  }
+  {
+    Run centre{L.centre_label, vertical(pm.theta_centre, 0, L.waist_y, L.hip_y)};
+    auto down = vertical(pm.theta_centre, 0, L.hip_y, L.hem_y);
+    centre.pts.insert(centre.pts.end(), down.begin() + 1, down.end());
+    runs.push_back(centre);
+  }
+  // Cast the rays; consecutive runs share their corner point.
+  std::vector<int> notch_ref;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    int li = piece.label_index(runs[r].label);
+    if (li < 0) {
+      piece.labels.push_back(runs[r].label);
+      li = static_cast<int>(piece.labels.size()) - 1;
+    }
+    const size_t first = r == 0 ? 0 : 1;
+    const size_t last = r + 1 == runs.size() ? runs[r].pts.size() - 1 : runs[r].pts.size();
+    for (size_t k = first; k < last; ++k) {
+      const RefPoint& rp = runs[r].pts[k];
+      Hit h = cast(panel, surf, grid, rp.y, rp.theta, rp.zone);
+      if (!h.ok) {
+        std::ostringstream e;
+        e << "line '" << runs[r].label << "': no cloth in zone " << rp.zone << " at height "
+          << rp.y * 1000 << " mm, angle " << rp.theta * 180 / kPi
+          << " deg (is the panel wide/long enough?)";
+        return Error{e.str()};
+      }
+      piece.outline.push_back(h.flat);
+      piece.outline3d.push_back(h.world);
+      piece.ref.emplace_back(rp.y, rp.theta, rp.zone);
+      piece.seg_label.push_back(li);
+      if (std::abs(rp.y - L.hip_y) < 1e-9 && (runs[r].label == "side" || runs[r].label == L.centre_label))
+        piece.notches.push_back(static_cast<int>(piece.outline.size()) - 1);
+    }
+  }
+  // Segment labels: the segment leaving point i belongs to the run of point i + 1 except at run
+  // starts, so shift: a point's label is the run that contains the segment after it.
+  const int n = static_cast<int>(piece.outline.size());
+  {
+    std::vector<int> lab(n);
+    for (int i = 0; i < n; ++i) lab[i] = piece.seg_label[(i + 1) % n];
+    piece.seg_label = lab;
+  }
+  // Darts: tip and leg tops from the labels.
+  for (int z = 1; z < nz; ++z) {
+    const std::string dn = "dart" + std::to_string(z);
+    const std::vector<int> l2 = piece.seam_points(dn + "_leg2"), l1 = piece.seam_points(dn + "_leg1");
+    if (l2.empty() || l1.empty()) continue;
+    PatternPiece::Dart d;
+    d.leg2_top = l2.front();
+    d.tip = l2.back();
+    d.leg1_top = l1.back();
+    d.intake = (piece.outline[d.leg1_top] - piece.outline[d.leg2_top]).norm();
+    piece.darts.push_back(d);
+    piece.notches.push_back(d.leg1_top);
+    piece.notches.push_back(d.leg2_top);
+  }
+  // Hip line (for the width measurement) and the grain line.
+  for (const RefPoint& rp : horizontal(L.hip_y, 0, 1, -1)) {
+    Hit h = cast(panel, surf, grid, rp.y, rp.theta, -1);
+    if (!h.ok) return Error{"line 'hip': no cloth at angle " + std::to_string(rp.theta)};
+    piece.hip_line.push_back(h.flat);
+  }
+  const double gu = 0.5 * (piece.hip_line.front().x() + piece.hip_line.back().x());
+  piece.grain_a = Vec2(gu, pm.v_of_y(L.hem_y) + 0.05);
+  piece.grain_b = Vec2(gu, pm.v_of_y(L.hip_y));
+  // Counter-clockwise orientation in material space.
+  if (piece.area() < 0) {
+    std::reverse(piece.outline.begin(), piece.outline.end());
+    std::reverse(piece.outline3d.begin(), piece.outline3d.end());
+    std::reverse(piece.ref.begin(), piece.ref.end());
+    std::vector<int> lab(n);
+    for (int k = 0; k < n; ++k) lab[k] = piece.seg_label[((n - 2 - k) % n + n) % n];
+    piece.seg_label = lab;
+    for (int& i : piece.notches) i = n - 1 - i;
+    for (auto& d : piece.darts) {
+      d.tip = n - 1 - d.tip;
+      d.leg1_top = n - 1 - d.leg1_top;
+      d.leg2_top = n - 1 - d.leg2_top;
+    }
+  }
+  return piece;
+}
+
+double outline_error_vs_mapping(const PatternPiece& piece, const Panel& panel,
+                                const MappingSurface& surf, const PieceMapping& pm) {
+  double err = 0;
+  for (size_t i = 0; i < piece.outline.size(); ++i) {
+    const double y = piece.ref[i].x(), th = piece.ref[i].y();
+    const int zone = static_cast<int>(piece.ref[i].z());
+    const ArcTable T = ArcTable::build(surf, y, pm.theta_centre, pm.dir);
+    // Zone -1 (any): the zone of the flat point found.
+    int z = zone;
+    if (z < 0) {
+      Vec3 b;
+      const int t = panel.locate(piece.outline[i], &b);
+      z = t >= 0 ? panel.cloth.topo.triangle_zone[t] : 0;
+    }
+    const Vec2 analytic(panel.u_of_distance(pm.l_at(z, y, th, T)), pm.v_of_y(y));
+    err = std::max(err, (analytic - piece.outline[i]).norm());
+  }
+  return err;
+}
+
+double draped_area(const PatternPiece& piece, const Panel& panel) {
+  const auto& topo = panel.cloth.topo;
+  const auto& x = panel.cloth.state.x;
+  // Seven sample points per triangle decide how much of it lies inside the outline.
+  static const double w[7][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.6, 0.2, 0.2}, {0.2, 0.6, 0.2},
+                                 {0.2, 0.2, 0.6},             {0.45, 0.45, 0.1}, {0.1, 0.45, 0.45},
+                                 {0.45, 0.1, 0.45}};
+  double a3 = 0, a2 = 0;
+  for (int t = 0; t < topo.num_triangles(); ++t) {
+    const auto& tri = topo.triangles[t];
+    int in = 0;
+    for (const auto& ww : w) {
+      const Vec2 p = ww[0] * topo.material[tri[0]] + ww[1] * topo.material[tri[1]] +
+                     ww[2] * topo.material[tri[2]];
+      in += inside_polygon(piece.outline, p) ? 1 : 0;
+    }
+    if (!in) continue;
+    // In the dart overlap, only the triangles of the layer the piece keeps count: the piece
+    // never contains flat points of the intake wedge, so the parity test already excludes them.
+    const Vec2 e1 = topo.material[tri[1]] - topo.material[tri[0]];
+    const Vec2 e2 = topo.material[tri[2]] - topo.material[tri[0]];
+    const double af = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+    const double a3d = 0.5 * (x[tri[1]] - x[tri[0]]).cross(x[tri[2]] - x[tri[0]]).norm();
+    a2 += af * in / 7.0;
+    a3 += a3d * in / 7.0;
+  }
+  return a2 > 0 ? a3 / a2 * std::abs(piece.area()) : 0;
+}
+
+}  // namespace drape::sim

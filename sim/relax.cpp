@@ -1,0 +1,209 @@
+// Static relaxation of mapped cloth: fixed lines, weak pressure, collision (method §2.1-2.2).
+#include "sim/relax.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "sim/dress_form.hpp"
+#include "sim/scene.hpp"
+#include "sim/solver_newton.hpp"
+
+namespace drape::sim {
+
+void add_triangle_edges(const std::vector<std::array<int32_t, 3>>& tris,
+                        const std::vector<Vec2>& material, int off, RelaxProblem& p) {
+  std::map<std::pair<int, int>, int> seen;
+  for (const auto& t : tris)
+    for (int k = 0; k < 3; ++k) {
+      int a = t[k], b = t[(k + 1) % 3];
+      if (a > b) std::swap(a, b);
+      if (!seen.emplace(std::make_pair(a, b), 1).second) continue;
+      p.edges.push_back({a + off, b + off});
+      p.rest.push_back((material[a] - material[b]).norm());
+    }
+}
+
+void edge_strain(const RelaxProblem& p, double* max_strain, double* rms_strain) {
+  double mx = 0, s2 = 0;
+  for (size_t e = 0; e < p.edges.size(); ++e) {
+    const double len = (p.x[p.edges[e][0]] - p.x[p.edges[e][1]]).norm();
+    const double s = len / p.rest[e] - 1.0;
+    mx = std::max(mx, std::abs(s));
+    s2 += s * s;
+  }
+  if (max_strain) *max_strain = mx;
+  if (rms_strain) *rms_strain = p.edges.empty() ? 0 : std::sqrt(s2 / p.edges.size());
+}
+
+RelaxStats relax_gauss_seidel(RelaxProblem& p, const MappingSurface& surf, const RelaxOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int nv = static_cast<int>(p.x.size());
+  if (p.fixed.size() != p.x.size()) p.fixed.resize(p.x.size(), 0);
+  std::vector<double> w(nv);
+  for (int i = 0; i < nv; ++i) w[i] = p.fixed[i] ? 0.0 : 1.0;
+  auto& x = p.x;
+  for (int it = 0; it < opt.iterations; ++it) {
+    // Weak pressure: a small step toward the section centre (the smoothing hand).
+    for (int i = 0; i < nv; ++i) {
+      if (!w[i]) continue;
+      const Vec2 c = surf.centre(x[i].y());
+      Vec3 r(x[i].x() - c.x(), 0, x[i].z() - c.y());
+      const double rn = r.norm();
+      if (rn > 1e-9) x[i] -= opt.pressure_step * r / rn;
+    }
+    // Inextensible-ish membrane: project every edge to its rest length (Gauss-Seidel).
+    for (size_t e = 0; e < p.edges.size(); ++e) {
+      const int a = p.edges[e][0], b = p.edges[e][1];
+      const double ws = w[a] + w[b];
+      if (ws == 0) continue;
+      Vec3 d = x[b] - x[a];
+      const double len = d.norm();
+      if (len < 1e-12) continue;
+      const Vec3 corr = (len - p.rest[e]) / (len * ws) * d;
+      x[a] += w[a] * corr;
+      x[b] -= w[b] * corr;
+    }
+    // Seams: stiff ties of a vertex onto a point of the other seam's polyline.
+    for (const SeamTie& s : p.seams) {
+      const Vec3 target = (1 - s.t) * x[s.b0] + s.t * x[s.b1];
+      const Vec3 c = x[s.a] - target;
+      const double ws = w[s.a] + (1 - s.t) * (1 - s.t) * w[s.b0] + s.t * s.t * w[s.b1];
+      if (ws == 0) continue;
+      x[s.a] -= w[s.a] / ws * c;
+      x[s.b0] += w[s.b0] * (1 - s.t) / ws * c;
+      x[s.b1] += w[s.b1] * s.t / ws * c;
+    }
+    // Grain control: consecutive warp nodes stay straight in the horizontal tangent direction.
+    for (const auto& g : p.grain) {
+      if (!w[g[1]]) continue;
+      const Vec2 c = surf.centre(x[g[1]].y());
+      const double th = std::atan2(x[g[1]].x() - c.x(), x[g[1]].z() - c.y());
+      const Vec3 t(std::cos(th), 0, -std::sin(th));
+      x[g[1]] += 0.5 * ((0.5 * (x[g[0]] + x[g[2]]) - x[g[1]]).dot(t)) * t;
+    }
+    for (const PlaneTie& pl : p.planes) x[pl.v] -= pl.n.dot(x[pl.v] - pl.p) * pl.n;
+    // Collision by section lookup (method §2.2), on the mapping surface (ease, hip shape).
+    if (opt.collide)
+      for (int i = 0; i < nv; ++i) {
+        if (!w[i]) continue;
+        const Vec2 c = surf.centre(x[i].y());
+        const double dx = x[i].x() - c.x(), dz = x[i].z() - c.y();
+        const double rn = std::hypot(dx, dz);
+        const double rs = surf.radius(x[i].y(), std::atan2(dx, dz)) + opt.collision_offset;
+        if (rn < rs && rn > 1e-9) {
+          x[i].x() = c.x() + dx * rs / rn;
+          x[i].z() = c.y() + dz * rs / rn;
+        }
+      }
+  }
+  RelaxStats st;
+  st.backend = "gauss-seidel";
+  st.iterations = opt.iterations;
+  edge_strain(p, &st.max_strain, &st.rms_strain);
+  st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return st;
+}
+
+namespace {
+
+// Fixed lines of a mapped panel: the hip row, the centre column, the node nearest the side line
+// in every row. Returns per-vertex role: 1 hip, 2 centre, 3 side.
+std::vector<uint8_t> fixed_line_roles(const Panel& panel, const MappingSurface& surf,
+                                      const PieceMapping& pm) {
+  const auto& topo = panel.cloth.topo;
+  std::vector<uint8_t> role(topo.num_vertices(), 0);
+  const double hip_y = surf.form().landmarks().hip_y;
+  const int j_hip = static_cast<int>(std::lround(pm.v_of_y(hip_y) / panel.dy));
+  const int centre_i = panel.design.centre_edge_left ? 0 : panel.nx - 1;
+  const int last_zone = panel.num_zones() - 1;
+  for (int j = 0; j < panel.ny; ++j) {
+    const double y = pm.y_of_v(j * panel.dy);
+    if (j == j_hip)
+      for (int i = 0; i < panel.nx; ++i) role[j * panel.nx + i] = 1;
+    if (!role[j * panel.nx + centre_i]) role[j * panel.nx + centre_i] = 2;
+    const ArcTable T = ArcTable::build(surf, y, pm.theta_centre, pm.dir);
+    const double l_side = pm.l_at(last_zone, y, pm.theta_side, T);
+    const int li = static_cast<int>(std::lround(l_side / panel.dx));
+    if (li <= 0 || li >= panel.nx) continue;
+    const int i = panel.design.centre_edge_left ? li : panel.nx - 1 - li;
+    int v = j * panel.nx + i;
+    // On a slit column above its tip the far-side twin belongs to the last zone.
+    for (const PanelSlit& s : panel.slits)
+      if (s.column == i && j > s.tip_row) v = s.far_nodes[j - s.tip_row - 1];
+    if (!role[v]) role[v] = 3;
+  }
+  return role;
+}
+
+}  // namespace
+
+RelaxStats relax_panel(Panel& panel, const MappingSurface& surf, const PieceMapping& pm,
+                       const PanelRelaxOptions& opt) {
+  Cloth& cloth = panel.cloth;
+  const std::vector<uint8_t> role = fixed_line_roles(panel, surf, pm);
+  const int nv = cloth.num_vertices();
+  if (opt.use_static_solver) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int i = 0; i < nv; ++i) {
+      cloth.state.flags[i] = role[i] ? kFlagPinned : 0;
+      cloth.state.inv_mass[i] = role[i] ? 0.0 : 1.0 / cloth.state.mass[i];
+    }
+    SceneObjects scene;
+    scene.form = std::shared_ptr<const DressForm>(&surf.form(), [](const DressForm*) {});
+    scene.floor = false;
+    scene.offset = surf.offset() + 1e-4;
+    StaticOptions so;
+    so.energy.gravity = false;
+    so.energy.pressure = opt.pressure_pa;
+    so.max_iterations = std::max(10, opt.iterations / 4);
+    const StaticResult r = relax_static(cloth, scene, so);
+    for (int i = 0; i < nv; ++i) cloth.state.flags[i] = 0;
+    RelaxProblem p;
+    p.x = cloth.state.x;
+    add_triangle_edges(cloth.topo.triangles, cloth.topo.material, 0, p);
+    RelaxStats st;
+    st.backend = "newton-static";
+    st.iterations = r.iterations;
+    st.converged = r.converged;
+    edge_strain(p, &st.max_strain, &st.rms_strain);
+    st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return st;
+  }
+  RelaxProblem p;
+  p.x = cloth.state.x;
+  add_triangle_edges(cloth.topo.triangles, cloth.topo.material, 0, p);
+  p.fixed.assign(nv, 0);
+  const auto tangent = [](double th) { return Vec3(std::cos(th), 0, -std::sin(th)); };
+  const Vec2 cw = surf.centre(surf.form().landmarks().waist_y);
+  const Vec3 axis_pt(cw.x(), 0, cw.y());
+  for (int i = 0; i < nv; ++i) {
+    if (role[i] == 1) p.fixed[i] = 1;
+    if (role[i] == 2) p.planes.push_back({i, axis_pt, tangent(pm.theta_centre)});
+    if (role[i] == 3) p.planes.push_back({i, axis_pt, tangent(pm.theta_side)});
+  }
+  if (opt.grain_control) {
+    const int nx = panel.nx;
+    for (const PanelSlit& s : panel.slits)
+      for (int i = std::max(0, s.column - 3); i <= std::min(nx - 1, s.column + 3); ++i) {
+        for (int side = 0; side < (i == s.column ? 2 : 1); ++side) {
+          const auto node = [&](int j) {
+            if (i == s.column && side == 1 && j > s.tip_row) return s.far_nodes[j - s.tip_row - 1];
+            return j * nx + i;
+          };
+          for (int j = std::max(1, s.tip_row - 3); j + 1 < panel.ny; ++j)
+            p.grain.push_back({node(j - 1), node(j), node(j + 1)});
+        }
+      }
+  }
+  RelaxOptions ro;
+  ro.iterations = opt.iterations;
+  RelaxStats st = relax_gauss_seidel(p, surf, ro);
+  cloth.state.x = p.x;
+  cloth.state.x_prev = p.x;
+  return st;
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,192 @@
+#include "sim/scenes.hpp"
+
+#include <cmath>
+
+#include "sim/dress_form.hpp"
+
+namespace drape::sim {
+
+StudyScene make_hanging_sheet(int res, const FabricParams& fabric) {
+  StudyScene s;
+  s.name = "sheet";
+  PanelSpec p;
+  p.width = p.height = 0.5;
+  p.nx = p.ny = res;
+  s.cloth = make_panel(p, fabric);
+  place_spread(s.cloth, Vec3(-0.25, 0.7, 0), Vec3::UnitX(), Vec3::UnitY());
+  s.cloth.state.flags[(res - 1) * res] |= kFlagPinned;
+  s.cloth.state.flags[res * res - 1] |= kFlagPinned;
+  s.cloth.relump_masses();
+  s.objects.floor = false;
+  s.duration = 2.0;
+  return s;
+}
+
+StudyScene make_chain(int particles, double mass, double k) {
+  StudyScene s;
+  s.name = "chain";
+  s.springs_model = true;
+  Cloth& c = s.cloth;
+  c.fabric.stretch_warp = c.fabric.stretch_weft = k;
+  c.topo.spacing = 0.1;
+  for (int i = 0; i < particles; ++i) {
+    c.topo.material.emplace_back(0.0, -0.1 * i);
+    c.topo.vertex_zone.push_back(0);
+    c.topo.vertex_origin.push_back(i);
+    c.state.x.emplace_back(0.0, 3.0 - 0.1 * i, 0.0);
+  }
+  c.topo.grid_nx = 1;
+  c.topo.grid_ny = particles;
+  c.state.x_prev = c.state.x;
+  c.state.v.assign(particles, Vec3::Zero());
+  c.state.flags.assign(particles, 0);
+  c.state.flags[0] = kFlagPinned;
+  c.state.mass.assign(particles, mass);
+  c.state.inv_mass.assign(particles, 1.0 / mass);
+  c.state.inv_mass[0] = 0;
+  s.objects.floor = false;
+  s.duration = 3.0;
+  return s;
+}
+
+StudyScene make_cantilever(double overhang, double spacing, double width,
+                           const FabricParams& fabric) {
+  StudyScene s;
+  s.name = "cantilever";
+  const int clamp_rows = 3;
+  PanelSpec p;
+  p.nx = std::max(2, static_cast<int>(std::lround(width / spacing)) + 1);
+  p.ny = static_cast<int>(std::lround(overhang / spacing)) + clamp_rows;
+  p.width = spacing * (p.nx - 1);
+  p.height = spacing * (p.ny - 1);
+  s.cloth = make_panel(p, fabric);
+  // Warp (v) runs along +x: the strip sticks out of the ledge at x = 0.
+  place_spread(s.cloth, Vec3(-spacing * (clamp_rows - 1), 1.0, 0), Vec3::UnitZ(), Vec3::UnitX());
+  for (int j = 0; j < clamp_rows; ++j)
+    for (int i = 0; i < p.nx; ++i) s.cloth.state.flags[j * p.nx + i] |= kFlagPinned;
+  s.cloth.relump_masses();
+  s.objects.floor = false;
+  s.duration = 3.0;
+  return s;
+}
+
+StudyScene make_form_drape(int res, const FabricParams& fabric) {
+  StudyScene s;
+  s.name = "form";
+  auto m = measurements_for_size("9AR");
+  FormMeasurements meas = m ? *m : FormMeasurements{};
+  auto form = DressForm::from_measurements(meas);
+  PanelSpec p;
+  p.width = p.height = 0.5;
+  p.nx = p.ny = res;
+  s.cloth = make_panel(p, fabric);
+  const double top = meas.bust_height + 0.12;
+  double zf = 0.12;
+  if (form) {
+    s.objects.form = std::make_shared<const DressForm>(std::move(*form));
+    zf = s.objects.form->surface_at(top, 0.0).z();
+  }
+  // Top edge (v = height) across the chest at z = front surface + 1 cm; hangs down.
+  place_spread(s.cloth, Vec3(-0.25, top - 0.5, zf + 0.01), Vec3::UnitX(), Vec3::UnitY());
+  for (int i = 0; i < res; ++i) s.cloth.state.flags[(res - 1) * res + i] |= kFlagPinned;
+  s.cloth.relump_masses();
+  s.objects.floor = true;
+  s.duration = 1.5;
+  return s;
+}
+
+StudyScene make_sphere_drape(int res, const FabricParams& fabric) {
+  StudyScene s;
+  s.name = "sphere";
+  PanelSpec p;
+  p.width = p.height = 0.6;
+  p.nx = p.ny = res | 1;  // odd: a centre vertex exists
+  const int n = p.nx;
+  s.cloth = make_panel(p, fabric);
+  Sphere sp;
+  sp.centre = Vec3(0, 0.5, 0);
+  sp.radius = 0.15;
+  s.objects.spheres.push_back(sp);
+  place_spread(s.cloth, Vec3(-0.3, 0.5 + 0.15 + 0.003, 0.3), Vec3::UnitX(), -Vec3::UnitZ());
+  s.cloth.state.flags[(n / 2) * n + n / 2] |= kFlagPinned;
+  s.cloth.relump_masses();
+  s.objects.floor = true;
+  s.duration = 2.0;
+  return s;
+}
+
+StudyScene make_scene(const std::string& name, int res) {
+  if (name == "chain") return make_chain();
+  if (name == "cantilever") return make_cantilever(0.037, 0.5 / std::max(res, 2));
+  if (name == "form") return make_form_drape(res);
+  if (name == "sphere") return make_sphere_drape(res);
+  return make_hanging_sheet(res);
+}
+
+Vec2 elastica_tip(double l, double B, double q, int steps) {
+  // RK4 on (theta, M, x, y) over s in [0, l] for a given M(0); M(l) must vanish.
+  auto shoot = [&](double M0, Vec2& tip) {
+    double th = 0, M = M0, x = 0, y = 0;
+    const double ds = l / steps;
+    auto f = [&](double s, double t, double m, double out[4]) {
+      out[0] = m / B;
+      out[1] = -q * (l - s) * std::cos(t);
+      out[2] = std::cos(t);
+      out[3] = std::sin(t);
+    };
+    for (int k = 0; k < steps; ++k) {
+      const double s = k * ds;
+      double k1[4], k2[4], k3[4], k4[4];
+      f(s, th, M, k1);
+      f(s + ds / 2, th + ds / 2 * k1[0], M + ds / 2 * k1[1], k2);
+      f(s + ds / 2, th + ds / 2 * k2[0], M + ds / 2 * k2[1], k3);
+      f(s + ds, th + ds * k3[0], M + ds * k3[1], k4);
+      th += ds / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]);
+      M += ds / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]);
+      x += ds / 6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]);
+      y += ds / 6 * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3]);
+    }
+    tip = Vec2(x, y);
+    return M;  // residual M(l)
+  };
+  // M(0) lies in [0, q l^2 / 2] (the straight-beam moment is the upper bound).
+  double lo = 0, hi = 0.5 * q * l * l;
+  Vec2 tip;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (shoot(mid, tip) > 0)
+      hi = mid;
+    else
+      lo = mid;
+  }
+  shoot(0.5 * (lo + hi), tip);
+  return tip;
+}
+
+double elastica_rigidity_for_drop(double l, double q, double tip_drop) {
+  double lo = std::log(1e-12), hi = std::log(1e2);
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    const double drop = elastica_tip(l, std::exp(mid), q, 1000).y();
+    if (drop > tip_drop)
+      lo = mid;
+    else
+      hi = mid;  // softer drops more
+  }
+  return std::exp(0.5 * (lo + hi));
+}
+
+void position_error(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double& rms,
+                    double& max) {
+  double s = 0;
+  max = 0;
+  const size_t n = std::min(a.size(), b.size());
+  for (size_t i = 0; i < n; ++i) {
+    const double d = (a[i] - b[i]).norm();
+    s += d * d;
+    max = std::max(max, d);
+  }
+  rms = n ? std::sqrt(s / n) : 0;
+}
+
+}  // namespace drape::sim

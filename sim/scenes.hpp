@@ -1,0 +1,54 @@
+// The study's scenes, written once and shared by tests and benchmarks (issue 3, item 5):
+// a sheet hanging from two corners, a 20-particle chain, a Peirce cantilever strip, a cloth
+// draped on the dress form, a cloth on a sphere. Plus the exact elastica of the cantilever.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim/cloth.hpp"
+#include "sim/energy.hpp"
+#include "sim/scene.hpp"
+
+namespace drape::sim {
+
+struct StudyScene {
+  std::string name;
+  Cloth cloth;
+  SceneObjects objects;
+  bool springs_model = false;  // the chain uses springs (no triangles)
+  double duration = 2.0;       // simulated seconds before the error is measured
+};
+
+// Muslin (or `fabric`) sheet of side 0.5 m with res x res vertices, hanging in the x-y plane
+// from its two top corners (pinned) at height 1.2 m; starts flat and sags.
+StudyScene make_hanging_sheet(int res, const FabricParams& fabric = {});
+// 20 particles of 1 kg, 0.1 m apart, hanging straight down from the top one (pinned), joined
+// by springs of stiffness k (N/m). The support force must equal the total weight (196.1 N).
+StudyScene make_chain(int particles = 20, double mass = 1.0, double k = 1e5);
+// Peirce cantilever strip (ASTM D1388) along the warp: width x overhang, clamped over
+// `clamp` (pinned rows), horizontal at 1 m; `spacing` = grid step.
+StudyScene make_cantilever(double overhang, double spacing, double width = 0.01,
+                           const FabricParams& fabric = {});
+// A res x res muslin panel 0.5 x 0.5 m whose top edge is pinned across the upper chest of
+// the parametric 9AR form; the rest falls over the bust (form collision).
+StudyScene make_form_drape(int res, const FabricParams& fabric = {});
+// A res x res panel 0.6 x 0.6 m dropped flat onto a sphere (r = 0.15 m) with its centre
+// vertex pinned on the sphere's top.
+StudyScene make_sphere_drape(int res, const FabricParams& fabric = {});
+// By name: "sheet", "chain", "cantilever", "form", "sphere".
+StudyScene make_scene(const std::string& name, int res);
+
+// Exact elastica of a cantilever of length l, rigidity B (N m, whole width) and weight per
+// length q (N/m), clamped horizontally: integrates theta' = M/B, M' = -q (l - s) cos theta by
+// shooting on M(0). Returns the tip (x forward, y down positive) relative to the clamp.
+Vec2 elastica_tip(double l, double B, double q, int steps = 2000);
+// The rigidity B for which the elastica's tip drops by `tip_drop` (bisection on log B).
+double elastica_rigidity_for_drop(double l, double q, double tip_drop);
+
+// RMS and max vertex distance (m) between two position arrays of equal size.
+void position_error(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double& rms,
+                    double& max);
+
+}  // namespace drape::sim

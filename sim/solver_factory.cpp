@@ -1,0 +1,50 @@
+#include "sim/solver_factory.hpp"
+
+#include "sim/solver_newton.hpp"
+#include "sim/solver_vbd.hpp"
+#include "sim/solver_xpbd.hpp"
+#include "sim/verlet_solver.hpp"
+#include "sim/watchdog.hpp"
+
+namespace drape::sim {
+
+Result<std::unique_ptr<Solver>> make_solver(const std::string& name, const SolverConfig& cfg) {
+  std::unique_ptr<Solver> s;
+  EnergyOptions eo;
+  if (cfg.springs_model) eo.model = EnergyOptions::Model::kSprings;
+  if (name == "vbd") {
+    VbdOptions o;
+    o.energy = eo;
+    if (cfg.substeps > 0) o.substeps = cfg.substeps;
+    if (cfg.iterations > 0) o.iterations = cfg.iterations;
+    if (cfg.tolerance > 0) o.tolerance = cfg.tolerance;
+    o.freeze = cfg.freeze;
+    o.chebyshev = cfg.chebyshev;
+    o.threads = cfg.threads;
+    s = std::make_unique<VbdSolver>(o);
+  } else if (name == "xpbd") {
+    XpbdOptions o;
+    o.energy = eo;
+    if (cfg.substeps > 0) o.substeps = cfg.substeps;
+    if (cfg.iterations > 0) o.iterations = cfg.iterations;
+    s = std::make_unique<XpbdSolver>(o);
+  } else if (name == "newton") {
+    NewtonOptions o;
+    o.energy = eo;
+    if (cfg.substeps > 0) o.substeps = cfg.substeps;
+    if (cfg.iterations > 0) o.max_iterations = cfg.iterations;
+    if (cfg.tolerance > 0) o.tolerance = cfg.tolerance;
+    s = std::make_unique<NewtonSolver>(o);
+  } else if (name == "verlet") {
+    VerletParams p;
+    if (cfg.substeps > 0) p.substeps = cfg.substeps;
+    s = std::make_unique<VerletSolver>(p);
+  } else {
+    return make_error("make_solver",
+                      "unknown solver '" + name + "' (expected vbd, xpbd, newton or verlet)");
+  }
+  if (cfg.watchdog) s = std::make_unique<WatchdogSolver>(std::move(s));
+  return s;
+}
+
+}  // namespace drape::sim

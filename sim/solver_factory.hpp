@@ -1,0 +1,27 @@
+// make_solver("vbd" | "xpbd" | "newton" | "verlet", options): one place that knows every
+// solver; wrapped in the divergence watchdog unless asked not to.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "sim/solver.hpp"
+#include "sim/types.hpp"
+
+namespace drape::sim {
+
+struct SolverConfig {
+  int substeps = 0;      // 0: the solver's default
+  int iterations = 0;    // 0: the solver's default
+  double tolerance = 0;  // 0: default
+  bool watchdog = true;
+  bool freeze = false;         // VBD: freeze regions at rest
+  bool chebyshev = false;      // VBD
+  bool springs_model = false;  // the study's 8-spring energy instead of FEM + bending
+  int threads = 2;
+};
+
+// Names: "vbd" (default real-time), "xpbd", "newton", "verlet" (the study's baseline).
+Result<std::unique_ptr<Solver>> make_solver(const std::string& name, const SolverConfig& cfg = {});
+
+}  // namespace drape::sim

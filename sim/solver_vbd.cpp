@@ -1,0 +1,164 @@
+#include "sim/solver_vbd.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace drape::sim {
+
+VbdSolver::VbdSolver(VbdOptions opt)
+    : opt_(opt), pool_(std::make_unique<ThreadPool>(std::max(1, opt.threads))) {}
+VbdSolver::~VbdSolver() = default;
+
+void VbdSolver::cook(const Cloth& cloth) {
+  energy_.build(cloth, opt_.energy);
+  energy_.vertex_neighbours(nbr_off_, nbrs_);
+  num_colours_ = greedy_colouring(nbr_off_, nbrs_, colour_of_, colour_off_, colour_items_);
+  const int n = cloth.num_vertices();
+  y_.resize(n);
+  xt_.resize(n);
+  xprev_iter_.resize(n);
+  xprev2_iter_.resize(n);
+  rest_count_.assign(n, 0);
+  worker_max_.assign(pool_->size() * 8, 0.0);
+}
+
+StepStats VbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
+  StepStats st;
+  if (!energy_.up_to_date(cloth)) cook(cloth);
+  energy_.set_form(&scene);
+  const int ns = std::max(1, opt_.substeps);
+  const double h = dt / ns;
+  for (int s = 0; s < ns; ++s) {
+    st.residual = substep(cloth, scene, h, st);
+    ++st.substeps;
+  }
+  return st;
+}
+
+double VbdSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, StepStats& st) {
+  auto& S = cloth.state;
+  const int n = cloth.num_vertices();
+  // Contacts once per substep, at the start-of-step positions.
+  const auto t0 = std::chrono::steady_clock::now();
+  if (opt_.contact_stiffness > 0) {
+    energy_.set_contact_stiffness(opt_.contact_stiffness);
+  } else {
+    // Stiff relative to the inertia of the heaviest vertex and to the membrane.
+    double mmax = 0;
+    for (int i = 0; i < n; ++i) mmax = std::max(mmax, S.mass[i]);
+    energy_.set_contact_stiffness(std::max(1e4, 1e3 * mmax / (h * h)));
+  }
+  st.max_penetration = std::max(st.max_penetration, energy_.detect_contacts(cloth, scene));
+  st.collision_ms +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+  const Vec3 g = opt_.energy.gravity ? opt_.energy.g : Vec3::Zero();
+  // Wake frozen vertices next to moving ones (and all when freezing is off).
+  if (!opt_.freeze) {
+    for (int i = 0; i < n; ++i) S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
+  } else {
+    for (int i = 0; i < n; ++i) {
+      if (!(S.flags[i] & kFlagFrozen)) continue;
+      bool wake = energy_.contact_of(i) >= 0 &&
+                  energy_.contacts()[energy_.contact_of(i)].n.dot(
+                      S.x[i] - energy_.contacts()[energy_.contact_of(i)].p) < 0;
+      for (int k = nbr_off_[i]; k < nbr_off_[i + 1] && !wake; ++k) {
+        const int j = nbrs_[k];
+        if (!(S.flags[j] & kFlagFrozen) &&
+            (S.v[j].norm() > opt_.freeze_speed * 10 || !cloth.is_free(j))) {
+          // A pinned/kinematic neighbour wakes only if it moved.
+          if (!cloth.is_free(j) && (S.x[j] - S.x_prev[j]).norm() < 1e-9) continue;
+          wake = true;
+        }
+      }
+      if (wake) {
+        S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
+        rest_count_[i] = 0;
+      }
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    xt_[i] = S.x[i];
+    if (cloth.is_free(i) && !(S.flags[i] & kFlagFrozen)) {
+      y_[i] = S.x[i] + h * S.v[i];
+      S.x[i] = y_[i] + h * h * g;  // initial guess: inertia + gravity
+    } else {
+      y_[i] = S.x[i];
+    }
+  }
+  const double inv_h2 = 1.0 / (h * h);
+  const double kd_h = opt_.damping / h;
+  double omega = 1.0;
+  double residual = 0;
+  for (int it = 0; it < opt_.iterations; ++it) {
+    std::fill(worker_max_.begin(), worker_max_.end(), 0.0);
+    if (opt_.chebyshev) {
+      for (int i = 0; i < n; ++i) {
+        xprev2_iter_[i] = xprev_iter_[i];
+        xprev_iter_[i] = S.x[i];
+      }
+    }
+    for (int c = 0; c < num_colours_; ++c) {
+      const int* items = colour_items_.data() + colour_off_[c];
+      const int count = colour_off_[c + 1] - colour_off_[c];
+      pool_->parallel_for(count, [&](int b, int e, int w) {
+        double local = 0;
+        for (int k = b; k < e; ++k) {
+          const int i = items[k];
+          if (!cloth.is_free(i) || (S.flags[i] & kFlagFrozen)) continue;
+          Vec3 f;
+          Mat3 H;
+          energy_.vertex_force_hessian(i, S.x, S.mass[i], f, H);
+          if (kd_h > 0) {
+            f -= kd_h * H * (S.x[i] - xt_[i]);
+            H *= (1.0 + kd_h);
+          }
+          const double m = S.mass[i] * inv_h2;
+          f -= m * (S.x[i] - y_[i]);
+          H.diagonal().array() += m;
+          const double det = H.determinant();
+          if (!(std::abs(det) > 1e-30)) continue;
+          Eigen::LLT<Mat3> llt(H);
+          const Vec3 dx = llt.info() == Eigen::Success ? Vec3(llt.solve(f)) : Vec3(H.inverse() * f);
+          S.x[i] += dx;
+          local = std::max(local, dx.squaredNorm());
+        }
+        worker_max_[w * 8] = std::max(worker_max_[w * 8], local);
+      });
+    }
+    ++st.iterations;
+    residual = 0;
+    for (int w = 0; w < pool_->size(); ++w) residual = std::max(residual, worker_max_[w * 8]);
+    residual = std::sqrt(residual);
+    if (opt_.chebyshev && it > 0) {
+      omega = it == 1 ? 2.0 / (2.0 - opt_.chebyshev_rho * opt_.chebyshev_rho)
+                      : 4.0 / (4.0 - opt_.chebyshev_rho * opt_.chebyshev_rho * omega);
+      for (int i = 0; i < n; ++i)
+        if (cloth.is_free(i) && !(S.flags[i] & kFlagFrozen))
+          S.x[i] = omega * (S.x[i] - xprev2_iter_[i]) + xprev2_iter_[i];
+    }
+    if (residual < opt_.tolerance) break;
+  }
+  frozen_count_ = 0;
+  for (int i = 0; i < n; ++i) {
+    S.x_prev[i] = xt_[i];
+    if (cloth.is_free(i) && !(S.flags[i] & kFlagFrozen)) {
+      S.v[i] = (S.x[i] - xt_[i]) / h;
+      if (opt_.freeze) {
+        rest_count_[i] = S.v[i].norm() < opt_.freeze_speed ? rest_count_[i] + 1 : 0;
+        if (rest_count_[i] >= opt_.freeze_steps) {
+          S.flags[i] |= kFlagFrozen;
+          S.v[i].setZero();
+        }
+      }
+    } else if (S.flags[i] & kFlagFrozen) {
+      S.v[i].setZero();
+    }
+    frozen_count_ += (S.flags[i] & kFlagFrozen) ? 1 : 0;
+  }
+  S.time += h;
+  return residual;
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,205 @@
+// `drape form`: build a dress form (standard size, measurement JSON or mesh) and report its
+// girths and landmarks, or export it as a mesh.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+
+#include "sim/dress_form.hpp"
+#include "sim/mesh_io.hpp"
+#include "xr_app/command.hpp"
+
+namespace {
+
+using drape::sim::DressForm;
+using drape::sim::MeshImportOptions;
+
+void usage() {
+  std::printf(
+      "usage: drape form [--size 7AR|9AR|11AR|13AR | --measurements FILE.json |\n"
+      "                   --mesh FILE [--units m|cm|mm|in] [--up y|z|x|-y|-z|-x]\n"
+      "                   [--front x|z|-x|-z]]\n"
+      "                  [--spacing M] [--report] [--export FILE.gltf|.glb|.obj]\n"
+      "Builds the dress form (default: the 9AR form) and prints its girths at bust, waist and\n"
+      "hip in mm and the landmark heights (--report, the default), or writes it as a mesh.\n");
+}
+
+bool parse_units(const std::string& s, MeshImportOptions::Units& u) {
+  using U = MeshImportOptions::Units;
+  if (s == "m") u = U::kMetres;
+  else if (s == "cm") u = U::kCentimetres;
+  else if (s == "mm") u = U::kMillimetres;
+  else if (s == "in") u = U::kInches;
+  else if (s == "auto") u = U::kAuto;
+  else return false;
+  return true;
+}
+
+bool parse_up(const std::string& s, MeshImportOptions::UpAxis& u) {
+  using U = MeshImportOptions::UpAxis;
+  if (s == "y" || s == "+y") u = U::kY;
+  else if (s == "z" || s == "+z") u = U::kZ;
+  else if (s == "x" || s == "+x") u = U::kX;
+  else if (s == "-y") u = U::kNegY;
+  else if (s == "-z") u = U::kNegZ;
+  else if (s == "-x") u = U::kNegX;
+  else if (s == "auto") u = U::kAuto;
+  else return false;
+  return true;
+}
+
+bool parse_front(const std::string& s, drape::sim::Vec3& f) {
+  if (s == "z" || s == "+z") f = {0, 0, 1};
+  else if (s == "-z") f = {0, 0, -1};
+  else if (s == "x" || s == "+x") f = {1, 0, 0};
+  else if (s == "-x") f = {-1, 0, 0};
+  else return false;
+  return true;
+}
+
+int run(int argc, char** argv) {
+  std::string size, measurements, mesh, export_path;
+  bool report = false;
+  double spacing = 0.0025;
+  MeshImportOptions opt;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&](const char* what) -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "drape form: %s needs a value\n", what);
+        return nullptr;
+      }
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      usage();
+      return 0;
+    } else if (a == "--report") {
+      report = true;
+    } else if (a == "--size" || a == "--measurements" || a == "--mesh" || a == "--export" ||
+               a == "--units" || a == "--up" || a == "--front" || a == "--spacing") {
+      const char* v = value(a.c_str());
+      if (!v) return 2;
+      if (a == "--size") size = v;
+      else if (a == "--measurements") measurements = v;
+      else if (a == "--mesh") mesh = v;
+      else if (a == "--export") export_path = v;
+      else if (a == "--units") {
+        if (!parse_units(v, opt.units)) {
+          std::fprintf(stderr, "drape form: --units '%s': use m, cm, mm or in\n", v);
+          return 2;
+        }
+      } else if (a == "--up") {
+        if (!parse_up(v, opt.up)) {
+          std::fprintf(stderr, "drape form: --up '%s': use y, z, x, -y, -z or -x\n", v);
+          return 2;
+        }
+      } else if (a == "--front") {
+        if (!parse_front(v, opt.front_axis)) {
+          std::fprintf(stderr, "drape form: --front '%s': use z, -z, x or -x\n", v);
+          return 2;
+        }
+        opt.front_auto = false;
+      } else {
+        char* end = nullptr;
+        spacing = std::strtod(v, &end);
+        if (!end || *end || !(spacing >= 0.0005 && spacing <= 0.05)) {
+          std::fprintf(stderr, "drape form: --spacing '%s': a length in metres in [0.0005, 0.05]\n",
+                       v);
+          return 2;
+        }
+      }
+    } else {
+      std::fprintf(stderr, "drape form: unknown argument '%s'\n", a.c_str());
+      usage();
+      return 2;
+    }
+  }
+  const int sources = !size.empty() + !measurements.empty() + !mesh.empty();
+  if (sources > 1) {
+    std::fprintf(stderr, "drape form: give only one of --size, --measurements, --mesh\n");
+    return 2;
+  }
+  if (sources == 0) size = "9AR";
+  if (export_path.empty()) report = true;
+
+  drape::sim::Result<DressForm> form = drape::sim::Error{"no form"};
+  drape::sim::MeshImportInfo info;
+  std::string what;
+  if (!mesh.empty()) {
+    opt.section_spacing = spacing;
+    auto m = drape::sim::load_mesh(mesh);
+    if (!m) {
+      std::fprintf(stderr, "drape form: %s\n", m.error().c_str());
+      return 1;
+    }
+    form = DressForm::from_triangles(*m, opt, mesh, &info);
+    what = "mesh " + mesh;
+  } else {
+    auto meas = measurements.empty() ? drape::sim::measurements_for_size(size)
+                                     : drape::sim::load_measurements(measurements);
+    if (!meas) {
+      std::fprintf(stderr, "drape form: %s\n", meas.error().c_str());
+      return 1;
+    }
+    form = DressForm::from_measurements(*meas, spacing);
+    what = measurements.empty() ? "size " + size : "measurements " + measurements;
+    if (form && report) {
+      std::printf("requested: bust %.1f mm, waist %.1f mm, hip %.1f mm\n",
+                  meas->bust_girth * 1000, meas->waist_girth * 1000, meas->hip_girth * 1000);
+    }
+  }
+  if (!form) {
+    std::fprintf(stderr, "drape form: %s\n", form.error().c_str());
+    return 1;
+  }
+  const DressForm& f = *form;
+  const auto& lm = f.landmarks();
+  if (report) {
+    std::printf("dress form from %s: %d sections x %d angles, spacing %.2f mm, y %.4f .. %.4f m\n",
+                what.c_str(), f.num_sections(), DressForm::kAngles, f.section_spacing() * 1000,
+                f.min_y(), f.max_y());
+    if (!mesh.empty()) {
+      std::printf("import: units %s%s (x%g), up axis %s%s, centre front %s (rotated %.1f deg), "
+                  "lifted %.4f m, %d triangles, %d rays filled\n",
+                  info.units.c_str(), info.units_detected ? " (detected)" : "", info.scale,
+                  info.up.c_str(), info.up_detected ? " (detected)" : "",
+                  info.front_detected ? "detected" : "from --front / +z",
+                  info.front_angle * 180.0 / 3.14159265358979323846, info.lift, info.triangles,
+                  info.filled_rays);
+    }
+    std::printf("%-6s %10s %12s\n", "line", "height m", "girth mm");
+    std::printf("%-6s %10.4f %12.1f\n", "bust", lm.bust_y, f.girth_at(lm.bust_y) * 1000);
+    std::printf("%-6s %10.4f %12.1f\n", "waist", lm.waist_y, f.girth_at(lm.waist_y) * 1000);
+    std::printf("%-6s %10.4f %12.1f\n", "hip", lm.hip_y, f.girth_at(lm.hip_y) * 1000);
+    std::printf("neck %.4f m, bottom %.4f m, top %.4f m; side lines at theta %.1f / %.1f deg "
+                "(centre front theta 0 faces +z, theta runs toward the form's left, +x)\n",
+                lm.neck_y, lm.bottom_y, lm.top_y, lm.left_side_theta * 180 / 3.14159265358979323846,
+                lm.right_side_theta * 180 / 3.14159265358979323846);
+  }
+  if (!export_path.empty()) {
+    const std::string err = drape::sim::write_meshes(export_path, {f.to_mesh()});
+    if (!err.empty()) {
+      std::fprintf(stderr, "drape form: %s\n", err.c_str());
+      return 1;
+    }
+    std::printf("wrote %s\n", export_path.c_str());
+  }
+  return 0;
+}
+
+int form_main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "drape form: error: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "drape form: unknown error\n");
+  }
+  return 1;
+}
+
+}  // namespace
+
+DRAPE_COMMAND(form, "dress form: girths report (--size/--measurements/--mesh), --export", form_main);
