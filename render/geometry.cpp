@@ -1,6 +1,7 @@
 // CPU geometry of a frame (render/geometry.hpp).
 #include "render/geometry.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -192,6 +193,38 @@ void vertex_normals(const std::vector<sim::Vec3f>& pos, const std::vector<uint32
   }
 }
 
+void material_strain(const std::vector<sim::Vec3f>& pos, const std::vector<sim::Vec2f>& mat,
+                     const std::vector<uint32_t>& idx, std::vector<float>& strain) {
+  strain.assign(pos.size(), 0.0f);
+  std::vector<float> weight(pos.size(), 0.0f);
+  if (mat.size() != pos.size()) return;
+  for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+    const uint32_t a = idx[t], b = idx[t + 1], c = idx[t + 2];
+    if (a >= pos.size() || b >= pos.size() || c >= pos.size()) continue;
+    Eigen::Matrix2f dm;
+    dm.col(0) = mat[b] - mat[a];
+    dm.col(1) = mat[c] - mat[a];
+    const float area = 0.5f * std::abs(dm.determinant());
+    if (area < 1e-12f) continue;
+    Eigen::Matrix<float, 3, 2> ds;
+    ds.col(0) = pos[b] - pos[a];
+    ds.col(1) = pos[c] - pos[a];
+    const Eigen::Matrix<float, 3, 2> f = ds * dm.inverse();
+    const Eigen::Matrix2f cg = f.transpose() * f;  // right Cauchy-Green tensor
+    const float tr = cg.trace(), det = cg.determinant();
+    const float disc = std::sqrt(std::max(0.25f * tr * tr - det, 0.0f));
+    const float s1 = std::sqrt(std::max(0.5f * tr + disc, 0.0f)) - 1.0f;
+    const float s2 = std::sqrt(std::max(0.5f * tr - disc, 0.0f)) - 1.0f;
+    const float s = std::abs(s1) >= std::abs(s2) ? s1 : s2;
+    for (uint32_t v : {a, b, c}) {
+      strain[v] += area * s;
+      weight[v] += area;
+    }
+  }
+  for (size_t i = 0; i < strain.size(); ++i)
+    if (weight[i] > 0) strain[i] /= weight[i];
+}
+
 void append_cloth(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& out) {
   const size_t nv = snap.positions.size();
   if (nv == 0 || snap.indices.size() < 3) return;
@@ -202,13 +235,19 @@ void append_cloth(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& 
     normals = &computed;
   }
   const bool have_uv = snap.material.size() == nv;
-  const bool strain = opt.colour_map == ColourMap::kStrain && snap.strain.size() == nv;
+  std::vector<float> own_strain;
+  const std::vector<float>* strain_values = &snap.strain;
+  if (opt.colour_map == ColourMap::kStrain && snap.strain.size() != nv) {
+    material_strain(snap.positions, snap.material, snap.indices, own_strain);
+    strain_values = &own_strain;
+  }
+  const bool strain = opt.colour_map == ColourMap::kStrain && strain_values->size() == nv;
   const bool ease = opt.colour_map == ColourMap::kEase && snap.form != nullptr;
   const auto base = static_cast<uint32_t>(out.vertices.size());
   out.vertices.reserve(out.vertices.size() + nv);
   for (size_t i = 0; i < nv; ++i) {
     float s = 0;
-    if (strain) s = std::clamp(snap.strain[i] / opt.strain_range, -1.0f, 1.0f);
+    if (strain) s = std::clamp((*strain_values)[i] / opt.strain_range, -1.0f, 1.0f);
     if (ease) {
       const float d = form_distance(*snap.form, snap.positions[i]);
       s = std::isfinite(d) ? std::clamp(d / opt.ease_range, 0.0f, 1.0f) : 1.0f;

@@ -74,6 +74,12 @@ float form_distance(const sim::DressForm& form, const Eigen::Vector3f& p);
 void vertex_normals(const std::vector<sim::Vec3f>& pos, const std::vector<uint32_t>& idx,
                     std::vector<sim::Vec3f>& normals);
 
+// Per-vertex membrane strain from material coordinates: for each triangle the principal
+// stretches of F (material -> 3D), the one furthest from 1 minus 1 (tension > 0, compression
+// < 0), averaged over the triangles around a vertex (weighted by material area).
+void material_strain(const std::vector<sim::Vec3f>& pos, const std::vector<sim::Vec2f>& material,
+                     const std::vector<uint32_t>& idx, std::vector<float>& strain);
+
 // Primitive builders (world space), used above and by tests.
 void append_sphere(Mesh& out, const Eigen::Vector3f& c, float r, const std::array<float, 3>& rgb,
                    ShadeMode mode, int slices = 12, int stacks = 8);

@@ -56,19 +56,6 @@ struct TargetFb {
   VkFramebuffer framebuffer = VK_NULL_HANDLE;
 };
 
-bool is_srgb(VkFormat f) {
-  switch (f) {
-    case VK_FORMAT_R8G8B8A8_SRGB:
-    case VK_FORMAT_B8G8R8A8_SRGB:
-    case VK_FORMAT_A8B8G8R8_SRGB_PACK32:
-    case VK_FORMAT_R8G8B8_SRGB:
-    case VK_FORMAT_B8G8R8_SRGB:
-      return true;
-    default:
-      return false;
-  }
-}
-
 // Formats holding linear values with more than 8 bits need no encoding either.
 bool needs_shader_encode(VkFormat f) {
   switch (f) {

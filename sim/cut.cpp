@@ -94,8 +94,7 @@ SurfacePoint on_triangle(const Cloth& cloth, int32_t ti, const Vec3& p) {
 }
 
 // Best surface point among the triangles incident to vertex v and its neighbours.
-SurfacePoint surface_near_vertex(const Cloth& cloth, const Adjacency& a, int32_t v,
-                                 const Vec3& p) {
+SurfacePoint surface_near_vertex(const Cloth& cloth, const Adjacency& a, int32_t v, const Vec3& p) {
   SurfacePoint best;
   best.distance = std::numeric_limits<double>::infinity();
   auto consider_vertex = [&](int32_t u) {
@@ -121,8 +120,7 @@ int32_t nearest_vertex_brute(const Cloth& cloth, const Vec3& p) {
 }
 
 // Hill-climb over mesh neighbours from `start` toward p: keeps a stroke on the layer it began on.
-int32_t nearest_vertex_walk(const Cloth& cloth, const Adjacency& a, int32_t start,
-                            const Vec3& p) {
+int32_t nearest_vertex_walk(const Cloth& cloth, const Adjacency& a, int32_t start, const Vec3& p) {
   const auto& x = cloth.state.x;
   int32_t cur = start;
   double cd = (x[cur] - p).squaredNorm();

@@ -32,13 +32,13 @@ struct CutOptions {
 
 struct CutResult {
   bool ok = false;
-  std::string reason;                   // why nothing was cut (when !ok)
-  std::vector<int32_t> path;            // vertex path along mesh edges (pre-split indices)
-  std::vector<int32_t> new_vertices;    // duplicates created (left side of the cut)
-  std::vector<Vec3> smooth_stroke;      // smoothed stroke in 3D (display)
-  std::vector<Vec2> smooth_stroke_uv;   // the same on the flat cloth (pattern outline)
+  std::string reason;                  // why nothing was cut (when !ok)
+  std::vector<int32_t> path;           // vertex path along mesh edges (pre-split indices)
+  std::vector<int32_t> new_vertices;   // duplicates created (left side of the cut)
+  std::vector<Vec3> smooth_stroke;     // smoothed stroke in 3D (display)
+  std::vector<Vec2> smooth_stroke_uv;  // the same on the flat cloth (pattern outline)
   int components_before = 0, components_after = 0;
-  double ms = 0;                        // time to compute and apply
+  double ms = 0;  // time to compute and apply
 };
 
 // Nearest point of the cloth surface to p (brute force over triangles).

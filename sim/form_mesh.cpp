@@ -225,9 +225,12 @@ Result<DressForm> DressForm::from_triangles(const TriMesh& mesh, const MeshImpor
         const double sp = score(ep), sn = score(en);
         if (std::abs(sp - sn) > 0.005) {
           front = sp > sn ? depth : Vec2(-depth);
-          have_front = true;
           inf.front_detected = true;
+        } else {  // depth axis clear, front/back not: the side nearer the given front axis
+          const Vec2 given(opt.front_axis.x(), opt.front_axis.z());
+          front = depth.dot(given) >= 0 ? depth : Vec2(-depth);
         }
+        have_front = true;
       }
     }
   }

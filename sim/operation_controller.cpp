@@ -31,8 +31,7 @@ void OperationController::apply_hands(World& w, const std::array<HandProxy, 2>& 
   ops_set_hands(w, state_, hands);
 }
 
-void OperationController::trigger(World& w, const std::string& name, TriggerPhase phase,
-                                  int hand) {
+void OperationController::trigger(World& w, const std::string& name, TriggerPhase phase, int hand) {
   if (replaying_ && !feeding_) {
     if (name == "stop") {
       replaying_ = false;
@@ -102,8 +101,8 @@ void OperationController::apply_trigger(World& w, const std::string& name, Trigg
       phase == TriggerPhase::kBegin || (phase == TriggerPhase::kToggle && !active(name, hand));
   if (name == "undo" || name == "redo") {
     if (!begin) return;
-    const std::string label = name == "undo" ? history_.undo(w.cloth, state_)
-                                             : history_.redo(w.cloth, state_);
+    const std::string label =
+        name == "undo" ? history_.undo(w.cloth, state_) : history_.redo(w.cloth, state_);
     if (label.empty())
       w.report(name + ": nothing to " + name + ": ignored");
     else
@@ -209,10 +208,18 @@ void OperationController::before_step(World& w, double dt) {
     while (replay_pos_ < log_.events.size() && log_.events[replay_pos_].step <= step_) {
       const SessionEvent& e = log_.events[replay_pos_++];
       switch (e.kind) {
-        case SessionEvent::Kind::kHands: apply_hands(w, e.hands); break;
-        case SessionEvent::Kind::kTrigger: apply_trigger(w, e.name, e.phase, e.hand); break;
-        case SessionEvent::Kind::kStroke: apply_stroke(w, e.hand, e.points); break;
-        case SessionEvent::Kind::kSelect: select_candidate(w, e.hand, e.index); break;
+        case SessionEvent::Kind::kHands:
+          apply_hands(w, e.hands);
+          break;
+        case SessionEvent::Kind::kTrigger:
+          apply_trigger(w, e.name, e.phase, e.hand);
+          break;
+        case SessionEvent::Kind::kStroke:
+          apply_stroke(w, e.hand, e.points);
+          break;
+        case SessionEvent::Kind::kSelect:
+          select_candidate(w, e.hand, e.index);
+          break;
       }
     }
     feeding_ = false;

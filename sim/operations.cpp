@@ -9,18 +9,20 @@
 #include <limits>
 
 #include "sim/dress_form.hpp"
-
-// The map operation calls the geometric draping module once its API is wired in here.
-// #include "sim/mapping.hpp"
+#include "sim/mapping.hpp"
 
 namespace drape::sim {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-std::string hand_name(int hand) { return hand == 0 ? "left hand" : "right hand"; }
+std::string hand_name(int hand) {
+  return hand == 0 ? "left hand" : "right hand";
+}
 
-bool valid_index(int hand) { return hand == 0 || hand == 1; }
+bool valid_index(int hand) {
+  return hand == 0 || hand == 1;
+}
 
 bool in_any_triangle(const Cloth& c, std::vector<char>& cache) {
   cache.assign(c.num_vertices(), 0);
@@ -326,7 +328,8 @@ bool ops_move_begin(World& w, OperationsState& s) {
   auto dist = [&](int h, int32_t v) {
     return s.hand_valid[h] ? (x[v] - s.hands[h].position).norm() : 0.0;
   };
-  const bool swap = dist(0, corners[1]) + dist(1, corners[0]) < dist(0, corners[0]) + dist(1, corners[1]);
+  const bool swap =
+      dist(0, corners[1]) + dist(1, corners[0]) < dist(0, corners[0]) + dist(1, corners[1]);
   std::array<int32_t, 2> mv{swap ? corners[1] : corners[0], swap ? corners[0] : corners[1]};
   for (int h = 0; h < 2; ++h) {
     if (is_pinched_by_any(s, mv[h])) {
@@ -378,8 +381,8 @@ bool apply_cut(World& w, OperationsState& s, CutResult r) {
   }
   char buf[160];
   std::snprintf(buf, sizeof buf, "cut: %zu edges, %zu new particles, %d → %d pieces, %.3f ms",
-                r.path.size() - 1, r.new_vertices.size(), r.components_before,
-                r.components_after, r.ms);
+                r.path.size() - 1, r.new_vertices.size(), r.components_before, r.components_after,
+                r.ms);
   w.report(buf);
   s.cut_strokes.push_back({r.smooth_stroke, r.smooth_stroke_uv});
   s.last_cut = std::move(r);
@@ -424,15 +427,70 @@ bool ops_smooth_end(World& w, OperationsState& s, int hand) {
 }
 
 bool ops_map(World& w, OperationsState& s) {
-  if (!w.scene.form) return w.report("map: no dress form in the scene: ignored"), false;
-#ifdef DRAPE_HAVE_MAPPING
-  (void)s;
-  return map_operation(w);
-#else
-  (void)s;
-  w.report("map: geometric mapping is not available in this build (sim/mapping.hpp): ignored");
-  return false;
-#endif
+  if (!w.scene.form || w.scene.form->num_sections() < 2)
+    return w.report("map: no dress form in the scene: ignored"), false;
+  if (s.pinched[0] >= 0 || s.pinched[1] >= 0 || s.moving)
+    return w.report("map: not while pinching or moving (the study: map does not combine)"), false;
+  Cloth& c = w.cloth;
+  std::vector<char> used;
+  in_any_triangle(c, used);
+  double umin = kInf, umax = -kInf, vmin = kInf, vmax = -kInf;
+  for (int32_t i = 0; i < c.num_vertices(); ++i) {
+    if (!used[i]) continue;
+    umin = std::min(umin, c.topo.material[i].x()), umax = std::max(umax, c.topo.material[i].x());
+    vmin = std::min(vmin, c.topo.material[i].y()), vmax = std::max(vmax, c.topo.material[i].y());
+  }
+  if (!(umax > umin && vmax > vmin)) return w.report("map: the cloth is empty: ignored"), false;
+  // Chapter 2 mapping (sim/mapping.hpp) with the grain (warp, v) on centre front: the panel's
+  // middle warp line u = uc on theta = 0, each half wrapped toward its side line along the
+  // sections, the top edge 3 cm above the waist (eq. 2-1).
+  const DressForm& form = *w.scene.form;
+  const MappingSurface surf(form, 0.0, false);  // the form itself (no tight-skirt hip shape)
+  Panel shape;
+  shape.design.width = umax - umin;
+  shape.design.height = vmax - vmin;
+  shape.design.top_above_waist = 0.03;
+  const double waist = form.landmarks().waist_y;
+  const double pi = 3.14159265358979323846;
+  const PieceMapping left = make_piece_mapping(shape, surf, 0.0, +1, pi / 2, waist);
+  const PieceMapping right = make_piece_mapping(shape, surf, 0.0, -1, 3 * pi / 2, waist);
+  const double uc = 0.5 * (umin + umax);
+  std::vector<std::pair<double, std::array<ArcTable, 2>>> tables;  // per distinct height
+  auto& st = c.state;
+  for (int32_t i = 0; i < c.num_vertices(); ++i) {
+    const Vec2 m = c.topo.material[i];
+    const double y = left.y_of_v(m.y() - vmin);
+    const std::array<ArcTable, 2>* T = nullptr;
+    for (const auto& [ty, t] : tables)
+      if (std::abs(ty - y) < 1e-12) T = &t;
+    if (!T) {
+      tables.push_back({y, {ArcTable::build(surf, y, 0.0, +1), ArcTable::build(surf, y, 0.0, -1)}});
+      T = &tables.back().second;
+    }
+    const double l = m.x() - uc;
+    const PieceMapping& pm = l >= 0 ? left : right;
+    const double theta = pm.theta(0, std::abs(l), y, (*T)[l >= 0 ? 0 : 1]);
+    Vec3 p = surf.point(y, theta);
+    p += DressForm::direction(theta) * w.scene.offset;  // just outside the collision offset
+    if (!p.allFinite()) return w.report("map: mapping produced a non-finite point: ignored"), false;
+    st.x[i] = p;
+  }
+  st.x_prev = st.x;
+  for (auto& v : st.v) v.setZero();
+  // Boundary conditions of the study's map (§3.3 (f)): top edge and centre line fixed.
+  const double tol = 0.5 * c.topo.spacing + 1e-9;
+  for (int32_t i = 0; i < c.num_vertices(); ++i) {
+    const Vec2 m = c.topo.material[i];
+    uint8_t set = 0;
+    if (m.y() > vmax - 1e-9 || std::abs(m.x() - uc) <= tol) set = kFlagPinned;
+    set_vertex_flags(c, i, set,
+                     static_cast<uint8_t>(kFlagPinned | kFlagKinematic | kFlagPinched) &
+                         static_cast<uint8_t>(~set));
+  }
+  s.settling.clear();
+  w.report(
+      "map: cloth mapped onto the form, grain on centre front; top edge and centre line fixed");
+  return true;
 }
 
 void ops_stop(World& w, OperationsState& s) {
@@ -507,9 +565,8 @@ void ops_after_step(World& w, OperationsState& s, const OperationParams& p, doub
     st.v[it->vertex].setZero();
     s.last_pin_distance = (st.x[it->vertex] - it->target).norm();
     s.last_pin_landing_error = (st.x[it->vertex] - want).norm();
-    w.report("pin: particle " + std::to_string(it->vertex) + " fixed " +
-             mm(s.last_pin_distance) + " off the chosen point (offset), landing error " +
-             mm(s.last_pin_landing_error));
+    w.report("pin: particle " + std::to_string(it->vertex) + " fixed " + mm(s.last_pin_distance) +
+             " off the chosen point (offset), landing error " + mm(s.last_pin_landing_error));
     it = s.settling.erase(it);
   }
   ops_update_candidates(w, s, p);
@@ -545,11 +602,6 @@ void ops_decorate(const World& w, const OperationsState& s, SceneSnapshot& snap)
     std::vector<Vec3f> pts;
     for (const Vec3& q : s.stroke[h]) pts.push_back(q.cast<float>());
     snap.cut_strokes.push_back(std::move(pts));
-  }
-  if (snap.pins.empty()) {
-    const auto& st = w.cloth.state;
-    for (int32_t i = 0; i < w.cloth.num_vertices(); ++i)
-      if (st.flags[i] & kFlagPinned) snap.pins.push_back(st.x[i].cast<float>());
   }
 }
 

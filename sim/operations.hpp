@@ -15,23 +15,23 @@
 namespace drape::sim {
 
 struct OperationParams {
-  double pinch_reach = 0.05;    // m: a particle farther than max(this, hand radius) is not taken
-  double release_reach = 0.30;  // m: the fixed particle to free must be this close
-  double pin_reach = 0.15;      // m: the object point to pin at must be this close
-  int pin_relax_ticks = 3;      // ticks the pinned particle stays on the object point (relax)
-  double smooth_radius = 0.06;  // m around the hand where the cloth is pressed onto the form
-  double smooth_pressure = 0.5; // Pa: the study's weak pressure toward the form (method §2.1)
-  double ray_length = 0.40;     // m: candidate ray along the hand's pointing direction
-  int max_candidates = 6;       // alternatives exposed per hand
+  double pinch_reach = 0.05;     // m: a particle farther than max(this, hand radius) is not taken
+  double release_reach = 0.30;   // m: the fixed particle to free must be this close
+  double pin_reach = 0.15;       // m: the object point to pin at must be this close
+  int pin_relax_ticks = 3;       // ticks the pinned particle stays on the object point (relax)
+  double smooth_radius = 0.06;   // m around the hand where the cloth is pressed onto the form
+  double smooth_pressure = 0.5;  // Pa: the study's weak pressure toward the form (method §2.1)
+  double ray_length = 0.40;      // m: candidate ray along the hand's pointing direction
+  int max_candidates = 6;        // alternatives exposed per hand
   CutOptions cut;
 };
 
 // A particle an operation could act on, for the renderer to highlight.
 struct Candidate {
   int32_t vertex = -1;
-  double distance = 0;   // from the hand (m)
-  bool from_ray = false; // found by the ray along the pointing direction (layer `layer`)
-  int layer = 0;         // order of the ray hit (0 = first surface under the hand)
+  double distance = 0;    // from the hand (m)
+  bool from_ray = false;  // found by the ray along the pointing direction (layer `layer`)
+  int layer = 0;          // order of the ray hit (0 = first surface under the hand)
 };
 
 struct HandCandidates {
@@ -39,19 +39,19 @@ struct HandCandidates {
   int chosen = 0;
   int32_t release_vertex = -1;  // fixed particle release would free (never a pinched one)
   bool has_object_point = false;
-  Vec3 object_point{0, 0, 0};   // nearest object point (pin target)
+  Vec3 object_point{0, 0, 0};  // nearest object point (pin target)
   Vec3 object_normal{0, 1, 0};
   bool object_is_form = false;
   int32_t chosen_vertex() const {
     return chosen >= 0 && chosen < static_cast<int>(particles.size()) ? particles[chosen].vertex
-                                                                     : -1;
+                                                                      : -1;
   }
 };
 
 // A cut stroke kept beside the mesh cut: smooth, for display and for the pattern outline.
 struct CutStroke {
-  std::vector<Vec3> smooth;     // 3D at the time of the cut
-  std::vector<Vec2> material;   // on the flat cloth (u, v)
+  std::vector<Vec3> smooth;    // 3D at the time of the cut
+  std::vector<Vec2> material;  // on the flat cloth (u, v)
 };
 
 struct SettlingPin {

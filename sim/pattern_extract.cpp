@@ -299,7 +299,8 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
   const int n = static_cast<int>(piece.outline.size());
   {
     std::vector<int> lab(n);
-    for (int i = 0; i < n; ++i) lab[i] = piece.seg_label[(i + 1) % n];
+    for (int i = 0; i + 1 < n; ++i) lab[i] = piece.seg_label[i + 1];
+    lab[n - 1] = piece.seg_label[n - 1];  // the closing segment belongs to the last run
     piece.seg_label = lab;
   }
   // Darts: tip and leg tops from the labels.

@@ -52,10 +52,14 @@ std::vector<double> hand_doubles(const std::array<HandProxy, 2>& hands) {
 }
 const char* kind_name(SessionEvent::Kind k) {
   switch (k) {
-    case SessionEvent::Kind::kHands: return "hands";
-    case SessionEvent::Kind::kTrigger: return "trigger";
-    case SessionEvent::Kind::kStroke: return "stroke";
-    case SessionEvent::Kind::kSelect: return "select";
+    case SessionEvent::Kind::kHands:
+      return "hands";
+    case SessionEvent::Kind::kTrigger:
+      return "trigger";
+    case SessionEvent::Kind::kStroke:
+      return "stroke";
+    case SessionEvent::Kind::kSelect:
+      return "select";
   }
   return "?";
 }
@@ -176,7 +180,8 @@ bool read_cloth(Reader& r, const json& c, Cloth& cloth) {
   int64_t n = 0, nt = 0, nx = 0, ny = 0, version = 0;
   if (!r.integer(c, P, "vertices", 0, 50'000'000, n)) return false;
   if (!r.integer(c, P, "triangles_count", 0, 100'000'000, nt)) return false;
-  if (!r.integer(c, P, "grid_nx", 0, 1'000'000, nx) || !r.integer(c, P, "grid_ny", 0, 1'000'000, ny))
+  if (!r.integer(c, P, "grid_nx", 0, 1'000'000, nx) ||
+      !r.integer(c, P, "grid_ny", 0, 1'000'000, ny))
     return false;
   if (!r.integer(c, P, "topology_version", 0, INT64_MAX, version)) return false;
   std::vector<int32_t> tris;
@@ -207,7 +212,8 @@ bool read_cloth(Reader& r, const json& c, Cloth& cloth) {
   if (!r.vec3s(c, P, "x", n, cloth.state.x) || !r.vec3s(c, P, "x_prev", n, cloth.state.x_prev) ||
       !r.vec3s(c, P, "v", n, cloth.state.v))
     return false;
-  if (!r.blob(c, P, "mass", n, cloth.state.mass) || !r.blob(c, P, "inv_mass", n, cloth.state.inv_mass))
+  if (!r.blob(c, P, "mass", n, cloth.state.mass) ||
+      !r.blob(c, P, "inv_mass", n, cloth.state.inv_mass))
     return false;
   for (int64_t i = 0; i < n; ++i)
     if (cloth.state.mass[i] < 0 || cloth.state.inv_mass[i] < 0)
@@ -226,10 +232,14 @@ bool read_cloth(Reader& r, const json& c, Cloth& cloth) {
     const char* key;
     double* v;
     bool may_be_zero;
-  } nums[] = {{"areal_density", &fp.areal_density, false}, {"thickness", &fp.thickness, false},
-              {"stretch_warp", &fp.stretch_warp, false},   {"stretch_weft", &fp.stretch_weft, false},
-              {"shear", &fp.shear, false},                 {"bending_warp", &fp.bending_warp, false},
-              {"bending_weft", &fp.bending_weft, false},   {"damping", &fp.damping, true}};
+  } nums[] = {{"areal_density", &fp.areal_density, false},
+              {"thickness", &fp.thickness, false},
+              {"stretch_warp", &fp.stretch_warp, false},
+              {"stretch_weft", &fp.stretch_weft, false},
+              {"shear", &fp.shear, false},
+              {"bending_warp", &fp.bending_warp, false},
+              {"bending_weft", &fp.bending_weft, false},
+              {"damping", &fp.damping, true}};
   for (auto& e : nums) {
     if (!r.number(*f, F, e.key, *e.v)) return false;
     if (*e.v < 0 || (!e.may_be_zero && *e.v == 0)) return r.fail(F + "." + e.key, "must be > 0");
@@ -283,8 +293,8 @@ bool base64_decode(const std::string& s, std::vector<uint8_t>& out) {
         if (v[k] < 0) return false;
       }
     }
-    const uint32_t w = (uint32_t(v[0]) << 18) | (uint32_t(v[1]) << 12) | (uint32_t(v[2]) << 6) |
-                       uint32_t(v[3]);
+    const uint32_t w =
+        (uint32_t(v[0]) << 18) | (uint32_t(v[1]) << 12) | (uint32_t(v[2]) << 6) | uint32_t(v[3]);
     out.push_back(static_cast<uint8_t>(w >> 16));
     if (pad < 2) out.push_back(static_cast<uint8_t>(w >> 8));
     if (pad < 1) out.push_back(static_cast<uint8_t>(w));
@@ -333,11 +343,11 @@ std::string session_to_json(const SessionLog& log) {
   j["cloth"] = std::move(jc);
   std::vector<double> plates, boxes, spheres;
   for (const Plate& p : log.plates)
-    plates.insert(plates.end(), {p.centre.x(), p.centre.y(), p.centre.z(), p.half_x, p.half_z,
-                                 p.thickness});
+    plates.insert(plates.end(),
+                  {p.centre.x(), p.centre.y(), p.centre.z(), p.half_x, p.half_z, p.thickness});
   for (const Box& b : log.boxes)
-    boxes.insert(boxes.end(), {b.centre.x(), b.centre.y(), b.centre.z(), b.half.x(), b.half.y(),
-                               b.half.z()});
+    boxes.insert(boxes.end(),
+                 {b.centre.x(), b.centre.y(), b.centre.z(), b.half.x(), b.half.y(), b.half.z()});
   for (const Sphere& s : log.spheres)
     spheres.insert(spheres.end(), {s.centre.x(), s.centre.y(), s.centre.z(), s.radius});
   j["scene"] = {{"floor", log.floor},
@@ -404,7 +414,8 @@ Result<SessionLog> parse_session(const std::string& text, const std::string& sou
         !r.blob(*sc, "scene", "plates", -1, plates) || !r.blob(*sc, "scene", "boxes", -1, boxes) ||
         !r.blob(*sc, "scene", "spheres", -1, spheres))
       return Error{r.err};
-    if (!(off[0] >= 0 && off[0] < 1)) return make_error(source, "scene.offset: must be in [0, 1) m");
+    if (!(off[0] >= 0 && off[0] < 1))
+      return make_error(source, "scene.offset: must be in [0, 1) m");
     log.offset = off[0];
     if (plates.size() % 6 || boxes.size() % 6 || spheres.size() % 4)
       return make_error(source, "scene: plates/boxes need 6 values each, spheres 4");

@@ -19,13 +19,13 @@ enum class TriggerPhase : uint8_t { kBegin = 0, kEnd = 1, kToggle = 2 };
 struct SessionEvent {
   enum class Kind : uint8_t { kHands = 0, kTrigger = 1, kStroke = 2, kSelect = 3 };
   Kind kind = Kind::kHands;
-  uint64_t step = 0;               // simulation step (before_step call) it was applied before
+  uint64_t step = 0;                 // simulation step (before_step call) it was applied before
   std::array<HandProxy, 2> hands{};  // kHands
-  std::string name;                // kTrigger: "pinch", "cut", ...
+  std::string name;                  // kTrigger: "pinch", "cut", ...
   TriggerPhase phase = TriggerPhase::kBegin;
-  int hand = 1;                    // kTrigger, kSelect, kStroke
-  int index = 0;                   // kSelect: candidate index
-  std::vector<Vec3> points;        // kStroke: predetermined cut stroke
+  int hand = 1;              // kTrigger, kSelect, kStroke
+  int index = 0;             // kSelect: candidate index
+  std::vector<Vec3> points;  // kStroke: predetermined cut stroke
 };
 
 struct SessionLog {

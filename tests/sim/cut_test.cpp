@@ -55,7 +55,7 @@ TEST(Cut, HorizontalLineAcrossSplitsInTwo) {
   const uint64_t v0 = c.topology_version;
   CutResult r = cut_along_material(c, {Vec2(0, 0.2), Vec2(0.4, 0.2)});
   ASSERT_TRUE(r.ok) << r.reason;
-  EXPECT_EQ(r.path.size(), static_cast<size_t>(n));  // straight along the grid row
+  EXPECT_EQ(r.path.size(), static_cast<size_t>(n));          // straight along the grid row
   EXPECT_EQ(r.new_vertices.size(), static_cast<size_t>(n));  // both ends on the boundary
   EXPECT_EQ(r.components_before, 1);
   EXPECT_EQ(r.components_after, 2);
@@ -73,14 +73,20 @@ TEST(Cut, HorizontalLineAcrossSplitsInTwo) {
       has_new = has_new || t[k] >= n * n;
       vc += c.topo.material[t[k]].y() / 3;
     }
-    if (has_new) EXPECT_GT(vc, 0.2);
+    if (has_new) {
+      EXPECT_GT(vc, 0.2);
+    }
   }
   // Components: the labels split at v = 0.2 exactly.
   auto lab = component_labels(c);
   for (int i = 0; i < n * n; ++i) {
     const double v = c.topo.material[i].y();
-    if (v < 0.2 - 1e-9) EXPECT_EQ(lab[i], lab[0]);
-    if (v > 0.2 + 1e-9) EXPECT_NE(lab[i], lab[0]);
+    if (v < 0.2 - 1e-9) {
+      EXPECT_EQ(lab[i], lab[0]);
+    }
+    if (v > 0.2 + 1e-9) {
+      EXPECT_NE(lab[i], lab[0]);
+    }
   }
   std::printf("horizontal cut: %zu path vertices, %zu new, %.3f ms\n", r.path.size(),
               r.new_vertices.size(), r.ms);
@@ -101,7 +107,9 @@ TEST(Cut, HalfLinesMakeSlitsWithoutSeparating) {
     Cloth c = flat(n);
     CutResult r = cut_along_material(c, {l.a, l.b});
     ASSERT_TRUE(r.ok) << l.name << ": " << r.reason;
-    if (l.path_len) EXPECT_EQ(r.path.size(), l.path_len) << l.name;
+    if (l.path_len) {
+      EXPECT_EQ(r.path.size(), l.path_len) << l.name;
+    }
     // The interior end is a slit tip: not duplicated; every other path vertex is.
     EXPECT_EQ(r.new_vertices.size(), r.path.size() - 1) << l.name;
     EXPECT_EQ(count_components(c), 1) << l.name;

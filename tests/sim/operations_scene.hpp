@@ -14,7 +14,9 @@
 namespace drape::sim::testing {
 
 enum class Initial { kSpread, kRolled };
-inline const char* initial_name(Initial s) { return s == Initial::kSpread ? "spread" : "rolled"; }
+inline const char* initial_name(Initial s) {
+  return s == Initial::kSpread ? "spread" : "rolled";
+}
 
 inline constexpr double kDt = 1.0 / 90;
 

@@ -10,13 +10,14 @@
 
 #include "operations_scene.hpp"
 #include "sim/cut.hpp"
+#include "sim/dress_form.hpp"
 
 namespace drape::sim {
 namespace {
 
-using testing::Initial;
 using testing::hand_at;
 using testing::has_message;
+using testing::Initial;
 using testing::stable;
 using testing::tick;
 
@@ -25,6 +26,7 @@ struct Ops : ::testing::TestWithParam<Initial> {
   std::shared_ptr<OperationController> c = std::make_shared<OperationController>();
   std::array<HandProxy, 2> hands{};
   void SetUpWorld(int fixed) {
+    c = std::make_shared<OperationController>();
     w = testing::make_world(GetParam(), fixed);
     c->install(w);
     hands[0] = hand_at(0, Vec3(-1, 2, 1));
@@ -95,10 +97,13 @@ TEST_P(Ops, MoveWithObstacle) {
   set(0, X(top(0)));
   set(1, X(top(8)));
   trig("move", TriggerPhase::kBegin);
-  // Lay the cloth over the plate: hands go forward and down to just above it.
+  // Lay the cloth over the plate: hands go forward and down to 6 cm above it.
+  const double goal_y = plate.centre.y() + 0.06, goal_z = 0.25;
+  const Vec3 step0 = (Vec3(hands[0].position.x(), goal_y, goal_z) - hands[0].position) / 60;
+  const Vec3 step1 = (Vec3(hands[1].position.x(), goal_y, goal_z) - hands[1].position) / 60;
   for (int i = 0; i < 60; ++i) {
-    set(0, hands[0].position + Vec3(0, -0.0065, 0.004));
-    set(1, hands[1].position + Vec3(0, -0.0065, 0.004));
+    set(0, hands[0].position + step0);
+    set(1, hands[1].position + step1);
     run(1);
   }
   run(60);
@@ -226,9 +231,12 @@ void pinch_then_pin(Ops& t) {
   box.centre = Vec3(0, 1.1, 0.25);
   box.half = Vec3(0.1, 0.1, 0.1);
   t.w.scene.boxes.push_back(box);
-  const int v = t.middle();
-  t.set(1, t.X(v));
-  t.trig("pinch", TriggerPhase::kBegin);
+  int v = t.c->state().pinched[1];
+  if (v < 0) {
+    v = t.middle();
+    t.set(1, t.X(v));
+    t.trig("pinch", TriggerPhase::kBegin);
+  }
   ASSERT_EQ(t.c->state().pinched[1], v);
   // Carry it to the box's front face (z = 0.15), 3 cm in front.
   const Vec3 goal(0.02, 1.12, 0.12);
@@ -244,7 +252,7 @@ void pinch_then_pin(Ops& t) {
   t.expect_undo_exact(h0);
   t.set(1, Vec3(0.5, 1.5, 0.5));  // the hand goes away: the pin stays
   t.run(20);
-  const Vec3 want(0.02, 1.12, 0.15 + t.w.scene.offset);
+  const Vec3 want(0.02, 1.12, 0.15 - t.w.scene.offset);  // normal toward the hand: -z
   std::printf("pin: landed %.3f mm from the object point + offset; distance to the point %.3f mm\n",
               (t.X(v) - want).norm() * 1e3, t.c->state().last_pin_distance * 1e3);
   EXPECT_LT((t.X(v) - want).norm(), 1e-9);
@@ -318,17 +326,17 @@ TEST_P(Ops, CutAlongPredeterminedLines) {
 
 TEST_P(Ops, CutByHandTrajectory) {
   SetUpWorld(2);
-  run(3);
-  // A line of constant v across the whole width, on the outermost layer for the rolled cloth.
+  run(150);  // let the cloth come to rest (the rolled one unrolls and hangs)
+  // A line of constant v across the whole width, drawn by the hand over the cloth as it is.
   const int row = 6;
-  const Vec3 p0 = X(row * 9 + 0), p1 = X(row * 9 + 8);
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0, 0.002);
-  set(1, p0 + (p0 - p1) * 0.05);
+  set(1, X(row * 9) + (X(row * 9) - X(row * 9 + 8)) * 0.05);
   const uint64_t h0 = state_hash(w.cloth);
   trig("cut", TriggerPhase::kBegin);
-  for (int i = 0; i <= 40; ++i) {
-    const Vec3 p = p0 + (p1 - p0) * (-0.05 + 1.1 * i / 40.0);
+  for (int i = 0; i <= 20; ++i) {
+    const Vec3 p0 = X(row * 9 + 0), p1 = X(row * 9 + 8);
+    const Vec3 p = p0 + (p1 - p0) * (-0.05 + 1.1 * i / 20.0);
     set(1, p + Vec3(noise(rng), noise(rng), noise(rng)));
     tick(w);  // while the stroke is drawn the cloth keeps moving
   }
@@ -350,8 +358,87 @@ TEST_P(Ops, MapWithoutFormIsRefusedWithAReason) {
   SetUpWorld(2);
   const uint64_t h0 = state_hash(w.cloth);
   trig("map", TriggerPhase::kBegin);
-  EXPECT_TRUE(has_message(w, "map:"));
+  EXPECT_TRUE(has_message(w, "map: no dress form"));
   EXPECT_EQ(state_hash(w.cloth), h0);
+}
+
+TEST_P(Ops, MapOntoTheFormAlongCentreFront) {
+  SetUpWorld(2);
+  auto m = measurements_for_size("9AR");
+  ASSERT_TRUE(m.ok()) << m.error();
+  auto form = DressForm::from_measurements(*m);
+  ASSERT_TRUE(form.ok()) << form.error();
+  w.scene.form = std::make_shared<const DressForm>(std::move(*form));
+  const DressForm& f = *w.scene.form;
+  const uint64_t h0 = state_hash(w.cloth);
+  trig("map", TriggerPhase::kBegin);
+  ASSERT_NE(state_hash(w.cloth), h0) << w.messages.back();
+  // On the surface (just outside the offset), the middle warp line on centre front (x = centre).
+  double worst_gap = 0, worst_cf = 0;
+  for (int v = 0; v < w.cloth.num_vertices(); ++v) {
+    const double sd = f.signed_distance(X(v));
+    if (std::isfinite(sd)) worst_gap = std::max(worst_gap, std::abs(sd - w.scene.offset));
+    if (std::abs(w.cloth.topo.material[v].x() - 0.2) < 1e-9) {
+      worst_cf = std::max(worst_cf, std::abs(X(v).x() - f.centre_at(X(v).y()).x()));
+      EXPECT_GT(X(v).z(), f.centre_at(X(v).y()).y());  // on the front
+      EXPECT_TRUE(w.cloth.state.flags[v] & kFlagPinned);
+    }
+  }
+  std::printf(
+      "map: worst distance to the form surface + offset %.3f mm, centre line off CF %.3f mm\n",
+      worst_gap * 1e3, worst_cf * 1e3);
+  EXPECT_LT(worst_gap, 1e-3);
+  EXPECT_LT(worst_cf, 1e-6);
+  // The top edge sits 3 cm above the waist line.
+  EXPECT_NEAR(X(top(4)).y(), f.landmarks().waist_y + 0.03, 1e-9);
+  expect_undo_exact(h0);
+  run(40);  // then dynamics: stays on the form, stable
+  double inside = 0;
+  for (int v = 0; v < w.cloth.num_vertices(); ++v)
+    if (std::isfinite(f.signed_distance(X(v)))) inside = std::max(inside, -f.signed_distance(X(v)));
+  EXPECT_LT(inside, 0.002);
+}
+
+// --- smooth (weak pressure onto the form under the hand) ----------------------------------
+TEST(OpsSmooth, PressesTheClothOntoTheFormUnderTheHand) {
+  World w = testing::make_world(Initial::kSpread, 2);
+  OperationController c;
+  c.install(w);
+  auto form = DressForm::from_measurements(*measurements_for_size("9AR"));
+  ASSERT_TRUE(form.ok()) << form.error();
+  w.scene.form = std::make_shared<const DressForm>(std::move(*form));
+  const DressForm& f = *w.scene.form;
+  double zfront = 0;
+  for (double y = 1.0; y <= 1.4; y += 0.01) zfront = std::max(zfront, f.surface_at(y, 0).z());
+  for (auto& p : w.cloth.state.x) p.z() = zfront + 0.03;
+  w.cloth.state.x_prev = w.cloth.state.x;
+  const int v = 4 * 9 + 4, far = 4 * 9 + 0;
+  std::array<HandProxy, 2> hands{hand_at(0, Vec3(-1, 2, 1)), hand_at(1, w.cloth.state.x[v])};
+  hands[0].tracked = false;
+  c.set_hands(w, hands);
+  const double d0 = f.signed_distance(w.cloth.state.x[v]);
+  const double f0 = f.signed_distance(w.cloth.state.x[far]);
+  c.trigger(w, "smooth", TriggerPhase::kBegin, 1);
+  for (int i = 0; i < 60; ++i) {
+    hands[1].position = w.cloth.state.x[v];
+    c.set_hands(w, hands);
+    tick(w);
+  }
+  c.trigger(w, "smooth", TriggerPhase::kEnd, 1);
+  const double d1 = f.signed_distance(w.cloth.state.x[v]);
+  const double f1 = f.signed_distance(w.cloth.state.x[far]);
+  std::printf("smooth: gap under the hand %.1f -> %.1f mm; far from the hand %.1f -> %.1f mm\n",
+              d0 * 1e3, d1 * 1e3, f0 * 1e3, f1 * 1e3);
+  EXPECT_LT(d1, d0 - 0.01);
+  EXPECT_GT(d1, w.scene.offset - 0.002);
+  EXPECT_LT(f0 - f1, 0.5 * (d0 - d1));  // local: the far edge is pressed much less
+  EXPECT_TRUE(stable(w.cloth));
+  // without a form: refused with a reason
+  World w2 = testing::make_world(Initial::kSpread, 2);
+  OperationController c2;
+  c2.install(w2);
+  c2.trigger(w2, "smooth", TriggerPhase::kBegin, 1);
+  EXPECT_TRUE(has_message(w2, "smooth: no dress form"));
 }
 
 // --- combinations ------------------------------------------------------------------------
@@ -365,7 +452,7 @@ TEST_P(Ops, PinchReleasePin) {
   trig("release", TriggerPhase::kBegin, 0);
   EXPECT_FALSE(w.cloth.state.flags[top(0)] & kFlagPinned);
   run(10);
-  pinch_then_pin(*this);  // pinches again after the first pinch is ended below
+  pinch_then_pin(*this);  // carries the particle still pinched by the right hand to the box
 }
 
 TEST_P(Ops, MovePinchReleaseInAnyOrderAndCount) {
@@ -379,12 +466,24 @@ TEST_P(Ops, MovePinchReleaseInAnyOrderAndCount) {
     const int v = std::uniform_int_distribution<int>(0, w.cloth.num_vertices() - 1)(rng);
     set(h, X(v) + Vec3(jitter(rng), jitter(rng), jitter(rng)) * 0.2);
     switch (op(rng)) {
-      case 0: trig("move", TriggerPhase::kToggle, h); break;
-      case 1: trig("pinch", TriggerPhase::kBegin, h); break;
-      case 2: trig("pinch", TriggerPhase::kEnd, h); break;
-      case 3: trig("release", TriggerPhase::kBegin, h); break;
-      case 4: trig("undo", TriggerPhase::kBegin, h); break;
-      default: trig("redo", TriggerPhase::kBegin, h); break;
+      case 0:
+        trig("move", TriggerPhase::kToggle, h);
+        break;
+      case 1:
+        trig("pinch", TriggerPhase::kBegin, h);
+        break;
+      case 2:
+        trig("pinch", TriggerPhase::kEnd, h);
+        break;
+      case 3:
+        trig("release", TriggerPhase::kBegin, h);
+        break;
+      case 4:
+        trig("undo", TriggerPhase::kBegin, h);
+        break;
+      default:
+        trig("redo", TriggerPhase::kBegin, h);
+        break;
     }
     for (int i = 0; i < 5; ++i) {
       set(h, hands[h].position + Vec3(jitter(rng), jitter(rng), jitter(rng)) * 0.05);
@@ -463,8 +562,12 @@ TEST_P(Ops, BothHandsPinchIndependently) {
 // --- candidates --------------------------------------------------------------------------
 TEST_P(Ops, CandidatesComeFromTheSurfaceUnderTheHand) {
   SetUpWorld(2);
-  // Hand 10 cm in front of the cloth (+z), pointing at it (-z: identity orientation).
-  const int v = middle();
+  // Hand 10 cm in front of the cloth (+z), pointing at it (-z: identity orientation), in front
+  // of the outermost layer.
+  int v = middle();
+  if (GetParam() == Initial::kRolled)
+    for (int i = 0; i < w.cloth.num_vertices(); ++i)
+      if (X(i).z() > X(v).z()) v = i;
   set(1, X(v) + Vec3(0.004, 0.004, 0.10));
   ops_update_candidates(w, c->state(), c->params());
   const auto& hc = c->state().candidates[1];

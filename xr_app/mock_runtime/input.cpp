@@ -29,19 +29,20 @@ const std::vector<Profile>& profiles() {
        {},
        {}},
       {"/interaction_profiles/oculus/touch_controller",
-       {"input/squeeze/value", "input/trigger/value", "input/trigger/touch",
-        "input/thumbstick/x", "input/thumbstick/y", "input/thumbstick/click",
-        "input/thumbstick/touch", "input/thumbrest/touch", "input/grip/pose", "input/aim/pose",
-        "output/haptic"},
+       {"input/squeeze/value", "input/trigger/value", "input/trigger/touch", "input/thumbstick/x",
+        "input/thumbstick/y", "input/thumbstick/click", "input/thumbstick/touch",
+        "input/thumbrest/touch", "input/grip/pose", "input/aim/pose", "output/haptic"},
        {"input/x/click", "input/x/touch", "input/y/click", "input/y/touch", "input/menu/click"},
        {"input/a/click", "input/a/touch", "input/b/click", "input/b/touch", "input/system/click"}},
       {"/interaction_profiles/valve/index_controller",
-       {"input/system/click", "input/system/touch", "input/a/click", "input/a/touch",
-        "input/b/click", "input/b/touch", "input/squeeze/value", "input/squeeze/force",
-        "input/trigger/click", "input/trigger/value", "input/trigger/touch",
-        "input/thumbstick/x", "input/thumbstick/y", "input/thumbstick/click",
-        "input/thumbstick/touch", "input/trackpad/x", "input/trackpad/y", "input/trackpad/force",
-        "input/trackpad/touch", "input/grip/pose", "input/aim/pose", "output/haptic"},
+       {"input/system/click",   "input/system/touch",     "input/a/click",
+        "input/a/touch",        "input/b/click",          "input/b/touch",
+        "input/squeeze/value",  "input/squeeze/force",    "input/trigger/click",
+        "input/trigger/value",  "input/trigger/touch",    "input/thumbstick/x",
+        "input/thumbstick/y",   "input/thumbstick/click", "input/thumbstick/touch",
+        "input/trackpad/x",     "input/trackpad/y",       "input/trackpad/force",
+        "input/trackpad/touch", "input/grip/pose",        "input/aim/pose",
+        "output/haptic"},
        {},
        {}},
       {"/interaction_profiles/htc/vive_controller",
@@ -157,8 +158,7 @@ XrResult XRAPI_CALL CreateAction(XrActionSet h, const XrActionCreateInfo* info, 
   DRAPE_LOCK;
   ActionSet* set = lookup<ActionSet>(h);
   if (!set) return XR_ERROR_HANDLE_INVALID;
-  if (!info || !out || info->type != XR_TYPE_ACTION_CREATE_INFO)
-    return XR_ERROR_VALIDATION_FAILURE;
+  if (!info || !out || info->type != XR_TYPE_ACTION_CREATE_INFO) return XR_ERROR_VALIDATION_FAILURE;
   if (set->attached) return XR_ERROR_ACTIONSETS_ALREADY_ATTACHED;
   if (!valid_name(info->actionName, XR_MAX_ACTION_NAME_SIZE)) return XR_ERROR_PATH_FORMAT_INVALID;
   if (strnlen(info->localizedActionName, XR_MAX_LOCALIZED_ACTION_NAME_SIZE) == 0)
@@ -208,15 +208,14 @@ XrResult XRAPI_CALL DestroyAction(XrAction h) {
   return XR_SUCCESS;
 }
 
-XrResult XRAPI_CALL SuggestInteractionProfileBindings(
-    XrInstance h, const XrInteractionProfileSuggestedBinding* sb) {
+XrResult XRAPI_CALL
+SuggestInteractionProfileBindings(XrInstance h, const XrInteractionProfileSuggestedBinding* sb) {
   DRAPE_LOCK;
   Instance* inst = lookup<Instance>(h);
   if (!inst) return XR_ERROR_HANDLE_INVALID;
   if (!sb || sb->type != XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING)
     return XR_ERROR_VALIDATION_FAILURE;
-  if (sb->countSuggestedBindings == 0 || !sb->suggestedBindings)
-    return XR_ERROR_VALIDATION_FAILURE;
+  if (sb->countSuggestedBindings == 0 || !sb->suggestedBindings) return XR_ERROR_VALIDATION_FAILURE;
   if (sb->interactionProfile == XR_NULL_PATH || sb->interactionProfile >= inst->paths.size())
     return XR_ERROR_PATH_INVALID;
   const Profile* prof = find_profile(inst->paths[sb->interactionProfile]);
@@ -249,7 +248,8 @@ XrResult XRAPI_CALL SuggestInteractionProfileBindings(
   return XR_SUCCESS;
 }
 
-XrResult XRAPI_CALL AttachSessionActionSets(XrSession h, const XrSessionActionSetsAttachInfo* info) {
+XrResult XRAPI_CALL AttachSessionActionSets(XrSession h,
+                                            const XrSessionActionSetsAttachInfo* info) {
   DRAPE_LOCK;
   Session* s = lookup<Session>(h);
   if (!s) return XR_ERROR_HANDLE_INVALID;
@@ -375,7 +375,9 @@ std::array<float, 2> read_component(const std::map<std::string, std::array<float
   return {0, 0};
 }
 
-int64_t sample_frame(Session* s) { return std::max<int64_t>(0, s->frames_waited - 1); }
+int64_t sample_frame(Session* s) {
+  return std::max<int64_t>(0, s->frames_waited - 1);
+}
 
 void evaluate(Session* s, Action* a, bool focused) {
   Instance* inst = instance_of(s);
@@ -497,7 +499,8 @@ XrResult XRAPI_CALL GetActionStateBoolean(XrSession h, const XrActionStateGetInf
   Session* s;
   Action* a;
   if (!st || st->type != XR_TYPE_ACTION_STATE_BOOLEAN) return XR_ERROR_VALIDATION_FAILURE;
-  if (XrResult r = get_action_for_state(h, info, XR_ACTION_TYPE_BOOLEAN_INPUT, &s, &a); r != XR_SUCCESS)
+  if (XrResult r = get_action_for_state(h, info, XR_ACTION_TYPE_BOOLEAN_INPUT, &s, &a);
+      r != XR_SUCCESS)
     return r;
   ActionStateSlot sl = slot_of(a, info->subactionPath);
   st->currentState = sl.value[0] >= 0.5f ? XR_TRUE : XR_FALSE;
@@ -513,7 +516,8 @@ XrResult XRAPI_CALL GetActionStateFloat(XrSession h, const XrActionStateGetInfo*
   Session* s;
   Action* a;
   if (!st || st->type != XR_TYPE_ACTION_STATE_FLOAT) return XR_ERROR_VALIDATION_FAILURE;
-  if (XrResult r = get_action_for_state(h, info, XR_ACTION_TYPE_FLOAT_INPUT, &s, &a); r != XR_SUCCESS)
+  if (XrResult r = get_action_for_state(h, info, XR_ACTION_TYPE_FLOAT_INPUT, &s, &a);
+      r != XR_SUCCESS)
     return r;
   ActionStateSlot sl = slot_of(a, info->subactionPath);
   st->currentState = sl.value[0];
@@ -546,7 +550,8 @@ XrResult XRAPI_CALL GetActionStatePose(XrSession h, const XrActionStateGetInfo* 
   Session* s;
   Action* a;
   if (!st || st->type != XR_TYPE_ACTION_STATE_POSE) return XR_ERROR_VALIDATION_FAILURE;
-  if (XrResult r = get_action_for_state(h, info, XR_ACTION_TYPE_POSE_INPUT, &s, &a); r != XR_SUCCESS)
+  if (XrResult r = get_action_for_state(h, info, XR_ACTION_TYPE_POSE_INPUT, &s, &a);
+      r != XR_SUCCESS)
     return r;
   st->isActive = slot_of(a, info->subactionPath).active ? XR_TRUE : XR_FALSE;
   return XR_SUCCESS;
@@ -711,18 +716,17 @@ XrResult XRAPI_CALL LocateHandJointsEXT(XrHandTrackerEXT h, const XrHandJointsLo
   XrPosef pb;
   bool tb;
   bool base_ok = space_pose_in_stage(s, base, info->time, &pb, &tb);
-  loc->isActive = (hs.tracked && base_ok && s->state == XR_SESSION_STATE_FOCUSED) ? XR_TRUE
-                                                                                   : XR_FALSE;
+  loc->isActive =
+      (hs.tracked && base_ok && s->state == XR_SESSION_STATE_FOCUSED) ? XR_TRUE : XR_FALSE;
   XrPosef inv = base_ok ? pose_inverse(pb) : pose_identity();
   for (int j = 0; j < XR_HAND_JOINT_COUNT_EXT; ++j) {
     XrHandJointLocationEXT& jl = loc->jointLocations[j];
     if (loc->isActive) {
       jl.pose = pose_mul(inv, hs.joints[j]);
       jl.radius = hs.radii[j];
-      jl.locationFlags = XR_SPACE_LOCATION_ORIENTATION_VALID_BIT |
-                         XR_SPACE_LOCATION_POSITION_VALID_BIT |
-                         XR_SPACE_LOCATION_ORIENTATION_TRACKED_BIT |
-                         XR_SPACE_LOCATION_POSITION_TRACKED_BIT;
+      jl.locationFlags =
+          XR_SPACE_LOCATION_ORIENTATION_VALID_BIT | XR_SPACE_LOCATION_POSITION_VALID_BIT |
+          XR_SPACE_LOCATION_ORIENTATION_TRACKED_BIT | XR_SPACE_LOCATION_POSITION_TRACKED_BIT;
     } else {
       jl.pose = pose_identity();
       jl.radius = 0;

@@ -305,20 +305,19 @@ XrResult XRAPI_CALL PollEvent(XrInstance h, XrEventDataBuffer* ev) {
   return XR_SUCCESS;
 }
 
-XrResult XRAPI_CALL ResultToString(XrInstance h, XrResult value, char buffer[XR_MAX_RESULT_STRING_SIZE]) {
+XrResult XRAPI_CALL ResultToString(XrInstance h, XrResult value,
+                                   char buffer[XR_MAX_RESULT_STRING_SIZE]) {
   DRAPE_LOCK;
   if (!lookup<Instance>(h)) return XR_ERROR_HANDLE_INVALID;
   if (!buffer) return XR_ERROR_VALIDATION_FAILURE;
-#define DRAPE_RESULT_CASE(name, val) \
-  case name:                         \
-    std::snprintf(buffer, XR_MAX_RESULT_STRING_SIZE, "%s", #name);  \
+#define DRAPE_RESULT_CASE(name, val)                               \
+  case name:                                                       \
+    std::snprintf(buffer, XR_MAX_RESULT_STRING_SIZE, "%s", #name); \
     return XR_SUCCESS;
-  switch (value) {
-    XR_LIST_ENUM_XrResult(DRAPE_RESULT_CASE) default : break;
-  }
+  switch (value) { XR_LIST_ENUM_XrResult(DRAPE_RESULT_CASE) default : break; }
 #undef DRAPE_RESULT_CASE
-  std::snprintf(buffer, XR_MAX_RESULT_STRING_SIZE, "XR_%s_%d", value < 0 ? "UNKNOWN_FAILURE" : "UNKNOWN_SUCCESS",
-                static_cast<int>(value));
+  std::snprintf(buffer, XR_MAX_RESULT_STRING_SIZE, "XR_%s_%d",
+                value < 0 ? "UNKNOWN_FAILURE" : "UNKNOWN_SUCCESS", static_cast<int>(value));
   return XR_SUCCESS;
 }
 
@@ -327,13 +326,11 @@ XrResult XRAPI_CALL StructureTypeToString(XrInstance h, XrStructureType value,
   DRAPE_LOCK;
   if (!lookup<Instance>(h)) return XR_ERROR_HANDLE_INVALID;
   if (!buffer) return XR_ERROR_VALIDATION_FAILURE;
-#define DRAPE_TYPE_CASE(name, val) \
-  case name:                       \
+#define DRAPE_TYPE_CASE(name, val)                                  \
+  case name:                                                        \
     std::snprintf(buffer, XR_MAX_STRUCTURE_NAME_SIZE, "%s", #name); \
     return XR_SUCCESS;
-  switch (value) {
-    XR_LIST_ENUM_XrStructureType(DRAPE_TYPE_CASE) default : break;
-  }
+  switch (value) { XR_LIST_ENUM_XrStructureType(DRAPE_TYPE_CASE) default : break; }
 #undef DRAPE_TYPE_CASE
   std::snprintf(buffer, XR_MAX_STRUCTURE_NAME_SIZE, "XR_UNKNOWN_STRUCTURE_TYPE_%d",
                 static_cast<int>(value));
@@ -571,8 +568,8 @@ XrResult XRAPI_CALL EnumerateReferenceSpaces(XrSession h, uint32_t cap, uint32_t
 bool valid_pose(const XrPosef& p) {
   const XrQuaternionf& q = p.orientation;
   float n = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
-  return std::abs(n - 1.f) < 1e-3f && std::isfinite(p.position.x) &&
-         std::isfinite(p.position.y) && std::isfinite(p.position.z);
+  return std::abs(n - 1.f) < 1e-3f && std::isfinite(p.position.x) && std::isfinite(p.position.y) &&
+         std::isfinite(p.position.z);
 }
 
 XrResult XRAPI_CALL CreateReferenceSpace(XrSession h, const XrReferenceSpaceCreateInfo* info,
@@ -643,7 +640,8 @@ XrResult XRAPI_CALL LocateSpace(XrSpace space, XrSpace base, XrTime time, XrSpac
     return XR_SUCCESS;
   }
   loc->pose = pose_mul(pose_inverse(pb), pa);
-  loc->locationFlags = XR_SPACE_LOCATION_ORIENTATION_VALID_BIT | XR_SPACE_LOCATION_POSITION_VALID_BIT;
+  loc->locationFlags =
+      XR_SPACE_LOCATION_ORIENTATION_VALID_BIT | XR_SPACE_LOCATION_POSITION_VALID_BIT;
   if (ta && tb)
     loc->locationFlags |=
         XR_SPACE_LOCATION_ORIENTATION_TRACKED_BIT | XR_SPACE_LOCATION_POSITION_TRACKED_BIT;
@@ -691,7 +689,8 @@ XrResult XRAPI_CALL LocateViews(XrSession h, const XrViewLocateInfo* info, XrVie
     views[i].fov = {-kHalfFov, kHalfFov, kHalfFov, -kHalfFov};
   }
   state->viewStateFlags = XR_VIEW_STATE_ORIENTATION_VALID_BIT | XR_VIEW_STATE_POSITION_VALID_BIT |
-                          XR_VIEW_STATE_ORIENTATION_TRACKED_BIT | XR_VIEW_STATE_POSITION_TRACKED_BIT;
+                          XR_VIEW_STATE_ORIENTATION_TRACKED_BIT |
+                          XR_VIEW_STATE_POSITION_TRACKED_BIT;
   return XR_SUCCESS;
 }
 
@@ -711,7 +710,8 @@ void fire_scenario_events(Session* s, Instance* inst, int64_t frame) {
     }
   }
   for (const AudioCue& c : inst->scenario.audio)
-    if (c.frame == frame) log("audio cue at frame %lld: %s", static_cast<long long>(frame), c.wav.c_str());
+    if (c.frame == frame)
+      log("audio cue at frame %lld: %s", static_cast<long long>(frame), c.wav.c_str());
 }
 
 XrResult XRAPI_CALL WaitFrame(XrSession h, const XrFrameWaitInfo* info, XrFrameState* state) {
@@ -737,10 +737,9 @@ XrResult XRAPI_CALL WaitFrame(XrSession h, const XrFrameWaitInfo* info, XrFrameS
     s->frame_waited = true;
     state->predictedDisplayTime = s->epoch + i * kFramePeriodNs;
     state->predictedDisplayPeriod = kFramePeriodNs;
-    state->shouldRender = (s->state == XR_SESSION_STATE_VISIBLE ||
-                           s->state == XR_SESSION_STATE_FOCUSED)
-                              ? XR_TRUE
-                              : XR_FALSE;
+    state->shouldRender =
+        (s->state == XR_SESSION_STATE_VISIBLE || s->state == XR_SESSION_STATE_FOCUSED) ? XR_TRUE
+                                                                                       : XR_FALSE;
     if (!inst->fast) sleep_until = s->real_epoch + i * kFramePeriodNs;
   }
   if (sleep_until > 0) {
@@ -841,8 +840,7 @@ XrResult XRAPI_CALL StringToPath(XrInstance h, const char* str, XrPath* out) {
   return XR_SUCCESS;
 }
 
-XrResult XRAPI_CALL PathToString(XrInstance h, XrPath p, uint32_t cap, uint32_t* count,
-                                 char* buf) {
+XrResult XRAPI_CALL PathToString(XrInstance h, XrPath p, uint32_t cap, uint32_t* count, char* buf) {
   DRAPE_LOCK;
   Instance* inst = lookup<Instance>(h);
   if (!inst) return XR_ERROR_HANDLE_INVALID;
@@ -853,7 +851,8 @@ XrResult XRAPI_CALL PathToString(XrInstance h, XrPath p, uint32_t cap, uint32_t*
 XrResult XRAPI_CALL GetInstanceProcAddr(XrInstance instance, const char* name,
                                         PFN_xrVoidFunction* function);
 
-#define DRAPE_ENTRY(fn) {"xr" #fn, reinterpret_cast<void*>(&fn)}
+#define DRAPE_ENTRY(fn) \
+  { "xr" #fn, reinterpret_cast<void*>(&fn) }
 const std::unordered_map<std::string, void*>& core_table() {
   static const std::unordered_map<std::string, void*> t = {
       DRAPE_ENTRY(GetInstanceProcAddr),
@@ -936,10 +935,14 @@ XrResult XRAPI_CALL GetInstanceProcAddr(XrInstance instance, const char* name,
 
 bool init_session_vulkan(Session* s);  // vulkan.cpp
 namespace {
-bool init_session_vulkan_wrapper(Session* s) { return init_session_vulkan(s); }
+bool init_session_vulkan_wrapper(Session* s) {
+  return init_session_vulkan(s);
+}
 }  // namespace
 
-void* GetInstanceProcAddrExported() { return reinterpret_cast<void*>(&GetInstanceProcAddr); }
+void* GetInstanceProcAddrExported() {
+  return reinterpret_cast<void*>(&GetInstanceProcAddr);
+}
 
 bool space_pose_in_stage(Session* s, Space* sp, XrTime t, XrPosef* out, bool* tracked) {
   Instance* inst = instance_of(s);
@@ -987,7 +990,7 @@ xrNegotiateLoaderRuntimeInterface(const drape::mock::XrNegotiateLoaderInfo* load
     return XR_ERROR_INITIALIZATION_FAILED;
   runtimeRequest->runtimeInterfaceVersion = kCurrentLoaderRuntimeVersion;
   runtimeRequest->runtimeApiVersion = XR_CURRENT_API_VERSION;
-  runtimeRequest->getInstanceProcAddr = reinterpret_cast<PFN_xrGetInstanceProcAddr>(
-      drape::mock::GetInstanceProcAddrExported());
+  runtimeRequest->getInstanceProcAddr =
+      reinterpret_cast<PFN_xrGetInstanceProcAddr>(drape::mock::GetInstanceProcAddrExported());
   return XR_SUCCESS;
 }

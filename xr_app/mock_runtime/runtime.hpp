@@ -5,6 +5,7 @@
 
 #define XR_USE_GRAPHICS_API_VULKAN
 #include <vulkan/vulkan.h>
+// (Vulkan first: openxr_platform.h uses its types)
 #include <openxr/openxr.h>
 #include <openxr/openxr_platform.h>
 
@@ -122,8 +123,8 @@ struct Session : Object {
   int64_t frames_begun = 0;
   bool frame_waited = false;  // a waited frame not yet begun
   bool frame_begun = false;
-  XrTime epoch = 0;         // display time of frame 0
-  int64_t real_epoch = 0;   // monotonic ns when frame 0 was handed out (paced mode)
+  XrTime epoch = 0;        // display time of frame 0
+  int64_t real_epoch = 0;  // monotonic ns when frame 0 was handed out (paced mode)
   // actions
   std::vector<uint64_t> attached_sets;
   XrPath profile[2] = {XR_NULL_PATH, XR_NULL_PATH};
@@ -212,7 +213,8 @@ bool space_pose_in_stage(Session* s, Space* sp, XrTime t, XrPosef* out, bool* tr
 void* input_proc(const std::string& name);
 void* vulkan_proc(const std::string& name);
 // Frame readback (vulkan.cpp): writes the left eye of a projection layer to PNG.
-void write_layer_png(Session* s, const XrCompositionLayerProjection* layer, const std::string& path);
+void write_layer_png(Session* s, const XrCompositionLayerProjection* layer,
+                     const std::string& path);
 void update_actions_on_sync(Session* s, Instance* inst);  // input.cpp
 bool action_pose(Session* s, Action* a, XrPath subaction, XrTime t, XrPosef* out, bool* tracked);
 

@@ -13,10 +13,13 @@ namespace drape::mock {
 
 // ---------------------------------------------------------------- pose math
 XrQuaternionf quat_mul(const XrQuaternionf& a, const XrQuaternionf& b) {
-  return {a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y, a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
-          a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w, a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z};
+  return {
+      a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y, a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+      a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w, a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z};
 }
-XrQuaternionf quat_conj(const XrQuaternionf& q) { return {-q.x, -q.y, -q.z, q.w}; }
+XrQuaternionf quat_conj(const XrQuaternionf& q) {
+  return {-q.x, -q.y, -q.z, q.w};
+}
 XrQuaternionf quat_normalize(const XrQuaternionf& q) {
   float n = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
   if (n < 1e-12f) return {0, 0, 0, 1};
@@ -56,7 +59,9 @@ XrPosef pose_inverse(const XrPosef& p) {
   r.position = {-t.x, -t.y, -t.z};
   return r;
 }
-XrPosef pose_identity() { return XrPosef{{0, 0, 0, 1}, {0, 0, 0}}; }
+XrPosef pose_identity() {
+  return XrPosef{{0, 0, 0, 1}, {0, 0, 0}};
+}
 XrPosef pose_lerp(const XrPosef& a, const XrPosef& b, float t) {
   XrPosef r;
   r.orientation = quat_slerp(a.orientation, b.orientation, t);
@@ -71,24 +76,48 @@ namespace {
 // Right hand, palm frame: +x towards the little finger, +y out of the back of the hand,
 // fingers along -z (the XR_EXT_hand_tracking joint convention).
 constexpr float kRightHand[kHandJointCount][3] = {
-    {0, 0, 0},                                                                       // palm
-    {0, 0, 0.045f},                                                                  // wrist
-    {-0.025f, -0.01f, 0.03f},   {-0.045f, -0.015f, 0.005f}, {-0.055f, -0.02f, -0.025f},
-    {-0.06f, -0.022f, -0.045f},                                                      // thumb
-    {-0.02f, 0, 0.035f},        {-0.022f, 0, -0.03f},      {-0.023f, 0, -0.07f},
-    {-0.024f, 0, -0.095f},      {-0.024f, 0, -0.115f},                               // index
-    {0, 0, 0.035f},             {0, 0, -0.035f},           {0, 0, -0.08f},
-    {0, 0, -0.108f},            {0, 0, -0.13f},                                      // middle
-    {0.018f, 0, 0.035f},        {0.02f, 0, -0.03f},        {0.021f, 0, -0.07f},
-    {0.022f, 0, -0.095f},       {0.022f, 0, -0.115f},                                // ring
-    {0.03f, 0, 0.035f},         {0.038f, 0, -0.02f},       {0.04f, 0, -0.05f},
-    {0.041f, 0, -0.068f},       {0.042f, 0, -0.085f},                                // little
+    {0, 0, 0},       // palm
+    {0, 0, 0.045f},  // wrist
+    {-0.025f, -0.01f, 0.03f},
+    {-0.045f, -0.015f, 0.005f},
+    {-0.055f, -0.02f, -0.025f},
+    {-0.06f, -0.022f, -0.045f},  // thumb
+    {-0.02f, 0, 0.035f},
+    {-0.022f, 0, -0.03f},
+    {-0.023f, 0, -0.07f},
+    {-0.024f, 0, -0.095f},
+    {-0.024f, 0, -0.115f},  // index
+    {0, 0, 0.035f},
+    {0, 0, -0.035f},
+    {0, 0, -0.08f},
+    {0, 0, -0.108f},
+    {0, 0, -0.13f},  // middle
+    {0.018f, 0, 0.035f},
+    {0.02f, 0, -0.03f},
+    {0.021f, 0, -0.07f},
+    {0.022f, 0, -0.095f},
+    {0.022f, 0, -0.115f},  // ring
+    {0.03f, 0, 0.035f},
+    {0.038f, 0, -0.02f},
+    {0.04f, 0, -0.05f},
+    {0.041f, 0, -0.068f},
+    {0.042f, 0, -0.085f},  // little
 };
-XrVector3f v3(const float* p) { return {p[0], p[1], p[2]}; }
-XrVector3f add(XrVector3f a, XrVector3f b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-XrVector3f sub(XrVector3f a, XrVector3f b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-XrVector3f mul(XrVector3f a, float s) { return {a.x * s, a.y * s, a.z * s}; }
-float len(XrVector3f a) { return std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z); }
+XrVector3f v3(const float* p) {
+  return {p[0], p[1], p[2]};
+}
+XrVector3f add(XrVector3f a, XrVector3f b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+XrVector3f sub(XrVector3f a, XrVector3f b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+XrVector3f mul(XrVector3f a, float s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+float len(XrVector3f a) {
+  return std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
+}
 }  // namespace
 
 void generate_hand(int hand, const XrPosef& palm, float pinch,
@@ -161,8 +190,8 @@ bool interpolated_input(const std::string& name) {
     std::string x(s);
     return name.size() >= x.size() && name.compare(name.size() - x.size(), x.size(), x) == 0;
   };
-  return ends("/value") || ends("/force") || ends("thumbstick") || ends("trackpad") ||
-         ends("/x") || ends("/y");
+  return ends("/value") || ends("/force") || ends("thumbstick") || ends("trackpad") || ends("/x") ||
+         ends("/y");
 }
 }  // namespace
 
@@ -262,7 +291,8 @@ XrVector3f vec3(const json& j, const std::string& field) {
 }
 
 XrPosef pose(const json& j, const std::string& field) {
-  if (!j.is_object()) throw FieldError(field + ": expected {\"position\": [..], \"orientation\": [..]}");
+  if (!j.is_object())
+    throw FieldError(field + ": expected {\"position\": [..], \"orientation\": [..]}");
   XrPosef p = pose_identity();
   if (!j.contains("position")) throw FieldError(field + ".position: missing");
   p.position = vec3(j["position"], field + ".position");
@@ -301,9 +331,17 @@ int hand_index(const std::string& key, const std::string& field) {
 
 void parse(const json& root, const std::filesystem::path& dir, Scenario* s) {
   if (!root.is_object()) throw FieldError("top level: expected an object");
-  static const char* known[] = {"end_after_frames", "fast", "interaction_profile", "head",
-                                "hands", "controllers", "audio", "events", "write_frames",
-                                "description", "name"};
+  static const char* known[] = {"end_after_frames",
+                                "fast",
+                                "interaction_profile",
+                                "head",
+                                "hands",
+                                "controllers",
+                                "audio",
+                                "events",
+                                "write_frames",
+                                "description",
+                                "name"};
   for (auto it = root.begin(); it != root.end(); ++it) {
     bool ok = false;
     for (const char* k : known) ok = ok || it.key() == k;
@@ -366,7 +404,8 @@ void parse(const json& root, const std::filesystem::path& dir, Scenario* s) {
             }
           }
         } else if (k.tracked) {
-          if (!kj.contains("palm")) throw FieldError(f + ": needs \"palm\" (+ \"pinch\") or \"joints\"");
+          if (!kj.contains("palm"))
+            throw FieldError(f + ": needs \"palm\" (+ \"pinch\") or \"joints\"");
           k.palm = pose(kj["palm"], f + ".palm");
           if (kj.contains("pinch")) {
             k.pinch = num(kj["pinch"], f + ".pinch");

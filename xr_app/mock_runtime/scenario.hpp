@@ -65,7 +65,7 @@ struct ScriptedEvent {
 };
 
 struct Scenario {
-  std::string path;  // the file it came from ("" = built-in default)
+  std::string path;               // the file it came from ("" = built-in default)
   int64_t end_after_frames = -1;  // -1: never
   bool fast = false;
   std::string interaction_profile;  // "" = first suggested in preference order

@@ -146,7 +146,8 @@ XrResult XRAPI_CALL CreateVulkanDeviceKHR(XrInstance h, const XrVulkanDeviceCrea
   auto create = reinterpret_cast<PFN_vkCreateDevice>(
       info->pfnGetInstanceProcAddr(inst->vk_instance, "vkCreateDevice"));
   if (!create) return XR_ERROR_RUNTIME_FAILURE;
-  *vk_result = create(info->vulkanPhysicalDevice, info->vulkanCreateInfo, info->vulkanAllocator, out);
+  *vk_result =
+      create(info->vulkanPhysicalDevice, info->vulkanCreateInfo, info->vulkanAllocator, out);
   return XR_SUCCESS;
 }
 
@@ -171,7 +172,8 @@ bool submit_and_wait(Session* s, VkCommandBuffer cb) {
   VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   si.commandBufferCount = 1;
   si.pCommandBuffers = &cb;
-  bool ok = vkQueueSubmit(q, 1, &si, VK_NULL_HANDLE) == VK_SUCCESS && vkQueueWaitIdle(q) == VK_SUCCESS;
+  bool ok =
+      vkQueueSubmit(q, 1, &si, VK_NULL_HANDLE) == VK_SUCCESS && vkQueueWaitIdle(q) == VK_SUCCESS;
   vkFreeCommandBuffers(s->vk_device, s->cmd_pool, 1, &cb);
   return ok;
 }
@@ -253,9 +255,12 @@ XrResult XRAPI_CALL CreateSwapchain(XrSession h, const XrSwapchainCreateInfo* in
     usage |= VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
   if (info->usageFlags & XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT)
     usage |= VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
-  if (info->usageFlags & XR_SWAPCHAIN_USAGE_UNORDERED_ACCESS_BIT) usage |= VK_IMAGE_USAGE_STORAGE_BIT;
-  if (info->usageFlags & XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT) usage |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-  if (info->usageFlags & XR_SWAPCHAIN_USAGE_TRANSFER_DST_BIT) usage |= VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  if (info->usageFlags & XR_SWAPCHAIN_USAGE_UNORDERED_ACCESS_BIT)
+    usage |= VK_IMAGE_USAGE_STORAGE_BIT;
+  if (info->usageFlags & XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT)
+    usage |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+  if (info->usageFlags & XR_SWAPCHAIN_USAGE_TRANSFER_DST_BIT)
+    usage |= VK_IMAGE_USAGE_TRANSFER_DST_BIT;
   if (info->usageFlags & XR_SWAPCHAIN_USAGE_SAMPLED_BIT) usage |= VK_IMAGE_USAGE_SAMPLED_BIT;
   if (info->usageFlags & XR_SWAPCHAIN_USAGE_INPUT_ATTACHMENT_BIT_MND)
     usage |= VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT;
@@ -369,7 +374,8 @@ XrResult XRAPI_CALL ReleaseSwapchainImage(XrSwapchain h, const XrSwapchainImageR
   DRAPE_LOCK;
   Swapchain* sc = lookup<Swapchain>(h);
   if (!sc) return XR_ERROR_HANDLE_INVALID;
-  if (info && info->type != XR_TYPE_SWAPCHAIN_IMAGE_RELEASE_INFO) return XR_ERROR_VALIDATION_FAILURE;
+  if (info && info->type != XR_TYPE_SWAPCHAIN_IMAGE_RELEASE_INFO)
+    return XR_ERROR_VALIDATION_FAILURE;
   if (sc->acquired.empty() || !sc->waited) return XR_ERROR_CALL_ORDER_INVALID;
   sc->last_released = sc->acquired.front();
   sc->acquired.pop_front();

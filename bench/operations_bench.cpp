@@ -1,0 +1,217 @@
+// Operations benchmark: the time to apply a cut across a 128² cloth (target < 2 ms), and the
+// latency of every operation through the SimThread in lock-step (target: visible in the snapshot
+// after the next tick). Writes out/bench/operations.csv: operation,resolution,ms,latency_ticks.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "sim/cut.hpp"
+#include "sim/operation_controller.hpp"
+#include "sim/sim_thread.hpp"
+#include "sim/solver_vbd.hpp"
+
+using namespace drape::sim;
+
+namespace {
+
+struct Row {
+  std::string op;
+  int res;
+  double ms;
+  int latency;
+};
+
+Cloth panel(int n, double size = 0.5) {
+  PanelSpec spec;
+  spec.width = spec.height = size;
+  spec.nx = spec.ny = n;
+  spec.spacing = size / (n - 1);
+  Cloth c = make_panel(spec, FabricParams{});
+  place_spread(c, Vec3(-size / 2, 1.0, 0), Vec3::UnitX(), Vec3::UnitY());
+  c.relump_masses();
+  return c;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// A hand stroke across the whole cloth at 90 Hz (1 s), with 3 mm tracking noise.
+std::vector<Vec3> stroke_across(double size) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0, 0.003);
+  std::vector<Vec3> s;
+  for (int i = 0; i <= 90; ++i) {
+    const double u = -0.02 + (size + 0.04) * i / 90.0;
+    s.emplace_back(-size / 2 + u + noise(rng), 1.0 + 0.45 * size + 0.1 * u + noise(rng),
+                   0.01 + noise(rng));
+  }
+  return s;
+}
+
+void bench_cut(int n, std::vector<Row>& rows) {
+  const Cloth base = panel(n);
+  const auto stroke = stroke_across(0.5);
+  std::vector<double> t_full, t_split;
+  CutResult last;
+  for (int rep = 0; rep < 15; ++rep) {
+    Cloth c = base;
+    const auto t0 = std::chrono::steady_clock::now();
+    last = cut_along(c, stroke);
+    t_full.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    if (!last.ok) {
+      std::fprintf(stderr, "cut failed: %s\n", last.reason.c_str());
+      return;
+    }
+    Cloth c2 = base;
+    const auto t1 = std::chrono::steady_clock::now();
+    cut_path(c2, last.path);
+    t_split.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count());
+  }
+  rows.push_back({"cut", n, median(t_full), -1});
+  rows.push_back({"cut_split_only", n, median(t_split), -1});
+  std::printf("cut across %d^2 (%d vertices): %zu path vertices, %zu new, %d pieces\n", n,
+              base.num_vertices(), last.path.size(), last.new_vertices.size(),
+              last.components_after);
+}
+
+// Latency of each operation through the sim thread: ticks until the snapshot shows its effect.
+void bench_latency(int n, std::vector<Row>& rows) {
+  World w;
+  w.cloth = panel(n);
+  const int top = (n - 1) * n;
+  w.cloth.state.flags[top] |= kFlagPinned;
+  w.cloth.state.flags[top + n - 1] |= kFlagPinned;
+  w.cloth.relump_masses();
+  Box box;
+  box.centre = Vec3(0, 1.2, 0.25);
+  box.half = Vec3(0.1, 0.1, 0.1);
+  w.scene.boxes.push_back(box);
+  VbdOptions vo;
+  vo.substeps = 2;
+  vo.iterations = 6;
+  w.solver = std::make_unique<VbdSolver>(vo);
+  auto c = std::make_shared<OperationController>();
+  c->install(w);
+  SimThreadOptions o;
+  o.lock_step = true;
+  SimThread sim(std::move(w), o);
+  SnapshotReader reader = sim.make_reader();
+  sim.start();
+  sim.advance(2);
+  auto P = [&](int v) { return reader.latest().positions[v].cast<double>(); };
+  const int mid = (n / 2) * n + n / 2;
+  std::array<HandProxy, 2> hands{};
+  for (int h = 0; h < 2; ++h) {
+    hands[h].id = h;
+    hands[h].tracked = true;
+    hands[h].radius = 0.03;
+  }
+  hands[0].position = P(top);
+  hands[1].position = P(mid);
+  auto set_hands = [&] {
+    auto h = hands;
+    sim.post([c, h](World& world) { c->set_hands(world, h); });
+  };
+  set_hands();
+  sim.advance(1);
+  // Posts `op` and counts ticks until `effect(snapshot)` holds (cap 10).
+  auto measure = [&](const std::string& name, std::function<void(World&)> op,
+                     std::function<bool(const SceneSnapshot&)> effect) {
+    auto ms = std::make_shared<double>(0);
+    sim.post([op, ms](World& world) {
+      const auto t0 = std::chrono::steady_clock::now();
+      op(world);
+      *ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    });
+    int ticks = 0;
+    do {
+      sim.advance(1);
+      ++ticks;
+    } while (!effect(reader.latest()) && ticks < 10);
+    rows.push_back({name, n, *ms, effect(reader.latest()) ? ticks : -1});
+  };
+  auto trig = [c](const char* name, TriggerPhase ph, int hand) {
+    return [c, name, ph, hand](World& world) { c->trigger(world, name, ph, hand); };
+  };
+  measure("pinch", trig("pinch", TriggerPhase::kBegin, 1),
+          [&](const SceneSnapshot& s) { return (s.flags[mid] & kFlagPinched) != 0; });
+  hands[1].position += Vec3(0.03, 0.02, 0.05);
+  {
+    const Vec3 target = hands[1].position;
+    auto h = hands;
+    measure(
+        "pinch_follow", [c, h](World& world) { c->set_hands(world, h); },
+        [&, target](const SceneSnapshot& s) {
+          return (s.positions[mid].cast<double>() - target).norm() < 1e-3;
+        });
+  }
+  measure("release", trig("release", TriggerPhase::kBegin, 0),
+          [&](const SceneSnapshot& s) { return (s.flags[top] & kFlagPinned) == 0; });
+  hands[1].position = Vec3(0.0, 1.2, 0.12);  // 3 cm in front of the box
+  set_hands();
+  sim.advance(3);
+  measure("pin", trig("pin", TriggerPhase::kBegin, 1), [&](const SceneSnapshot& s) {
+    return (s.flags[mid] & kFlagPinned) != 0 && std::abs(s.positions[mid].z() - 0.15f) < 1e-3f;
+  });
+  hands[0].position = P(top + n - 1);
+  hands[1].position = P(top);
+  set_hands();
+  sim.advance(1);
+  measure("move", trig("move", TriggerPhase::kBegin, 0),
+          [&](const SceneSnapshot& s) { return (s.flags[top + n - 1] & kFlagKinematic) != 0; });
+  measure("move_end", trig("move", TriggerPhase::kEnd, 0), [&](const SceneSnapshot& s) {
+    return (s.flags[top + n - 1] & kFlagKinematic) == 0 && (s.flags[top + n - 1] & kFlagPinned);
+  });
+  const size_t nv = reader.latest().positions.size();
+  {
+    std::vector<Vec3> stroke;
+    const int row = n / 4;
+    for (int i = -1; i <= n; ++i) {
+      const int k = std::clamp(i, 0, n - 1);
+      stroke.push_back(P(row * n + k) + Vec3(i < 0 ? -0.01 : i >= n ? 0.01 : 0, 0, 0.002));
+    }
+    measure(
+        "cut", [c, stroke](World& world) { c->cut_stroke(world, 0, stroke); },
+        [&](const SceneSnapshot& s) { return s.positions.size() > nv; });
+  }
+  measure("undo", trig("undo", TriggerPhase::kBegin, 0),
+          [&](const SceneSnapshot& s) { return s.positions.size() == nv; });
+  measure("redo", trig("redo", TriggerPhase::kBegin, 0),
+          [&](const SceneSnapshot& s) { return s.positions.size() > nv; });
+  sim.stop();
+}
+
+}  // namespace
+
+int main() {
+  std::vector<Row> rows;
+  for (int n : {32, 64, 128}) bench_cut(n, rows);
+  bench_latency(64, rows);
+  std::filesystem::create_directories("out/bench");
+  std::ofstream csv("out/bench/operations.csv");
+  csv << "operation,resolution,ms,latency_ticks\n";
+  std::printf("\n%-16s %10s %10s %14s\n", "operation", "resolution", "ms", "latency_ticks");
+  bool ok = true;
+  for (const Row& r : rows) {
+    csv << r.op << ',' << r.res << ',' << r.ms << ',' << r.latency << '\n';
+    std::printf("%-16s %7d^2 %10.3f %14d\n", r.op.c_str(), r.res, r.ms, r.latency);
+    if (r.op == "cut" && r.res == 128 && r.ms >= 2.0) ok = false;
+    if (r.latency > 1) ok = false;
+  }
+  std::printf("\ntargets: cut across 128^2 < 2 ms, every latency <= 1 tick: %s\n",
+              ok ? "met" : "NOT met");
+  std::printf("wrote out/bench/operations.csv\n");
+  return 0;
+}

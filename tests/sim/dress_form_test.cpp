@@ -1,0 +1,255 @@
+// The section model: parametric girths, O(1) collision vs analytic, interpolation, landmarks.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <random>
+#include <set>
+
+#include "sim/dress_form.hpp"
+#include "sim/mesh_io.hpp"
+
+namespace drape::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kN = DressForm::kAngles;
+
+DressForm circle_form(double r, Vec2 c, double y0 = 0.5, double dy = 0.01, int ns = 50) {
+  std::vector<Vec2> centres(ns, c);
+  std::vector<double> radii(static_cast<size_t>(ns) * kN, r);
+  FormLandmarks lm;
+  lm.bottom_y = y0, lm.top_y = y0 + dy * (ns - 1);
+  return DressForm(y0, dy, centres, radii, lm);
+}
+
+TEST(DressForm, ParametricGirthsAllSizes) {
+  for (const char* size : {"7AR", "9AR", "11AR", "13AR"}) {
+    auto m = measurements_for_size(size);
+    ASSERT_TRUE(m.ok()) << m.error();
+    auto f = DressForm::from_measurements(*m);
+    ASSERT_TRUE(f.ok()) << f.error();
+    const auto& lm = f->landmarks();
+    const double gb = f->girth_at(lm.bust_y), gw = f->girth_at(lm.waist_y),
+                 gh = f->girth_at(lm.hip_y);
+    std::printf("%s: bust %.2f (want %.1f) waist %.2f (want %.1f) hip %.2f (want %.1f) mm\n", size,
+                gb * 1e3, m->bust_girth * 1e3, gw * 1e3, m->waist_girth * 1e3, gh * 1e3,
+                m->hip_girth * 1e3);
+    EXPECT_NEAR(gb, m->bust_girth, 0.002);
+    EXPECT_NEAR(gw, m->waist_girth, 0.002);
+    EXPECT_NEAR(gh, m->hip_girth, 0.002);
+    EXPECT_DOUBLE_EQ(lm.bust_y, m->bust_height);
+    EXPECT_DOUBLE_EQ(lm.waist_y, m->waist_height);
+    EXPECT_DOUBLE_EQ(lm.hip_y, m->hip_height);
+    EXPECT_NEAR(f->min_y(), m->bottom_height, 1e-12);
+    EXPECT_NEAR(f->max_y(), m->neck_height, 0.0025);
+  }
+}
+
+TEST(DressForm, ParametricOffGridLandmarksExact) {
+  FormMeasurements m;  // 9AR defaults with heights off the 2.5 mm grid
+  m.bust_height = 1.1517, m.waist_height = 0.9691, m.hip_height = 0.7813;
+  auto f = DressForm::from_measurements(m, 0.0025);
+  ASSERT_TRUE(f.ok()) << f.error();
+  const double eb = f->girth_at(m.bust_height) - m.bust_girth;
+  const double ew = f->girth_at(m.waist_height) - m.waist_girth;
+  const double eh = f->girth_at(m.hip_height) - m.hip_girth;
+  std::printf("off-grid errors: bust %.4f waist %.4f hip %.4f mm\n", eb * 1e3, ew * 1e3, eh * 1e3);
+  EXPECT_LT(std::abs(eb), 1e-4);
+  EXPECT_LT(std::abs(ew), 1e-4);
+  EXPECT_LT(std::abs(eh), 1e-4);
+}
+
+TEST(DressForm, ParametricShapeIsTorsoLike) {
+  auto f = DressForm::from_measurements(FormMeasurements{});
+  ASSERT_TRUE(f.ok()) << f.error();
+  const auto& lm = f->landmarks();
+  auto width_depth = [&](double y) {
+    double xmax = -1, xmin = 1, zmax = -1, zmin = 1;
+    for (int n = 0; n < kN; ++n) {
+      const Vec3 p = f->surface_at(y, DressForm::theta(n));
+      xmax = std::max(xmax, p.x()), xmin = std::min(xmin, p.x());
+      zmax = std::max(zmax, p.z()), zmin = std::min(zmin, p.z());
+    }
+    return std::array<double, 4>{xmax - xmin, zmax - zmin, zmax, zmin};
+  };
+  const auto b = width_depth(lm.bust_y), w = width_depth(lm.waist_y), h = width_depth(lm.hip_y);
+  std::printf("width/depth: bust %.3f waist %.3f hip %.3f; front z bust %.3f waist %.3f; back z "
+              "hip %.3f waist %.3f\n",
+              b[0] / b[1], w[0] / w[1], h[0] / h[1], b[2], w[2], h[3], w[3]);
+  // Non-circular sections near the README's ratios (bust points and seat bumps add a little).
+  EXPECT_NEAR(b[0] / b[1], 1.3, 0.15);
+  EXPECT_NEAR(w[0] / w[1], 1.3, 0.15);
+  EXPECT_NEAR(h[0] / h[1], 1.4, 0.15);
+  EXPECT_GT(b[2], w[2] + 0.02);  // bust protrudes forward of the waist
+  EXPECT_LT(h[3], w[3] - 0.02);  // seat protrudes backward of the waist
+  // Symmetric about the centre front/back plane.
+  EXPECT_NEAR(f->radius_at(lm.bust_y, 0.7), f->radius_at(lm.bust_y, 2 * kPi - 0.7), 1e-9);
+  // Monotone interpolation: between waist and hip the girth stays within [waist, hip].
+  for (double y = lm.hip_y; y <= lm.waist_y; y += 0.005) {
+    const double g = f->girth_at(y);
+    EXPECT_GE(g, 0.64 - 1e-6);
+    EXPECT_LE(g, 0.91 + 1e-6);
+  }
+  // Smooth along the height: no jump between neighbouring sections above 3 mm of girth.
+  for (int j = 0; j + 1 < f->num_sections(); ++j)
+    EXPECT_LT(std::abs(f->girth_at(f->section_y(j + 1)) - f->girth_at(f->section_y(j))), 0.003)
+        << "at section " << j;
+}
+
+TEST(DressForm, GirthOfCircleIsPolygonPerimeter) {
+  const double r = 0.13;
+  DressForm f = circle_form(r, Vec2(0.02, -0.03));
+  const double expect = 2 * kN * r * std::sin(kPi / kN);
+  EXPECT_NEAR(f.girth_at(0.7), expect, 1e-12);
+  EXPECT_NEAR(f.girth_at(0.7), 2 * kPi * r, 2 * kPi * r * 1e-4);
+}
+
+TEST(DressForm, PushOutsideCylinderAnalytic) {
+  const double r = 0.12, off = 0.004;
+  const Vec2 c(0.03, -0.02);
+  DressForm f = circle_form(r, c);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> ang(-10, 10), rad(0.0, 0.2), hy(0.5, 0.99);
+  double max_err = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const double th = ang(rng), d = rad(rng), y = hy(rng);
+    Vec3 p(c.x() + d * std::sin(th), y, c.y() + d * std::cos(th));
+    const Vec3 p0 = p;
+    const double pen = f.push_outside(p, off);
+    if (d < r + off) {
+      ASSERT_GT(pen, 0.0);
+      EXPECT_NEAR(pen, r + off - d, 1e-12);
+      const double nd = std::hypot(p.x() - c.x(), p.z() - c.y());
+      max_err = std::max(max_err, std::abs(nd - (r + off)));
+      EXPECT_DOUBLE_EQ(p.y(), y);
+      if (d > 1e-6) {  // radial: same angle
+        EXPECT_NEAR(std::atan2(p.x() - c.x(), p.z() - c.y()), std::atan2(std::sin(th), std::cos(th)),
+                    1e-9);
+      }
+    } else {
+      EXPECT_EQ(pen, 0.0);
+      EXPECT_EQ(p, p0);
+    }
+  }
+  std::printf("cylinder push_outside: max radial error %.3g m\n", max_err);
+  EXPECT_LT(max_err, 1e-12);
+  // Outside the height range: untouched.
+  Vec3 below(c.x(), 0.49, c.y()), above(c.x(), 1.0, c.y());
+  EXPECT_EQ(f.push_outside(below, off), 0.0);
+  EXPECT_EQ(f.push_outside(above, off), 0.0);
+  EXPECT_EQ(below, Vec3(c.x(), 0.49, c.y()));
+  EXPECT_TRUE(std::isinf(f.signed_distance(below)));
+  EXPECT_NEAR(f.signed_distance(Vec3(c.x() + 0.2, 0.7, c.y())), 0.2 - r, 1e-12);
+  EXPECT_NEAR(f.signed_distance(Vec3(c.x(), 0.7, c.y() + 0.05)), 0.05 - r, 1e-12);
+  // NaN never moves anything.
+  Vec3 bad(std::nan(""), 0.7, 0.0);
+  EXPECT_EQ(f.push_outside(bad, off), 0.0);
+}
+
+TEST(DressForm, BilinearInterpolationExactForBilinearField) {
+  // r(j, n) = a + b j + c n for n in [0, 255]: bilinear interpolation reproduces it exactly
+  // away from the wrap between n = 255 and n = 0.
+  const int ns = 20;
+  const double y0 = 0.6, dy = 0.0025, a = 0.1, b = 0.001, cc = 0.0001;
+  std::vector<Vec2> centres(ns);
+  std::vector<double> radii(static_cast<size_t>(ns) * kN);
+  for (int j = 0; j < ns; ++j) {
+    centres[j] = Vec2(0.001 * j, -0.002 * j);
+    for (int n = 0; n < kN; ++n) radii[static_cast<size_t>(j) * kN + n] = a + b * j + cc * n;
+  }
+  DressForm f(y0, dy, centres, radii, FormLandmarks{});
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> su(0, ns - 1), nu(0, kN - 1);
+  for (int i = 0; i < 500; ++i) {
+    const double s = su(rng), nn = nu(rng);
+    const double y = y0 + s * dy, th = 2 * kPi * nn / kN;
+    EXPECT_NEAR(f.radius_at(y, th), a + b * s + cc * nn, 1e-12);
+    const Vec3 p = f.surface_at(y, th);
+    const Vec2 c = f.centre_at(y);
+    EXPECT_NEAR(c.x(), 0.001 * s, 1e-12);
+    EXPECT_NEAR(c.y(), -0.002 * s, 1e-12);
+    const double r = a + b * s + cc * nn;
+    EXPECT_NEAR(p.x(), c.x() + r * std::sin(th), 1e-12);
+    EXPECT_NEAR(p.z(), c.y() + r * std::cos(th), 1e-12);
+    EXPECT_DOUBLE_EQ(p.y(), y);
+  }
+  // Samples are hit exactly; the angle wraps (theta and theta + 2 pi agree).
+  EXPECT_DOUBLE_EQ(f.radius_at(f.section_y(5), DressForm::theta(17)), f.radius(5, 17));
+  EXPECT_NEAR(f.radius_at(0.61, 1.0), f.radius_at(0.61, 1.0 + 2 * kPi), 1e-12);
+  EXPECT_NEAR(f.radius_at(0.61, -1.0), f.radius_at(0.61, 2 * kPi - 1.0), 1e-12);
+  // Clamped outside the height range.
+  EXPECT_DOUBLE_EQ(f.radius_at(0.0, 0.0), f.radius(0, 0));
+  EXPECT_DOUBLE_EQ(f.radius_at(5.0, 0.0), f.radius(ns - 1, 0));
+  // The frame: theta = 0 is +z (centre front), pi/2 is +x (the form's left).
+  EXPECT_TRUE(DressForm::direction(0).isApprox(Vec3(0, 0, 1)));
+  EXPECT_TRUE(DressForm::direction(kPi / 2).isApprox(Vec3(1, 0, 0)));
+}
+
+TEST(DressForm, PushOutsideParametricAgreesWithSurface) {
+  auto f = DressForm::from_measurements(FormMeasurements{});
+  ASSERT_TRUE(f.ok()) << f.error();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> ang(0, 2 * kPi), fy(0.61, 1.33), fr(0.0, 0.99);
+  int pushed = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const double y = fy(rng), th = ang(rng);
+    const Vec2 c = f->centre_at(y);
+    const double r = f->radius_at(y, th) * fr(rng);
+    Vec3 p(c.x() + r * std::sin(th), y, c.y() + r * std::cos(th));
+    const double pen = f->push_outside(p, 0.002);
+    ASSERT_GT(pen, 0);
+    ++pushed;
+    EXPECT_NEAR(f->signed_distance(p), 0.002, 1e-9);
+  }
+  EXPECT_EQ(pushed, 3000);
+}
+
+TEST(DressForm, LandmarksAndReferenceLines) {
+  auto f = DressForm::from_measurements(FormMeasurements{});
+  ASSERT_TRUE(f.ok());
+  const auto& lm = f->landmarks();
+  EXPECT_EQ(lm.centre_front_theta, 0.0);
+  EXPECT_NEAR(lm.centre_back_theta, kPi, 1e-12);
+  EXPECT_NEAR(lm.left_side_theta, kPi / 2, 1e-12);
+  EXPECT_NEAR(lm.right_side_theta, 3 * kPi / 2, 1e-12);
+  EXPECT_LT(lm.bottom_y, lm.hip_y);
+  EXPECT_LT(lm.hip_y, lm.waist_y);
+  EXPECT_LT(lm.waist_y, lm.bust_y);
+  EXPECT_LT(lm.bust_y, lm.neck_y);
+  // Centre front is the +z side: the surface at theta 0 is in front of the centre.
+  EXPECT_GT(f->surface_at(lm.bust_y, 0).z(), f->centre_at(lm.bust_y).y());
+  EXPECT_GT(f->surface_at(lm.bust_y, kPi / 2).x(), 0.1);
+}
+
+TEST(DressForm, ToMeshClosedAndOutward) {
+  auto f = DressForm::from_measurements(FormMeasurements{}, 0.01);
+  ASSERT_TRUE(f.ok());
+  TriMesh m = f->to_mesh();
+  ASSERT_EQ(m.vertices.size(), static_cast<size_t>(f->num_sections()) * kN + 2);
+  std::map<std::pair<int, int>, int> edges;
+  double vol = 0;
+  for (const auto& t : m.triangles) {
+    for (int e = 0; e < 3; ++e) edges[{t[e], t[(e + 1) % 3]}]++;
+    vol += m.vertices[t[0]].dot(m.vertices[t[1]].cross(m.vertices[t[2]])) / 6.0;
+  }
+  for (const auto& [e, n] : edges) {  // closed and consistently oriented
+    EXPECT_EQ(n, 1);
+    EXPECT_EQ(edges.count({e.second, e.first}), 1u);
+  }
+  // Volume by the sections (sum of polygon areas x spacing) vs the mesh volume.
+  double vsec = 0;
+  for (int j = 0; j < f->num_sections(); ++j) {
+    double area = 0;
+    for (int n = 0; n < kN; ++n)
+      area += 0.5 * f->radius(j, n) * f->radius(j, (n + 1) % kN) * std::sin(2 * kPi / kN);
+    vsec += area * f->section_spacing() * ((j == 0 || j + 1 == f->num_sections()) ? 0.5 : 1.0);
+  }
+  std::printf("form volume: mesh %.5f m^3, sections %.5f m^3\n", vol, vsec);
+  EXPECT_GT(vol, 0);  // outward normals
+  EXPECT_NEAR(vol, vsec, 0.01 * vsec);
+}
+
+}  // namespace
+}  // namespace drape::sim

@@ -1,0 +1,774 @@
+// The drape OpenXR application (see xr_app.hpp).
+#include "xr_app/app/xr_app.hpp"
+
+#include <unistd.h>
+#include <vulkan/vulkan.h>
+// (Vulkan first: openxr_platform.h uses its types)
+#define XR_USE_GRAPHICS_API_VULKAN
+#include <openxr/openxr.h>
+#include <openxr/openxr_platform.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <thread>
+
+#ifdef DRAPE_XR_WITH_RENDER
+#include "render/camera.hpp"
+#include "render/renderer.hpp"
+#include "sim/scenes.hpp"
+#include "sim/sim_thread.hpp"
+#include "sim/solver_factory.hpp"
+#endif
+
+namespace drape::app {
+
+const char* to_string(XrAppState s) {
+  switch (s) {
+    case XrAppState::kNoRuntime:
+      return "no_runtime";
+    case XrAppState::kInstance:
+      return "instance";
+    case XrAppState::kSessionIdle:
+      return "session_idle";
+    case XrAppState::kSessionRunning:
+      return "session_running";
+    case XrAppState::kSessionStopping:
+      return "session_stopping";
+    case XrAppState::kSessionLost:
+      return "session_lost";
+    case XrAppState::kExiting:
+      return "exiting";
+    case XrAppState::kFailed:
+      return "failed";
+  }
+  return "?";
+}
+
+std::string select_runtime() {
+  if (const char* j = std::getenv("XR_RUNTIME_JSON"); j && *j) return j;
+  namespace fs = std::filesystem;
+  std::vector<fs::path> dirs;
+  if (const char* x = std::getenv("XDG_CONFIG_HOME"); x && *x) dirs.emplace_back(x);
+  if (const char* h = std::getenv("HOME"); h && *h) dirs.push_back(fs::path(h) / ".config");
+  if (const char* x = std::getenv("XDG_CONFIG_DIRS"); x && *x) {
+    std::string s = x;
+    size_t p = 0;
+    while (p <= s.size()) {
+      size_t q = s.find(':', p);
+      if (q == std::string::npos) q = s.size();
+      if (q > p) dirs.emplace_back(s.substr(p, q - p));
+      p = q + 1;
+    }
+  }
+  dirs.emplace_back("/etc/xdg");
+  std::error_code ec;
+  for (const auto& d : dirs)
+    if (fs::exists(d / "openxr/1/active_runtime.json", ec)) return "";
+  // No runtime configured: the mock runtime built next to this executable.
+  fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  fs::path mock = exe.parent_path() / "drape_mock_runtime.json";
+  if (!ec && fs::exists(mock, ec)) {
+    setenv("XR_RUNTIME_JSON", mock.c_str(), 1);
+    return mock.string();
+  }
+  return "";
+}
+
+namespace {
+
+const char* const kProfiles[] = {
+    "/interaction_profiles/khr/simple_controller", "/interaction_profiles/oculus/touch_controller",
+    "/interaction_profiles/valve/index_controller", "/interaction_profiles/htc/vive_controller",
+    "/interaction_profiles/microsoft/motion_controller"};
+
+XRAPI_ATTR XrBool32 XRAPI_CALL debug_callback(XrDebugUtilsMessageSeverityFlagsEXT,
+                                              XrDebugUtilsMessageTypeFlagsEXT,
+                                              const XrDebugUtilsMessengerCallbackDataEXT* data,
+                                              void* user) {
+  auto* r = static_cast<XrAppResult*>(user);
+  ++r->validation_messages;
+  if (r->log.size() < 200)
+    r->log.push_back(std::string("validation: ") + (data && data->message ? data->message : ""));
+  return XR_FALSE;
+}
+
+class App {
+ public:
+  App(const XrAppOptions& opt, XrAppResult* res) : opt_(opt), r_(*res) {}
+  ~App() { teardown_all(); }
+
+  void run();
+  XrAppState state() const { return state_; }
+
+ private:
+  bool ok(XrResult x, const char* what) {
+    if (XR_SUCCEEDED(x)) return true;
+    char buf[XR_MAX_RESULT_STRING_SIZE] = "";
+    if (instance_ != XR_NULL_HANDLE) xrResultToString(instance_, x, buf);
+    r_.error = std::string(what) + " failed: " + (buf[0] ? buf : std::to_string(x));
+    note(r_.error);
+    return false;
+  }
+  void note(const std::string& s) {
+    r_.log.push_back(s);
+    if (opt_.verbose) std::fprintf(stderr, "[drape xr] %s\n", s.c_str());
+  }
+  void set_state(XrAppState s) {
+    if (state_ == s) return;
+    note(std::string("state ") + to_string(state_) + " -> " + to_string(s));
+    state_ = s;
+  }
+  template <class F>
+  F fn(const char* name) {
+    PFN_xrVoidFunction f = nullptr;
+    if (XR_FAILED(xrGetInstanceProcAddr(instance_, name, &f))) return nullptr;
+    return reinterpret_cast<F>(f);
+  }
+  XrPath path(const char* s) {
+    XrPath p = XR_NULL_PATH;
+    xrStringToPath(instance_, s, &p);
+    return p;
+  }
+
+  bool create_instance();
+  bool create_vulkan();
+  bool create_session();
+  void create_actions();
+  void destroy_session();
+  void teardown_all();
+  bool handle_events();
+  bool frame();
+
+  XrAppOptions opt_;
+  XrAppResult& r_;
+  XrAppState state_ = XrAppState::kNoRuntime;
+  XrInstance instance_ = XR_NULL_HANDLE;
+  XrSystemId system_ = XR_NULL_SYSTEM_ID;
+  XrDebugUtilsMessengerEXT messenger_ = XR_NULL_HANDLE;
+  bool has_hands_ext_ = false, has_debug_ext_ = false;
+  // Vulkan (created through the runtime)
+  VkInstance vk_instance_ = VK_NULL_HANDLE;
+  VkPhysicalDevice vk_physical_ = VK_NULL_HANDLE;
+  VkDevice vk_device_ = VK_NULL_HANDLE;
+  uint32_t queue_family_ = 0;
+  // session
+  XrSession session_ = XR_NULL_HANDLE;
+  XrSessionState xr_state_ = XR_SESSION_STATE_UNKNOWN;
+  bool running_ = false;
+  bool exit_requested_ = false;
+  XrSpace space_ = XR_NULL_HANDLE;
+  XrActionSet action_set_ = XR_NULL_HANDLE;
+  XrAction pinch_ = XR_NULL_HANDLE, grab_ = XR_NULL_HANDLE, pose_ = XR_NULL_HANDLE,
+           menu_ = XR_NULL_HANDLE, haptic_ = XR_NULL_HANDLE;
+  XrPath hand_paths_[2] = {XR_NULL_PATH, XR_NULL_PATH};
+  XrSpace hand_spaces_[2] = {XR_NULL_HANDLE, XR_NULL_HANDLE};
+  XrHandTrackerEXT trackers_[2] = {XR_NULL_HANDLE, XR_NULL_HANDLE};
+  PFN_xrLocateHandJointsEXT locate_joints_ = nullptr;
+  struct Eye {
+    XrSwapchain chain = XR_NULL_HANDLE;
+    uint32_t width = 0, height = 0;
+    std::vector<XrSwapchainImageVulkan2KHR> images;
+  } eyes_[2];
+  int64_t format_ = VK_FORMAT_R8G8B8A8_SRGB;
+#ifdef DRAPE_XR_WITH_RENDER
+  std::unique_ptr<render::Renderer> renderer_;
+  std::unique_ptr<sim::SimThread> sim_;
+  sim::SnapshotReader reader_;
+#endif
+};
+
+bool App::create_instance() {
+  uint32_t n = 0;
+  XrResult x = xrEnumerateInstanceExtensionProperties(nullptr, 0, &n, nullptr);
+  if (XR_FAILED(x)) {
+    r_.error = "no OpenXR runtime (xrEnumerateInstanceExtensionProperties: " + std::to_string(x) +
+               "); set XR_RUNTIME_JSON or install a runtime (docs/xr.md)";
+    note(r_.error);
+    set_state(XrAppState::kNoRuntime);
+    return false;
+  }
+  std::vector<XrExtensionProperties> props(n, {XR_TYPE_EXTENSION_PROPERTIES});
+  xrEnumerateInstanceExtensionProperties(nullptr, n, &n, props.data());
+  bool has_vk2 = false;
+  for (const auto& p : props) {
+    has_vk2 = has_vk2 || !std::strcmp(p.extensionName, XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME);
+    has_hands_ext_ =
+        has_hands_ext_ || !std::strcmp(p.extensionName, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
+    has_debug_ext_ =
+        has_debug_ext_ || !std::strcmp(p.extensionName, XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  }
+  // Extensions of explicitly enabled API layers (the core validation layer's debug utils).
+  if (const char* layers = std::getenv("XR_ENABLE_API_LAYERS"); layers && !has_debug_ext_) {
+    std::string all = layers;
+    size_t p = 0;
+    while (p <= all.size()) {
+      size_t q = all.find_first_of(":;", p);
+      if (q == std::string::npos) q = all.size();
+      std::string layer = all.substr(p, q - p);
+      p = q + 1;
+      if (layer.empty()) continue;
+      uint32_t ln = 0;
+      if (XR_FAILED(xrEnumerateInstanceExtensionProperties(layer.c_str(), 0, &ln, nullptr)))
+        continue;
+      std::vector<XrExtensionProperties> lp(ln, {XR_TYPE_EXTENSION_PROPERTIES});
+      xrEnumerateInstanceExtensionProperties(layer.c_str(), ln, &ln, lp.data());
+      for (const auto& e : lp)
+        has_debug_ext_ =
+            has_debug_ext_ || !std::strcmp(e.extensionName, XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    }
+  }
+  if (!has_vk2) {
+    r_.error = "the OpenXR runtime does not offer XR_KHR_vulkan_enable2";
+    set_state(XrAppState::kFailed);
+    return false;
+  }
+  std::vector<const char*> exts = {XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME};
+  if (has_hands_ext_) exts.push_back(XR_EXT_HAND_TRACKING_EXTENSION_NAME);
+  if (has_debug_ext_) exts.push_back(XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
+  std::snprintf(ci.applicationInfo.applicationName, XR_MAX_APPLICATION_NAME_SIZE, "drape");
+  ci.applicationInfo.applicationVersion = 1;
+  std::snprintf(ci.applicationInfo.engineName, XR_MAX_ENGINE_NAME_SIZE, "drape");
+  ci.applicationInfo.apiVersion = XR_MAKE_VERSION(1, 0, 0);
+  ci.enabledExtensionCount = static_cast<uint32_t>(exts.size());
+  ci.enabledExtensionNames = exts.data();
+  x = xrCreateInstance(&ci, &instance_);
+  if (XR_FAILED(x)) {
+    r_.error = "xrCreateInstance failed (" + std::to_string(x) + ")";
+    note(r_.error);
+    set_state(x == XR_ERROR_RUNTIME_UNAVAILABLE ? XrAppState::kNoRuntime : XrAppState::kFailed);
+    return false;
+  }
+  if (has_debug_ext_) {
+    auto create = fn<PFN_xrCreateDebugUtilsMessengerEXT>("xrCreateDebugUtilsMessengerEXT");
+    XrDebugUtilsMessengerCreateInfoEXT mi{XR_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    mi.messageSeverities = XR_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                           XR_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mi.messageTypes = XR_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                      XR_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                      XR_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT |
+                      XR_DEBUG_UTILS_MESSAGE_TYPE_CONFORMANCE_BIT_EXT;
+    mi.userCallback = &debug_callback;
+    mi.userData = &r_;
+    if (create) create(instance_, &mi, &messenger_);
+  }
+  XrInstanceProperties ip{XR_TYPE_INSTANCE_PROPERTIES};
+  if (XR_SUCCEEDED(xrGetInstanceProperties(instance_, &ip))) r_.runtime_name = ip.runtimeName;
+  note("runtime: " + r_.runtime_name);
+  XrSystemGetInfo gi{XR_TYPE_SYSTEM_GET_INFO};
+  gi.formFactor = XR_FORM_FACTOR_HEAD_MOUNTED_DISPLAY;
+  for (int attempt = 0;; ++attempt) {
+    x = xrGetSystem(instance_, &gi, &system_);
+    if (x != XR_ERROR_FORM_FACTOR_UNAVAILABLE || attempt >= 20) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));  // headset not yet plugged in
+  }
+  if (!ok(x, "xrGetSystem")) return false;
+  if (has_hands_ext_) {
+    XrSystemHandTrackingPropertiesEXT ht{XR_TYPE_SYSTEM_HAND_TRACKING_PROPERTIES_EXT};
+    XrSystemProperties sp{XR_TYPE_SYSTEM_PROPERTIES, &ht};
+    if (XR_SUCCEEDED(xrGetSystemProperties(instance_, system_, &sp)))
+      r_.hand_tracking = ht.supportsHandTracking == XR_TRUE;
+  }
+  set_state(XrAppState::kInstance);
+  return true;
+}
+
+bool App::create_vulkan() {
+  auto reqs = fn<PFN_xrGetVulkanGraphicsRequirements2KHR>("xrGetVulkanGraphicsRequirements2KHR");
+  auto mk_inst = fn<PFN_xrCreateVulkanInstanceKHR>("xrCreateVulkanInstanceKHR");
+  auto get_dev = fn<PFN_xrGetVulkanGraphicsDevice2KHR>("xrGetVulkanGraphicsDevice2KHR");
+  auto mk_dev = fn<PFN_xrCreateVulkanDeviceKHR>("xrCreateVulkanDeviceKHR");
+  if (!reqs || !mk_inst || !get_dev || !mk_dev) {
+    r_.error = "XR_KHR_vulkan_enable2 functions missing";
+    return false;
+  }
+  XrGraphicsRequirementsVulkan2KHR rq{XR_TYPE_GRAPHICS_REQUIREMENTS_VULKAN2_KHR};
+  if (!ok(reqs(instance_, system_, &rq), "xrGetVulkanGraphicsRequirements2KHR")) return false;
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "drape";
+  app.apiVersion = VK_API_VERSION_1_1;
+  VkInstanceCreateInfo vci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  vci.pApplicationInfo = &app;
+  XrVulkanInstanceCreateInfoKHR xi{XR_TYPE_VULKAN_INSTANCE_CREATE_INFO_KHR};
+  xi.systemId = system_;
+  xi.pfnGetInstanceProcAddr = &vkGetInstanceProcAddr;
+  xi.vulkanCreateInfo = &vci;
+  VkResult vr = VK_SUCCESS;
+  if (!ok(mk_inst(instance_, &xi, &vk_instance_, &vr), "xrCreateVulkanInstanceKHR")) return false;
+  if (vr != VK_SUCCESS) {
+    r_.error = "vkCreateInstance failed: " + std::to_string(vr);
+    return false;
+  }
+  XrVulkanGraphicsDeviceGetInfoKHR gi{XR_TYPE_VULKAN_GRAPHICS_DEVICE_GET_INFO_KHR};
+  gi.systemId = system_;
+  gi.vulkanInstance = vk_instance_;
+  if (!ok(get_dev(instance_, &gi, &vk_physical_), "xrGetVulkanGraphicsDevice2KHR")) return false;
+  uint32_t nq = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(vk_physical_, &nq, nullptr);
+  std::vector<VkQueueFamilyProperties> qf(nq);
+  vkGetPhysicalDeviceQueueFamilyProperties(vk_physical_, &nq, qf.data());
+  queue_family_ = 0;
+  while (queue_family_ < nq && !(qf[queue_family_].queueFlags & VK_QUEUE_GRAPHICS_BIT))
+    ++queue_family_;
+  if (queue_family_ == nq) {
+    r_.error = "no graphics queue";
+    return false;
+  }
+  float prio = 1;
+  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  qci.queueFamilyIndex = queue_family_;
+  qci.queueCount = 1;
+  qci.pQueuePriorities = &prio;
+  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  dci.queueCreateInfoCount = 1;
+  dci.pQueueCreateInfos = &qci;
+  XrVulkanDeviceCreateInfoKHR xd{XR_TYPE_VULKAN_DEVICE_CREATE_INFO_KHR};
+  xd.systemId = system_;
+  xd.pfnGetInstanceProcAddr = &vkGetInstanceProcAddr;
+  xd.vulkanPhysicalDevice = vk_physical_;
+  xd.vulkanCreateInfo = &dci;
+  if (!ok(mk_dev(instance_, &xd, &vk_device_, &vr), "xrCreateVulkanDeviceKHR")) return false;
+  if (vr != VK_SUCCESS) {
+    r_.error = "vkCreateDevice failed: " + std::to_string(vr);
+    return false;
+  }
+#ifdef DRAPE_XR_WITH_RENDER
+  if (opt_.render) {
+    render::ExternalDevice ed;
+    ed.instance = vk_instance_;
+    ed.physical_device = vk_physical_;
+    ed.device = vk_device_;
+    ed.queue_family = queue_family_;
+    auto rr = render::Renderer::create_on(ed);
+    if (!rr) {
+      r_.error = "renderer: " + rr.error();
+      return false;
+    }
+    renderer_ = std::move(rr.value());
+    auto scene = sim::make_form_drape(opt_.cloth_res);
+    auto solver = sim::make_solver("vbd");
+    if (!solver) {
+      r_.error = "solver: " + solver.error();
+      return false;
+    }
+    sim::World w;
+    w.cloth = std::move(scene.cloth);
+    w.scene = std::move(scene.objects);
+    w.solver = std::move(solver.value());
+    sim_ = std::make_unique<sim::SimThread>(std::move(w));
+    reader_ = sim_->make_reader();
+    sim_->start();
+  }
+#endif
+  return true;
+}
+
+void App::create_actions() {
+  XrActionSetCreateInfo si{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::snprintf(si.actionSetName, XR_MAX_ACTION_SET_NAME_SIZE, "drape");
+  std::snprintf(si.localizedActionSetName, XR_MAX_LOCALIZED_ACTION_SET_NAME_SIZE, "Drape");
+  if (!ok(xrCreateActionSet(instance_, &si, &action_set_), "xrCreateActionSet")) return;
+  hand_paths_[0] = path("/user/hand/left");
+  hand_paths_[1] = path("/user/hand/right");
+  auto make = [&](const char* name, const char* loc, XrActionType t) {
+    XrActionCreateInfo ai{XR_TYPE_ACTION_CREATE_INFO};
+    std::snprintf(ai.actionName, XR_MAX_ACTION_NAME_SIZE, "%s", name);
+    std::snprintf(ai.localizedActionName, XR_MAX_LOCALIZED_ACTION_NAME_SIZE, "%s", loc);
+    ai.actionType = t;
+    ai.countSubactionPaths = 2;
+    ai.subactionPaths = hand_paths_;
+    XrAction a = XR_NULL_HANDLE;
+    ok(xrCreateAction(action_set_, &ai, &a), name);
+    return a;
+  };
+  pinch_ = make("pinch", "Pinch", XR_ACTION_TYPE_FLOAT_INPUT);
+  grab_ = make("grab", "Grab", XR_ACTION_TYPE_BOOLEAN_INPUT);
+  pose_ = make("hand_pose", "Hand pose", XR_ACTION_TYPE_POSE_INPUT);
+  menu_ = make("menu", "Menu", XR_ACTION_TYPE_BOOLEAN_INPUT);
+  haptic_ = make("haptic", "Haptic", XR_ACTION_TYPE_VIBRATION_OUTPUT);
+  for (const char* prof : kProfiles) {
+    std::string p = prof;
+    std::vector<XrActionSuggestedBinding> b;
+    for (const char* side : {"left", "right"}) {
+      std::string h = std::string("/user/hand/") + side;
+      bool simple = p.find("simple") != std::string::npos;
+      bool oculus = p.find("oculus") != std::string::npos;
+      bool index = p.find("index") != std::string::npos;
+      b.push_back(
+          {pinch_, path((h + (simple ? "/input/select/click" : "/input/trigger/value")).c_str())});
+      if (!simple)
+        b.push_back(
+            {grab_, path((h + (oculus || index ? "/input/squeeze/value" : "/input/squeeze/click"))
+                             .c_str())});
+      b.push_back({pose_, path((h + "/input/grip/pose").c_str())});
+      if (!index && !(oculus && std::string(side) == "right"))
+        b.push_back({menu_, path((h + "/input/menu/click").c_str())});
+      b.push_back({haptic_, path((h + "/output/haptic").c_str())});
+    }
+    XrInteractionProfileSuggestedBinding sb{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+    sb.interactionProfile = path(prof);
+    sb.countSuggestedBindings = static_cast<uint32_t>(b.size());
+    sb.suggestedBindings = b.data();
+    ok(xrSuggestInteractionProfileBindings(instance_, &sb), prof);
+  }
+}
+
+bool App::create_session() {
+  XrGraphicsBindingVulkan2KHR gb{XR_TYPE_GRAPHICS_BINDING_VULKAN2_KHR};
+  gb.instance = vk_instance_;
+  gb.physicalDevice = vk_physical_;
+  gb.device = vk_device_;
+  gb.queueFamilyIndex = queue_family_;
+  XrSessionCreateInfo ci{XR_TYPE_SESSION_CREATE_INFO, &gb};
+  ci.systemId = system_;
+  if (!ok(xrCreateSession(instance_, &ci, &session_), "xrCreateSession")) return false;
+  ++r_.sessions;
+  xr_state_ = XR_SESSION_STATE_UNKNOWN;
+  set_state(XrAppState::kSessionIdle);
+  // STAGE (floor at y = 0) when offered, LOCAL otherwise.
+  uint32_t n = 0;
+  xrEnumerateReferenceSpaces(session_, 0, &n, nullptr);
+  std::vector<XrReferenceSpaceType> types(n);
+  xrEnumerateReferenceSpaces(session_, n, &n, types.data());
+  bool stage = false;
+  for (auto t : types) stage = stage || t == XR_REFERENCE_SPACE_TYPE_STAGE;
+  XrReferenceSpaceCreateInfo rs{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
+  rs.referenceSpaceType = stage ? XR_REFERENCE_SPACE_TYPE_STAGE : XR_REFERENCE_SPACE_TYPE_LOCAL;
+  rs.poseInReferenceSpace.orientation.w = 1;
+  if (!stage) rs.poseInReferenceSpace.position.y = -1.6f;  // LOCAL: put the floor below the head
+  if (!ok(xrCreateReferenceSpace(session_, &rs, &space_), "xrCreateReferenceSpace")) return false;
+  note(stage ? "space: STAGE" : "space: LOCAL (no STAGE)");
+  if (action_set_ == XR_NULL_HANDLE) create_actions();
+  XrSessionActionSetsAttachInfo at{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+  at.countActionSets = 1;
+  at.actionSets = &action_set_;
+  ok(xrAttachSessionActionSets(session_, &at), "xrAttachSessionActionSets");
+  for (int h = 0; h < 2; ++h) {
+    XrActionSpaceCreateInfo as{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+    as.action = pose_;
+    as.subactionPath = hand_paths_[h];
+    as.poseInActionSpace.orientation.w = 1;
+    ok(xrCreateActionSpace(session_, &as, &hand_spaces_[h]), "xrCreateActionSpace");
+  }
+  if (r_.hand_tracking) {
+    auto create = fn<PFN_xrCreateHandTrackerEXT>("xrCreateHandTrackerEXT");
+    locate_joints_ = fn<PFN_xrLocateHandJointsEXT>("xrLocateHandJointsEXT");
+    for (int h = 0; h < 2 && create; ++h) {
+      XrHandTrackerCreateInfoEXT hc{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
+      hc.hand = h == 0 ? XR_HAND_LEFT_EXT : XR_HAND_RIGHT_EXT;
+      hc.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
+      ok(create(session_, &hc, &trackers_[h]), "xrCreateHandTrackerEXT");
+    }
+  }
+  // Swapchains: one per eye, sRGB colour.
+  uint32_t nf = 0;
+  xrEnumerateSwapchainFormats(session_, 0, &nf, nullptr);
+  std::vector<int64_t> formats(nf);
+  xrEnumerateSwapchainFormats(session_, nf, &nf, formats.data());
+  format_ = formats.empty() ? VK_FORMAT_R8G8B8A8_SRGB : formats[0];
+  for (int64_t want : {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_B8G8R8A8_SRGB}) {
+    bool found = false;
+    for (int64_t f : formats) found = found || f == want;
+    if (found) {
+      format_ = want;
+      break;
+    }
+  }
+  uint32_t nv = 0;
+  xrEnumerateViewConfigurationViews(instance_, system_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO,
+                                    0, &nv, nullptr);
+  std::vector<XrViewConfigurationView> vcv(nv, {XR_TYPE_VIEW_CONFIGURATION_VIEW});
+  xrEnumerateViewConfigurationViews(instance_, system_, XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO,
+                                    nv, &nv, vcv.data());
+  if (nv < 2) {
+    r_.error = "the system has no stereo view configuration";
+    return false;
+  }
+  for (int e = 0; e < 2; ++e) {
+    XrSwapchainCreateInfo sc{XR_TYPE_SWAPCHAIN_CREATE_INFO};
+    sc.usageFlags = XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_SAMPLED_BIT;
+    sc.format = format_;
+    sc.sampleCount = 1;
+    sc.width =
+        opt_.eye_size > 0 ? static_cast<uint32_t>(opt_.eye_size) : vcv[e].recommendedImageRectWidth;
+    sc.height = opt_.eye_size > 0 ? static_cast<uint32_t>(opt_.eye_size)
+                                  : vcv[e].recommendedImageRectHeight;
+    sc.faceCount = sc.arraySize = sc.mipCount = 1;
+    if (!ok(xrCreateSwapchain(session_, &sc, &eyes_[e].chain), "xrCreateSwapchain")) return false;
+    eyes_[e].width = sc.width;
+    eyes_[e].height = sc.height;
+    uint32_t ni = 0;
+    xrEnumerateSwapchainImages(eyes_[e].chain, 0, &ni, nullptr);
+    eyes_[e].images.assign(ni, {XR_TYPE_SWAPCHAIN_IMAGE_VULKAN2_KHR});
+    if (!ok(xrEnumerateSwapchainImages(
+                eyes_[e].chain, ni, &ni,
+                reinterpret_cast<XrSwapchainImageBaseHeader*>(eyes_[e].images.data())),
+            "xrEnumerateSwapchainImages"))
+      return false;
+  }
+  return true;
+}
+
+void App::destroy_session() {
+#ifdef DRAPE_XR_WITH_RENDER
+  if (renderer_) renderer_->forget_targets();
+#endif
+  if (vk_device_ != VK_NULL_HANDLE) vkDeviceWaitIdle(vk_device_);
+  for (auto& e : eyes_) {
+    if (e.chain != XR_NULL_HANDLE) xrDestroySwapchain(e.chain);
+    e = Eye{};
+  }
+  auto destroy_tracker = trackers_[0] || trackers_[1]
+                             ? fn<PFN_xrDestroyHandTrackerEXT>("xrDestroyHandTrackerEXT")
+                             : nullptr;
+  for (int h = 0; h < 2; ++h) {
+    if (trackers_[h] && destroy_tracker) destroy_tracker(trackers_[h]);
+    trackers_[h] = XR_NULL_HANDLE;
+    if (hand_spaces_[h]) xrDestroySpace(hand_spaces_[h]);
+    hand_spaces_[h] = XR_NULL_HANDLE;
+  }
+  if (space_) xrDestroySpace(space_);
+  space_ = XR_NULL_HANDLE;
+  if (session_) xrDestroySession(session_);
+  session_ = XR_NULL_HANDLE;
+  running_ = false;
+}
+
+void App::teardown_all() {
+  destroy_session();
+#ifdef DRAPE_XR_WITH_RENDER
+  if (sim_) sim_->stop();
+  reader_ = sim::SnapshotReader();
+  sim_.reset();
+  renderer_.reset();
+#endif
+  if (vk_device_) vkDestroyDevice(vk_device_, nullptr);
+  vk_device_ = VK_NULL_HANDLE;
+  if (vk_instance_) vkDestroyInstance(vk_instance_, nullptr);
+  vk_instance_ = VK_NULL_HANDLE;
+  if (action_set_) xrDestroyActionSet(action_set_);
+  action_set_ = XR_NULL_HANDLE;
+  if (messenger_) {
+    auto destroy = fn<PFN_xrDestroyDebugUtilsMessengerEXT>("xrDestroyDebugUtilsMessengerEXT");
+    if (destroy) destroy(messenger_);
+    messenger_ = XR_NULL_HANDLE;
+  }
+  if (instance_) xrDestroyInstance(instance_);
+  instance_ = XR_NULL_HANDLE;
+}
+
+// Returns false when the app should leave the loop.
+bool App::handle_events() {
+  XrEventDataBuffer ev{XR_TYPE_EVENT_DATA_BUFFER};
+  while (xrPollEvent(instance_, &ev) == XR_SUCCESS) {
+    if (ev.type == XR_TYPE_EVENT_DATA_SESSION_STATE_CHANGED) {
+      auto* sc = reinterpret_cast<XrEventDataSessionStateChanged*>(&ev);
+      xr_state_ = sc->state;
+      switch (sc->state) {
+        case XR_SESSION_STATE_READY: {
+          XrSessionBeginInfo bi{XR_TYPE_SESSION_BEGIN_INFO};
+          bi.primaryViewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+          if (ok(xrBeginSession(session_, &bi), "xrBeginSession")) {
+            running_ = true;
+            set_state(XrAppState::kSessionRunning);
+          }
+          break;
+        }
+        case XR_SESSION_STATE_STOPPING:
+          set_state(XrAppState::kSessionStopping);
+          ok(xrEndSession(session_), "xrEndSession");
+          running_ = false;
+          break;
+        case XR_SESSION_STATE_EXITING:
+          set_state(XrAppState::kExiting);
+          return false;
+        case XR_SESSION_STATE_LOSS_PENDING:
+          ++r_.sessions_lost;
+          set_state(XrAppState::kSessionLost);
+          destroy_session();
+          if (r_.sessions_lost > opt_.max_session_restarts) {
+            r_.error = "session lost too often";
+            return false;
+          }
+          if (!create_session()) return false;
+          break;
+        default:
+          break;
+      }
+    } else if (ev.type == XR_TYPE_EVENT_DATA_INSTANCE_LOSS_PENDING) {
+      r_.error = "instance loss pending";
+      set_state(XrAppState::kFailed);
+      return false;
+    }
+    ev = {XR_TYPE_EVENT_DATA_BUFFER};
+  }
+  return true;
+}
+
+bool App::frame() {
+  XrFrameState fs{XR_TYPE_FRAME_STATE};
+  XrResult x = xrWaitFrame(session_, nullptr, &fs);
+  if (x == XR_ERROR_SESSION_LOST) return true;  // LOSS_PENDING arrives through the event queue
+  if (!ok(x, "xrWaitFrame")) return false;
+  x = xrBeginFrame(session_, nullptr);
+  if (x == XR_ERROR_SESSION_LOST) return true;
+  if (!ok(x, "xrBeginFrame")) return false;
+
+  // Input: actions and hands.
+  XrActiveActionSet active{action_set_, XR_NULL_PATH};
+  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
+  sync.countActiveActionSets = 1;
+  sync.activeActionSets = &active;
+  if (XR_SUCCEEDED(xrSyncActions(session_, &sync))) {
+    for (int h = 0; h < 2; ++h) {
+      XrActionStateGetInfo gi{XR_TYPE_ACTION_STATE_GET_INFO};
+      gi.action = pinch_;
+      gi.subactionPath = hand_paths_[h];
+      XrActionStateFloat f{XR_TYPE_ACTION_STATE_FLOAT};
+      if (XR_SUCCEEDED(xrGetActionStateFloat(session_, &gi, &f)) && f.isActive)
+        r_.max_trigger = std::max(r_.max_trigger, f.currentState);
+    }
+  }
+  if (locate_joints_ && trackers_[1]) {
+    XrHandJointLocationEXT j[XR_HAND_JOINT_COUNT_EXT];
+    XrHandJointLocationsEXT loc{XR_TYPE_HAND_JOINT_LOCATIONS_EXT};
+    loc.jointCount = XR_HAND_JOINT_COUNT_EXT;
+    loc.jointLocations = j;
+    XrHandJointsLocateInfoEXT li{XR_TYPE_HAND_JOINTS_LOCATE_INFO_EXT};
+    li.baseSpace = space_;
+    li.time = fs.predictedDisplayTime;
+    if (XR_SUCCEEDED(locate_joints_(trackers_[1], &li, &loc)) && loc.isActive) {
+      ++r_.hand_frames_tracked;
+      auto& a = j[XR_HAND_JOINT_THUMB_TIP_EXT].pose.position;
+      auto& b = j[XR_HAND_JOINT_INDEX_TIP_EXT].pose.position;
+      float d = std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) +
+                          (a.z - b.z) * (a.z - b.z));
+      r_.min_pinch_gap_m = std::min(r_.min_pinch_gap_m, d);
+    }
+  }
+
+  XrCompositionLayerProjectionView pv[2] = {{XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW},
+                                            {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW}};
+  XrCompositionLayerProjection layer{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
+  const XrCompositionLayerBaseHeader* layers[1] = {
+      reinterpret_cast<XrCompositionLayerBaseHeader*>(&layer)};
+  uint32_t layer_count = 0;
+  if (fs.shouldRender) {
+    XrView views[2] = {{XR_TYPE_VIEW}, {XR_TYPE_VIEW}};
+    XrViewState vs{XR_TYPE_VIEW_STATE};
+    XrViewLocateInfo vl{XR_TYPE_VIEW_LOCATE_INFO};
+    vl.viewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+    vl.displayTime = fs.predictedDisplayTime;
+    vl.space = space_;
+    uint32_t nv = 0;
+    x = xrLocateViews(session_, &vl, &vs, 2, &nv, views);
+    bool located = XR_SUCCEEDED(x) && (vs.viewStateFlags & XR_VIEW_STATE_ORIENTATION_VALID_BIT) &&
+                   (vs.viewStateFlags & XR_VIEW_STATE_POSITION_VALID_BIT);
+    if (located) {
+#ifdef DRAPE_XR_WITH_RENDER
+      const sim::SceneSnapshot* snap = renderer_ ? &reader_.latest() : nullptr;
+#endif
+      for (int e = 0; e < 2; ++e) {
+        uint32_t idx = 0;
+        if (!ok(xrAcquireSwapchainImage(eyes_[e].chain, nullptr, &idx), "xrAcquireSwapchainImage"))
+          return false;
+        XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
+        wi.timeout = XR_INFINITE_DURATION;
+        if (!ok(xrWaitSwapchainImage(eyes_[e].chain, &wi), "xrWaitSwapchainImage")) return false;
+#ifdef DRAPE_XR_WITH_RENDER
+        if (renderer_ && snap) {
+          render::Pose pose;
+          const XrPosef& p = views[e].pose;
+          pose.orientation = Eigen::Quaternionf(p.orientation.w, p.orientation.x, p.orientation.y,
+                                                p.orientation.z);
+          pose.position = {p.position.x, p.position.y, p.position.z};
+          render::Fov fov{views[e].fov.angleLeft, views[e].fov.angleRight, views[e].fov.angleUp,
+                          views[e].fov.angleDown};
+          render::ColorTarget t;
+          t.image = eyes_[e].images[idx].image;
+          t.format = static_cast<VkFormat>(format_);
+          t.width = eyes_[e].width;
+          t.height = eyes_[e].height;
+          auto st = renderer_->render(*snap, render::make_view(pose, fov), t);
+          if (!st) note("render: " + st.error);
+        }
+#endif
+        if (!ok(xrReleaseSwapchainImage(eyes_[e].chain, nullptr), "xrReleaseSwapchainImage"))
+          return false;
+        pv[e].pose = views[e].pose;
+        pv[e].fov = views[e].fov;
+        pv[e].subImage.swapchain = eyes_[e].chain;
+        pv[e].subImage.imageRect = {
+            {0, 0}, {static_cast<int32_t>(eyes_[e].width), static_cast<int32_t>(eyes_[e].height)}};
+      }
+      layer.space = space_;
+      layer.viewCount = 2;
+      layer.views = pv;
+      layer_count = 1;
+    }
+  }
+  XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
+  ei.displayTime = fs.predictedDisplayTime;
+  ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
+  ei.layerCount = layer_count;
+  ei.layers = layers;
+  x = xrEndFrame(session_, &ei);
+  if (x == XR_ERROR_SESSION_LOST) return true;
+  if (!ok(x, "xrEndFrame")) return false;
+  ++r_.frames;
+  if (layer_count) ++r_.frames_rendered;
+  if (opt_.max_frames > 0 && r_.frames >= opt_.max_frames && !exit_requested_) {
+    exit_requested_ = true;
+    ok(xrRequestExitSession(session_), "xrRequestExitSession");
+  }
+  return true;
+}
+
+void App::run() {
+  if (!create_instance()) return;
+  if (!create_vulkan()) {
+    set_state(XrAppState::kFailed);
+    return;
+  }
+  if (!create_session()) {
+    set_state(XrAppState::kFailed);
+    return;
+  }
+  for (;;) {
+    if (!handle_events()) break;
+    if (state_ == XrAppState::kFailed) break;
+    if (running_) {
+      if (!frame()) {
+        set_state(XrAppState::kFailed);
+        break;
+      }
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));  // wait for READY / EXITING
+    }
+  }
+}
+
+}  // namespace
+
+XrAppResult run_xr_app(const XrAppOptions& opt) {
+  XrAppResult res;
+  {
+    App app(opt, &res);
+    app.run();
+    res.final_state = app.state();
+  }
+  if (res.final_state == XrAppState::kExiting && res.error.empty())
+    res.exit_code = 0;
+  else if (res.final_state == XrAppState::kNoRuntime)
+    res.exit_code = 3;
+  else
+    res.exit_code = 1;
+  return res;
+}
+
+}  // namespace drape::app

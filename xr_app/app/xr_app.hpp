@@ -1,0 +1,58 @@
+// The drape OpenXR application: instance, system and session lifecycle as a state machine
+// (a missing runtime and a lost session are ordinary states), STAGE space (LOCAL fallback),
+// controller actions, XR_EXT_hand_tracking when offered, and the frame loop that renders the
+// simulation's latest snapshot into the runtime's swapchains. See docs/xr.md.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace drape::app {
+
+enum class XrAppState {
+  kNoRuntime,       // no OpenXR runtime could be loaded
+  kInstance,        // instance + system, no session
+  kSessionIdle,     // session created, waiting for READY
+  kSessionRunning,  // between xrBeginSession and STOPPING
+  kSessionStopping,
+  kSessionLost,  // LOSS_PENDING: the session is destroyed and re-created
+  kExiting,      // EXITING (or the frame budget is spent)
+  kFailed,
+};
+const char* to_string(XrAppState s);
+
+struct XrAppOptions {
+  int64_t max_frames = -1;  // stop (xrRequestExitSession) after this many frames; -1: never
+  int eye_size = 0;         // swapchain edge (px); 0 = the runtime's recommendation
+  bool render = true;       // draw the scene (drape_render) or only clear the swapchains
+  int cloth_res = 24;       // cloth resolution of the default scene
+  int max_session_restarts = 3;
+  bool verbose = false;
+};
+
+struct XrAppResult {
+  int exit_code = 0;  // 0 ok, 3 no runtime, 1 failure
+  XrAppState final_state = XrAppState::kFailed;
+  std::string runtime_name;
+  std::string error;
+  int64_t frames = 0;           // xrEndFrame calls that succeeded
+  int64_t frames_rendered = 0;  // frames with a projection layer
+  int sessions = 0;             // sessions created
+  int sessions_lost = 0;
+  bool hand_tracking = false;
+  int64_t hand_frames_tracked = 0;   // frames with an active right-hand joint set
+  float min_pinch_gap_m = 1e9f;      // smallest right thumb-index tip distance seen
+  float max_trigger = 0.f;           // largest "pinch" action value seen
+  uint32_t validation_messages = 0;  // XR_EXT_debug_utils errors/warnings (validation layer)
+  std::vector<std::string> log;      // state transitions and notable events
+};
+
+// Points XR_RUNTIME_JSON at the mock runtime next to the executable when no runtime is
+// configured (XR_RUNTIME_JSON unset and no active_runtime.json). Returns the manifest used
+// ("" = the system's active runtime).
+std::string select_runtime();
+
+XrAppResult run_xr_app(const XrAppOptions& opt);
+
+}  // namespace drape::app
