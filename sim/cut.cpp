@@ -136,12 +136,6 @@ int32_t nearest_vertex_walk(const Cloth& cloth, const Adjacency& a, int32_t star
   return cur;
 }
 
-bool has_vertex_in_triangle(const Cloth& cloth, int32_t v) {
-  for (const auto& t : cloth.topo.triangles)
-    if (t[0] == v || t[1] == v || t[2] == v) return true;
-  return false;
-}
-
 double dist_point_line(const Vec2& p, const Vec2& a, const Vec2& b) {
   const Vec2 d = b - a;
   const double l2 = d.squaredNorm();
@@ -325,6 +319,41 @@ CutResult cut_path_impl(Cloth& cloth, const Adjacency& a, const std::vector<int3
   return r;
 }
 
+// Anchors in different pieces (a stroke crossing an earlier full cut) cannot be joined by one
+// edge path: cut each run of anchors that lie in one piece separately, merging the results.
+CutResult cut_runs(Cloth& cloth, const std::vector<int32_t>& anchors) {
+  CutResult total;
+  std::vector<int32_t> labels = component_labels(cloth);
+  std::vector<std::vector<int32_t>> runs;
+  for (int32_t a : anchors) {
+    if (runs.empty() || labels[a] != labels[runs.back().back()]) runs.push_back({});
+    if (runs.back().empty() || runs.back().back() != a) runs.back().push_back(a);
+  }
+  total.components_before = count_components(cloth);
+  std::string why;
+  for (const auto& run : runs) {
+    if (run.size() < 2) continue;
+    const Adjacency a = build_adjacency(cloth);
+    auto path = edge_path_impl(cloth, a, run);
+    if (path.size() < 2) {
+      why = "cut: no edge path joins the stroke's particles";
+      continue;
+    }
+    CutResult r = cut_path_impl(cloth, a, path);
+    if (!r.ok) {
+      why = r.reason;
+      continue;
+    }
+    total.ok = true;
+    total.path.insert(total.path.end(), r.path.begin(), r.path.end());
+    total.new_vertices.insert(total.new_vertices.end(), r.new_vertices.begin(),
+                              r.new_vertices.end());
+  }
+  total.components_after = count_components(cloth);
+  if (!total.ok) total.reason = why.empty() ? "cut: stroke covers a single particle" : why;
+  return total;
+}
+
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -426,14 +455,9 @@ CutResult cut_along(Cloth& cloth, const std::vector<Vec3>& stroke_points,
     r.reason = "cut: stroke covers a single particle";
     return r;
   }
-  auto path = edge_path_impl(cloth, a, anchors);
-  if (path.size() < 2) {
-    r.reason = "cut: no edge path joins the stroke's particles";
-    return r;
-  }
   auto stroke3 = std::move(r.smooth_stroke);
   auto stroke_uv = std::move(r.smooth_stroke_uv);
-  r = cut_path_impl(cloth, a, path);
+  r = cut_runs(cloth, anchors);
   r.smooth_stroke = std::move(stroke3);
   r.smooth_stroke_uv = std::move(stroke_uv);
   r.ms = ms_since(t0);
@@ -445,15 +469,30 @@ CutResult cut_along_material(Cloth& cloth, const std::vector<Vec2>& stroke_uv) {
   CutResult r;
   std::vector<int32_t> anchors;
   const auto& m = cloth.topo.material;
-  for (const Vec2& q : stroke_uv) {
-    if (!q.allFinite()) continue;
+  // Densify to half the grid spacing so a stroke crossing an earlier cut has anchors on both
+  // sides of it.
+  std::vector<Vec2> dense;
+  const double step = 0.5 * std::max(cloth.topo.spacing, 1e-4);
+  for (size_t i = 0; i < stroke_uv.size(); ++i) {
+    if (!stroke_uv[i].allFinite()) continue;
+    if (!dense.empty()) {
+      const Vec2 a = dense.back(), b = stroke_uv[i];
+      const int k = std::min(100000, static_cast<int>((b - a).norm() / step));
+      for (int j = 1; j < k; ++j) dense.push_back(a + (b - a) * (double(j) / k));
+    }
+    dense.push_back(stroke_uv[i]);
+  }
+  std::vector<char> used(cloth.num_vertices(), 0);
+  for (const auto& t : cloth.topo.triangles)
+    for (int k = 0; k < 3; ++k) used[t[k]] = 1;
+  for (const Vec2& q : dense) {
     int32_t best = -1;
     double bd = std::numeric_limits<double>::infinity();
     for (int32_t i = 0; i < cloth.num_vertices(); ++i) {
       const double d = (m[i] - q).squaredNorm();
       if (d < bd - 1e-18) bd = d, best = i;  // lowest index wins among duplicates
     }
-    if (best >= 0 && has_vertex_in_triangle(cloth, best)) anchors.push_back(best);
+    if (best >= 0 && used[best]) anchors.push_back(best);
     r.smooth_stroke_uv.push_back(q);
   }
   anchors.erase(std::unique(anchors.begin(), anchors.end()), anchors.end());
@@ -461,14 +500,8 @@ CutResult cut_along_material(Cloth& cloth, const std::vector<Vec2>& stroke_uv) {
     r.reason = "cut: material stroke has fewer than 2 distinct particles";
     return r;
   }
-  const Adjacency a = build_adjacency(cloth);
-  auto path = edge_path_impl(cloth, a, anchors);
-  if (path.size() < 2) {
-    r.reason = "cut: no edge path joins the stroke's particles";
-    return r;
-  }
   auto uv = std::move(r.smooth_stroke_uv);
-  r = cut_path_impl(cloth, a, path);
+  r = cut_runs(cloth, anchors);
   r.smooth_stroke_uv = std::move(uv);
   for (int32_t v : r.path) r.smooth_stroke.push_back(cloth.state.x[v]);
   r.ms = ms_since(t0);

@@ -7,6 +7,7 @@
 // once) and intersects the rays with the segments, each segment only with the rays inside the
 // angle it subtends: O(triangles + sections x 256) overall.
 #include <algorithm>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <sstream>
 
@@ -198,7 +199,7 @@ Result<DressForm> DressForm::from_triangles(const TriMesh& mesh, const MeshImpor
     if (area > 0) {
       mean /= area;
       cov = cov / area - mean * mean.transpose();
-      const double tr = cov.trace(), det = cov.determinant();
+      const double tr = cov.trace(), det = cov(0, 0) * cov(1, 1) - cov(0, 1) * cov(1, 0);
       const double disc = std::sqrt(std::max(tr * tr / 4 - det, 0.0));
       const double l1 = tr / 2 + disc, l2 = tr / 2 - disc;
       if (l1 > 0 && l2 < 0.9 * l1) {

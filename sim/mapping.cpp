@@ -84,8 +84,8 @@ ArcTable ArcTable::build(const MappingSurface& s, double y, double theta0, int d
   for (int m = 1; m <= kN; ++m) {  // eq. 2-3: chord lengths L_n from the centre-line point
     const double t = theta0 + dir * m * kStep;
     const double r = s.sample_radius(y, n0 + dir * m);
-    T.cum[m] = T.cum[m - 1] + std::hypot(r * std::sin(t) - rp * std::sin(tp),
-                                         r * std::cos(t) - rp * std::cos(tp));
+    T.cum[m] = T.cum[m - 1] +
+               std::hypot(r * std::sin(t) - rp * std::sin(tp), r * std::cos(t) - rp * std::cos(tp));
     rp = r;
     tp = t;
   }
@@ -162,7 +162,8 @@ PieceMapping make_piece_mapping(const Panel& panel, const MappingSurface& surf, 
     for (int it = 0; it < 60; ++it) {
       const double mid = 0.5 * (lo + hi);
       pm.darts.back().a = mid;
-      const double intake = c_prev - (Tw.arc_at(pm.zone_start_theta(static_cast<int>(s) + 1, waist_y)) - d.l);
+      const double intake =
+          c_prev - (Tw.arc_at(pm.zone_start_theta(static_cast<int>(s) + 1, waist_y)) - d.l);
       (intake < d.intake ? lo : hi) = mid;
     }
     pm.darts.back().a = 0.5 * (lo + hi);

@@ -39,11 +39,11 @@ class MappingSurface {
 // (eqs. 2-3, 2-4): maps a weft distance to a centre angle (2-6) and back.
 struct ArcTable {
   double theta0 = 0;
-  int dir = 1;                 // +1: theta increases (toward the form's left), -1: decreases
-  std::vector<double> cum;     // 257 entries, cum[0] = 0
+  int dir = 1;              // +1: theta increases (toward the form's left), -1: decreases
+  std::vector<double> cum;  // 257 entries, cum[0] = 0
   static ArcTable build(const MappingSurface& s, double y, double theta0, int dir);
-  double theta_at(double l) const;      // eq. 2-6 (extrapolates linearly past a full turn)
-  double arc_at(double theta) const;    // inverse: arc from theta0 to theta in direction dir
+  double theta_at(double l) const;    // eq. 2-6 (extrapolates linearly past a full turn)
+  double arc_at(double theta) const;  // inverse: arc from theta0 to theta in direction dir
 };
 
 // How one panel sits on the form: which centre line, which way round, where the top is, and

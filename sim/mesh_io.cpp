@@ -7,6 +7,7 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
 #include <memory>

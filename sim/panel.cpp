@@ -10,7 +10,9 @@
 namespace drape::sim {
 namespace {
 
-bool finite_pos(double x) { return std::isfinite(x) && x > 0; }
+bool finite_pos(double x) {
+  return std::isfinite(x) && x > 0;
+}
 
 int grid_count(double len, double spacing) {
   return std::max(2, static_cast<int>(std::lround(len / spacing)) + 1);
@@ -46,15 +48,18 @@ std::string validate_panel(const PanelDesign& d, const std::string& where, const
   for (size_t s = 0; s < d.slits.size(); ++s) {
     const DartSlit& sl = d.slits[s];
     const std::string f = where + ".slits[" + std::to_string(s) + "]";
-    const int li = std::isfinite(sl.position) ? static_cast<int>(std::lround(sl.position / dx)) : -1;
+    const int li =
+        std::isfinite(sl.position) ? static_cast<int>(std::lround(sl.position / dx)) : -1;
     if (!std::isfinite(sl.position) || sl.position <= 0 || sl.position >= d.width || li < 1 ||
         li > nx - 2) {
       e << f << ".position: slit off the panel (" << sl.position * 1000 << " mm; the panel is "
         << d.width * 1000 << " mm wide and a slit needs one grid column on each side)";
       return e.str();
     }
-    const int tip = std::isfinite(sl.depth) ? static_cast<int>(std::lround((d.height - sl.depth) / dy)) : -1;
-    if (!std::isfinite(sl.depth) || sl.depth <= 0 || sl.depth >= d.height || tip < 1 || tip > ny - 2) {
+    const int tip =
+        std::isfinite(sl.depth) ? static_cast<int>(std::lround((d.height - sl.depth) / dy)) : -1;
+    if (!std::isfinite(sl.depth) || sl.depth <= 0 || sl.depth >= d.height || tip < 1 ||
+        tip > ny - 2) {
       e << f << ".depth: slit off the panel (" << sl.depth * 1000 << " mm; the panel is "
         << d.height * 1000 << " mm high)";
       return e.str();
@@ -168,7 +173,8 @@ Result<Panel> build_panel(const PanelDesign& d, const FabricParams& fabric,
   st.v.assign(nv, Vec3::Zero());
   st.mass.assign(nv, 0.0);
   for (const auto& tri : t.triangles) {
-    const Vec2 e1 = t.material[tri[1]] - t.material[tri[0]], e2 = t.material[tri[2]] - t.material[tri[0]];
+    const Vec2 e1 = t.material[tri[1]] - t.material[tri[0]],
+               e2 = t.material[tri[2]] - t.material[tri[0]];
     const double m = 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x()) * fabric.areal_density / 3;
     for (int vi : tri) st.mass[vi] += m;
   }

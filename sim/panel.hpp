@@ -21,21 +21,21 @@ struct DartSlit {
 
 // Size and placement of one rectangular panel.
 struct PanelDesign {
-  double width = 0.28;    // m, along the weft (u)
-  double height = 0.62;   // m, along the warp (v, grain)
-  double spacing = 0.01;  // m, grid spacing (snapped so the width/height divide evenly)
-  bool centre_edge_left = true;  // the u = 0 edge lies on the centre line (else u = width)
+  double width = 0.28;            // m, along the weft (u)
+  double height = 0.62;           // m, along the warp (v, grain)
+  double spacing = 0.01;          // m, grid spacing (snapped so the width/height divide evenly)
+  bool centre_edge_left = true;   // the u = 0 edge lies on the centre line (else u = width)
   double top_above_waist = 0.03;  // m: top edge this far above the waist line (eq. 2-1)
   std::vector<DartSlit> slits;
 };
 
 // One slit after cutting: grid column, rows, and the node pairs on both of its sides.
 struct PanelSlit {
-  int column = 0;       // grid column i of the slit
-  int tip_row = 0;      // grid row of the slit end (not duplicated)
-  double l = 0;         // weft distance from the centre edge (snapped)
-  double v_tip = 0;     // material v of the slit end
-  double intake = 0;    // wanted waist intake (m)
+  int column = 0;     // grid column i of the slit
+  int tip_row = 0;    // grid row of the slit end (not duplicated)
+  double l = 0;       // weft distance from the centre edge (snapped)
+  double v_tip = 0;   // material v of the slit end
+  double intake = 0;  // wanted waist intake (m)
   int tip_node = -1;
   std::vector<int> near_nodes;  // nodes on the centre side (rows tip_row+1 .. top), zone k
   std::vector<int> far_nodes;   // their duplicates on the far side, zone k + 1
@@ -45,8 +45,8 @@ struct PanelSlit {
 struct Panel {
   PanelDesign design;
   Cloth cloth;
-  int nx = 0, ny = 0;        // grid vertices along u and v (before duplication)
-  double dx = 0, dy = 0;     // actual grid spacing
+  int nx = 0, ny = 0;            // grid vertices along u and v (before duplication)
+  double dx = 0, dy = 0;         // actual grid spacing
   std::vector<PanelSlit> slits;  // ordered by distance from the centre edge
   int num_zones() const { return static_cast<int>(slits.size()) + 1; }
   // Weft distance from the centre-line edge of a material point (l of eq. 2-3).

@@ -13,9 +13,9 @@
 namespace drape::sim {
 namespace {
 
-constexpr double kMm = 1000.0;     // m -> mm
-constexpr double kMargin = 20.0;   // mm around and between pieces in the layout
-constexpr double kNotch = 6.0;     // mm notch length
+constexpr double kMm = 1000.0;    // m -> mm
+constexpr double kMargin = 20.0;  // mm around and between pieces in the layout
+constexpr double kNotch = 6.0;    // mm notch length
 
 Vec2 edge_normal(const Vec2& a, const Vec2& b) {  // outward for a counter-clockwise polygon
   const Vec2 d = (b - a).normalized();
@@ -109,7 +109,8 @@ std::vector<Vec2> cut_line(const PatternPiece& pc, double sa) {
   std::vector<bool> skip(n, false);
   for (const auto& d : pc.darts) {
     // Points strictly between the two leg tops along the outline (the dart V) are bridged.
-    for (int i = (d.leg2_top + 1) % n, guard = 0; i != d.leg1_top && guard < n; i = (i + 1) % n, ++guard)
+    for (int i = (d.leg2_top + 1) % n, guard = 0; i != d.leg1_top && guard < n;
+         i = (i + 1) % n, ++guard)
       skip[i] = true;
     if (skip[d.leg1_top]) {  // the V runs the other way round (reversed outline)
       std::fill(skip.begin(), skip.end(), false);
@@ -136,7 +137,8 @@ std::string write_svg(const std::string& path, const std::vector<PatternPiece>& 
     << fmt(L.height) << "mm\" viewBox=\"0 0 " << fmt(L.width) << " " << fmt(L.height) << "\">\n"
     << "<title>" << opt.style << " pattern (units: mm, scale 1:1)</title>\n"
     << "<defs><marker id=\"arrow\" markerWidth=\"6\" markerHeight=\"6\" refX=\"5\" refY=\"3\" "
-       "orient=\"auto-start-reverse\"><path d=\"M0,0 L6,3 L0,6 z\" fill=\"black\"/></marker></defs>\n";
+       "orient=\"auto-start-reverse\"><path d=\"M0,0 L6,3 L0,6 z\" "
+       "fill=\"black\"/></marker></defs>\n";
   for (const Placed& p : L.pieces) {
     const PatternPiece& pc = *p.piece;
     f << "<g id=\"" << pc.name << "\">\n<path class=\"cut\" fill=\"none\" stroke=\"black\" "
@@ -181,51 +183,99 @@ std::string write_dxf(const std::string& path, const std::vector<PatternPiece>& 
   const auto g = [&](int code, const std::string& v) { f << code << "\n" << v << "\n"; };
   const auto num = [&](int code, double v) { g(code, fmt(v)); };
   const auto line = [&](const std::string& layer, const Vec2& a, const Vec2& b) {
-    g(0, "LINE"); g(8, layer);
-    num(10, a.x()); num(20, a.y()); num(30, 0); num(11, b.x()); num(21, b.y()); num(31, 0);
+    g(0, "LINE");
+    g(8, layer);
+    num(10, a.x());
+    num(20, a.y());
+    num(30, 0);
+    num(11, b.x());
+    num(21, b.y());
+    num(31, 0);
   };
   const auto text = [&](const std::string& layer, const Vec2& p, double h, const std::string& s) {
-    g(0, "TEXT"); g(8, layer); num(10, p.x()); num(20, p.y()); num(30, 0); num(40, h); g(1, s);
+    g(0, "TEXT");
+    g(8, layer);
+    num(10, p.x());
+    num(20, p.y());
+    num(30, 0);
+    num(40, h);
+    g(1, s);
   };
   const auto polyline = [&](const std::string& layer, const std::vector<Vec2>& pts, bool closed) {
-    g(0, "POLYLINE"); g(8, layer); g(66, "1"); num(10, 0); num(20, 0); num(30, 0);
+    g(0, "POLYLINE");
+    g(8, layer);
+    g(66, "1");
+    num(10, 0);
+    num(20, 0);
+    num(30, 0);
     g(70, closed ? "1" : "0");
     for (const Vec2& q : pts) {
-      g(0, "VERTEX"); g(8, layer); num(10, q.x()); num(20, q.y()); num(30, 0);
+      g(0, "VERTEX");
+      g(8, layer);
+      num(10, q.x());
+      num(20, q.y());
+      num(30, 0);
     }
-    g(0, "SEQEND"); g(8, layer);
+    g(0, "SEQEND");
+    g(8, layer);
   };
-  g(0, "SECTION"); g(2, "HEADER");
-  g(9, "$ACADVER"); g(1, "AC1009");
-  g(9, "$INSUNITS"); g(70, "4");
-  g(9, "$MEASUREMENT"); g(70, "1");
+  g(0, "SECTION");
+  g(2, "HEADER");
+  g(9, "$ACADVER");
+  g(1, "AC1009");
+  g(9, "$INSUNITS");
+  g(70, "4");
+  g(9, "$MEASUREMENT");
+  g(70, "1");
   g(0, "ENDSEC");
-  g(0, "SECTION"); g(2, "TABLES");
-  g(0, "TABLE"); g(2, "LTYPE"); g(70, "1");
-  g(0, "LTYPE"); g(2, "CONTINUOUS"); g(70, "0"); g(3, "Solid line"); g(72, "65"); g(73, "0"); num(40, 0);
+  g(0, "SECTION");
+  g(2, "TABLES");
+  g(0, "TABLE");
+  g(2, "LTYPE");
+  g(70, "1");
+  g(0, "LTYPE");
+  g(2, "CONTINUOUS");
+  g(70, "0");
+  g(3, "Solid line");
+  g(72, "65");
+  g(73, "0");
+  num(40, 0);
   g(0, "ENDTAB");
   const char* layers[] = {"0", "1", "4", "7", "8", "14"};
-  g(0, "TABLE"); g(2, "LAYER"); g(70, "6");
+  g(0, "TABLE");
+  g(2, "LAYER");
+  g(70, "6");
   for (const char* l : layers) {
-    g(0, "LAYER"); g(2, l); g(70, "0"); g(62, "7"); g(6, "CONTINUOUS");
+    g(0, "LAYER");
+    g(2, l);
+    g(70, "0");
+    g(62, "7");
+    g(6, "CONTINUOUS");
   }
   g(0, "ENDTAB");
   g(0, "ENDSEC");
   // One block per piece in piece coordinates (mm); inserted at its layout position.
-  g(0, "SECTION"); g(2, "BLOCKS");
+  g(0, "SECTION");
+  g(2, "BLOCKS");
   for (const Placed& p : L.pieces) {
     const PatternPiece& pc = *p.piece;
     const auto loc = [&](const Vec2& q) { return Vec2(q - p.shift); };
-    g(0, "BLOCK"); g(8, "0"); g(2, pc.name); g(70, "0"); num(10, 0); num(20, 0); num(30, 0);
+    g(0, "BLOCK");
+    g(8, "0");
+    g(2, pc.name);
+    g(70, "0");
+    num(10, 0);
+    num(20, 0);
+    num(30, 0);
     g(3, pc.name);
     std::vector<Vec2> cut, seam;
     for (const Vec2& q : p.cut) cut.push_back(loc(q));
     for (const Vec2& q : p.seam) seam.push_back(loc(q));
-    polyline("1", cut, true);                                  // boundary (cut line)
-    if (opt.seam_allowance > 0) polyline("14", seam, true);    // sew line
-    line("7", pc.grain_a * kMm, pc.grain_b * kMm);             // grain line
+    polyline("1", cut, true);                                // boundary (cut line)
+    if (opt.seam_allowance > 0) polyline("14", seam, true);  // sew line
+    line("7", pc.grain_a * kMm, pc.grain_b * kMm);           // grain line
     for (const Notch& nt : notches(L, p, opt.seam_allowance)) line("4", loc(nt.a), loc(nt.b));
-    for (const auto& d : pc.darts) {                           // internal lines: dart legs
+    for (const auto& d : pc.darts) {  // internal lines: dart legs
       line("8", seam[d.tip], seam[d.leg1_top]);
       line("8", seam[d.tip], seam[d.leg2_top]);
     }
@@ -233,14 +283,20 @@ std::string write_dxf(const std::string& path, const std::vector<PatternPiece>& 
     text("1", t, 5, "Piece Name: " + pc.name);
     text("1", t - Vec2(0, 8), 5, "Size: " + pc.size);
     text("1", t - Vec2(0, 16), 5, "Quantity: " + std::to_string(pc.quantity));
-    g(0, "ENDBLK"); g(8, "0");
+    g(0, "ENDBLK");
+    g(8, "0");
   }
   g(0, "ENDSEC");
-  g(0, "SECTION"); g(2, "ENTITIES");
+  g(0, "SECTION");
+  g(2, "ENTITIES");
   text("1", Vec2(kMargin, 8), 5, "Style Name: " + opt.style);
   text("1", Vec2(kMargin + 120, 8), 5, "Units: METRIC");
   for (const Placed& p : L.pieces) {
-    g(0, "INSERT"); g(8, "0"); g(2, p.piece->name); num(10, p.shift.x()); num(20, p.shift.y());
+    g(0, "INSERT");
+    g(8, "0");
+    g(2, p.piece->name);
+    num(10, p.shift.x());
+    num(20, p.shift.y());
     num(30, 0);
   }
   g(0, "ENDSEC");
@@ -257,7 +313,8 @@ std::string write_pdf(const std::string& path, const std::vector<PatternPiece>& 
   const double sx = pw - overlap, sy = ph - overlap;
   const int cols = std::max(1, static_cast<int>(std::ceil((L.width - overlap) / sx)));
   const int rows = std::max(1, static_cast<int>(std::ceil((L.height - overlap) / sy)));
-  cairo_surface_t* s = cairo_pdf_surface_create(path.c_str(), paper.width_mm * pt, paper.height_mm * pt);
+  cairo_surface_t* s =
+      cairo_pdf_surface_create(path.c_str(), paper.width_mm * pt, paper.height_mm * pt);
   if (cairo_surface_status(s) != CAIRO_STATUS_SUCCESS) {
     cairo_surface_destroy(s);
     return path + ": cannot create PDF";
@@ -268,13 +325,17 @@ std::string write_pdf(const std::string& path, const std::vector<PatternPiece>& 
   // Cover page: title, the 10 cm check square, the tile map.
   cairo_set_font_size(cr, 6);
   cairo_move_to(cr, 20, 25);
-  cairo_show_text(cr, (opt.style + " pattern, 1:1, " + paper.name + ", " + std::to_string(rows * cols) +
-                       " tiles (" + std::to_string(rows) + " rows x " + std::to_string(cols) + " columns)").c_str());
+  cairo_show_text(
+      cr, (opt.style + " pattern, 1:1, " + paper.name + ", " + std::to_string(rows * cols) +
+           " tiles (" + std::to_string(rows) + " rows x " + std::to_string(cols) + " columns)")
+              .c_str());
   cairo_set_font_size(cr, 4);
   cairo_move_to(cr, 20, 35);
-  cairo_show_text(cr, "Print at 100% (no fit-to-page). The black square must measure 10 cm x 10 cm.");
+  cairo_show_text(cr,
+                  "Print at 100% (no fit-to-page). The black square must measure 10 cm x 10 cm.");
   cairo_move_to(cr, 20, 42);
-  cairo_show_text(cr, "Trim each page on its margin, align the registration crosses, tape. Units: mm.");
+  cairo_show_text(cr,
+                  "Trim each page on its margin, align the registration crosses, tape. Units: mm.");
   cairo_set_source_rgb(cr, 0, 0, 0);
   cairo_rectangle(cr, kScaleSquareX, kScaleSquareY, kScaleSquareSize, kScaleSquareSize);
   cairo_fill(cr);
@@ -288,14 +349,17 @@ std::string write_pdf(const std::string& path, const std::vector<PatternPiece>& 
       cairo_stroke(cr);
       cairo_move_to(cr, 21 + c * cell, map_y + r * cell + 4);
       cairo_set_font_size(cr, 2.5);
-      cairo_show_text(cr, (std::string(1, static_cast<char>('A' + r)) + std::to_string(c + 1)).c_str());
+      cairo_show_text(cr,
+                      (std::string(1, static_cast<char>('A' + r)) + std::to_string(c + 1)).c_str());
     }
   cairo_show_page(cr);
   const auto draw_poly = [&](const std::vector<Vec2>& pts, double lw, bool dashed) {
     for (size_t i = 0; i < pts.size(); ++i) {
       const double x = pts[i].x(), y = L.height - pts[i].y();
-      if (i) cairo_line_to(cr, x, y);
-      else cairo_move_to(cr, x, y);
+      if (i)
+        cairo_line_to(cr, x, y);
+      else
+        cairo_move_to(cr, x, y);
     }
     cairo_close_path(cr);
     cairo_set_line_width(cr, lw);
@@ -330,7 +394,8 @@ std::string write_pdf(const std::string& path, const std::vector<PatternPiece>& 
         cairo_move_to(cr, t.x(), L.height - t.y());
         cairo_set_font_size(cr, 5);
         cairo_show_text(cr, (p.piece->name + " - size " + p.piece->size + " - cut " +
-                             std::to_string(p.piece->quantity)).c_str());
+                             std::to_string(p.piece->quantity))
+                                .c_str());
       }
       cairo_restore(cr);
       // Registration crosses at the corners of the printable area, the page label outside it.
@@ -347,9 +412,10 @@ std::string write_pdf(const std::string& path, const std::vector<PatternPiece>& 
         }
       cairo_set_font_size(cr, 3.5);
       cairo_move_to(cr, margin + 6, margin - 3);
-      cairo_show_text(cr, ("page " + label + " (row " + std::to_string(r + 1) + "/" + std::to_string(rows) +
-                           ", column " + std::to_string(c + 1) + "/" + std::to_string(cols) +
-                           "), overlap 10 mm").c_str());
+      cairo_show_text(cr, ("page " + label + " (row " + std::to_string(r + 1) + "/" +
+                           std::to_string(rows) + ", column " + std::to_string(c + 1) + "/" +
+                           std::to_string(cols) + "), overlap 10 mm")
+                              .c_str());
       cairo_show_page(cr);
     }
   cairo_destroy(cr);

@@ -126,7 +126,9 @@ struct RefPoint {
   int zone;
 };
 
-int steps_for(double len, double step) { return std::max(2, static_cast<int>(std::ceil(len / step))); }
+int steps_for(double len, double step) {
+  return std::max(2, static_cast<int>(std::ceil(len / step)));
+}
 
 }  // namespace
 
@@ -230,12 +232,14 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
     for (int k = 0; k <= n; ++k) {
       const double y = y_tip + (L.waist_y - y_tip) * k / n;
       while (seg + 2 < edge.size() && edge[seg + 1].y() < y) ++seg;
-      const double f = std::clamp((y - edge[seg].y()) / (edge[seg + 1].y() - edge[seg].y()), 0.0, 1.0);
+      const double f =
+          std::clamp((y - edge[seg].y()) / (edge[seg + 1].y() - edge[seg].y()), 0.0, 1.0);
       const Vec3 p = edge[seg] + f * (edge[seg + 1] - edge[seg]);
       const Vec2 c = surf.centre(y);
       dart_line[s].push_back({y, std::atan2(p.x() - c.x(), p.z() - c.y()), 0});
     }
-    dart_f_waist[s] = std::abs(wrap_pi(pm.dir * (dart_line[s].back().theta - pm.theta_centre))) / span;
+    dart_f_waist[s] =
+        std::abs(wrap_pi(pm.dir * (dart_line[s].back().theta - pm.theta_centre))) / span;
   }
   // Runs in counter-clockwise order for a centre-left panel: hem, side, waist with darts, centre.
   runs.push_back({"hem", horizontal(L.hem_y, 0, 1, -1)});
@@ -290,7 +294,8 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
       piece.outline3d.push_back(h.world);
       piece.ref.emplace_back(rp.y, rp.theta, rp.zone);
       piece.seg_label.push_back(li);
-      if (std::abs(rp.y - L.hip_y) < 1e-9 && (runs[r].label == "side" || runs[r].label == L.centre_label))
+      if (std::abs(rp.y - L.hip_y) < 1e-9 &&
+          (runs[r].label == "side" || runs[r].label == L.centre_label))
         piece.notches.push_back(static_cast<int>(piece.outline.size()) - 1);
     }
   }
@@ -306,7 +311,8 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
   // Darts: tip and leg tops from the labels.
   for (int z = 1; z < nz; ++z) {
     const std::string dn = "dart" + std::to_string(z);
-    const std::vector<int> l2 = piece.seam_points(dn + "_leg2"), l1 = piece.seam_points(dn + "_leg1");
+    const std::vector<int> l2 = piece.seam_points(dn + "_leg2"),
+                           l1 = piece.seam_points(dn + "_leg1");
     if (l2.empty() || l1.empty()) continue;
     PatternPiece::Dart d;
     d.leg2_top = l2.front();
@@ -368,9 +374,9 @@ double draped_area(const PatternPiece& piece, const Panel& panel) {
   const auto& topo = panel.cloth.topo;
   const auto& x = panel.cloth.state.x;
   // Seven sample points per triangle decide how much of it lies inside the outline.
-  static const double w[7][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.6, 0.2, 0.2}, {0.2, 0.6, 0.2},
-                                 {0.2, 0.2, 0.6},             {0.45, 0.45, 0.1}, {0.1, 0.45, 0.45},
-                                 {0.45, 0.1, 0.45}};
+  static const double w[7][3] = {
+      {1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.6, 0.2, 0.2},   {0.2, 0.6, 0.2},  {0.2, 0.2, 0.6},
+      {0.45, 0.45, 0.1},           {0.1, 0.45, 0.45}, {0.45, 0.1, 0.45}};
   double a3 = 0, a2 = 0;
   for (int t = 0; t < topo.num_triangles(); ++t) {
     const auto& tri = topo.triangles[t];

@@ -16,24 +16,24 @@ struct PatternPiece {
   std::string name = "piece";
   std::string size = "9AR";
   int quantity = 1;
-  std::vector<Vec2> outline;      // closed polygon, the last point is not repeated
-  std::vector<Vec3> outline3d;    // where each outline point lies on the draped cloth
-  std::vector<Vec3> ref;          // (y, theta, zone) of the reference point of each outline point
-  std::vector<int> seg_label;     // label of segment i (outline[i] -> outline[i + 1])
+  std::vector<Vec2> outline;        // closed polygon, the last point is not repeated
+  std::vector<Vec3> outline3d;      // where each outline point lies on the draped cloth
+  std::vector<Vec3> ref;            // (y, theta, zone) of the reference point of each outline point
+  std::vector<int> seg_label;       // label of segment i (outline[i] -> outline[i + 1])
   std::vector<std::string> labels;  // seam names: centre_front, side, waist, hem, dart1_leg1...
-  std::vector<int> notches;       // outline indices marked with a notch (dart legs, hip line)
+  std::vector<int> notches;         // outline indices marked with a notch (dart legs, hip line)
   struct Dart {
     int tip = -1, leg1_top = -1, leg2_top = -1;  // outline indices
     double intake = 0;                           // flat distance between the leg tops (m)
   };
   std::vector<Dart> darts;
-  std::vector<Vec2> hip_line;     // flat points along the hip line, centre -> side
+  std::vector<Vec2> hip_line;         // flat points along the hip line, centre -> side
   Vec2 grain_a{0, 0}, grain_b{0, 0};  // grain line (parallel to the warp)
 
   int label_index(const std::string& name) const;
-  double area() const;                               // polygon area (m^2)
+  double area() const;                                 // polygon area (m^2)
   double seam_length(const std::string& label) const;  // total length of segments with label
-  double hip_width() const;                          // length of the hip polyline
+  double hip_width() const;                            // length of the hip polyline
   // Outline indices of one seam in order (empty if absent).
   std::vector<int> seam_points(const std::string& label) const;
 };

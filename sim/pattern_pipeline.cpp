@@ -130,11 +130,13 @@ Result<Design> parse_design(const std::string& text, const std::string& src) {
       return Error{w + ".centre_line: '" + p.centre_line + "' is not a centre line"};
     if (p.side_line != "left_side" && p.side_line != "right_side")
       return Error{w + ".side_line: '" + p.side_line + "' is not a side line"};
-    if (p.top_line != "waist") return Error{w + ".top_line: only 'waist' is supported as the top line"};
+    if (p.top_line != "waist")
+      return Error{w + ".top_line: only 'waist' is supported as the top line"};
     if (p.bottom_line != "hem" && p.bottom_line != "hip")
       return Error{w + ".bottom_line: must be 'hem' or 'hip'"};
     if (p.quantity < 1 || p.quantity > 100) return Error{w + ".quantity: must be within 1..100"};
-    if (!pj.contains("panel") || !pj["panel"].is_object()) return Error{w + ".panel: missing object"};
+    if (!pj.contains("panel") || !pj["panel"].is_object())
+      return Error{w + ".panel: missing object"};
     const json& panel = pj["panel"];
     const std::string pw = w + ".panel";
     check(get_num(panel, "width", pw, &p.panel.width));
@@ -144,7 +146,8 @@ Result<Design> parse_design(const std::string& text, const std::string& src) {
     std::string edge = p.panel.centre_edge_left ? "left" : "right";
     check(get_str(panel, "centre_edge", pw, &edge));
     if (!err.empty()) return Error{err};
-    if (edge != "left" && edge != "right") return Error{pw + ".centre_edge: must be 'left' or 'right'"};
+    if (edge != "left" && edge != "right")
+      return Error{pw + ".centre_edge: must be 'left' or 'right'"};
     p.panel.centre_edge_left = edge == "left";
     if (pj.contains("darts")) {
       if (!pj["darts"].is_array()) return Error{w + ".darts: must be an array"};
@@ -200,8 +203,11 @@ std::string PipelineReport::to_json() const {
   j["outline_error_before_relax_mm"] = outline_error_before_relax_mm;
   j["quarter_difference_mm"] = quarter_difference_mm;
   j["relax_backend"] = relax_backend;
-  j["timing_ms"] = {{"mapping_extraction", mapping_extraction_ms}, {"relax", relax_ms},
-                    {"remesh", remesh_ms},  {"sew", sew_ms}, {"export", export_ms}};
+  j["timing_ms"] = {{"mapping_extraction", mapping_extraction_ms},
+                    {"relax", relax_ms},
+                    {"remesh", remesh_ms},
+                    {"sew", sew_ms},
+                    {"export", export_ms}};
   j["pipeline_ms"] = pipeline_ms;
   j["files"] = files;
   for (const PieceReport& p : pieces) {
@@ -214,10 +220,11 @@ std::string PipelineReport::to_json() const {
     for (double v : p.dart_intake_mm) total += v;
     pj["darts"] = json::array();
     for (size_t k = 0; k < p.dart_intake_mm.size(); ++k)
-      pj["darts"].push_back({{"intake_mm", p.dart_intake_mm[k]},
-                             {"intake_wanted_mm", p.dart_intake_wanted_mm[k]},
-                             {"fraction_of_quarter_difference",
-                              quarter_difference_mm > 0 ? p.dart_intake_mm[k] / quarter_difference_mm : 0}});
+      pj["darts"].push_back(
+          {{"intake_mm", p.dart_intake_mm[k]},
+           {"intake_wanted_mm", p.dart_intake_wanted_mm[k]},
+           {"fraction_of_quarter_difference",
+            quarter_difference_mm > 0 ? p.dart_intake_mm[k] / quarter_difference_mm : 0}});
     pj["dart_intake_total_mm"] = total;
     pj["side_shaping_mm"] = quarter_difference_mm - total;
     pj["outline_error_before_relax_mm"] = p.outline_error_before_relax_mm;
@@ -233,8 +240,10 @@ std::string PipelineReport::to_json() const {
     };
     pj["grain_deviation_mapped"] = grain(p.grain_before);
     pj["grain_deviation_relaxed"] = grain(p.grain_after);
-    pj["relax"] = {{"backend", p.relax.backend},     {"iterations", p.relax.iterations},
-                   {"max_strain", p.relax.max_strain}, {"rms_strain", p.relax.rms_strain},
+    pj["relax"] = {{"backend", p.relax.backend},
+                   {"iterations", p.relax.iterations},
+                   {"max_strain", p.relax.max_strain},
+                   {"rms_strain", p.relax.rms_strain},
                    {"ms", p.relax.ms}};
     pj["remesh"] = {{"vertices", p.remesh_vertices},
                     {"triangles", p.remesh_triangles},
@@ -277,7 +286,8 @@ Result<PipelineResult> run_pattern_pipeline(const Design& design_in, const Dress
     const double top_y = lm.waist_y + pd.panel.top_above_waist;
     if (std::string e = validate_panel(pd.panel, where, &form, d.ease, top_y); !e.empty())
       return Error{e};
-    if (top_y - pd.panel.height > (pd.bottom_line == "hip" ? lines.hip_y : lines.hem_y) - pd.panel.spacing)
+    if (top_y - pd.panel.height >
+        (pd.bottom_line == "hip" ? lines.hip_y : lines.hem_y) - pd.panel.spacing)
       return Error{where + ".height: the panel does not reach the " + pd.bottom_line + " line"};
     auto panel = build_panel(pd.panel, fabric, where);
     if (!panel) return Error{panel.error()};
@@ -352,7 +362,8 @@ Result<PipelineResult> run_pattern_pipeline(const Design& design_in, const Dress
   // Mirror, sew, relax the garment.
   const auto t_sew = Clock::now();
   std::vector<SewInput> in;
-  for (size_t i = 0; i < R.pieces.size(); ++i) in.push_back({&R.pieces[i], &R.meshes[i], &R.panels[i]});
+  for (size_t i = 0; i < R.pieces.size(); ++i)
+    in.push_back({&R.pieces[i], &R.meshes[i], &R.panels[i]});
   SewOptions so;
   so.mirror_x = surf.centre(lm.waist_y).x();
   so.relax_iterations = d.relax_iterations;
@@ -383,7 +394,8 @@ Result<PipelineResult> run_pattern_pipeline(const Design& design_in, const Dress
     out("pattern_a4.pdf", write_pdf(o + "pattern_a4.pdf", R.pieces, xo, Paper::a4()));
     out("pattern_letter.pdf", write_pdf(o + "pattern_letter.pdf", R.pieces, xo, Paper::letter()));
     std::vector<TriMesh> draped;
-    for (size_t i = 0; i < R.panels.size(); ++i) draped.push_back(panel_mesh(R.panels[i], R.pieces[i].name));
+    for (size_t i = 0; i < R.panels.size(); ++i)
+      draped.push_back(panel_mesh(R.panels[i], R.pieces[i].name));
     out("draped_panels.gltf", write_meshes(o + "draped_panels.gltf", draped));
     out("garment.gltf", write_meshes(o + "garment.gltf", {garment_to_mesh(R.garment, d.name)}));
     if (!e.empty()) return Error{e};

@@ -48,12 +48,12 @@ Result<Design> parse_design(const std::string& json_text, const std::string& sou
 Result<Design> load_design(const std::string& path);
 
 struct PipelineOptions {
-  std::string out_dir;           // empty: write nothing
-  double ease = -1;              // >= 0 overrides the design's ease (m)
-  double seam_allowance = -1;    // >= 0 overrides the design's print seam allowance (m)
-  double spacing = 0;            // > 0 overrides every panel's grid spacing (m)
-  double remesh_edge = 0;        // > 0 overrides the remesh size bound (m)
-  int relax_iterations = -1;     // >= 0 overrides
+  std::string out_dir;             // empty: write nothing
+  double ease = -1;                // >= 0 overrides the design's ease (m)
+  double seam_allowance = -1;      // >= 0 overrides the design's print seam allowance (m)
+  double spacing = 0;              // > 0 overrides every panel's grid spacing (m)
+  double remesh_edge = 0;          // > 0 overrides the remesh size bound (m)
+  int relax_iterations = -1;       // >= 0 overrides
   bool use_static_solver = false;  // relax with relax_static (Newton) instead of Gauss-Seidel
   bool grain_control = true;
 };

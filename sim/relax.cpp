@@ -38,7 +38,8 @@ void edge_strain(const RelaxProblem& p, double* max_strain, double* rms_strain) 
   if (rms_strain) *rms_strain = p.edges.empty() ? 0 : std::sqrt(s2 / p.edges.size());
 }
 
-RelaxStats relax_gauss_seidel(RelaxProblem& p, const MappingSurface& surf, const RelaxOptions& opt) {
+RelaxStats relax_gauss_seidel(RelaxProblem& p, const MappingSurface& surf,
+                              const RelaxOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   const int nv = static_cast<int>(p.x.size());
   if (p.fixed.size() != p.x.size()) p.fixed.resize(p.x.size(), 0);
@@ -169,7 +170,8 @@ RelaxStats relax_panel(Panel& panel, const MappingSurface& surf, const PieceMapp
     st.iterations = r.iterations;
     st.converged = r.converged;
     edge_strain(p, &st.max_strain, &st.rms_strain);
-    st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    st.ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return st;
   }
   RelaxProblem p;

@@ -41,15 +41,15 @@ void add_triangle_edges(const std::vector<std::array<int32_t, 3>>& tris,
 
 struct RelaxOptions {
   int iterations = 200;
-  double pressure_step = 2e-5;   // m per iteration toward the section centre (weak pressure)
-  double collision_offset = 0;   // m outside the mapping surface
+  double pressure_step = 2e-5;  // m per iteration toward the section centre (weak pressure)
+  double collision_offset = 0;  // m outside the mapping surface
   bool collide = true;
 };
 
 struct RelaxStats {
-  std::string backend;     // "newton-static" or "gauss-seidel"
+  std::string backend;  // "newton-static" or "gauss-seidel"
   int iterations = 0;
-  double max_strain = 0;   // max |length / rest - 1| over edges at the end
+  double max_strain = 0;  // max |length / rest - 1| over edges at the end
   double rms_strain = 0;
   double ms = 0;
   bool converged = true;

@@ -58,7 +58,8 @@ Result<RemeshedPiece> remesh_piece(const PatternPiece& piece, const RemeshOption
     return Error{"remesh: max_edge and shape_bound must be positive"};
   CDT cdt;
   std::vector<CDT::Vertex_handle> vh(n);
-  for (int i = 0; i < n; ++i) vh[i] = cdt.insert(CDT::Point(piece.outline[i].x(), piece.outline[i].y()));
+  for (int i = 0; i < n; ++i)
+    vh[i] = cdt.insert(CDT::Point(piece.outline[i].x(), piece.outline[i].y()));
   for (int i = 0; i < n; ++i)
     if (vh[i] != vh[(i + 1) % n]) cdt.insert_constraint(vh[i], vh[(i + 1) % n]);
   CGAL::refine_Delaunay_mesh_2(cdt, Criteria(opt.shape_bound, opt.max_edge));
@@ -90,7 +91,8 @@ Result<RemeshedPiece> remesh_piece(const PatternPiece& piece, const RemeshOption
       out.min_angle_deg = std::min(out.min_angle_deg, ang * 180 / 3.141592653589793);
     }
   }
-  if (out.triangles.empty()) return Error{"remesh: piece '" + piece.name + "' produced no triangles"};
+  if (out.triangles.empty())
+    return Error{"remesh: piece '" + piece.name + "' produced no triangles"};
   // Seam labels: boundary vertices lie on an outline segment.
   const double tol = 1e-7;
   out.boundary_param.assign(out.material.size(), -1.0);

@@ -17,8 +17,8 @@ struct RemeshOptions {
 };
 
 struct RemeshedPiece {
-  std::vector<Vec2> material;                      // material coordinates (m)
-  std::vector<std::array<int32_t, 3>> triangles;   // counter-clockwise
+  std::vector<Vec2> material;                     // material coordinates (m)
+  std::vector<std::array<int32_t, 3>> triangles;  // counter-clockwise
   std::vector<double> boundary_param;  // -1 interior; else outline parameter i + f on segment i
   std::vector<int> vertex_label;       // -1 interior; else the label of its outline segment
   double min_angle_deg = 0;            // smallest triangle angle

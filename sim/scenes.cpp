@@ -1,8 +1,14 @@
 #include "sim/scenes.hpp"
 
 #include <cmath>
+#include <functional>
 
+#include <random>
+
+#include "sim/cut.hpp"
 #include "sim/dress_form.hpp"
+#include "sim/solver_factory.hpp"
+#include "sim/watchdog.hpp"
 
 namespace drape::sim {
 
@@ -174,6 +180,92 @@ double elastica_rigidity_for_drop(double l, double q, double tip_drop) {
       hi = mid;  // softer drops more
   }
   return std::exp(0.5 * (lo + hi));
+}
+
+const std::vector<std::string>& stress_case_names() {
+  static const std::vector<std::string> names{"large_dt", "stiffness_ratio", "jerk", "cuts",
+                                              "crush"};
+  return names;
+}
+
+StressResult run_stress_case(const std::string& name, const std::string& solver, int scale) {
+  StressResult r;
+  scale = std::max(scale, 1);
+  SolverConfig cfg;
+  auto made = make_solver(solver, cfg);
+  if (!made) {
+    r.note = made.error();
+    r.failures = 1;
+    return r;
+  }
+  std::unique_ptr<Solver> s = std::move(*made);
+  StudyScene sc;
+  double dt = 1.0 / 90;
+  int steps = 60 * scale;
+  std::function<void(int)> before = [](int) {};
+  if (name == "large_dt") {
+    sc = make_hanging_sheet(12 + 8 * scale);
+    dt = 1.0 / 30;
+  } else if (name == "stiffness_ratio") {
+    FabricParams f;
+    f.stretch_warp = 1e4;
+    f.stretch_weft = 1e4;
+    f.shear = 1.0;  // 1e4 : 1
+    sc = make_hanging_sheet(12 + 8 * scale, f);
+  } else if (name == "jerk") {
+    sc = make_hanging_sheet(12 + 8 * scale);
+    const int n = sc.cloth.topo.grid_nx;
+    const int corner = n * n - 1;
+    before = [&sc, corner, dt](int k) {
+      auto& S = sc.cloth.state;
+      if (k < 20) S.x[corner] += Vec3(10.0 * dt, 0, 0);  // 10 m/s for 20 frames
+    };
+  } else if (name == "cuts") {
+    sc = make_hanging_sheet(24 + 24 * scale);
+    const int cuts = scale > 1 ? 100 : 20;
+    steps = cuts * 3;
+    auto rng = std::make_shared<std::mt19937>(12345);
+    before = [&sc, rng, &r](int k) {
+      if (k % 3 != 0) return;
+      std::uniform_real_distribution<double> u(0.02, 0.48);
+      std::vector<Vec2> stroke{Vec2(u(*rng), u(*rng)), Vec2(u(*rng), u(*rng))};
+      CutResult c = cut_along_material(sc.cloth, stroke);
+      if (!c.ok && r.note.empty()) r.note = "a cut was refused: " + c.reason;
+      for (int i = static_cast<int>(sc.cloth.state.v.size()); i < sc.cloth.num_vertices(); ++i)
+        sc.cloth.state.v.push_back(Vec3::Zero());
+    };
+  } else if (name == "crush") {
+    sc = make_form_drape(12 + 8 * scale);
+    // A plate rises under the form's bottom into it, squeezing the cloth's lower part.
+    Plate p;
+    p.half_x = p.half_z = 0.4;
+    const double y0 = sc.objects.form ? sc.objects.form->min_y() - 0.05 : 0.55;
+    p.centre = Vec3(0, y0, 0);
+    sc.objects.plates.push_back(p);
+    before = [&sc, y0, dt](int k) {
+      sc.objects.plates[0].centre.y() = y0 + std::min(0.15, 0.5 * dt * k);
+    };
+  } else {
+    r.note = "unknown stress case '" + name + "'";
+    r.failures = 1;
+    return r;
+  }
+  for (int k = 0; k < steps; ++k) {
+    before(k);
+    StepStats st = s->step(sc.cloth, sc.objects, dt);
+    r.rollbacks += st.retries;
+    ++r.steps;
+    bool ok = cloth_finite(sc.cloth);
+    double ke = 0, m = 0;
+    for (int i = 0; ok && i < sc.cloth.num_vertices(); ++i) {
+      if (sc.cloth.state.x[i].norm() > 10.0) ok = false;
+      ke += 0.5 * sc.cloth.state.mass[i] * sc.cloth.state.v[i].squaredNorm();
+      m += sc.cloth.state.mass[i];
+    }
+    if (!ok || ke > 1e3 * m) ++r.failures;
+  }
+  r.vertices = sc.cloth.num_vertices();
+  return r;
 }
 
 void position_error(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double& rms,

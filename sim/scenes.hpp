@@ -47,6 +47,22 @@ Vec2 elastica_tip(double l, double B, double q, int steps = 2000);
 // The rigidity B for which the elastica's tip drops by `tip_drop` (bisection on log B).
 double elastica_rigidity_for_drop(double l, double q, double tip_drop);
 
+// Stress cases (issue 3, item 7), shared by tests/sim/stress_test.cpp and bench/stress_bench:
+// "large_dt" (dt = 1/30 s), "stiffness_ratio" (warp/shear = 1e4), "jerk" (a pinned vertex
+// jerked at 10 m/s), "cuts" (random cuts on a dense cloth), "crush" (cloth between the form and
+// a rising plate). `scale` 1 = test size, larger = benchmark size (more steps, cuts, vertices).
+// A step fails when, after the solver (with its watchdog), a position is non-finite, a vertex
+// is beyond 10 m, or the kinetic energy exceeds 1e3 J/kg.
+struct StressResult {
+  int steps = 0;
+  int failures = 0;
+  int rollbacks = 0;  // watchdog retries
+  int vertices = 0;
+  std::string note;
+};
+StressResult run_stress_case(const std::string& name, const std::string& solver, int scale);
+const std::vector<std::string>& stress_case_names();
+
 // RMS and max vertex distance (m) between two position arrays of equal size.
 void position_error(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double& rms,
                     double& max);

@@ -27,8 +27,8 @@ void tie_seams(Garment& g, const std::vector<int>& a, std::vector<int> b) {
     const std::vector<double> sp = arc_params(g, p), sq = arc_params(g, q);
     for (size_t i = 0; i < p.size(); ++i) {
       const size_t k = std::min<size_t>(
-          q.size() - 2,
-          static_cast<size_t>(std::max<long>(0, std::upper_bound(sq.begin(), sq.end(), sp[i]) - sq.begin() - 1)));
+          q.size() - 2, static_cast<size_t>(std::max<long>(
+                            0, std::upper_bound(sq.begin(), sq.end(), sp[i]) - sq.begin() - 1)));
       const double span = sq[k + 1] - sq[k];
       const double t = span > 0 ? std::clamp((sp[i] - sq[k]) / span, 0.0, 1.0) : 0.0;
       if (p[i] == q[k] || p[i] == q[k + 1]) continue;
@@ -48,7 +48,8 @@ Result<Garment> sew_garment(const std::vector<SewInput>& right, const MappingSur
   std::vector<std::array<std::vector<int>, 2>> ids(right.size());
   for (size_t p = 0; p < right.size(); ++p) {
     const SewInput& in = right[p];
-    if (!in.piece || !in.mesh || !in.panel) return Error{"sew: piece " + std::to_string(p) + " incomplete"};
+    if (!in.piece || !in.mesh || !in.panel)
+      return Error{"sew: piece " + std::to_string(p) + " incomplete"};
     const RemeshedPiece& m = *in.mesh;
     const std::string centre = in.piece->labels.empty() ? "" : in.piece->labels.back();
     std::vector<int> centre_vs;
@@ -98,7 +99,8 @@ Result<Garment> sew_garment(const std::vector<SewInput>& right, const MappingSur
         g.seams.push_back(g.piece_names[pid] + ": " + l + " + " + l2);
       }
     }
-    if (!centre_vs.empty()) g.seams.push_back(in.piece->name + ": centre seam (mirror, identified)");
+    if (!centre_vs.empty())
+      g.seams.push_back(in.piece->name + ": centre seam (mirror, identified)");
   }
   // Side seams: every pair of pieces with a "side" seam, on each half.
   for (size_t p = 0; p < right.size(); ++p)
@@ -147,7 +149,9 @@ double garment_girth(const Garment& g, const MappingSurface& surf, double y) {
   std::vector<Vec2> sum(bins, Vec2::Zero());
   std::vector<int> cnt(bins, 0);
   for (const auto& p : pts) {
-    const int b = std::clamp(static_cast<int>((p.first + 3.141592653589793) / (2 * 3.141592653589793) * bins), 0, bins - 1);
+    const int b =
+        std::clamp(static_cast<int>((p.first + 3.141592653589793) / (2 * 3.141592653589793) * bins),
+                   0, bins - 1);
     sum[b] += p.second;
     ++cnt[b];
   }

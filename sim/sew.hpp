@@ -28,8 +28,8 @@ struct Garment {
   std::vector<int> vertex_piece;         // index into piece_names
   std::vector<std::string> piece_names;  // "Front (right)", "Front (left)", ...
   std::vector<SeamTie> ties;
-  int merged_vertices = 0;               // vertices identified on mirrored centre seams
-  std::vector<std::string> seams;        // human-readable list of the joins made
+  int merged_vertices = 0;         // vertices identified on mirrored centre seams
+  std::vector<std::string> seams;  // human-readable list of the joins made
 };
 
 struct SewOptions {

@@ -12,13 +12,14 @@
 namespace {
 
 void usage() {
-  std::fprintf(stderr,
-               "usage: drape pattern --design NAME|FILE.json [--form 9AR|FILE.json] [--out DIR]\n"
-               "                     [--ease MM] [--seam-allowance MM] [--spacing MM]\n"
-               "                     [--relax-iterations N] [--static-solver] [--no-grain-control]\n"
-               "Drapes the design's panels on the form, extracts the pattern, sews the garment and\n"
-               "writes pattern.svg, pattern.dxf, pattern_a4.pdf, pattern_letter.pdf,\n"
-               "draped_panels.gltf, garment.gltf and report.json into DIR (out/pattern/).\n");
+  std::fprintf(
+      stderr,
+      "usage: drape pattern --design NAME|FILE.json [--form 9AR|FILE.json] [--out DIR]\n"
+      "                     [--ease MM] [--seam-allowance MM] [--spacing MM]\n"
+      "                     [--relax-iterations N] [--static-solver] [--no-grain-control]\n"
+      "Drapes the design's panels on the form, extracts the pattern, sews the garment and\n"
+      "writes pattern.svg, pattern.dxf, pattern_a4.pdf, pattern_letter.pdf,\n"
+      "draped_panels.gltf, garment.gltf and report.json into DIR (out/pattern/).\n");
 }
 
 bool parse_mm(const char* s, double* out) {
@@ -46,17 +47,21 @@ int run_pattern(int argc, char** argv) {
       out = argv[++i];
     } else if (a == "--ease" && has) {
       if (!parse_mm(argv[++i], &opt.ease)) {
-        std::fprintf(stderr, "drape pattern: --ease: expected millimetres within 0..1000, got '%s'\n", argv[i]);
+        std::fprintf(stderr,
+                     "drape pattern: --ease: expected millimetres within 0..1000, got '%s'\n",
+                     argv[i]);
         return 2;
       }
     } else if (a == "--seam-allowance" && has) {
       if (!parse_mm(argv[++i], &opt.seam_allowance)) {
-        std::fprintf(stderr, "drape pattern: --seam-allowance: expected millimetres, got '%s'\n", argv[i]);
+        std::fprintf(stderr, "drape pattern: --seam-allowance: expected millimetres, got '%s'\n",
+                     argv[i]);
         return 2;
       }
     } else if (a == "--spacing" && has) {
       if (!parse_mm(argv[++i], &opt.spacing) || opt.spacing <= 0) {
-        std::fprintf(stderr, "drape pattern: --spacing: expected positive millimetres, got '%s'\n", argv[i]);
+        std::fprintf(stderr, "drape pattern: --spacing: expected positive millimetres, got '%s'\n",
+                     argv[i]);
         return 2;
       }
     } else if (a == "--relax-iterations" && has) {
@@ -73,16 +78,16 @@ int run_pattern(int argc, char** argv) {
   }
   const std::string root = DRAPE_SOURCE_DIR;
   std::string design_path = design;
-  if (design_path.find('/') == std::string::npos &&
-      design_path.find(".json") == std::string::npos)
+  if (design_path.find('/') == std::string::npos && design_path.find(".json") == std::string::npos)
     design_path = root + "/assets/designs/" + design + ".json";
   auto d = drape::sim::load_design(design_path);
   if (!d) {
     std::fprintf(stderr, "drape pattern: %s\n", d.error().c_str());
     return 1;
   }
-  auto m = form_name.find(".json") != std::string::npos ? drape::sim::load_measurements(form_name)
-                                                        : drape::sim::measurements_for_size(form_name);
+  auto m = form_name.find(".json") != std::string::npos
+               ? drape::sim::load_measurements(form_name)
+               : drape::sim::measurements_for_size(form_name);
   if (!m) {
     std::fprintf(stderr, "drape pattern: --form: %s\n", m.error().c_str());
     return 1;
@@ -94,8 +99,10 @@ int run_pattern(int argc, char** argv) {
   }
   d->form = m->size;
   drape::sim::FabricParams fabric;
-  if (auto f = drape::sim::load_fabric(root + "/assets/fabrics.json", d->fabric)) fabric = *f;
-  else std::fprintf(stderr, "drape pattern: note: %s; using the default muslin\n", f.error().c_str());
+  if (auto f = drape::sim::load_fabric(root + "/assets/fabrics.json", d->fabric))
+    fabric = *f;
+  else
+    std::fprintf(stderr, "drape pattern: note: %s; using the default muslin\n", f.error().c_str());
   opt.out_dir = out;
   auto r = drape::sim::run_pattern_pipeline(*d, *form, fabric, opt);
   if (!r) {
@@ -106,8 +113,8 @@ int run_pattern(int argc, char** argv) {
   std::printf("design %s on form %s (ease %.1f mm), relaxation: %s\n", rep.design.c_str(),
               rep.form.c_str(), rep.ease_mm, rep.relax_backend.c_str());
   std::printf("  outline error before relaxation  %8.4f mm\n", rep.outline_error_before_relax_mm);
-  std::printf("  hip widths sum %.2f mm vs hip girth %.2f mm: error %+.3f mm\n", rep.hip_width_sum_mm,
-              rep.form_hip_girth_mm + rep.ease_mm, rep.hip_width_error_mm);
+  std::printf("  hip widths sum %.2f mm vs hip girth %.2f mm: error %+.3f mm\n",
+              rep.hip_width_sum_mm, rep.form_hip_girth_mm + rep.ease_mm, rep.hip_width_error_mm);
   std::printf("  waist widths - intakes %.2f mm vs waist girth %.2f mm: error %+.3f mm\n",
               rep.waist_width_minus_intakes_sum_mm, rep.form_waist_girth_mm + rep.ease_mm,
               rep.waist_width_error_mm);
@@ -122,12 +129,14 @@ int run_pattern(int argc, char** argv) {
                 rep.quarter_difference_mm, p.grain_after.max_tilt_near_darts_deg,
                 p.grain_after.max_kink_near_darts_deg);
   }
-  std::printf("  time: mapping+extraction %.1f ms, relax %.1f ms, remesh %.1f ms, sew %.1f ms, "
-              "export %.1f ms, pipeline %.1f ms\n",
-              rep.mapping_extraction_ms, rep.relax_ms, rep.remesh_ms, rep.sew_ms, rep.export_ms,
-              rep.pipeline_ms);
+  std::printf(
+      "  time: mapping+extraction %.1f ms, relax %.1f ms, remesh %.1f ms, sew %.1f ms, "
+      "export %.1f ms, pipeline %.1f ms\n",
+      rep.mapping_extraction_ms, rep.relax_ms, rep.remesh_ms, rep.sew_ms, rep.export_ms,
+      rep.pipeline_ms);
   std::printf("  wrote %s/{", out.c_str());
-  for (size_t i = 0; i < rep.files.size(); ++i) std::printf("%s%s", i ? "," : "", rep.files[i].c_str());
+  for (size_t i = 0; i < rep.files.size(); ++i)
+    std::printf("%s%s", i ? "," : "", rep.files[i].c_str());
   std::printf("}\n");
   return 0;
 }

@@ -149,15 +149,19 @@ TEST(Cut, NoisyHandStrokeIn3D) {
   EXPECT_EQ(count_components(c), 2);
   EXPECT_GE(r.smooth_stroke.size(), 2u);
   EXPECT_EQ(r.smooth_stroke.size(), r.smooth_stroke_uv.size());
-  // The smooth stroke in material space follows the drawn line (x = u on this flat cloth).
-  double worst = 0;
-  for (size_t i = 0; i < r.smooth_stroke_uv.size(); ++i) {
-    const Vec2 q = r.smooth_stroke_uv[i];
-    worst = std::max(worst, std::abs(q.y() - (0.23 + 0.05 * q.x())));
-  }
-  std::printf("3D stroke: smooth outline deviates %.2f mm from the line (noise 3 mm)\n",
-              worst * 1e3);
-  EXPECT_LT(worst, 0.006);
+  // The smooth stroke in material space follows the drawn line (x = u on this flat cloth)
+  // closer than the raw noisy samples do.
+  auto rms_dev = [](const std::vector<Vec2>& pts) {
+    double s = 0;
+    for (const Vec2& q : pts) s += std::pow(q.y() - (0.23 + 0.05 * q.x()), 2);
+    return std::sqrt(s / pts.size());
+  };
+  std::vector<Vec2> raw;
+  for (const Vec3& p : stroke) raw.emplace_back(p.x(), p.y());
+  const double smooth = rms_dev(r.smooth_stroke_uv), noisy = rms_dev(raw);
+  std::printf("3D stroke: RMS deviation from the drawn line %.2f mm raw, %.2f mm smoothed\n",
+              noisy * 1e3, smooth * 1e3);
+  EXPECT_LT(smooth, 0.7 * noisy);
   expect_material_kept(c, r);
 }
 

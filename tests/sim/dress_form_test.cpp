@@ -1,5 +1,6 @@
 // The section model: parametric girths, O(1) collision vs analytic, interpolation, landmarks.
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <cstdio>
@@ -92,10 +93,17 @@ TEST(DressForm, ParametricShapeIsTorsoLike) {
     EXPECT_GE(g, 0.64 - 1e-6);
     EXPECT_LE(g, 0.91 + 1e-6);
   }
-  // Smooth along the height: no jump between neighbouring sections above 3 mm of girth.
-  for (int j = 0; j + 1 < f->num_sections(); ++j)
-    EXPECT_LT(std::abs(f->girth_at(f->section_y(j + 1)) - f->girth_at(f->section_y(j))), 0.003)
-        << "at section " << j;
+  // Smooth along the height: the second difference of the girth between neighbouring sections
+  // (2.5 mm apart) stays small from the bottom to the armpit (above it the shoulders narrow
+  // quickly into the neck).
+  double worst = 0;
+  for (int j = 1; j + 1 < f->num_sections() && f->section_y(j) < lm.bust_y + 0.06; ++j) {
+    const double d2 = f->girth_at(f->section_y(j + 1)) - 2 * f->girth_at(f->section_y(j)) +
+                      f->girth_at(f->section_y(j - 1));
+    worst = std::max(worst, std::abs(d2));
+  }
+  std::printf("largest girth second difference below the armpit: %.3f mm\n", worst * 1e3);
+  EXPECT_LT(worst, 0.0015);  // a kink (slope jump at a knot) would give several mm
 }
 
 TEST(DressForm, GirthOfCircleIsPolygonPerimeter) {

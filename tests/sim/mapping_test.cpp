@@ -1,12 +1,13 @@
 // Mapping along the grain (method §2.4-2.5): arc length kept along every section, centre line
 // on centre front, the hip shape below the hip, ease as an offset, and the dart intake.
+#include "sim/mapping.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 
 #include "sim/dress_form.hpp"
-#include "sim/mapping.hpp"
 
 using namespace drape::sim;
 
@@ -58,7 +59,8 @@ TEST(Mapping, GeneralMappingKeepsWeftLengthAndGrain) {
     const Vec3 cf = x[j * p->nx];
     worst_cf = std::max(worst_cf, std::abs(cf.x() - s.centre(cf.y()).x()));
     // Eq. 2-1: height from the top edge.
-    worst_y = std::max(worst_y, std::abs(cf.y() - (lm.waist_y + d.top_above_waist - (d.height - j * p->dy))));
+    worst_y = std::max(
+        worst_y, std::abs(cf.y() - (lm.waist_y + d.top_above_waist - (d.height - j * p->dy))));
     // Weft neighbours are at most one spacing apart and not much closer (chords of the arc).
     for (int i = 0; i + 1 < p->nx; ++i) {
       const double len = (x[j * p->nx + i + 1] - x[j * p->nx + i]).norm();
@@ -83,7 +85,8 @@ TEST(Mapping, HipShapeBelowHipAndEase) {
     EXPECT_NEAR(s.radius(hip - 0.2, th), s.radius(hip, th), 1e-12);
   const MappingSurface s0(form);
   const double g0 = s0.girth(hip), g1 = s.girth(hip);
-  std::printf("ease 50 mm: girth %.3f -> %.3f mm (+%.3f)\n", g0 * 1000, g1 * 1000, (g1 - g0) * 1000);
+  std::printf("ease 50 mm: girth %.3f -> %.3f mm (+%.3f)\n", g0 * 1000, g1 * 1000,
+              (g1 - g0) * 1000);
   EXPECT_NEAR(g1 - g0, 0.05, 0.0005);
 }
 

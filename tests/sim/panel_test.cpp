@@ -1,10 +1,11 @@
 // Panel with dart slits (method §2.3): node duplication, zones, validation errors by field.
+#include "sim/panel.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
 
 #include "sim/dress_form.hpp"
-#include "sim/panel.hpp"
 
 using namespace drape::sim;
 
@@ -58,7 +59,8 @@ TEST(Panel, GridAndSlitDuplication) {
   // The slit is open: the twin nodes are not joined by any triangle edge to the far side twin.
   double area = 0;
   for (const auto& tri : t.triangles) {
-    const Vec2 e1 = t.material[tri[1]] - t.material[tri[0]], e2 = t.material[tri[2]] - t.material[tri[0]];
+    const Vec2 e1 = t.material[tri[1]] - t.material[tri[0]],
+               e2 = t.material[tri[2]] - t.material[tri[0]];
     const double a = 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
     EXPECT_GT(a, 0);  // counter-clockwise
     area += a;
@@ -92,7 +94,8 @@ TEST(Panel, BadInputNamesTheField) {
     auto p = build_panel(d, FabricParams{}, "front.panel");
     ASSERT_FALSE(p.ok());
     std::printf("%s\n", p.error().c_str());
-    EXPECT_NE(p.error().find("front.panel.slits[1].position: overlapping slits"), std::string::npos);
+    EXPECT_NE(p.error().find("front.panel.slits[1].position: overlapping slits"),
+              std::string::npos);
   }
   {
     PanelDesign d = two_darts();
@@ -100,7 +103,8 @@ TEST(Panel, BadInputNamesTheField) {
     auto p = build_panel(d, FabricParams{}, "front.panel");
     ASSERT_FALSE(p.ok());
     std::printf("%s\n", p.error().c_str());
-    EXPECT_NE(p.error().find("front.panel.slits[0].position: slit off the panel"), std::string::npos);
+    EXPECT_NE(p.error().find("front.panel.slits[0].position: slit off the panel"),
+              std::string::npos);
   }
   {
     PanelDesign d = two_darts();

@@ -1,6 +1,8 @@
 // End-to-end tight skirt (issue 4 "Must show"): outline before relaxation equals the flat panel
 // region, hip/waist widths against the form's girths, piece area against draped area, sewn
 // garment girth at the hip, and bad design input named by field.
+#include "sim/pattern_pipeline.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -8,7 +10,6 @@
 #include <nlohmann/json.hpp>
 
 #include "sim/dress_form.hpp"
-#include "sim/pattern_pipeline.hpp"
 
 using namespace drape::sim;
 
@@ -34,11 +35,12 @@ void check_must_show(double ease_m) {
   auto r = run_pattern_pipeline(*d, form, FabricParams{}, opt);
   ASSERT_TRUE(r.ok()) << r.error();
   const PipelineReport& rep = r->report;
-  std::printf("ease %.1f mm: outline error before relax %.5f mm, hip error %+.3f mm, waist error "
-              "%+.3f mm, area error %.3f %%, garment hip girth error %+.3f %% (%s), %.0f ms\n",
-              ease_m * 1000, rep.outline_error_before_relax_mm, rep.hip_width_error_mm,
-              rep.waist_width_error_mm, rep.area_error_pct, rep.garment_hip_girth_error_pct,
-              rep.relax_backend.c_str(), rep.pipeline_ms);
+  std::printf(
+      "ease %.1f mm: outline error before relax %.5f mm, hip error %+.3f mm, waist error "
+      "%+.3f mm, area error %.3f %%, garment hip girth error %+.3f %% (%s), %.0f ms\n",
+      ease_m * 1000, rep.outline_error_before_relax_mm, rep.hip_width_error_mm,
+      rep.waist_width_error_mm, rep.area_error_pct, rep.garment_hip_girth_error_pct,
+      rep.relax_backend.c_str(), rep.pipeline_ms);
   EXPECT_LT(rep.outline_error_before_relax_mm, 0.05);
   EXPECT_NEAR(rep.hip_width_error_mm, 0.0, 2.0);
   EXPECT_NEAR(rep.waist_width_error_mm, 0.0, 2.0);
@@ -57,9 +59,13 @@ void check_must_show(double ease_m) {
 
 }  // namespace
 
-TEST(PatternPipeline, TightSkirtMustShow) { check_must_show(0.0); }
+TEST(PatternPipeline, TightSkirtMustShow) {
+  check_must_show(0.0);
+}
 
-TEST(PatternPipeline, TightSkirtWithEase) { check_must_show(0.04); }
+TEST(PatternPipeline, TightSkirtWithEase) {
+  check_must_show(0.04);
+}
 
 TEST(PatternPipeline, WritesReportAndFiles) {
   const DressForm form = form9();
@@ -73,9 +79,9 @@ TEST(PatternPipeline, WritesReportAndFiles) {
   std::ifstream f(opt.out_dir + "/report.json");
   ASSERT_TRUE(f.good());
   const auto j = nlohmann::json::parse(f);
-  for (const char* k : {"hip_width_error_mm", "waist_width_error_mm", "area_error_pct",
-                        "garment_hip_girth_error_pct", "outline_error_before_relax_mm",
-                        "pipeline_ms"})
+  for (const char* k :
+       {"hip_width_error_mm", "waist_width_error_mm", "area_error_pct",
+        "garment_hip_girth_error_pct", "outline_error_before_relax_mm", "pipeline_ms"})
     EXPECT_TRUE(j.contains(k) && j[k].is_number()) << k;
   EXPECT_DOUBLE_EQ(j["hip_width_error_mm"].get<double>(), r->report.hip_width_error_mm);
   for (const char* file : {"pattern.svg", "pattern.dxf", "pattern_a4.pdf", "pattern_letter.pdf",
@@ -95,7 +101,8 @@ TEST(PatternPipeline, BadDesignNamesTheField) {
     auto d = parse_design(b.dump(), "bad.json");
     ASSERT_FALSE(d.ok());
     std::printf("%s\n", d.error().c_str());
-    EXPECT_NE(d.error().find("bad.json: pieces[1].side_line: unknown line 'rigth_side'"), std::string::npos);
+    EXPECT_NE(d.error().find("bad.json: pieces[1].side_line: unknown line 'rigth_side'"),
+              std::string::npos);
   }
   {
     auto b = j;
@@ -122,7 +129,8 @@ TEST(PatternPipeline, BadDesignNamesTheField) {
     auto r = run_pattern_pipeline(*d, form, FabricParams{});
     ASSERT_FALSE(r.ok());
     std::printf("%s\n", r.error().c_str());
-    EXPECT_NE(r.error().find("pieces[0].panel.width: panel larger than the form"), std::string::npos);
+    EXPECT_NE(r.error().find("pieces[0].panel.width: panel larger than the form"),
+              std::string::npos);
   }
   {
     auto d = parse_design("{\"pieces\": 3", "broken.json");

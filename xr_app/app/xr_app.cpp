@@ -470,8 +470,8 @@ bool App::create_session() {
   xrEnumerateSwapchainFormats(session_, 0, &nf, nullptr);
   std::vector<int64_t> formats(nf);
   xrEnumerateSwapchainFormats(session_, nf, &nf, formats.data());
-  format_ = formats.empty() ? VK_FORMAT_R8G8B8A8_SRGB : formats[0];
-  for (int64_t want : {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_B8G8R8A8_SRGB}) {
+  format_ = formats.empty() ? int64_t{VK_FORMAT_R8G8B8A8_SRGB} : formats[0];
+  for (int64_t want : {int64_t{VK_FORMAT_R8G8B8A8_SRGB}, int64_t{VK_FORMAT_B8G8R8A8_SRGB}}) {
     bool found = false;
     for (int64_t f : formats) found = found || f == want;
     if (found) {

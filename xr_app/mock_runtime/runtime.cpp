@@ -698,8 +698,8 @@ XrResult XRAPI_CALL LocateViews(XrSession h, const XrViewLocateInfo* info, XrVie
 void fire_scenario_events(Session* s, Instance* inst, int64_t frame) {
   for (size_t i = 0; i < inst->scenario.events.size(); ++i) {
     const ScriptedEvent& e = inst->scenario.events[i];
-    if (e.frame > frame || s->fired_events.count(i)) continue;
-    s->fired_events.insert(i);
+    if (e.frame > frame || inst->fired_events.count(i)) continue;
+    inst->fired_events.insert(i);
     if (e.type == "session_loss") {
       log("scripted session loss at frame %lld", static_cast<long long>(frame));
       queue_state(s, XR_SESSION_STATE_LOSS_PENDING);

@@ -130,7 +130,6 @@ struct Session : Object {
   XrPath profile[2] = {XR_NULL_PATH, XR_NULL_PATH};
   bool profile_event_sent = false;
   bool synced_once = false;
-  std::set<size_t> fired_events;  // scenario events already fired
 };
 
 struct Instance : Object {
@@ -154,6 +153,7 @@ struct Instance : Object {
   int64_t frames_with_layers = 0;
   int64_t frames_written = 0;
   bool suggested_any = false;
+  std::set<size_t> fired_events;  // scenario events already fired (once per instance)
   std::map<XrPath, std::set<uint64_t>> suggested_profiles;  // profile -> actions
 };
 

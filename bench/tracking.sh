@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# ./drape bench tracking: One-Euro jitter vs lag and Kinect pipeline fps on one core.
+set -euo pipefail
+ROOT="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
+cd "$ROOT"
+BUILD="${DRAPE_BUILD_DIR:-build}"
+mkdir -p out/bench
+if command -v taskset > /dev/null; then
+  exec taskset -c 0 "$BUILD/bin/tracking_bench"
+fi
+exec "$BUILD/bin/tracking_bench"

@@ -1,0 +1,156 @@
+// Mesh I/O through assimp: round trips, node transforms, bad files.
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "sim/cloth.hpp"
+#include "sim/mesh_io.hpp"
+
+namespace drape::sim {
+namespace {
+
+std::filesystem::path tmp_dir() {
+  const auto dir = std::filesystem::path(DRAPE_BINARY_DIR) / "test_tmp" / "mesh_io";
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+std::string write_text(const std::string& name, const std::string& text) {
+  const auto p = tmp_dir() / name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p.string();
+}
+
+TriMesh tetra(const std::string& name, Vec3 shift) {
+  TriMesh m;
+  m.name = name;
+  m.vertices = {Vec3(0, 0, 0) + shift, Vec3(1, 0, 0) + shift, Vec3(0, 1, 0) + shift,
+                Vec3(0, 0, 1) + shift};
+  m.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  m.uv = {Vec2(0, 0), Vec2(1, 0), Vec2(0, 1), Vec2(0.5, 0.5)};
+  return m;
+}
+
+TEST(MeshIo, RoundTripGltfGlbObj) {
+  const std::vector<TriMesh> meshes = {tetra("a", Vec3(0, 0, 0)), tetra("b", Vec3(2, 0.5, -1))};
+  for (const char* ext : {".gltf", ".glb", ".obj"}) {
+    const std::string path = (tmp_dir() / (std::string("two") + ext)).string();
+    const std::string err = write_meshes(path, meshes);
+    ASSERT_EQ(err, "") << err;
+    auto back = load_mesh(path);
+    ASSERT_TRUE(back.ok()) << back.error();
+    EXPECT_EQ(back->triangles.size(), 8u) << ext;
+    EXPECT_EQ(back->vertices.size(), 8u) << ext;
+    // Every written vertex is found in the file read back (float precision).
+    for (const auto& m : meshes) {
+      for (const Vec3& v : m.vertices) {
+        double best = 1e9;
+        for (const Vec3& w : back->vertices) best = std::min(best, (v - w).norm());
+        EXPECT_LT(best, 1e-6) << ext;
+      }
+    }
+    if (std::string(ext) != ".obj") {
+      ASSERT_EQ(back->uv.size(), back->vertices.size()) << ext;
+    }
+    // Triangle orientation survives: total signed volume of the two tetrahedra.
+    double vol = 0;
+    for (const auto& t : back->triangles)
+      vol += back->vertices[t[0]].dot(back->vertices[t[1]].cross(back->vertices[t[2]])) / 6.0;
+    EXPECT_NEAR(vol, 2.0 / 6.0, 1e-6) << ext;
+  }
+}
+
+TEST(MeshIo, WriteErrors) {
+  EXPECT_NE(write_meshes((tmp_dir() / "x.fbx").string(), {tetra("a", Vec3::Zero())}), "");
+  EXPECT_NE(write_meshes((tmp_dir() / "x.gltf").string(), {}), "");
+  TriMesh bad = tetra("bad", Vec3::Zero());
+  bad.triangles.push_back({0, 1, 7});
+  EXPECT_NE(write_meshes((tmp_dir() / "x.gltf").string(), {bad}), "");
+  TriMesh nan = tetra("nan", Vec3::Zero());
+  nan.vertices[1].x() = std::nan("");
+  EXPECT_NE(write_meshes((tmp_dir() / "x.obj").string(), {nan}), "");
+}
+
+TEST(MeshIo, NodeTransformsApplied) {
+  // A glTF whose node translates a triangle by (1, 2, 3) and scales it by 2; the buffer
+  // (3 float32 positions + 3 uint16 indices + 2 pad bytes) is embedded as base64.
+  const std::string gltf = R"({
+  "asset": {"version": "2.0"},
+  "scene": 0, "scenes": [{"nodes": [0]}],
+  "nodes": [{"mesh": 0, "translation": [1, 2, 3], "scale": [2, 2, 2]}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+  "buffers": [{"byteLength": 44, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA="}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                  {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [1, 1, 0]},
+                {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]
+})";
+  auto m = load_mesh(write_text("node.gltf", gltf));
+  ASSERT_TRUE(m.ok()) << m.error();
+  ASSERT_EQ(m->vertices.size(), 3u);
+  ASSERT_EQ(m->triangles.size(), 1u);
+  EXPECT_TRUE(m->vertices[0].isApprox(Vec3(1, 2, 3)));
+  EXPECT_TRUE(m->vertices[1].isApprox(Vec3(3, 2, 3)));
+  EXPECT_TRUE(m->vertices[2].isApprox(Vec3(1, 4, 3)));
+}
+
+void expect_load_error(const std::string& path, const char* what) {
+  auto m = load_mesh(path);
+  ASSERT_FALSE(m.ok()) << what;
+  std::printf("%s -> %s\n", what, m.error().c_str());
+  EXPECT_NE(m.error().find(path), std::string::npos) << m.error();
+}
+
+TEST(MeshIo, BadFiles) {
+  expect_load_error((tmp_dir() / "does_not_exist.obj").string(), "missing");
+  expect_load_error(write_text("empty.obj", ""), "empty");
+  expect_load_error(write_text("prose.obj", "This is not a mesh.\nJust some words.\n"),
+                    "text .obj");
+  expect_load_error(write_text("prose.stl", "This is not a mesh at all, only text here...\n"),
+                    "text .stl");
+  expect_load_error(write_text("prose.ply", "hello world\n"), "text .ply");
+  expect_load_error(write_text("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"), "no faces");
+  expect_load_error(write_text("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"),
+                    "NaN vertex");
+  expect_load_error(tmp_dir().string(), "directory");
+  // Truncated binary files written from a valid one.
+  const std::string glb = (tmp_dir() / "t.glb").string();
+  ASSERT_EQ(write_meshes(glb, {tetra("t", Vec3::Zero())}), "");
+  std::ifstream in(glb, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_GT(bytes.size(), 40u);
+  expect_load_error(write_text("truncated.glb", bytes.substr(0, bytes.size() / 2)),
+                    "truncated glb");
+  // From memory too.
+  auto mm = load_mesh_from_memory(bytes.data(), bytes.size() / 2, "glb", "mem.glb");
+  ASSERT_FALSE(mm.ok());
+  EXPECT_NE(mm.error().find("mem.glb"), std::string::npos);
+  auto ok = load_mesh_from_memory(bytes.data(), bytes.size(), "glb", "mem.glb");
+  ASSERT_TRUE(ok.ok()) << ok.error();
+  EXPECT_EQ(ok->triangles.size(), 4u);
+}
+
+TEST(MeshIo, ClothToMesh) {
+  Cloth c;
+  c.topo.material = {Vec2(0, 0), Vec2(0.1, 0), Vec2(0, 0.1), Vec2(0.1, 0.1)};
+  c.topo.triangles = {{0, 1, 3}, {0, 3, 2}};
+  c.state.x = {Vec3(0, 1, 0), Vec3(0.1, 1, 0), Vec3(0, 1.1, 0), Vec3(0.1, 1.1, 0.01)};
+  TriMesh m = cloth_to_mesh(c, "panel");
+  EXPECT_EQ(m.name, "panel");
+  EXPECT_EQ(m.vertices, c.state.x);
+  EXPECT_EQ(m.triangles, c.topo.triangles);
+  EXPECT_EQ(m.uv, c.topo.material);
+  const std::string path = (tmp_dir() / "cloth.gltf").string();
+  ASSERT_EQ(write_meshes(path, {m}), "");
+  auto back = load_mesh(path);
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back->triangles.size(), 2u);
+  ASSERT_EQ(back->uv.size(), 4u);
+}
+
+}  // namespace
+}  // namespace drape::sim

@@ -1,0 +1,120 @@
+// Vertex Block Descent: chain support force, convergence to the Newton reference on the
+// hanging sheet, cantilever rigidity, colouring validity, freezing, form contact.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "sim/parallel.hpp"
+#include "sim/scenes.hpp"
+#include "sim/solver_newton.hpp"
+#include "sim/solver_vbd.hpp"
+#include "sim/dress_form.hpp"
+
+using namespace drape::sim;
+
+TEST(Vbd, ColouringSeparatesNeighbours) {
+  StudyScene sc = make_hanging_sheet(12);
+  ClothEnergy e;
+  e.build(sc.cloth, EnergyOptions{});
+  std::vector<int> off, nb, col, coff, items;
+  e.vertex_neighbours(off, nb);
+  const int nc = greedy_colouring(off, nb, col, coff, items);
+  std::printf("%d colours for %d vertices\n", nc, sc.cloth.num_vertices());
+  EXPECT_LE(nc, 16);
+  for (int i = 0; i < sc.cloth.num_vertices(); ++i)
+    for (int k = off[i]; k < off[i + 1]; ++k) EXPECT_NE(col[i], col[nb[k]]);
+}
+
+TEST(Vbd, ChainSupportForceEqualsTotalWeight) {
+  StudyScene sc = make_chain(20, 1.0, 1e5);
+  VbdOptions o;
+  o.energy.model = EnergyOptions::Model::kSprings;
+  o.substeps = 4;
+  o.iterations = 50;
+  o.tolerance = 1e-9;
+  VbdSolver s(o);
+  for (int k = 0; k < 400; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  const auto& x = sc.cloth.state.x;
+  const double support = 1e5 * ((x[0] - x[1]).norm() - 0.1) + kGravity;
+  std::printf("VBD chain: support %.4f N vs weight %.4f N (%.3f %%)\n", support, 20 * kGravity,
+              100 * (support / (20 * kGravity) - 1));
+  EXPECT_NEAR(support / (20 * kGravity), 1.0, 0.01);
+}
+
+TEST(Vbd, HangingSheetConvergesToNewtonReference) {
+  StudyScene ref = make_hanging_sheet(12);
+  StaticOptions so;
+  so.tolerance = 1e-9;
+  relax_static(ref.cloth, ref.objects, so);
+  StudyScene sc = make_hanging_sheet(12);
+  VbdOptions o;
+  o.substeps = 2;
+  o.iterations = 20;
+  o.damping = 0.01;
+  VbdSolver s(o);
+  for (int k = 0; k < 450; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  double rms, mx;
+  position_error(sc.cloth.state.x, ref.cloth.state.x, rms, mx);
+  std::printf("VBD sheet after 5 s vs static Newton: rms %.3f mm, max %.3f mm\n", rms * 1e3,
+              mx * 1e3);
+  EXPECT_LT(rms, 2e-3);  // stated tolerance: 2 mm RMS on a 0.5 m sheet
+  EXPECT_LT(mx, 5e-3);
+}
+
+TEST(Vbd, CantileverRigidityWithinFivePercent) {
+  const FabricParams f;
+  const double c = std::cbrt(f.bending_warp / (f.areal_density * kGravity));
+  const double spacing = 2 * c / 12;
+  StudyScene sc = make_cantilever(2 * c, spacing, 0.01);
+  VbdOptions o;
+  o.substeps = 4;
+  o.iterations = 40;
+  o.damping = 0.02;
+  VbdSolver s(o);
+  for (int k = 0; k < 270; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  const int nx = sc.cloth.topo.grid_nx, ny = sc.cloth.topo.grid_ny;
+  double drop = 0;
+  for (int i = 0; i < nx; ++i) drop += 1.0 - sc.cloth.state.x[(ny - 1) * nx + i].y();
+  drop /= nx;
+  const double width = spacing * (nx - 1);
+  const double B = elastica_rigidity_for_drop(spacing * (ny - 3),
+                                              f.areal_density * kGravity * width, drop) / width;
+  std::printf("VBD cantilever: drop %.2f mm, B %.4e vs %.4e (%.2f %%)\n", drop * 1e3, B,
+              f.bending_warp, 100 * (B / f.bending_warp - 1));
+  EXPECT_NEAR(B / f.bending_warp, 1.0, 0.05);
+}
+
+TEST(Vbd, FormDrapeStaysOutsideTheForm) {
+  StudyScene sc = make_form_drape(16);
+  ASSERT_TRUE(sc.objects.form);
+  VbdSolver s;
+  double pen = 0;
+  for (int k = 0; k < 90; ++k) pen = std::max(pen, s.step(sc.cloth, sc.objects, 1.0 / 90).max_penetration);
+  double worst = 0;
+  for (const auto& p : sc.cloth.state.x)
+    worst = std::min(worst, sc.objects.form->signed_distance(p));
+  std::printf("deepest vertex inside the form after 1 s: %.3f mm (offset %.1f mm)\n",
+              -worst * 1e3, sc.objects.offset * 1e3);
+  EXPECT_GT(worst, -1e-3);
+}
+
+TEST(Vbd, FreezingSkipsRestingVerticesAndWakes) {
+  StudyScene sc = make_hanging_sheet(10);
+  VbdOptions o;
+  o.freeze = true;
+  o.damping = 0.02;
+  VbdSolver s(o);
+  for (int k = 0; k < 600; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  std::printf("frozen after rest: %d of %d\n", s.frozen_count(), sc.cloth.num_vertices());
+  EXPECT_GT(s.frozen_count(), sc.cloth.num_vertices() / 2);
+  // Move a pinned corner: neighbours wake and the cloth follows.
+  const Vec3 before = sc.cloth.state.x[0];
+  for (int k = 0; k < 45; ++k) {
+    sc.cloth.state.x[99] += Vec3(0.2 / 90, 0, 0);
+    s.step(sc.cloth, sc.objects, 1.0 / 90);
+  }
+  std::printf("bottom-left moved %.2f mm after the corner moved, frozen %d\n",
+              (sc.cloth.state.x[0] - before).norm() * 1e3, s.frozen_count());
+  EXPECT_LT(s.frozen_count(), sc.cloth.num_vertices() / 2);
+}
