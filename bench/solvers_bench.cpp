@@ -133,7 +133,7 @@ void write_svg(const std::vector<Row>& rows, const std::string& scene, int res,
 
 int main(int argc, char** argv) {
   bool quick = false;
-  int max_res = 128;
+  int max_res = 64;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--quick")) quick = true;
     if (!std::strcmp(argv[i], "--max-res") && i + 1 < argc) max_res = std::atoi(argv[++i]);
@@ -149,9 +149,12 @@ int main(int argc, char** argv) {
                            {"vbd", 4, 10},   {"vbd", 4, 20},   {"xpbd", 5, 1},   {"xpbd", 10, 1},
                            {"xpbd", 20, 1},  {"xpbd", 40, 1},  {"newton", 1, 20}, {"newton", 2, 20},
                            {"verlet", 0, 1}};
-  std::vector<Job> jobs{{"chain", 20, full}, {"sheet", 16, full}, {"sheet", 32, full},
-                        {"sphere", 32, full}, {"form", 32, full}};
+  std::vector<Job> jobs{{"chain", 20, full}, {"sheet", 16, full}, {"form", 32, full}};
+  if (quick && max_res >= 128)
+    jobs.push_back({"form", 128, {{"vbd", 1, 5}, {"vbd", 2, 5}, {"vbd", 2, 10}, {"xpbd", 10, 1}}});
   if (!quick) {
+    jobs.push_back({"sheet", 32, full});
+    jobs.push_back({"sphere", 32, full});
     jobs.push_back({"form", 64, full});
     if (max_res >= 128)
       jobs.push_back({"form", 128,

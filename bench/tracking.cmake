@@ -1,6 +1,6 @@
-# Tracking benchmarks (bench/voice_bench.cpp, bench/tracking_bench.cpp) link drape_tracking.
-foreach(b voice_bench tracking_bench)
-  if(TARGET ${b})
-    target_link_libraries(${b} PRIVATE drape_tracking nlohmann_json::nlohmann_json)
-  endif()
+# Tracking benchmark drivers, linked to drape_tracking only (run by bench/voice.sh and
+# bench/tracking.sh; executables voice_bench and tracking_bench in build/bin).
+foreach(b voice tracking)
+  add_executable(${b}_bench ${CMAKE_CURRENT_SOURCE_DIR}/${b}_driver.cpp)
+  target_link_libraries(${b}_bench PRIVATE drape_options drape_tracking nlohmann_json::nlohmann_json)
 endforeach()

@@ -2,6 +2,7 @@
 // mass lumping, vertex duplication for topology edits, validation and the state hash.
 #include "sim/cloth.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstring>

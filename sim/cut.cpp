@@ -325,8 +325,29 @@ CutResult cut_runs(Cloth& cloth, const std::vector<int32_t>& anchors) {
   CutResult total;
   std::vector<int32_t> labels = component_labels(cloth);
   std::vector<std::vector<int32_t>> runs;
+  // The vertex of piece `label` nearest to material point q.
+  auto nearest_in = [&](int32_t label, const Vec2& q) {
+    int32_t best = -1;
+    double bd = std::numeric_limits<double>::infinity();
+    for (int32_t i = 0; i < cloth.num_vertices(); ++i) {
+      if (labels[i] != label) continue;
+      const double d = (cloth.topo.material[i] - q).squaredNorm();
+      if (d < bd) bd = d, best = i;
+    }
+    return best;
+  };
+  const auto& m = cloth.topo.material;
   for (int32_t a : anchors) {
-    if (runs.empty() || labels[a] != labels[runs.back().back()]) runs.push_back({});
+    if (!runs.empty() && labels[a] != labels[runs.back().back()]) {
+      // Crossing into another piece: both runs are extended to meet at the earlier cut.
+      const int32_t last = runs.back().back();
+      const int32_t tail = nearest_in(labels[last], m[a]);
+      if (tail >= 0 && tail != last) runs.back().push_back(tail);
+      const int32_t head = nearest_in(labels[a], m[runs.back().back()]);
+      runs.push_back({});
+      if (head >= 0 && head != a) runs.back().push_back(head);
+    }
+    if (runs.empty()) runs.push_back({});
     if (runs.back().empty() || runs.back().back() != a) runs.back().push_back(a);
   }
   total.components_before = count_components(cloth);
@@ -485,14 +506,20 @@ CutResult cut_along_material(Cloth& cloth, const std::vector<Vec2>& stroke_uv) {
   std::vector<char> used(cloth.num_vertices(), 0);
   for (const auto& t : cloth.topo.triangles)
     for (int k = 0; k < 3; ++k) used[t[k]] = 1;
+  const std::vector<int32_t> labels = component_labels(cloth);
   for (const Vec2& q : dense) {
     int32_t best = -1;
     double bd = std::numeric_limits<double>::infinity();
+    const int32_t prev_label = anchors.empty() ? -2 : labels[anchors.back()];
     for (int32_t i = 0; i < cloth.num_vertices(); ++i) {
+      if (!used[i]) continue;
       const double d = (m[i] - q).squaredNorm();
-      if (d < bd - 1e-18) bd = d, best = i;  // lowest index wins among duplicates
+      // Among duplicates (same material point, after earlier cuts) stay in the current piece.
+      if (d < bd - 1e-18 ||
+          (d <= bd + 1e-18 && labels[i] == prev_label && labels[best] != prev_label))
+        bd = d, best = i;
     }
-    if (best >= 0 && used[best]) anchors.push_back(best);
+    if (best >= 0) anchors.push_back(best);
     r.smooth_stroke_uv.push_back(q);
   }
   anchors.erase(std::unique(anchors.begin(), anchors.end()), anchors.end());

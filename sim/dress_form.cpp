@@ -32,7 +32,9 @@ DressForm::DressForm(double y0, double dy, std::vector<Vec2> centres, std::vecto
   if (!(dy_ > 0)) dy_ = 1.0;
 }
 
-Vec3 DressForm::direction(double theta) { return Vec3(std::sin(theta), 0.0, std::cos(theta)); }
+Vec3 DressForm::direction(double theta) {
+  return Vec3(std::sin(theta), 0.0, std::cos(theta));
+}
 
 Vec3 DressForm::point(int j, int n) const {
   const Vec2& c = centres_[j];
@@ -58,6 +60,7 @@ inline void locate(double y, double y0, double dy, int ns, int& j, double& t) {
 // Angle index and fraction for theta (any real).
 inline void locate_angle(double theta, int& n, double& u) {
   double a = theta * kAnglesPerRadian;
+  if (!std::isfinite(a)) a = 0.0;  // NaN/inf angle: use centre front rather than index garbage
   a -= DressForm::kAngles * std::floor(a / DressForm::kAngles);
   n = static_cast<int>(a);
   if (n >= DressForm::kAngles) n = 0, a = 0;
@@ -132,7 +135,8 @@ double DressForm::push_outside(Vec3& p, double offset) const {
   const Vec2 c = centres_[j] + (centres_[j1] - centres_[j]) * t;
   const double dx = p.x() - c.x(), dz = p.z() - c.y();
   const double d2 = dx * dx + dz * dz;
-  double th = std::atan2(dx, dz);  // 0 at +z (centre front), +pi/2 at +x (left side)
+  if (!std::isfinite(d2)) return 0.0;  // NaN/inf coordinates: leave the point alone
+  double th = std::atan2(dx, dz);      // 0 at +z (centre front), +pi/2 at +x (left side)
   int n;
   double u;
   locate_angle(th, n, u);
@@ -181,7 +185,7 @@ TriMesh DressForm::to_mesh() const {
   }
   auto idx = [](int j, int n) { return j * kAngles + (n & (kAngles - 1)); };
   // Outward-facing (counter-clockwise seen from outside): theta runs from +z toward +x, i.e.
-  // clockwise seen from above, so (j,n) -> (j,n+1) -> (j+1,n) faces outward.
+  // counter-clockwise seen from above, so (j,n) -> (j,n+1) -> (j+1,n) faces outward.
   for (int j = 0; j + 1 < ns; ++j) {
     for (int n = 0; n < kAngles; ++n) {
       const int a = idx(j, n), b = idx(j, n + 1), c = idx(j + 1, n), d = idx(j + 1, n + 1);

@@ -25,12 +25,12 @@ struct FormMeasurements {
   double bust_girth = 0.83;
   double waist_girth = 0.64;
   double hip_girth = 0.91;
-  double height = 1.58;        // the person's height
-  double bust_height = 1.15;   // above the floor
+  double height = 1.58;       // the person's height
+  double bust_height = 1.15;  // above the floor
   double waist_height = 0.97;
-  double hip_height = 0.78;    // waist - 0.19
-  double neck_height = 1.34;   // base of the neck (top of the torso)
-  double bottom_height = 0.60; // bottom of the form (upper thigh)
+  double hip_height = 0.78;     // waist - 0.19
+  double neck_height = 1.34;    // base of the neck (top of the torso)
+  double bottom_height = 0.60;  // bottom of the form (upper thigh)
   // Width/depth of the sections (method digest: ~1.3 at bust and waist, 1.4 at hip).
   double bust_aspect = 1.3, waist_aspect = 1.3, hip_aspect = 1.4;
 };
@@ -49,8 +49,8 @@ struct MeshImportOptions {
   enum class UpAxis { kAuto, kY, kZ, kX, kNegY, kNegZ, kNegX };
   Units units = Units::kAuto;
   UpAxis up = UpAxis::kAuto;
-  bool front_auto = true;     // detect centre front (bust protrudes); else front_axis is used
-  Vec3 front_axis{0, 0, 1};   // in the file's frame after the up-axis change
+  bool front_auto = true;           // detect centre front (bust protrudes); else front_axis is used
+  Vec3 front_axis{0, 0, 1};         // in the file's frame after the up-axis change
   double section_spacing = 0.0025;  // m between sections
   // Height of the form's bottom in stage space (m). NaN (default): keep the file's height
   // (after units and up axis) when the whole form is above the floor, else put the bottom at
@@ -62,14 +62,14 @@ struct MeshImportOptions {
 
 // What from_mesh detected (for reports).
 struct MeshImportInfo {
-  double scale = 1.0;                 // file units -> metres
-  std::string units;                  // "m", "cm", "mm", "in"
-  std::string up;                     // "+y", "+z", ... (the file's axis that became +y)
+  double scale = 1.0;  // file units -> metres
+  std::string units;   // "m", "cm", "mm", "in"
+  std::string up;      // "+y", "+z", ... (the file's axis that became +y)
   bool units_detected = false, up_detected = false, front_detected = false;
-  double front_angle = 0.0;           // rotation about +y applied to bring centre front to +z
-  double lift = 0.0;                  // vertical translation applied (m)
+  double front_angle = 0.0;  // rotation about +y applied to bring centre front to +z
+  double lift = 0.0;         // vertical translation applied (m)
   int triangles = 0;
-  int filled_rays = 0;                // rays that missed and were filled from neighbours
+  int filled_rays = 0;  // rays that missed and were filled from neighbours
 };
 
 // Where the reference lines and landmarks are.
@@ -77,9 +77,9 @@ struct FormLandmarks {
   double bottom_y = 0, top_y = 0;             // extent of the section model
   double hip_y = 0, waist_y = 0, bust_y = 0;  // heights of the horizontal reference lines
   double neck_y = 0;
-  double centre_front_theta = 0.0;            // always 0 by construction
+  double centre_front_theta = 0.0;  // always 0 by construction
   double centre_back_theta = 3.14159265358979323846;
-  double left_side_theta = 3.14159265358979323846 / 2;   // side lines (may differ from pi/2
+  double left_side_theta = 3.14159265358979323846 / 2;       // side lines (may differ from pi/2
   double right_side_theta = 3 * 3.14159265358979323846 / 2;  // on an asymmetric scan)
 };
 
@@ -98,8 +98,7 @@ class DressForm {
   // The same from a mesh already in memory (`name` appears in errors); `info` (optional)
   // receives what was detected.
   static Result<DressForm> from_triangles(const TriMesh& mesh, const MeshImportOptions& opt,
-                                          const std::string& name,
-                                          MeshImportInfo* info = nullptr);
+                                          const std::string& name, MeshImportInfo* info = nullptr);
 
   int num_sections() const { return num_sections_; }
   double section_y(int j) const { return y0_ + dy_ * j; }

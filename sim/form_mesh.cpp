@@ -6,8 +6,8 @@
 // segment in the plane y, so each section slices the triangles of its height band (bucketed
 // once) and intersects the rays with the segments, each segment only with the rays inside the
 // angle it subtends: O(triangles + sections x 256) overall.
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -25,7 +25,9 @@ struct Seg {
   Vec2 a, b;  // (x, z)
 };
 
-inline double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+inline double cross2(const Vec2& a, const Vec2& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 // Slice segment of triangle (p0,p1,p2) with the plane Y = y (half-open rule: a vertex is above
 // when its y > the plane), in (x, z). Returns false when the plane does not cross it.
@@ -54,12 +56,24 @@ Mat3 up_rotation(MeshImportOptions::UpAxis up) {
   Mat3 r;
   using U = MeshImportOptions::UpAxis;
   switch (up) {
-    case U::kZ: r << 1, 0, 0, 0, 0, 1, 0, -1, 0; break;
-    case U::kX: r << 0, -1, 0, 1, 0, 0, 0, 0, 1; break;
-    case U::kNegY: r << 1, 0, 0, 0, -1, 0, 0, 0, -1; break;
-    case U::kNegZ: r << 1, 0, 0, 0, 0, -1, 0, 1, 0; break;
-    case U::kNegX: r << 0, 1, 0, -1, 0, 0, 0, 0, 1; break;
-    default: r.setIdentity(); break;
+    case U::kZ:
+      r << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+      break;
+    case U::kX:
+      r << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+      break;
+    case U::kNegY:
+      r << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+      break;
+    case U::kNegZ:
+      r << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+      break;
+    case U::kNegX:
+      r << 0, 1, 0, -1, 0, 0, 0, 0, 1;
+      break;
+    default:
+      r.setIdentity();
+      break;
   }
   return r;
 }
@@ -67,12 +81,18 @@ Mat3 up_rotation(MeshImportOptions::UpAxis up) {
 const char* up_name(MeshImportOptions::UpAxis up) {
   using U = MeshImportOptions::UpAxis;
   switch (up) {
-    case U::kZ: return "+z";
-    case U::kX: return "+x";
-    case U::kNegY: return "-y";
-    case U::kNegZ: return "-z";
-    case U::kNegX: return "-x";
-    default: return "+y";
+    case U::kZ:
+      return "+z";
+    case U::kX:
+      return "+x";
+    case U::kNegY:
+      return "-y";
+    case U::kNegZ:
+      return "-z";
+    case U::kNegX:
+      return "-x";
+    default:
+      return "+y";
   }
 }
 
@@ -153,17 +173,29 @@ Result<DressForm> DressForm::from_triangles(const TriMesh& mesh, const MeshImpor
   double scale = 1.0;
   using Un = MeshImportOptions::Units;
   switch (opt.units) {
-    case Un::kMetres: scale = 1.0, inf.units = "m"; break;
-    case Un::kCentimetres: scale = 0.01, inf.units = "cm"; break;
-    case Un::kMillimetres: scale = 0.001, inf.units = "mm"; break;
-    case Un::kInches: scale = 0.0254, inf.units = "in"; break;
+    case Un::kMetres:
+      scale = 1.0, inf.units = "m";
+      break;
+    case Un::kCentimetres:
+      scale = 0.01, inf.units = "cm";
+      break;
+    case Un::kMillimetres:
+      scale = 0.001, inf.units = "mm";
+      break;
+    case Un::kInches:
+      scale = 0.0254, inf.units = "in";
+      break;
     case Un::kAuto: {
       // A torso is 0.5-2 m tall. Ranges: m [0.5, 2], in [19.7, 50), cm [50, 200], mm [500, 2000].
       inf.units_detected = true;
-      if (h >= 0.5 && h <= 2.0) scale = 1.0, inf.units = "m";
-      else if (h >= 19.7 && h < 50.0) scale = 0.0254, inf.units = "in";
-      else if (h >= 50.0 && h <= 200.0) scale = 0.01, inf.units = "cm";
-      else if (h >= 500.0 && h <= 2000.0) scale = 0.001, inf.units = "mm";
+      if (h >= 0.5 && h <= 2.0)
+        scale = 1.0, inf.units = "m";
+      else if (h >= 19.7 && h < 50.0)
+        scale = 0.0254, inf.units = "in";
+      else if (h >= 50.0 && h <= 200.0)
+        scale = 0.01, inf.units = "cm";
+      else if (h >= 500.0 && h <= 2000.0)
+        scale = 0.001, inf.units = "mm";
       else {
         std::ostringstream os;
         os << "cannot detect the units: the height extent " << h
@@ -178,6 +210,18 @@ Result<DressForm> DressForm::from_triangles(const TriMesh& mesh, const MeshImpor
   for (Vec3& p : v) p *= scale;
   ymin *= scale, ymax *= scale;
   const double height = ymax - ymin;
+  if (!(height >= 0.1 && height <= 3.0)) {
+    std::ostringstream os;
+    os << "the mesh is " << height << " m tall in " << inf.units
+       << ": not a torso (0.1-3 m); check the units (--units)";
+    return make_error(name, os.str());
+  }
+  {
+    double wmax = 0;
+    for (const Vec3& p : v) wmax = std::max({wmax, std::abs(p.x()), std::abs(p.z())});
+    if (!(wmax <= 3.0))
+      return make_error(name, "the mesh is wider than 3 m: not a torso; check the units (--units)");
+  }
   if (height < 4 * dy) return make_error(name, "the mesh is too short for the section spacing");
 
   // --- centre front --------------------------------------------------------------------------
@@ -253,8 +297,10 @@ Result<DressForm> DressForm::from_triangles(const TriMesh& mesh, const MeshImpor
 
   // --- vertical placement --------------------------------------------------------------------
   double lift = 0.0;
-  if (std::isfinite(opt.bottom_y)) lift = opt.bottom_y - ymin;
-  else if (ymin < 0) lift = 0.60 - ymin;
+  if (std::isfinite(opt.bottom_y))
+    lift = opt.bottom_y - ymin;
+  else if (ymin < 0)
+    lift = 0.60 - ymin;
   inf.lift = lift;
   for (Vec3& p : v) p.y() += lift;
   ymin += lift, ymax += lift;
@@ -351,7 +397,7 @@ Result<DressForm> DressForm::from_triangles(const TriMesh& mesh, const MeshImpor
   int first = 0, last = ns - 1;
   while (first < ns && !valid[first]) ++first;
   while (last >= 0 && !valid[last]) --last;
-  const int kept = last - first + 1;
+  const int kept = std::max(last - first + 1, 0);
   int inner_bad = 0;
   for (int j = first; j <= last; ++j) inner_bad += valid[j] ? 0 : 1;
   if (kept < std::max(8, ns / 2) || inner_bad > std::max(1, kept / 50)) {

@@ -70,8 +70,8 @@ double ray_polygon(const std::vector<Vec2>& pts, const Vec2& d) {
     const Vec2 e = b - a;
     const double den = d.x() * e.y() - d.y() * e.x();
     if (std::abs(den) < 1e-18) continue;
-    const double t = (a.x() * e.y() - a.y() * e.x()) / den;    // along d
-    const double s = (a.x() * d.y() - a.y() * d.x()) / den;    // along e
+    const double t = (a.x() * e.y() - a.y() * e.x()) / den;  // along d
+    const double s = (a.x() * d.y() - a.y() * d.x()) / den;  // along e
     if (t > 0 && s >= -1e-12 && s <= 1 + 1e-12) best = std::max(best, t);
   }
   return best;
@@ -81,7 +81,8 @@ double ray_polygon(const std::vector<Vec2>& pts, const Vec2& d) {
 // follows).
 void convexify(std::array<double, kN>& r) {
   std::vector<Vec2> p(kN);
-  for (int n = 0; n < kN; ++n) p[n] = r[n] * Vec2(std::sin(DressForm::theta(n)), std::cos(DressForm::theta(n)));
+  for (int n = 0; n < kN; ++n)
+    p[n] = r[n] * Vec2(std::sin(DressForm::theta(n)), std::cos(DressForm::theta(n)));
   std::vector<Vec2> s = p;
   std::sort(s.begin(), s.end(), [](const Vec2& a, const Vec2& b) {
     return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
@@ -130,12 +131,12 @@ std::string validate(const FormMeasurements& m, const std::string& src) {
     double lo, hi;
   };
   const F fields[] = {
-      {"bust_girth", m.bust_girth, 0.3, 3.0},     {"waist_girth", m.waist_girth, 0.2, 3.0},
-      {"hip_girth", m.hip_girth, 0.3, 3.0},       {"height", m.height, 0.5, 2.6},
-      {"bust_height", m.bust_height, 0.2, 2.5},   {"waist_height", m.waist_height, 0.2, 2.5},
-      {"hip_height", m.hip_height, 0.1, 2.5},     {"neck_height", m.neck_height, 0.3, 2.6},
+      {"bust_girth", m.bust_girth, 0.3, 3.0},       {"waist_girth", m.waist_girth, 0.2, 3.0},
+      {"hip_girth", m.hip_girth, 0.3, 3.0},         {"height", m.height, 0.5, 2.6},
+      {"bust_height", m.bust_height, 0.2, 2.5},     {"waist_height", m.waist_height, 0.2, 2.5},
+      {"hip_height", m.hip_height, 0.1, 2.5},       {"neck_height", m.neck_height, 0.3, 2.6},
       {"bottom_height", m.bottom_height, 0.0, 2.5}, {"bust_aspect", m.bust_aspect, 1.0, 2.5},
-      {"waist_aspect", m.waist_aspect, 1.0, 2.5}, {"hip_aspect", m.hip_aspect, 1.0, 2.5},
+      {"waist_aspect", m.waist_aspect, 1.0, 2.5},   {"hip_aspect", m.hip_aspect, 1.0, 2.5},
   };
   for (const F& f : fields) {
     if (!std::isfinite(f.v)) return src + ": field '" + f.name + "' is not a finite number";
@@ -152,11 +153,10 @@ std::string validate(const FormMeasurements& m, const std::string& src) {
     return src + ": field '" + hi + "' must be at least 2 cm above '" + lo +
            "' (inconsistent heights)";
   };
-  for (std::string e :
-       {order("bottom_height", m.bottom_height, "hip_height", m.hip_height),
-        order("hip_height", m.hip_height, "waist_height", m.waist_height),
-        order("waist_height", m.waist_height, "bust_height", m.bust_height),
-        order("bust_height", m.bust_height, "neck_height", m.neck_height)}) {
+  for (std::string e : {order("bottom_height", m.bottom_height, "hip_height", m.hip_height),
+                        order("hip_height", m.hip_height, "waist_height", m.waist_height),
+                        order("waist_height", m.waist_height, "bust_height", m.bust_height),
+                        order("bust_height", m.bust_height, "neck_height", m.neck_height)}) {
     if (!e.empty()) return e;
   }
   if (m.neck_height > m.height)
@@ -223,13 +223,20 @@ Result<FormMeasurements> parse_measurements(const std::string& json_text,
     bool required;
   };
   const Field fields[] = {
-      {"bust_girth", &m.bust_girth, true},     {"waist_girth", &m.waist_girth, true},
-      {"hip_girth", &m.hip_girth, true},       {"height", &m.height, true},
-      {"bust_height", &m.bust_height, true},   {"waist_height", &m.waist_height, true},
-      {"hip_height", &m.hip_height, true},     {"neck_height", &m.neck_height, true},
+      {"bust_girth", &m.bust_girth, true},       {"waist_girth", &m.waist_girth, true},
+      {"hip_girth", &m.hip_girth, true},         {"height", &m.height, true},
+      {"bust_height", &m.bust_height, true},     {"waist_height", &m.waist_height, true},
+      {"hip_height", &m.hip_height, true},       {"neck_height", &m.neck_height, true},
       {"bottom_height", &m.bottom_height, true}, {"bust_aspect", &m.bust_aspect, false},
-      {"waist_aspect", &m.waist_aspect, false}, {"hip_aspect", &m.hip_aspect, false},
+      {"waist_aspect", &m.waist_aspect, false},  {"hip_aspect", &m.hip_aspect, false},
   };
+  for (const auto& item : j.items()) {  // typos in optional fields must not pass silently
+    const std::string& key = item.key();
+    if (key.empty() || key[0] == '_' || key == "size") continue;
+    bool known = false;
+    for (const Field& f : fields) known = known || key == f.name;
+    if (!known) return make_error(source, "unknown field '" + key + "'");
+  }
   for (const Field& f : fields) {
     if (!j.contains(f.name)) {
       if (f.required) return make_error(source, std::string("missing field '") + f.name + "'");

@@ -1,13 +1,13 @@
 // Triangle meshes in and out through assimp.
 #include "sim/mesh_io.hpp"
 
-#include <assimp/Exporter.hpp>
-#include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -42,8 +42,10 @@ void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent
     for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
       const aiVector3D p = m * mesh->mVertices[v];
       out.vertices.emplace_back(p.x, p.y, p.z);
-      if (has_uv) out.uv.emplace_back(mesh->mTextureCoords[0][v].x, mesh->mTextureCoords[0][v].y);
-      else out.uv.emplace_back(0.0, 0.0);
+      if (has_uv)
+        out.uv.emplace_back(mesh->mTextureCoords[0][v].x, mesh->mTextureCoords[0][v].y);
+      else
+        out.uv.emplace_back(0.0, 0.0);
     }
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
@@ -68,13 +70,14 @@ Result<TriMesh> convert(const aiScene* scene, const std::string& name,
                         const std::string& importer_error) {
   if (!scene) {
     std::string why = importer_error.empty() ? "unknown reason" : importer_error;
-    return make_error(name, "cannot be read as a mesh (truncated, corrupt or not a mesh "
-                            "format assimp reads): " + why);
+    return make_error(name,
+                      "cannot be read as a mesh (truncated, corrupt or not a mesh "
+                      "format assimp reads): " +
+                          why);
   }
   if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
     return make_error(name, "incomplete scene (no mesh data; not a mesh file?)");
-  if (scene->mNumMeshes == 0 || !scene->mRootNode)
-    return make_error(name, "contains no mesh");
+  if (scene->mNumMeshes == 0 || !scene->mRootNode) return make_error(name, "contains no mesh");
   TriMesh out;
   out.name = std::filesystem::path(name).stem().string();
   bool bad_index = false;
@@ -132,11 +135,12 @@ Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char*
 std::string write_meshes(const std::string& path, const std::vector<TriMesh>& meshes) {
   namespace fs = std::filesystem;
   std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
-    return static_cast<char>(std::tolower(c));
-  });
-  const char* format = ext == ".gltf" ? "gltf2" : ext == ".glb" ? "glb2" : ext == ".obj" ? "obj"
-                                                                                         : nullptr;
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const char* format = ext == ".gltf"  ? "gltf2"
+                       : ext == ".glb" ? "glb2"
+                       : ext == ".obj" ? "obj"
+                                       : nullptr;
   if (!format) return path + ": unsupported extension (use .gltf, .glb or .obj)";
   if (meshes.empty()) return path + ": nothing to write (no meshes)";
   for (const TriMesh& m : meshes) {
@@ -195,8 +199,8 @@ std::string write_meshes(const std::string& path, const std::vector<TriMesh>& me
       mesh->mTextureCoords[0] = new aiVector3D[nv];
       mesh->mNumUVComponents[0] = 2;
       for (unsigned v = 0; v < nv; ++v)
-        mesh->mTextureCoords[0][v] = aiVector3D(static_cast<ai_real>(src.uv[v].x()),
-                                                static_cast<ai_real>(src.uv[v].y()), 0);
+        mesh->mTextureCoords[0][v] =
+            aiVector3D(static_cast<ai_real>(src.uv[v].x()), static_cast<ai_real>(src.uv[v].y()), 0);
     }
     const unsigned nf = static_cast<unsigned>(src.triangles.size());
     mesh->mNumFaces = nf;

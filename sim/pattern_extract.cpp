@@ -1,6 +1,7 @@
 // Pattern extraction by rays from the section centres and barycentric coordinates (§2.6).
 #include "sim/pattern_extract.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>

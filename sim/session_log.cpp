@@ -76,7 +76,8 @@ struct Reader {
     return false;
   }
   const json* field(const json& obj, const std::string& path, const char* key) {
-    if (!obj.is_object()) return fail(path, "is not an object"), nullptr;
+    if (!obj.is_object())
+      return fail(path.empty() ? "top level" : path, "is not a JSON object"), nullptr;
     auto it = obj.find(key);
     if (it == obj.end()) return fail(path.empty() ? key : path + "." + key, "missing"), nullptr;
     return &*it;

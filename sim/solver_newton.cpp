@@ -62,6 +62,10 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
       if (dof_[i] < 0) continue;
       Vec3 gi = grad_[i];
       if (inv_h2 > 0) gi += inv_h2 * S.mass[i] * (S.x[i] - (*y)[i]);
+      if (!gi.allFinite()) {
+        residual = std::numeric_limits<double>::infinity();
+        return it;
+      }
       rhs_.segment<3>(3 * dof_[i]) = -gi;
       gmax = std::max(gmax, gi.cwiseAbs().maxCoeff());
     }

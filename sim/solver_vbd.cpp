@@ -1,5 +1,6 @@
 #include "sim/solver_vbd.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>

@@ -9,10 +9,14 @@ namespace drape::tracking {
 
 const char* phase_name(Phase p) {
   switch (p) {
-    case Phase::Begin: return "begin";
-    case Phase::End: return "end";
-    case Phase::Toggle: return "toggle";
-    case Phase::Once: return "once";
+    case Phase::Begin:
+      return "begin";
+    case Phase::End:
+      return "end";
+    case Phase::Toggle:
+      return "toggle";
+    case Phase::Once:
+      return "once";
   }
   return "?";
 }
@@ -95,11 +99,16 @@ std::optional<CommandMap> CommandMap::parse(const std::string& text, const std::
       return fail(where + ": unknown operation '" + x.action.operation + "'");
     if (x.edge != "begin" && x.edge != "end" && x.edge != "any")
       return fail(where + ": field 'edge' must be begin, end or any");
-    if (ph == "begin") x.action.phase = Phase::Begin;
-    else if (ph == "end") x.action.phase = Phase::End;
-    else if (ph == "toggle") x.action.phase = Phase::Toggle;
-    else if (ph == "once") x.action.phase = Phase::Once;
-    else return fail(where + ": field 'phase' must be begin, end, toggle or once");
+    if (ph == "begin")
+      x.action.phase = Phase::Begin;
+    else if (ph == "end")
+      x.action.phase = Phase::End;
+    else if (ph == "toggle")
+      x.action.phase = Phase::Toggle;
+    else if (ph == "once")
+      x.action.phase = Phase::Once;
+    else
+      return fail(where + ": field 'phase' must be begin, end, toggle or once");
     m.b_.push_back(x);
   }
   return m;

@@ -58,8 +58,7 @@ class GestureRecognizer {
 // Controller buttons -> triggers: edges of named buttons ("trigger", "grip", "a", "b", ...).
 class ButtonMapper {
  public:
-  void update(Hand h, const std::string& button, bool pressed, double t,
-              std::vector<Trigger>& out);
+  void update(Hand h, const std::string& button, bool pressed, double t, std::vector<Trigger>& out);
 
  private:
   std::vector<std::pair<std::string, bool>> state_[2];

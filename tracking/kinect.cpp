@@ -1,15 +1,15 @@
 #include "tracking/kinect.hpp"
 
 #include <libfreenect.h>
+#include <sys/stat.h>
 
 #include <algorithm>
-#include <utility>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
-#include <sys/stat.h>
+#include <utility>
 
 namespace drape::tracking {
 
@@ -58,8 +58,8 @@ std::vector<DetectedHand> HandSegmenter::detect(const cv::Mat& depth) {
     // Blob mask inside its box (only this contour, filled), padded by 1 so the distance
     // transform sees a border.
     cv::Mat blob = cv::Mat::zeros(box.height + 2, box.width + 2, CV_8U);
-    cv::drawContours(blob, contours, b.idx, cv::Scalar(255), cv::FILLED, cv::LINE_8,
-                     cv::noArray(), 0, cv::Point(1 - box.x, 1 - box.y));
+    cv::drawContours(blob, contours, b.idx, cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(),
+                     0, cv::Point(1 - box.x, 1 - box.y));
     cv::Mat dist;
     cv::distanceTransform(blob, dist, cv::DIST_L2, 3);
     double maxv;
@@ -98,7 +98,8 @@ std::vector<HandFrame> HandSegmenter::process_raw11(const uint16_t* raw, int wid
   if (lut_.empty()) {
     lut_.resize(2048);
     for (int i = 0; i < 2048; ++i)
-      lut_[i] = static_cast<uint16_t>(std::lround(kinect_raw_to_m(static_cast<uint16_t>(i)) * 1000));
+      lut_[i] =
+          static_cast<uint16_t>(std::lround(kinect_raw_to_m(static_cast<uint16_t>(i)) * 1000));
   }
   cv::Mat mm(height, width, CV_16UC1);
   const size_t n = static_cast<size_t>(width) * height;
@@ -135,8 +136,7 @@ struct KinectSource::Impl {
 
 namespace {
 double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 void depth_cb(freenect_device* dev, void* data, uint32_t) {
   auto* impl = static_cast<KinectSource::Impl*>(freenect_get_user(dev));
@@ -145,7 +145,8 @@ void depth_cb(freenect_device* dev, void* data, uint32_t) {
   ++impl->frames;
   std::lock_guard lk(impl->mu);
   for (auto& f : frames) impl->pending.push_back(f);
-  if (impl->pending.size() > 64) impl->pending.erase(impl->pending.begin(), impl->pending.end() - 64);
+  if (impl->pending.size() > 64)
+    impl->pending.erase(impl->pending.begin(), impl->pending.end() - 64);
   impl->status = {SourceState::Ok, "kinect: streaming"};
 }
 }  // namespace
@@ -158,7 +159,7 @@ KinectSource::KinectSource(SegmenterParams p, int device_index) : impl_(std::mak
   };
   // Under fakenect a missing recording directory would make the library exit(): check first.
   if (const char* fp = std::getenv("FAKENECT_PATH")) {
-    struct stat st{};
+    struct stat st {};
     const std::string index = std::string(fp) + "/INDEX.txt";
     if (::stat(index.c_str(), &st) != 0) {
       set(SourceState::Unavailable, "kinect: FAKENECT_PATH set but " + index + " is missing");
@@ -183,8 +184,8 @@ KinectSource::KinectSource(SegmenterParams p, int device_index) : impl_(std::mak
     return;
   }
   freenect_set_user(impl_->dev, impl_.get());
-  freenect_set_depth_mode(impl_->dev,
-                          freenect_find_depth_mode(FREENECT_RESOLUTION_MEDIUM, FREENECT_DEPTH_11BIT));
+  freenect_set_depth_mode(
+      impl_->dev, freenect_find_depth_mode(FREENECT_RESOLUTION_MEDIUM, FREENECT_DEPTH_11BIT));
   freenect_set_depth_callback(impl_->dev, depth_cb);
   if (freenect_start_depth(impl_->dev) < 0) {
     set(SourceState::Error, "kinect: cannot start depth stream");
@@ -213,8 +214,12 @@ KinectSource::~KinectSource() {
   if (impl_->ctx) freenect_shutdown(impl_->ctx);
 }
 
-uint64_t KinectSource::frames_processed() const { return impl_->frames.load(); }
-bool KinectSource::running() const { return impl_->running.load(); }
+uint64_t KinectSource::frames_processed() const {
+  return impl_->frames.load();
+}
+bool KinectSource::running() const {
+  return impl_->running.load();
+}
 
 std::vector<HandFrame> KinectSource::poll() {
   std::lock_guard lk(impl_->mu);

@@ -33,17 +33,17 @@ uint16_t kinect_m_to_raw(double metres);
 
 struct SegmenterParams {
   double min_depth = 0.4, max_depth = 3.0;  // m: valid range
-  double band = 0.15;        // m: hand pixels are within this of the nearest point
-  double min_area_m2 = 0.004;  // metric blob area (about 6x6 cm) to count as a hand
+  double band = 0.15;                       // m: hand pixels are within this of the nearest point
+  double min_area_m2 = 0.004;               // metric blob area (about 6x6 cm) to count as a hand
   int max_hands = 2;
 };
 
 struct DetectedHand {
-  double u = 0, v = 0;      // palm centre in pixels
-  double radius_px = 0;     // inscribed circle radius (distance transform maximum)
-  double depth = 0;         // m
+  double u = 0, v = 0;   // palm centre in pixels
+  double radius_px = 0;  // inscribed circle radius (distance transform maximum)
+  double depth = 0;      // m
   double area_m2 = 0;
-  Vec3 position;            // camera frame (see DepthIntrinsics)
+  Vec3 position;  // camera frame (see DepthIntrinsics)
 };
 
 class HandSegmenter {

@@ -5,7 +5,9 @@
 
 namespace drape::tracking {
 
-const char* hand_name(Hand h) { return h == Hand::Left ? "left" : "right"; }
+const char* hand_name(Hand h) {
+  return h == Hand::Left ? "left" : "right";
+}
 
 namespace {
 double alpha(double cutoff, double dt) {
@@ -55,8 +57,8 @@ Vec3 HandFilter::blend(const Vec3& filtered, const Vec3& held, double t) const {
 }
 
 HandFrame HandFilter::update(const HandFrame& raw) {
-  const bool ok = raw.tracked && raw.confidence >= p_.min_confidence &&
-                  raw.palm.position.allFinite();
+  const bool ok =
+      raw.tracked && raw.confidence >= p_.min_confidence && raw.palm.position.allFinite();
   out_.hand = raw.hand;
   out_.time = raw.time;
   if (!ok) {

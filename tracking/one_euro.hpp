@@ -7,7 +7,7 @@ namespace drape::tracking {
 
 struct OneEuroParams {
   double min_cutoff = 1.0;  // Hz: cutoff at rest; lower = less jitter, more lag
-  double beta = 0.5;        // s/m: cutoff grows by beta * |speed|; higher = less lag when moving
+  double beta = 2.0;        // s/m: cutoff grows by beta * |speed|; higher = less lag when moving
   double d_cutoff = 1.0;    // Hz: cutoff of the speed estimate
 };
 

@@ -2,8 +2,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 
 namespace drape::tracking {
 
@@ -74,8 +74,7 @@ std::optional<std::vector<HandFrame>> read_trace(const std::string& path, std::s
       f.joints[j] = Vec3(v[12 + 3 * j], v[13 + 3 * j], v[14 + 3 * j]);
     if (!std::isfinite(f.time) || !f.palm.position.allFinite())
       return fail(where + "non-finite time or position");
-    if (!frames.empty() && f.time < frames.back().time)
-      return fail(where + "time goes backwards");
+    if (!frames.empty() && f.time < frames.back().time) return fail(where + "time goes backwards");
     frames.push_back(f);
   }
   return frames;

@@ -13,11 +13,32 @@ using Quat = Eigen::Quaterniond;
 
 // Joint order of XR_EXT_hand_tracking (XrHandJointEXT).
 enum class Joint : int {
-  Palm = 0, Wrist, ThumbMetacarpal, ThumbProximal, ThumbDistal, ThumbTip,
-  IndexMetacarpal, IndexProximal, IndexIntermediate, IndexDistal, IndexTip,
-  MiddleMetacarpal, MiddleProximal, MiddleIntermediate, MiddleDistal, MiddleTip,
-  RingMetacarpal, RingProximal, RingIntermediate, RingDistal, RingTip,
-  LittleMetacarpal, LittleProximal, LittleIntermediate, LittleDistal, LittleTip
+  Palm = 0,
+  Wrist,
+  ThumbMetacarpal,
+  ThumbProximal,
+  ThumbDistal,
+  ThumbTip,
+  IndexMetacarpal,
+  IndexProximal,
+  IndexIntermediate,
+  IndexDistal,
+  IndexTip,
+  MiddleMetacarpal,
+  MiddleProximal,
+  MiddleIntermediate,
+  MiddleDistal,
+  MiddleTip,
+  RingMetacarpal,
+  RingProximal,
+  RingIntermediate,
+  RingDistal,
+  RingTip,
+  LittleMetacarpal,
+  LittleProximal,
+  LittleIntermediate,
+  LittleDistal,
+  LittleTip
 };
 inline constexpr int kJointCount = 26;
 

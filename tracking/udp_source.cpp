@@ -29,8 +29,7 @@ bool fail(std::string* why, const std::string& m) {
   return false;
 }
 double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 }  // namespace
 
@@ -67,8 +66,8 @@ bool parse_udp_packet(const uint8_t* d, size_t n, UdpPacket& out, std::string* w
     f.confidence = conf;
     float q[4];
     for (int k = 0; k < 4; ++k) q[k] = rd<float>(d + off + 8 + 4 * k);
-    const double qn = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] +
-                                double(q[2]) * q[2] + double(q[3]) * q[3]);
+    const double qn = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] +
+                                double(q[3]) * q[3]);
     if (!(qn > 0.5 && qn < 1.5)) return fail(why, "palm orientation not a unit quaternion");
     f.palm.orientation = Quat(q[3] / qn, q[0] / qn, q[1] / qn, q[2] / qn);
     off += 24;

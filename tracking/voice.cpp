@@ -19,11 +19,14 @@ namespace drape::tracking {
 
 namespace {
 double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
-uint32_t le32(const unsigned char* p) { return p[0] | p[1] << 8 | p[2] << 16 | uint32_t(p[3]) << 24; }
-uint16_t le16(const unsigned char* p) { return static_cast<uint16_t>(p[0] | p[1] << 8); }
+uint32_t le32(const unsigned char* p) {
+  return p[0] | p[1] << 8 | p[2] << 16 | uint32_t(p[3]) << 24;
+}
+uint16_t le16(const unsigned char* p) {
+  return static_cast<uint16_t>(p[0] | p[1] << 8);
+}
 
 // Parses the RIFF header; leaves the stream at the first sample. Returns sample count.
 long parse_wav_header(std::istream& in, const std::string& path, std::string* error) {
@@ -86,8 +89,7 @@ class WavInput : public AudioInput {
     in_.read(reinterpret_cast<char*>(buf), n * 2);
     const long got = static_cast<long>(in_.gcount() / 2);
     if (got < n) {
-      err_ = path_ + ": truncated data chunk (" + std::to_string(left_ - got) +
-             " samples missing)";
+      err_ = path_ + ": truncated data chunk (" + std::to_string(left_ - got) + " samples missing)";
       ok_ = false;
       return got > 0 ? got : -1;
     }
@@ -182,10 +184,14 @@ bool read_wav(const std::string& path, std::vector<int16_t>& s, std::string* err
 
 const char* rejection_name(Rejection r) {
   switch (r) {
-    case Rejection::None: return "none";
-    case Rejection::Duration: return "duration";
-    case Rejection::Garbage: return "garbage";
-    case Rejection::Combined: return "garbage+duration";
+    case Rejection::None:
+      return "none";
+    case Rejection::Duration:
+      return "duration";
+    case Rejection::Garbage:
+      return "garbage";
+    case Rejection::Combined:
+      return "garbage+duration";
   }
   return "?";
 }
@@ -200,9 +206,9 @@ VoiceRecognizer::VoiceRecognizer(VoiceConfig cfg) : cfg_(std::move(cfg)) {
       return;
     }
   }
-  cmd_ln_t* c = cmd_ln_init(nullptr, ps_args(), TRUE, "-hmm", cfg_.model_dir.c_str(), "-dict",
-                            cfg_.dict.c_str(), "-logfn", "/dev/null", "-remove_silence", "no",
-                            nullptr);
+  cmd_ln_t* c =
+      cmd_ln_init(nullptr, ps_args(), TRUE, "-hmm", cfg_.model_dir.c_str(), "-dict",
+                  cfg_.dict.c_str(), "-logfn", "/dev/null", "-remove_silence", "no", nullptr);
   if (!c) {
     error_ = "voice: pocketsphinx rejected the configuration";
     return;

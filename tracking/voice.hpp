@@ -44,8 +44,8 @@ const char* rejection_name(Rejection r);
 
 struct VoiceConfig {
   std::string model_dir = "/usr/share/pocketsphinx/model/en-us/en-us";
-  std::string dict = "";      // default: <source>/assets/voice/commands.dict
-  std::string grammar = "";   // default: <source>/assets/voice/commands.jsgf
+  std::string dict = "";             // default: <source>/assets/voice/commands.dict
+  std::string grammar = "";          // default: <source>/assets/voice/commands.jsgf
   std::string garbage_grammar = "";  // default: <source>/assets/voice/garbage.jsgf
   std::vector<std::string> commands = {"pinch", "release", "pin",  "cut", "stop",
                                        "map",   "move",    "undo", "redo"};
@@ -54,10 +54,10 @@ struct VoiceConfig {
   double min_command_s = 0.12;
   double garbage_margin = 40.0;  // log-likelihood units (logbase 1.0001) per 10 ms frame
   // Energy VAD (10 ms frames).
-  double vad_on_db = 9.0;     // dB above the noise floor to start speech
-  double vad_off_db = 6.0;    // dB above the noise floor to continue speech
-  double hangover_s = 0.25;   // silence that ends an utterance (latency floor)
-  double preroll_s = 0.2;     // audio kept before the detected start
+  double vad_on_db = 9.0;    // dB above the noise floor to start speech
+  double vad_off_db = 6.0;   // dB above the noise floor to continue speech
+  double hangover_s = 0.25;  // silence that ends an utterance (latency floor)
+  double preroll_s = 0.2;    // audio kept before the detected start
 };
 
 struct VoiceResult {
@@ -114,7 +114,7 @@ class EnergyVad {
 struct VoiceEvent {
   VoiceResult result;
   long speech_end = 0, decided = 0;  // sample indices (stream clock)
-  double latency_ms = 0;  // (decided - speech_end) / rate + decode time
+  double latency_ms = 0;             // (decided - speech_end) / rate + decode time
 };
 
 // Voice on its own thread: audio input -> VAD -> recognizer -> triggers.

@@ -56,8 +56,12 @@ void XrHandSource::feed_controller(Hand h, const XrControllerInput& in) {
   edge("b", in.b && in.active);
 }
 
-std::vector<HandFrame> XrHandSource::poll() { return std::exchange(pending_, {}); }
-std::vector<Trigger> XrHandSource::take_triggers() { return std::exchange(triggers_, {}); }
+std::vector<HandFrame> XrHandSource::poll() {
+  return std::exchange(pending_, {});
+}
+std::vector<Trigger> XrHandSource::take_triggers() {
+  return std::exchange(triggers_, {});
+}
 
 SourceStatus XrHandSource::status() const {
   if (last_time_ < 0) return {SourceState::NoData, "xr: nothing fed yet"};

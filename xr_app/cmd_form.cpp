@@ -27,34 +27,53 @@ void usage() {
 
 bool parse_units(const std::string& s, MeshImportOptions::Units& u) {
   using U = MeshImportOptions::Units;
-  if (s == "m") u = U::kMetres;
-  else if (s == "cm") u = U::kCentimetres;
-  else if (s == "mm") u = U::kMillimetres;
-  else if (s == "in") u = U::kInches;
-  else if (s == "auto") u = U::kAuto;
-  else return false;
+  if (s == "m")
+    u = U::kMetres;
+  else if (s == "cm")
+    u = U::kCentimetres;
+  else if (s == "mm")
+    u = U::kMillimetres;
+  else if (s == "in")
+    u = U::kInches;
+  else if (s == "auto")
+    u = U::kAuto;
+  else
+    return false;
   return true;
 }
 
 bool parse_up(const std::string& s, MeshImportOptions::UpAxis& u) {
   using U = MeshImportOptions::UpAxis;
-  if (s == "y" || s == "+y") u = U::kY;
-  else if (s == "z" || s == "+z") u = U::kZ;
-  else if (s == "x" || s == "+x") u = U::kX;
-  else if (s == "-y") u = U::kNegY;
-  else if (s == "-z") u = U::kNegZ;
-  else if (s == "-x") u = U::kNegX;
-  else if (s == "auto") u = U::kAuto;
-  else return false;
+  if (s == "y" || s == "+y")
+    u = U::kY;
+  else if (s == "z" || s == "+z")
+    u = U::kZ;
+  else if (s == "x" || s == "+x")
+    u = U::kX;
+  else if (s == "-y")
+    u = U::kNegY;
+  else if (s == "-z")
+    u = U::kNegZ;
+  else if (s == "-x")
+    u = U::kNegX;
+  else if (s == "auto")
+    u = U::kAuto;
+  else
+    return false;
   return true;
 }
 
 bool parse_front(const std::string& s, drape::sim::Vec3& f) {
-  if (s == "z" || s == "+z") f = {0, 0, 1};
-  else if (s == "-z") f = {0, 0, -1};
-  else if (s == "x" || s == "+x") f = {1, 0, 0};
-  else if (s == "-x") f = {-1, 0, 0};
-  else return false;
+  if (s == "z" || s == "+z")
+    f = {0, 0, 1};
+  else if (s == "-z")
+    f = {0, 0, -1};
+  else if (s == "x" || s == "+x")
+    f = {1, 0, 0};
+  else if (s == "-x")
+    f = {-1, 0, 0};
+  else
+    return false;
   return true;
 }
 
@@ -81,10 +100,14 @@ int run(int argc, char** argv) {
                a == "--units" || a == "--up" || a == "--front" || a == "--spacing") {
       const char* v = value(a.c_str());
       if (!v) return 2;
-      if (a == "--size") size = v;
-      else if (a == "--measurements") measurements = v;
-      else if (a == "--mesh") mesh = v;
-      else if (a == "--export") export_path = v;
+      if (a == "--size")
+        size = v;
+      else if (a == "--measurements")
+        measurements = v;
+      else if (a == "--mesh")
+        mesh = v;
+      else if (a == "--export")
+        export_path = v;
       else if (a == "--units") {
         if (!parse_units(v, opt.units)) {
           std::fprintf(stderr, "drape form: --units '%s': use m, cm, mm or in\n", v);
@@ -146,8 +169,8 @@ int run(int argc, char** argv) {
     form = DressForm::from_measurements(*meas, spacing);
     what = measurements.empty() ? "size " + size : "measurements " + measurements;
     if (form && report) {
-      std::printf("requested: bust %.1f mm, waist %.1f mm, hip %.1f mm\n",
-                  meas->bust_girth * 1000, meas->waist_girth * 1000, meas->hip_girth * 1000);
+      std::printf("requested: bust %.1f mm, waist %.1f mm, hip %.1f mm\n", meas->bust_girth * 1000,
+                  meas->waist_girth * 1000, meas->hip_girth * 1000);
     }
   }
   if (!form) {
@@ -161,22 +184,24 @@ int run(int argc, char** argv) {
                 what.c_str(), f.num_sections(), DressForm::kAngles, f.section_spacing() * 1000,
                 f.min_y(), f.max_y());
     if (!mesh.empty()) {
-      std::printf("import: units %s%s (x%g), up axis %s%s, centre front %s (rotated %.1f deg), "
-                  "lifted %.4f m, %d triangles, %d rays filled\n",
-                  info.units.c_str(), info.units_detected ? " (detected)" : "", info.scale,
-                  info.up.c_str(), info.up_detected ? " (detected)" : "",
-                  info.front_detected ? "detected" : "from --front / +z",
-                  info.front_angle * 180.0 / 3.14159265358979323846, info.lift, info.triangles,
-                  info.filled_rays);
+      std::printf(
+          "import: units %s%s (x%g), up axis %s%s, centre front %s (rotated %.1f deg), "
+          "lifted %.4f m, %d triangles, %d rays filled\n",
+          info.units.c_str(), info.units_detected ? " (detected)" : "", info.scale, info.up.c_str(),
+          info.up_detected ? " (detected)" : "",
+          info.front_detected ? "detected" : "from --front / +z",
+          info.front_angle * 180.0 / 3.14159265358979323846, info.lift, info.triangles,
+          info.filled_rays);
     }
     std::printf("%-6s %10s %12s\n", "line", "height m", "girth mm");
     std::printf("%-6s %10.4f %12.1f\n", "bust", lm.bust_y, f.girth_at(lm.bust_y) * 1000);
     std::printf("%-6s %10.4f %12.1f\n", "waist", lm.waist_y, f.girth_at(lm.waist_y) * 1000);
     std::printf("%-6s %10.4f %12.1f\n", "hip", lm.hip_y, f.girth_at(lm.hip_y) * 1000);
-    std::printf("neck %.4f m, bottom %.4f m, top %.4f m; side lines at theta %.1f / %.1f deg "
-                "(centre front theta 0 faces +z, theta runs toward the form's left, +x)\n",
-                lm.neck_y, lm.bottom_y, lm.top_y, lm.left_side_theta * 180 / 3.14159265358979323846,
-                lm.right_side_theta * 180 / 3.14159265358979323846);
+    std::printf(
+        "neck %.4f m, bottom %.4f m, top %.4f m; side lines at theta %.1f / %.1f deg "
+        "(centre front theta 0 faces +z, theta runs toward the form's left, +x)\n",
+        lm.neck_y, lm.bottom_y, lm.top_y, lm.left_side_theta * 180 / 3.14159265358979323846,
+        lm.right_side_theta * 180 / 3.14159265358979323846);
   }
   if (!export_path.empty()) {
     const std::string err = drape::sim::write_meshes(export_path, {f.to_mesh()});
@@ -202,4 +227,5 @@ int form_main(int argc, char** argv) {
 
 }  // namespace
 
-DRAPE_COMMAND(form, "dress form: girths report (--size/--measurements/--mesh), --export", form_main);
+DRAPE_COMMAND(form, "dress form: girths report (--size/--measurements/--mesh), --export",
+              form_main);

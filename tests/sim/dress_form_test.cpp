@@ -1,14 +1,15 @@
 // The section model: parametric girths, O(1) collision vs analytic, interpolation, landmarks.
-#include <gtest/gtest.h>
-#include <Eigen/Geometry>
+#include "sim/dress_form.hpp"
 
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <random>
 #include <set>
 
-#include "sim/dress_form.hpp"
 #include "sim/mesh_io.hpp"
 
 namespace drape::sim {
@@ -76,9 +77,10 @@ TEST(DressForm, ParametricShapeIsTorsoLike) {
     return std::array<double, 4>{xmax - xmin, zmax - zmin, zmax, zmin};
   };
   const auto b = width_depth(lm.bust_y), w = width_depth(lm.waist_y), h = width_depth(lm.hip_y);
-  std::printf("width/depth: bust %.3f waist %.3f hip %.3f; front z bust %.3f waist %.3f; back z "
-              "hip %.3f waist %.3f\n",
-              b[0] / b[1], w[0] / w[1], h[0] / h[1], b[2], w[2], h[3], w[3]);
+  std::printf(
+      "width/depth: bust %.3f waist %.3f hip %.3f; front z bust %.3f waist %.3f; back z "
+      "hip %.3f waist %.3f\n",
+      b[0] / b[1], w[0] / w[1], h[0] / h[1], b[2], w[2], h[3], w[3]);
   // Non-circular sections near the README's ratios (bust points and seat bumps add a little).
   EXPECT_NEAR(b[0] / b[1], 1.3, 0.15);
   EXPECT_NEAR(w[0] / w[1], 1.3, 0.15);
@@ -133,8 +135,8 @@ TEST(DressForm, PushOutsideCylinderAnalytic) {
       max_err = std::max(max_err, std::abs(nd - (r + off)));
       EXPECT_DOUBLE_EQ(p.y(), y);
       if (d > 1e-6) {  // radial: same angle
-        EXPECT_NEAR(std::atan2(p.x() - c.x(), p.z() - c.y()), std::atan2(std::sin(th), std::cos(th)),
-                    1e-9);
+        EXPECT_NEAR(std::atan2(p.x() - c.x(), p.z() - c.y()),
+                    std::atan2(std::sin(th), std::cos(th)), 1e-9);
       }
     } else {
       EXPECT_EQ(pen, 0.0);

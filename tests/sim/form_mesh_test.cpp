@@ -2,8 +2,8 @@
 // and up axes, read back through assimp and resampled by ray casting; girths vs the analytic
 // ellipse perimeter (Ramanujan II). Bad input gives a clear error naming the file.
 #include <gtest/gtest.h>
-#include <Eigen/Geometry>
 
+#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -88,11 +88,21 @@ TriMesh to_file_frame(TriMesh m, double per_metre, Up up) {
   for (Vec3& v : m.vertices) {
     Vec3 p = v * per_metre;
     switch (up) {
-      case Up::kZ: v = Vec3(p.x(), -p.z(), p.y()); break;   // file z = stage y
-      case Up::kX: v = Vec3(p.y(), -p.x(), p.z()); break;   // file x = stage y
-      case Up::kNegY: v = Vec3(p.x(), -p.y(), -p.z()); break;
-      case Up::kNegZ: v = Vec3(p.x(), p.z(), -p.y()); break;
-      default: v = p; break;
+      case Up::kZ:
+        v = Vec3(p.x(), -p.z(), p.y());
+        break;  // file z = stage y
+      case Up::kX:
+        v = Vec3(p.y(), -p.x(), p.z());
+        break;  // file x = stage y
+      case Up::kNegY:
+        v = Vec3(p.x(), -p.y(), -p.z());
+        break;
+      case Up::kNegZ:
+        v = Vec3(p.x(), p.z(), -p.y());
+        break;
+      default:
+        v = p;
+        break;
     }
   }
   return m;
@@ -102,15 +112,16 @@ void write_obj(const std::string& path, const TriMesh& m) {
   std::ofstream f(path);
   f.precision(10);
   for (const Vec3& v : m.vertices) f << "v " << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
-  for (const auto& t : m.triangles) f << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+  for (const auto& t : m.triangles)
+    f << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
 }
 
 void write_ply_ascii(const std::string& path, const TriMesh& m) {
   std::ofstream f(path);
   f.precision(10);
   f << "ply\nformat ascii 1.0\nelement vertex " << m.vertices.size()
-    << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
-    << m.triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+    << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << m.triangles.size()
+    << "\nproperty list uchar int vertex_indices\nend_header\n";
   for (const Vec3& v : m.vertices) f << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
   for (const auto& t : m.triangles) f << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
 }
@@ -139,10 +150,14 @@ void write_stl_binary(const std::string& path, const TriMesh& m) {
 std::string write_as(const std::string& name, const TriMesh& m) {
   const std::string path = (tmp_dir() / name).string();
   const std::string ext = std::filesystem::path(name).extension().string();
-  if (ext == ".obj") write_obj(path, m);
-  else if (ext == ".ply") write_ply_ascii(path, m);
-  else if (ext == ".stl") write_stl_binary(path, m);
-  else EXPECT_EQ(write_meshes(path, {m}), "");
+  if (ext == ".obj")
+    write_obj(path, m);
+  else if (ext == ".ply")
+    write_ply_ascii(path, m);
+  else if (ext == ".stl")
+    write_stl_binary(path, m);
+  else
+    EXPECT_EQ(write_meshes(path, {m}), "");
   return path;
 }
 
@@ -187,10 +202,11 @@ TEST(FormMesh, EllipticCylinderAllFormatsUnitsAxes) {
       const double g = f->girth_at(y);
       worst = std::max(worst, std::abs(g / expect - 1));
     }
-    std::printf("%-20s units %-2s up %-2s: girth %.2f mm vs %.2f mm (worst rel err %.4f %%), "
-                "r(front) %.4f r(side) %.4f\n",
-                c.file, info.units.c_str(), info.up.c_str(), f->girth_at(0.9) * 1e3,
-                expect * 1e3, worst * 100, f->radius_at(0.9, 0), f->radius_at(0.9, kPi / 2));
+    std::printf(
+        "%-20s units %-2s up %-2s: girth %.2f mm vs %.2f mm (worst rel err %.4f %%), "
+        "r(front) %.4f r(side) %.4f\n",
+        c.file, info.units.c_str(), info.up.c_str(), f->girth_at(0.9) * 1e3, expect * 1e3,
+        worst * 100, f->radius_at(0.9, 0), f->radius_at(0.9, kPi / 2));
     EXPECT_LT(worst, 0.005) << c.file;
     // The depth axis ends up along z (front-back), the width along x.
     EXPECT_NEAR(f->radius_at(0.9, 0), b, 0.002) << c.file;
@@ -233,8 +249,7 @@ TEST(FormMesh, EllipsoidGirthAtHeights) {
         std::printf("%-14s units %-2s up %-2s: equator girth %.2f mm vs %.2f mm\n", cs.file,
                     info.units.c_str(), info.up.c_str(), g * 1e3, expect * 1e3);
     }
-    std::printf("%-14s worst relative girth error over 5 heights: %.4f %%\n", cs.file,
-                worst * 100);
+    std::printf("%-14s worst relative girth error over 5 heights: %.4f %%\n", cs.file, worst * 100);
     EXPECT_LT(worst, 0.005) << cs.file;
   }
 }
@@ -266,10 +281,11 @@ TEST(FormMesh, ParametricFormRoundTripDetectsFrontAndUp) {
   const auto& lm = src->landmarks();
   for (double y : {lm.hip_y, lm.waist_y, lm.bust_y}) {
     const double g0 = src->girth_at(y), g1 = f->girth_at(y);
-    std::printf("y %.3f: source %.2f mm, imported %.2f mm (%.3f %%); r(front) %.4f / %.4f "
-                "r(back) %.4f / %.4f\n",
-                y, g0 * 1e3, g1 * 1e3, 100 * (g1 / g0 - 1), src->radius_at(y, 0),
-                f->radius_at(y, 0), src->radius_at(y, kPi), f->radius_at(y, kPi));
+    std::printf(
+        "y %.3f: source %.2f mm, imported %.2f mm (%.3f %%); r(front) %.4f / %.4f "
+        "r(back) %.4f / %.4f\n",
+        y, g0 * 1e3, g1 * 1e3, 100 * (g1 / g0 - 1), src->radius_at(y, 0), f->radius_at(y, 0),
+        src->radius_at(y, kPi), f->radius_at(y, kPi));
     EXPECT_NEAR(g1 / g0, 1.0, 0.005);
   }
   // Front really at +z: the bust is ahead of the section centre more than the back is behind.
@@ -330,8 +346,7 @@ TEST(FormMesh, BadInput) {
   {
     std::ifstream in(glb, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), {});
-    expect_form_error(write("truncated.glb", bytes.substr(0, bytes.size() - 100)),
-                      "truncated glb");
+    expect_form_error(write("truncated.glb", bytes.substr(0, bytes.size() - 100)), "truncated glb");
   }
   // A flat plane (vertical and horizontal): rays miss.
   TriMesh plane;

@@ -30,8 +30,7 @@ TEST(Measurements, StandardSizesMatchReadme) {
   };
   for (const Row& r : {Row{"7AR", 80, 61, 87}, Row{"9AR", 83, 64, 91}, Row{"11AR", 86, 67, 93},
                        Row{"13AR", 89, 70, 95}}) {
-    const std::string path =
-        std::string(DRAPE_SOURCE_DIR) + "/assets/forms/" + r.size + ".json";
+    const std::string path = std::string(DRAPE_SOURCE_DIR) + "/assets/forms/" + r.size + ".json";
     auto f = load_measurements(path);
     ASSERT_TRUE(f.ok()) << f.error();
     EXPECT_EQ(f->size, r.size);
@@ -97,6 +96,7 @@ TEST(Measurements, BadFieldsNamed) {
   expect_error("neck.json", replace(g, "1.34", "1.10"), "neck_height");
   expect_error("aspect.json", replace(g, "}", R"(, "hip_aspect": "wide"})"), "hip_aspect");
   expect_error("size.json", replace(g, R"("X")", "7"), "size");
+  expect_error("typo.json", replace(g, "}", R"(, "hip_aspekt": 1.4})"), "hip_aspekt");
   expect_error("array.json", "[1, 2, 3]", "");
   expect_error("truncated.json", g.substr(0, g.size() / 2), "");
   expect_error("empty.json", "", "empty");

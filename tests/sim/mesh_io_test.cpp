@@ -1,13 +1,14 @@
 // Mesh I/O through assimp: round trips, node transforms, bad files.
-#include <gtest/gtest.h>
-#include <Eigen/Geometry>
+#include "sim/mesh_io.hpp"
 
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "sim/cloth.hpp"
-#include "sim/mesh_io.hpp"
 
 namespace drape::sim {
 namespace {
@@ -114,8 +115,7 @@ TEST(MeshIo, BadFiles) {
                     "text .stl");
   expect_load_error(write_text("prose.ply", "hello world\n"), "text .ply");
   expect_load_error(write_text("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"), "no faces");
-  expect_load_error(write_text("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"),
-                    "NaN vertex");
+  expect_load_error(write_text("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), "NaN vertex");
   expect_load_error(tmp_dir().string(), "directory");
   // Truncated binary files written from a valid one.
   const std::string glb = (tmp_dir() / "t.glb").string();

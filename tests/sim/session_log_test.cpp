@@ -126,7 +126,7 @@ TEST(SessionLog, BadFilesGiveClearErrors) {
   };
   bad("", "not valid JSON");
   bad(good.substr(0, good.size() / 2), "not valid JSON");
-  bad("[1,2]", "format");
+  bad("[1,2]", "top level: is not a JSON object");
   bad(edit([](json& j) { j["format"] = "x"; }), "format");
   bad(edit([](json& j) { j["version"] = 9; }), "version");
   bad(edit([](json& j) { j.erase("cloth"); }), "cloth: missing");

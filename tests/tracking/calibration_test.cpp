@@ -1,9 +1,9 @@
+#include "tracking/calibration.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <random>
-
-#include "tracking/calibration.hpp"
 
 using namespace drape::tracking;
 
@@ -33,8 +33,7 @@ TEST(Calibration, RecoversSimilarityAndReportsResidual) {
   EXPECT_LT(c->rms_residual, 1e-9);
   auto cn = calibrate(src, dst_noisy, &err);
   ASSERT_TRUE(cn);
-  std::printf("noisy (2 mm): residual rms %.4f m max %.4f m\n", cn->rms_residual,
-              cn->max_residual);
+  std::printf("noisy (2 mm): residual rms %.4f m max %.4f m\n", cn->rms_residual, cn->max_residual);
   EXPECT_GT(cn->rms_residual, 0.0005);
   EXPECT_LT(cn->rms_residual, 0.004);
   // Three points are enough.
@@ -70,7 +69,8 @@ TEST(Calibration, SaveLoadRoundTripAndBadFiles) {
   EXPECT_LT((l->rotation - c.rotation).norm(), 1e-12);
   EXPECT_NEAR(l->rms_residual, 0.004, 1e-12);
   const std::string bad = std::string(DRAPE_BINARY_DIR) + "/calib_bad.json";
-  std::ofstream(bad) << R"({"scale": 1, "rotation": [[1,0,0],[0,1,0],[0,0,2]], "translation": [0,0,0]})";
+  std::ofstream(bad)
+      << R"({"scale": 1, "rotation": [[1,0,0],[0,1,0],[0,0,2]], "translation": [0,0,0]})";
   EXPECT_FALSE(load_calibration(bad, &err));
   EXPECT_NE(err.find("rotation"), std::string::npos) << err;
   std::ofstream(bad) << "{ not json";

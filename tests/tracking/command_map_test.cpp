@@ -1,6 +1,6 @@
-#include <gtest/gtest.h>
-
 #include "tracking/command_map.hpp"
+
+#include <gtest/gtest.h>
 
 using namespace drape::tracking;
 
@@ -36,7 +36,8 @@ TEST(CommandMap, BadInputNamesField) {
   std::string err;
   EXPECT_FALSE(CommandMap::parse("{", "m.json", &err));
   EXPECT_NE(err.find("m.json"), std::string::npos);
-  EXPECT_FALSE(CommandMap::parse(R"({"bindings": [{"source": "voice", "command": "cut"}]})", "m.json", &err));
+  EXPECT_FALSE(CommandMap::parse(R"({"bindings": [{"source": "voice", "command": "cut"}]})",
+                                 "m.json", &err));
   EXPECT_NE(err.find("operation"), std::string::npos);
   EXPECT_FALSE(CommandMap::parse(
       R"({"bindings": [{"source": "voice", "command": "cut", "operation": "fly", "phase": "once"}]})",

@@ -1,6 +1,6 @@
-#include <gtest/gtest.h>
-
 #include "tracking/gestures.hpp"
+
+#include <gtest/gtest.h>
 
 using namespace drape::tracking;
 

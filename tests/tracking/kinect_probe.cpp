@@ -25,8 +25,8 @@ int main(int argc, char** argv) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   for (const auto& f : k.poll())
-    std::printf("%s %.5f %.5f %.5f\n", hand_name(f.hand), f.palm.position.x(),
-                f.palm.position.y(), f.palm.position.z());
+    std::printf("%s %.5f %.5f %.5f\n", hand_name(f.hand), f.palm.position.x(), f.palm.position.y(),
+                f.palm.position.z());
   std::printf("frames %llu\nstatus %s\n", static_cast<unsigned long long>(k.frames_processed()),
               k.status().message.c_str());
   return k.frames_processed() > 0 ? 0 : 2;

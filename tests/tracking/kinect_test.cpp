@@ -1,3 +1,5 @@
+#include "tracking/kinect.hpp"
+
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
@@ -7,8 +9,6 @@
 #include <opencv2/core.hpp>
 #include <random>
 #include <sstream>
-
-#include "tracking/kinect.hpp"
 
 using namespace drape::tracking;
 

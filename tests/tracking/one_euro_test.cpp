@@ -1,9 +1,9 @@
+#include "tracking/one_euro.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
-
-#include "tracking/one_euro.hpp"
 
 using namespace drape::tracking;
 

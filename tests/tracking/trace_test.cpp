@@ -1,8 +1,8 @@
+#include "tracking/trace.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
-
-#include "tracking/trace.hpp"
 
 using namespace drape::tracking;
 

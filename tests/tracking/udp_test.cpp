@@ -28,7 +28,8 @@ HandFrame sample_hand(Hand h, bool joints) {
 }  // namespace
 
 TEST(UdpPacket, RoundTrip) {
-  auto b = encode_udp_packet(42, 12.5, {sample_hand(Hand::Left, true), sample_hand(Hand::Right, false)});
+  auto b =
+      encode_udp_packet(42, 12.5, {sample_hand(Hand::Left, true), sample_hand(Hand::Right, false)});
   EXPECT_EQ(b.size(), kUdpHeaderSize + (24 + 12 * 26) + (24 + 12));
   UdpPacket p;
   std::string why;
@@ -41,7 +42,9 @@ TEST(UdpPacket, RoundTrip) {
   EXPECT_FALSE(p.hands[1].has_joints);
   EXPECT_NEAR((p.hands[1].palm.position - Vec3(0.1, 1.2, -0.4)).norm(), 0, 1e-6);
   EXPECT_NEAR(p.hands[1].confidence, 0.75, 1e-6);
-  EXPECT_NEAR(p.hands[1].palm.orientation.angularDistance(sample_hand(Hand::Right, false).palm.orientation), 0, 1e-5);
+  EXPECT_NEAR(
+      p.hands[1].palm.orientation.angularDistance(sample_hand(Hand::Right, false).palm.orientation),
+      0, 1e-5);
 }
 
 TEST(UdpPacket, RejectsTruncatedOversizedNaNAndGarbage) {
@@ -74,7 +77,8 @@ TEST(UdpPacket, RejectsTruncatedOversizedNaNAndGarbage) {
   auto joints = good;
   joints[kUdpHeaderSize + 2] = 5;
   EXPECT_FALSE(parse_udp_packet(joints.data(), joints.size(), p, &why));
-  auto two = encode_udp_packet(1, 0.0, {sample_hand(Hand::Left, false), sample_hand(Hand::Left, false)});
+  auto two =
+      encode_udp_packet(1, 0.0, {sample_hand(Hand::Left, false), sample_hand(Hand::Left, false)});
   EXPECT_FALSE(parse_udp_packet(two.data(), two.size(), p, &why));
   EXPECT_NE(why.find("duplicate"), std::string::npos);
 }
@@ -95,8 +99,8 @@ TEST(UdpSource, LoopbackCountsMalformedAndStale) {
   auto trunc = encode_udp_packet(11, 1.0, {sample_hand(Hand::Right, true)});
   trunc.resize(30);
   send(trunc);
-  send(std::vector<uint8_t>(1500, 0xab));                                // oversized garbage
-  send(encode_udp_packet(9, 0.9, {sample_hand(Hand::Right, false)}));   // stale
+  send(std::vector<uint8_t>(1500, 0xab));                              // oversized garbage
+  send(encode_udp_packet(9, 0.9, {sample_hand(Hand::Right, false)}));  // stale
   send(encode_udp_packet(12, 1.1, {sample_hand(Hand::Left, false)}));
   std::vector<HandFrame> got;
   for (int i = 0; i < 100 && got.size() < 2; ++i) {

@@ -1,11 +1,11 @@
 // Generates a few utterances with espeak-ng + sox into the build dir at test time and runs them
 // through the threaded voice source (energy VAD -> pocketsphinx grammar -> rejection).
+#include "tracking/voice.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <fstream>
-
-#include "tracking/voice.hpp"
 
 using namespace drape::tracking;
 
@@ -16,8 +16,8 @@ const std::string kDir = std::string(DRAPE_BINARY_DIR) + "/voice_test";
 std::string synth(const std::string& name, const std::string& text, const std::string& voice) {
   const std::string out = kDir + "/" + name + ".wav";
   const std::string cmd =
-      "set -e; cd '" + kDir + "'; espeak-ng -v " + voice + " -s 150 -w " + name +
-      ".raw.wav '" + text + "'; sox " + name + ".raw.wav -r 16000 -c 1 -b 16 " + name +
+      "set -e; cd '" + kDir + "'; espeak-ng -v " + voice + " -s 150 -w " + name + ".raw.wav '" +
+      text + "'; sox " + name + ".raw.wav -r 16000 -c 1 -b 16 " + name +
       ".s.wav norm -6 pad 0.4 0.7; d=$(soxi -D " + name + ".s.wav); sox -n -r 16000 -c 1 -b 16 " +
       name + ".n.wav synth $d pinknoise vol 0.02; sox -m -v 1 " + name + ".s.wav -v 1 " + name +
       ".n.wav " + name + ".wav";
@@ -56,9 +56,9 @@ TEST_F(Voice, RecognisesCommandsAndRejectsSentence) {
     const auto ev = run(wav);
     std::string got;
     for (const auto& e : ev) {
-      std::printf("'%s' -> hyp '%s' command '%s' (%s) margin %.1f speech %.2f s latency %.0f ms\n", c.text,
-                  e.result.hypothesis.c_str(), e.result.command.c_str(), e.result.reason.c_str(), e.result.margin,
-                  e.result.speech_s, e.latency_ms);
+      std::printf("'%s' -> hyp '%s' command '%s' (%s) margin %.1f speech %.2f s latency %.0f ms\n",
+                  c.text, e.result.hypothesis.c_str(), e.result.command.c_str(),
+                  e.result.reason.c_str(), e.result.margin, e.result.speech_s, e.latency_ms);
       if (!e.result.command.empty()) got += (got.empty() ? "" : " ") + e.result.command;
     }
     EXPECT_EQ(got, c.expect) << c.text;
@@ -81,9 +81,10 @@ TEST_F(Voice, CorruptAudioAndMissingMicrophoneGiveStatus) {
   const std::string trunc = kDir + "/truncated.wav";
   {
     std::ofstream f(trunc, std::ios::binary);
-    const unsigned char h[44] = {'R', 'I', 'F', 'F', 36, 0, 1, 0, 'W', 'A', 'V', 'E', 'f', 'm', 't',
-                                 ' ', 16, 0, 0, 0, 1, 0, 1, 0, 0x80, 0x3e, 0, 0, 0, 0x7d, 0, 0,
-                                 2, 0, 16, 0, 'd', 'a', 't', 'a', 0, 0, 1, 0};
+    const unsigned char h[44] = {'R', 'I', 'F',  'F',  36,  0,   1,   0,    'W', 'A', 'V',
+                                 'E', 'f', 'm',  't',  ' ', 16,  0,   0,    0,   1,   0,
+                                 1,   0,   0x80, 0x3e, 0,   0,   0,   0x7d, 0,   0,   2,
+                                 0,   16,  0,    'd',  'a', 't', 'a', 0,    0,   1,   0};
     f.write(reinterpret_cast<const char*>(h), 44);
     std::vector<char> some(1000, 0);
     f.write(some.data(), some.size());

@@ -94,10 +94,11 @@ int main() {
     OneEuroParams p;
   };
   const OneEuroParams def;
-  std::vector<P> ps = {{"default (1.0 Hz, beta 0.5)", def},
-                       {"min_cutoff 0.5, beta 0.5", {0.5, 0.5, 1.0}},
-                       {"min_cutoff 2.0, beta 0.5", {2.0, 0.5, 1.0}},
-                       {"min_cutoff 1.0, beta 2.0", {1.0, 2.0, 1.0}},
+  std::vector<P> ps = {{"default (1.0 Hz, beta 2.0)", def},
+                       {"min_cutoff 1.0, beta 0.5", {1.0, 0.5, 1.0}},
+                       {"min_cutoff 0.5, beta 2.0", {0.5, 2.0, 1.0}},
+                       {"min_cutoff 2.0, beta 2.0", {2.0, 2.0, 1.0}},
+                       {"min_cutoff 1.0, beta 4.0", {1.0, 4.0, 1.0}},
                        {"min_cutoff 1.0, beta 0 (EMA)", {1.0, 0.0, 1.0}}};
   for (const auto& p : ps) {
     OneEuro f(p.p);
@@ -107,7 +108,8 @@ int main() {
     const double red = 1 - s.jitter_mm / r.jitter_mm;
     std::printf("%-28s %12.2f %13.1f%% %12.1f\n", p.name, s.jitter_mm, 100 * red,
                 s.lag_ms - r.lag_ms);
-    j["filters"][p.name] = {{"jitter_mm", s.jitter_mm}, {"jitter_reduction", red},
+    j["filters"][p.name] = {{"jitter_mm", s.jitter_mm},
+                            {"jitter_reduction", red},
                             {"added_lag_ms", s.lag_ms - r.lag_ms}};
     if (&p == &ps[0]) {
       j["jitter_reduction"] = red;
@@ -142,9 +144,10 @@ int main() {
     el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   const double fps = processed / el;
-  std::printf("\nKinect pipeline 640x480 (raw11 -> mm -> segment -> 3D), one thread: %.0f fps "
-              "(%.2f ms/frame, %.2f hands/frame; target >= 30)\n",
-              fps, 1000 / fps, double(found) / processed);
+  std::printf(
+      "\nKinect pipeline 640x480 (raw11 -> mm -> segment -> 3D), one thread: %.0f fps "
+      "(%.2f ms/frame, %.2f hands/frame; target >= 30)\n",
+      fps, 1000 / fps, double(found) / processed);
   j["kinect_fps"] = fps;
   j["kinect_ms_per_frame"] = 1000 / fps;
   std::ofstream("out/bench/tracking.json") << j.dump(2) << "\n";

@@ -1,6 +1,6 @@
-// Voice benchmark driver (run by bench/voice.sh): reads a list "wav \t expected \t text \t
-// speech_end_s", decodes every file through the same path as the app (energy VAD ->
-// pocketsphinx), compares rejection methods and writes out/bench/voice.json.
+// Voice benchmark driver (bench/voice_driver.cpp, run by bench/voice.sh): reads a list "wav \t
+// expected \t text \t speech_end_s", decodes every file through the same path as the app (energy
+// VAD -> pocketsphinx), compares rejection methods and writes out/bench/voice.json.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -71,7 +71,8 @@ int main(int argc, char** argv) {
       if (!best || s.speech_end - s.start > best->speech_end - best->start) best = &s;
     if (best) {
       const double speech_s = double(best->speech_end - best->start) / kVoiceRate - cfg.preroll_s;
-      const auto r = rec.decode(best->audio.data(), static_cast<long>(best->audio.size()), speech_s);
+      const auto r =
+          rec.decode(best->audio.data(), static_cast<long>(best->audio.size()), speech_s);
       o.hyp = r.hypothesis;
       o.command = r.command;
       o.garbage_hyp = r.garbage_hypothesis;
@@ -88,7 +89,7 @@ int main(int argc, char** argv) {
     double margin;  // reject if margin < -margin
     bool duration;
   };
-  std::vector<Method> methods = {{"none", 1e9, false},        {"duration", 1e9, true},
+  std::vector<Method> methods = {{"none", 1e9, false},         {"duration", 1e9, true},
                                  {"garbage(m=10)", 10, false}, {"garbage(m=0)", 0, false},
                                  {"garbage(m=-5)", -5, false}, {"garbage(m=0)+duration", 0, true}};
   nlohmann::json j;
@@ -146,9 +147,10 @@ int main(int argc, char** argv) {
                            {"margin", out[i].margin},
                            {"speech_s", out[i].speech_s},
                            {"latency_ms", out[i].latency_ms}});
-  std::printf("\nlatency end of utterance -> trigger: median %.0f ms, p90 %.0f ms (hangover %.0f ms "
-              "+ decode %.0f ms mean)\nutterances: %zu\n",
-              med, p90, cfg.hangover_s * 1000, j["decode_ms_mean"].get<double>(), items.size());
+  std::printf(
+      "\nlatency end of utterance -> trigger: median %.0f ms, p90 %.0f ms (hangover %.0f ms "
+      "+ decode %.0f ms mean)\nutterances: %zu\n",
+      med, p90, cfg.hangover_s * 1000, j["decode_ms_mean"].get<double>(), items.size());
   std::ofstream(argv[2]) << j.dump(2) << "\n";
   std::printf("wrote %s\n", argv[2]);
   return 0;

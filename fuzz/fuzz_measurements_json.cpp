@@ -1,0 +1,18 @@
+// Fuzz: measurement JSON -> FormMeasurements -> parametric form (never crashes; errors only).
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "sim/dress_form.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  auto m = drape::sim::parse_measurements(text, "fuzz.json");
+  if (m.ok()) {
+    // A valid set of measurements must give a form (coarse spacing keeps the fuzzer fast).
+    auto f = drape::sim::DressForm::from_measurements(*m, 0.02);
+    if (!f.ok()) __builtin_trap();
+    (void)f->girth_at(m->waist_height);
+  }
+  return 0;
+}
