@@ -70,7 +70,7 @@ bool run(const SceneDescription& d, int samples, int frames, uint32_t size, Resu
   vkBindImageMemory(ctx.device, image, mem, 0);
   std::vector<double> eye_ms, cpu_ms, build, wait;
   const Fov fov{-0.785f, 0.785f, 0.785f, -0.785f};  // 90 degrees, like a headset eye
-  for (int f = -2; f < frames; ++f) {                 // two warm-up frames
+  for (int f = -2; f < frames; ++f) {               // two warm-up frames
     const double c0 = thread_cpu_ms();
     for (uint32_t eye = 0; eye < 2; ++eye) {
       Pose p;
@@ -119,17 +119,18 @@ int main(int argc, char** argv) {
   std::string device;
   if (!run(*scene, 1, frames, size, r1, device) || !run(*scene, 4, frames, size, r4, device))
     return 1;
-  std::printf("\nrenderer, %ux%u per eye, 128x128 cloth + 9AR form, device: %s, %d frames\n",
-              size, size, device.c_str(), frames);
-  std::printf("%-12s %12s %16s %12s %12s %10s\n", "MSAA", "ms/eye", "render CPU ms/fr",
-              "build ms", "wait ms", "triangles");
+  std::printf("\nrenderer, %ux%u per eye, 128x128 cloth + 9AR form, device: %s, %d frames\n", size,
+              size, device.c_str(), frames);
+  std::printf("%-12s %12s %16s %12s %12s %10s\n", "MSAA", "ms/eye", "render CPU ms/fr", "build ms",
+              "wait ms", "triangles");
   for (const auto& [name, r] : {std::pair{"1x", r1}, std::pair{"4x", r4}})
-    std::printf("%-12s %12.2f %16.2f %12.2f %12.2f %10zu\n", name, r.ms_per_eye,
-                r.cpu_ms_per_frame, r.build_ms, r.wait_ms, r.triangles);
+    std::printf("%-12s %12.2f %16.2f %12.2f %12.2f %10zu\n", name, r.ms_per_eye, r.cpu_ms_per_frame,
+                r.build_ms, r.wait_ms, r.triangles);
   std::printf("ratio 4x/1x ms/eye: %.2f\n", r4.ms_per_eye / std::max(r1.ms_per_eye, 1e-9));
   std::filesystem::create_directories("out/bench");
   std::ofstream js("out/bench/render.json");
-  js << "{\n  \"device\": \"" << device << "\",\n  \"size\": " << size << ",\n  \"cloth\": \"128x128\",\n"
+  js << "{\n  \"device\": \"" << device << "\",\n  \"size\": " << size
+     << ",\n  \"cloth\": \"128x128\",\n"
      << "  \"frames\": " << frames << ",\n  \"ms_per_eye_1024\": " << r1.ms_per_eye
      << ",\n  \"render_cpu_ms\": " << r1.cpu_ms_per_frame
      << ",\n  \"build_ms_per_eye\": " << r1.build_ms << ",\n  \"triangles\": " << r1.triangles

@@ -59,8 +59,8 @@ Row run(const std::string& scene, int res, const Config& c, const std::vector<Ve
   if (!cloth_finite(sc.cloth)) stable = false;
   double rms = 0, mx = 0;
   position_error(sc.cloth.state.x, ref, rms, mx);
-  return {scene, c.solver, res, frame / used_substeps, c.iterations, ms / frames, rms * 1e3,
-          mx * 1e3, stable};
+  return {scene,     c.solver, res,   frame / used_substeps, c.iterations, ms / frames,
+          rms * 1e3, mx * 1e3, stable};
 }
 
 std::vector<Vec3> reference(const std::string& scene, int res) {
@@ -70,8 +70,8 @@ std::vector<Vec3> reference(const std::string& scene, int res) {
   so.max_iterations = 200;
   if (sc.springs_model) so.energy.model = EnergyOptions::Model::kSprings;
   StaticResult r = relax_static(sc.cloth, sc.objects, so);
-  std::printf("reference %s %d: %d Newton iterations, residual %.1e, %.0f ms\n", scene.c_str(),
-              res, r.iterations, r.residual, r.ms);
+  std::printf("reference %s %d: %d Newton iterations, residual %.1e, %.0f ms\n", scene.c_str(), res,
+              r.iterations, r.residual, r.ms);
   return sc.cloth.state.x;
 }
 
@@ -97,7 +97,8 @@ void write_svg(const std::vector<Row>& rows, const std::string& scene, int res,
   };
   std::ofstream o(path);
   o << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H
-    << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n";
+    << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' "
+       "fill='white'/>\n";
   o << "<text x='" << L << "' y='18'>" << scene << " " << res << "x" << res
     << ": RMS error vs compute per 1/90 s frame (log-log)</text>\n";
   for (double d = lt0; d <= lt1; d += 1)
@@ -106,8 +107,8 @@ void write_svg(const std::vector<Row>& rows, const std::string& scene, int res,
       << H - B + 16 << "'>" << std::pow(10, d) << "</text>\n";
   for (double d = le0; d <= le1; d += 1)
     o << "<line x1='" << L << "' y1='" << Y(std::pow(10, d)) << "' x2='" << W - R << "' y2='"
-      << Y(std::pow(10, d)) << "' stroke='#ddd'/><text x='10' y='" << Y(std::pow(10, d)) + 4
-      << "'>" << std::pow(10, d) << "</text>\n";
+      << Y(std::pow(10, d)) << "' stroke='#ddd'/><text x='10' y='" << Y(std::pow(10, d)) + 4 << "'>"
+      << std::pow(10, d) << "</text>\n";
   o << "<text x='" << (W - R) / 2 << "' y='" << H - 10 << "'>ms per frame</text>\n";
   o << "<text x='10' y='" << T - 5 << "'>RMS mm</text>\n";
   const char* colours[] = {"#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"};
@@ -145,9 +146,9 @@ int main(int argc, char** argv) {
     int res;
     std::vector<Config> configs;
   };
-  std::vector<Config> full{{"vbd", 1, 5},    {"vbd", 1, 10},   {"vbd", 2, 5},    {"vbd", 2, 10},
-                           {"vbd", 4, 10},   {"vbd", 4, 20},   {"xpbd", 5, 1},   {"xpbd", 10, 1},
-                           {"xpbd", 20, 1},  {"xpbd", 40, 1},  {"newton", 1, 20}, {"newton", 2, 20},
+  std::vector<Config> full{{"vbd", 1, 5},   {"vbd", 1, 10},  {"vbd", 2, 5},     {"vbd", 2, 10},
+                           {"vbd", 4, 10},  {"vbd", 4, 20},  {"xpbd", 5, 1},    {"xpbd", 10, 1},
+                           {"xpbd", 20, 1}, {"xpbd", 40, 1}, {"newton", 1, 20}, {"newton", 2, 20},
                            {"verlet", 0, 1}};
   std::vector<Job> jobs{{"chain", 20, full}, {"sheet", 16, full}, {"form", 32, full}};
   if (quick && max_res >= 128)
@@ -157,9 +158,16 @@ int main(int argc, char** argv) {
     jobs.push_back({"sphere", 32, full});
     jobs.push_back({"form", 64, full});
     if (max_res >= 128)
-      jobs.push_back({"form", 128,
-                      {{"vbd", 1, 5}, {"vbd", 1, 10}, {"vbd", 2, 5}, {"vbd", 2, 10}, {"vbd", 4, 10},
-                       {"xpbd", 10, 1}, {"xpbd", 20, 1}, {"verlet", 0, 1}}});
+      jobs.push_back({"form",
+                      128,
+                      {{"vbd", 1, 5},
+                       {"vbd", 1, 10},
+                       {"vbd", 2, 5},
+                       {"vbd", 2, 10},
+                       {"vbd", 4, 10},
+                       {"xpbd", 10, 1},
+                       {"xpbd", 20, 1},
+                       {"verlet", 0, 1}}});
     if (max_res >= 256) jobs.push_back({"form", 256, {{"vbd", 1, 5}, {"vbd", 2, 10}}});
   }
   for (const auto& j : jobs) {
@@ -176,9 +184,9 @@ int main(int argc, char** argv) {
   std::ofstream csv("out/bench/solvers.csv");
   csv << "scene,solver,resolution,dt,iterations,ms_per_frame,rms_error_mm,max_error_mm,stable\n";
   for (const auto& r : rows)
-    csv << r.scene << "," << r.solver << "," << r.resolution << "," << r.dt << ","
-        << r.iterations << "," << r.ms_per_frame << "," << r.rms_mm << "," << r.max_mm << ","
-        << (r.stable ? 1 : 0) << "\n";
+    csv << r.scene << "," << r.solver << "," << r.resolution << "," << r.dt << "," << r.iterations
+        << "," << r.ms_per_frame << "," << r.rms_mm << "," << r.max_mm << "," << (r.stable ? 1 : 0)
+        << "\n";
   int top = 0;
   for (const auto& j : jobs)
     if (j.scene == "form") top = std::max(top, j.res);

@@ -17,8 +17,8 @@ int main() {
   for (const auto& c : stress_case_names())
     for (const char* s : {"vbd", "xpbd", "newton", "verlet"}) {
       StressResult r = run_stress_case(c, s, 3);
-      std::printf("%-16s %-8s %6d %8d %9d %8d %s\n", c.c_str(), s, r.steps, r.failures,
-                  r.rollbacks, r.vertices, r.note.c_str());
+      std::printf("%-16s %-8s %6d %8d %9d %8d %s\n", c.c_str(), s, r.steps, r.failures, r.rollbacks,
+                  r.vertices, r.note.c_str());
       std::fflush(stdout);
       csv << c << "," << s << "," << r.steps << "," << r.failures << "\n";
     }

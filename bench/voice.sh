@@ -1,51 +1,98 @@
 #!/usr/bin/env bash
-# ./drape bench voice: synthesises a command / non-command test set with espeak-ng (several
-# voices and speeds), mixes pink and white noise with sox at 10 dB SNR (measured on the speech),
-# then runs build/bin/voice_bench, which writes out/bench/voice.json and prints a table.
+# ./drape bench voice: synthesises two disjoint sets with espeak-ng and mixes pink noise with sox
+# at 10 dB SNR (measured on the speech):
+#   TUNING set: 4 voices x 2 speeds x the command phrases + 16 non-command sentences x 3 voices;
+#   TEST set:   5 OTHER voices x 3 other speeds x the phrases + 20 other sentences x 5 voices,
+#               noise taken from another part of the noise recording.
+# build/bin/voice_bench --tune picks the filler weight and the duration limit on the tuning set
+# only; the test set is then decoded once with that fixed configuration -> out/bench/voice.json.
+# VOICE_PHRASES=assets/voice/words.tsv measures the old one-word commands.
 set -euo pipefail
 ROOT="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
 cd "$ROOT"
 BUILD="${DRAPE_BUILD_DIR:-build}"
-SET="$BUILD/voice_set"
+SET="$BUILD/voice_set2"
+PHRASES="${VOICE_PHRASES:-assets/voice/phrases.tsv}"
 NOISE="${VOICE_NOISE:-pinknoise}"
 mkdir -p "$SET" out/bench
-VOICES=(en-us en-us+f3 en-us+m3 en-gb-x-rp en-us+f2)
-SPEEDS=(130 170)
-COMMANDS=(pinch release pin cut stop map move undo redo)
-SENTENCES=("the weather is nice today" "please hand me the scissors" "I think we should go home"
+# One reproducible noise recording (sox -R); the tuning set uses its first half, the test set
+# its second half.
+[ -s "$SET/$NOISE.wav" ] || sox -R -n -r 16000 -c 1 -b 16 "$SET/$NOISE.wav" synth 400 "$NOISE"
+mapfile -t PHR < <(grep -v '^#' "$PHRASES" | cut -f1)
+mapfile -t CMD < <(grep -v '^#' "$PHRASES" | cut -f2)
+TUNE_VOICES=(en-us en-us+f3 en-us+m3 en-gb-x-rp)
+TUNE_SPEEDS=(130 170)
+TEST_VOICES=(en-us+f2 en-us+m1 en-gb en-029 en-us-nyc)
+TEST_SPEEDS=(120 150 180)
+TUNE_SENT=("the weather is nice today" "please hand me the scissors" "I think we should go home"
   "where is the red fabric" "can you help me with this" "the dress is almost finished"
   "what time is it now" "this looks really good" "let me see the pattern" "open the window please"
-  "how long is the skirt" "we need more thread")
-LIST="$SET/list.tsv"
-: > "$LIST"
-gen() { # out text voice speed
-  local out="$1" text="$2" v="$3" s="$4"
-  if [ ! -s "$out" ]; then
-    espeak-ng -v "$v" -s "$s" -w "$SET/t.wav" "$text"
-    sox "$SET/t.wav" -r 16000 -c 1 -b 16 "$SET/s.wav" norm -6
-    local rs; rs=$(sox "$SET/s.wav" -n stat 2>&1 | awk '/RMS +amplitude/{print $3}')
-    sox "$SET/s.wav" "$SET/c.wav" pad 0.5 0.8
-    local d; d=$(soxi -D "$SET/c.wav")
-    sox -n -r 16000 -c 1 -b 16 "$SET/n.wav" synth "$d" "$NOISE"
-    local rn; rn=$(sox "$SET/n.wav" -n stat 2>&1 | awk '/RMS +amplitude/{print $3}')
+  "how long is the skirt" "we need more thread" "the cloth is too long here"
+  "I will cut it later" "move a little to the left" "that pin is crooked")
+TEST_SENT=("good morning everyone" "the sleeve needs another fitting" "is the kettle on"
+  "I like the blue one better" "turn the form around" "that was a long day"
+  "she sewed the hem by hand" "pass me the tape measure" "we can finish this tomorrow"
+  "the seam allowance is one centimetre" "do you have the pattern paper" "it fits much better now"
+  "cut the fabric along the grain" "pin the sleeve to the bodice" "can we undo the last seam"
+  "the map is on the table" "stop talking and listen" "please release the brake"
+  "move the chair over there" "I need a pinch of salt")
+gen() { # list out text voice speed expect noise_offset_s
+  local list="$1" out="$2" text="$3" v="$4" s="$5" exp="$6" off="$7"
+  local t="$out.t.wav" sp="$out.s.wav" c="$out.c.wav" n="$out.n.wav"
+  if [ ! -s "$out" ] || [ ! -s "$sp" ]; then
+    espeak-ng -v "$v" -s "$s" -w "$t" "$text"
+    sox "$t" -r 16000 -c 1 -b 16 "$sp" norm -6
+    local rs; rs=$(sox "$sp" -n stat 2>&1 | awk '/RMS +amplitude/{print $3}')
+    sox "$sp" "$c" pad 0.5 0.8
+    local d; d=$(soxi -D "$c")
+    sox "$SET/$NOISE.wav" "$n" trim "$off" "$d"
+    local rn; rn=$(sox "$n" -n stat 2>&1 | awk '/RMS +amplitude/{print $3}')
     local g; g=$(awk -v a="$rs" -v b="$rn" 'BEGIN{print a/b/10^(10/20)}')
-    sox -m -v 1 "$SET/c.wav" -v "$g" "$SET/n.wav" "$out"
+    sox -m -v 1 "$c" -v "$g" "$n" "$out"
+    rm -f "$t" "$c" "$n"
   fi
   # speech ends 0.5 s + speech length into the file
-  local e; e=$(awk -v a="$(soxi -D "$SET/s.wav" 2>/dev/null || echo 0)" 'BEGIN{print 0.5+a}')
-  printf '%s\t%s\t%s\t%s\n' "$out" "$5" "$text" "$e" >> "$LIST"
+  local e; e=$(awk -v a="$(soxi -D "$sp")" 'BEGIN{print 0.5+a}')
+  printf '%s\t%s\t%s\t%s\n' "$out" "$exp" "$text" "$e" >> "$list"
 }
-echo "synthesising test set into $SET ($NOISE, 10 dB SNR) ..."
-for v in "${VOICES[@]}"; do
-  for s in "${SPEEDS[@]}"; do
-    for c in "${COMMANDS[@]}"; do gen "$SET/${NOISE}_${v}_${s}_$c.wav" "$c" "$v" "$s" "$c"; done
+name() { echo "$1" | tr ' +' '__'; }
+echo "synthesising tuning and test sets into $SET ($NOISE, 10 dB SNR) ..."
+TUNE="$SET/tune.tsv" TEST="$SET/test.tsv"
+: > "$TUNE"
+: > "$TEST"
+k=0
+for v in "${TUNE_VOICES[@]}"; do
+  for s in "${TUNE_SPEEDS[@]}"; do
+    for i in "${!PHR[@]}"; do
+      k=$((k + 1))
+      gen "$TUNE" "$SET/tune_$(name "$v")_${s}_$(name "${PHR[$i]}").wav" "${PHR[$i]}" "$v" "$s" \
+        "${CMD[$i]}" $((k % 190))
+    done
   done
 done
-i=0
-for t in "${SENTENCES[@]}"; do
+for t in "${TUNE_SENT[@]}"; do
   for v in en-us en-us+f3 en-gb-x-rp; do
-    i=$((i + 1))
-    gen "$SET/${NOISE}_sent_${i}.wav" "$t" "$v" 150 "-"
+    k=$((k + 1))
+    gen "$TUNE" "$SET/tune_sent_$(name "$v")_$(name "$t").wav" "$t" "$v" 150 - $((k % 190))
   done
 done
-exec "$BUILD/bin/voice_bench" "$LIST" out/bench/voice.json
+for v in "${TEST_VOICES[@]}"; do
+  for s in "${TEST_SPEEDS[@]}"; do
+    for i in "${!PHR[@]}"; do
+      k=$((k + 1))
+      gen "$TEST" "$SET/test_$(name "$v")_${s}_$(name "${PHR[$i]}").wav" "${PHR[$i]}" "$v" "$s" \
+        "${CMD[$i]}" $((200 + k % 190))
+    done
+  done
+done
+for t in "${TEST_SENT[@]}"; do
+  for v in "${TEST_VOICES[@]}"; do
+    k=$((k + 1))
+    gen "$TEST" "$SET/test_sent_$(name "$v")_$(name "$t").wav" "$t" "$v" 150 - $((200 + k % 190))
+  done
+done
+"$BUILD/bin/voice_bench" --tune "$TUNE" "$SET/tuned.txt" --phrases "$PHRASES" \
+  ${VOICE_WEIGHTS:+--weights "$VOICE_WEIGHTS"}
+read -r W MAXS < "$SET/tuned.txt"
+exec "$BUILD/bin/voice_bench" "$TEST" out/bench/voice.json --phrases "$PHRASES" --weight "$W" \
+  --max-s "$MAXS"

@@ -1,9 +1,14 @@
 // Voice benchmark driver (bench/voice_driver.cpp, run by bench/voice.sh): reads a list "wav \t
-// expected \t text \t speech_end_s", decodes every file through the same path as the app (energy
-// VAD -> pocketsphinx), compares rejection methods and writes out/bench/voice.json.
+// expected \t text \t speech_end_s" and decodes every file through the same path as the app
+// (energy VAD -> one pocketsphinx pass over command phrases + filler loop).
+//   voice_bench --tune list.tsv tuned.txt [--phrases F]: grid over the filler weight and the
+//     duration limit; picks the best accuracy with false triggers <= 1 % and writes
+//     "filler_weight max_command_s" to tuned.txt. Only the tuning set is used here.
+//   voice_bench list.tsv out.json [--weight W] [--max-s D] [--phrases F]: evaluates one fixed
+//     configuration on the (separate) test set and writes out/bench/voice.json.
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -15,6 +20,7 @@
 
 using namespace drape::tracking;
 
+namespace {
 struct Item {
   std::string wav, expect, text;
   double speech_end = 0;
@@ -22,41 +28,24 @@ struct Item {
 };
 
 struct Outcome {
-  std::string hyp, command, garbage_hyp;
-  double speech_s = 0, margin = 0, latency_ms = 0, decode_ms = 0;
+  std::string hyp, command;
+  double speech_s = 0, latency_ms = 0, decode_ms = 0;
+  bool heard = false;
 };
 
-int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::fprintf(stderr, "usage: voice_bench list.tsv out.json\n");
-    return 2;
-  }
-  std::vector<Item> items;
-  std::ifstream in(argv[1]);
-  for (std::string line; std::getline(in, line);) {
-    std::stringstream ss(line);
-    Item it;
-    std::string end;
-    std::getline(ss, it.wav, '\t');
-    std::getline(ss, it.expect, '\t');
-    std::getline(ss, it.text, '\t');
-    std::getline(ss, end, '\t');
-    it.speech_end = std::stod(end);
-    std::string err;
-    if (!read_wav(it.wav, it.audio, &err)) {
-      std::fprintf(stderr, "%s\n", err.c_str());
-      return 1;
-    }
-    items.push_back(std::move(it));
-  }
-  // Decode once with everything computed (garbage margin on), then apply each rejection rule.
-  VoiceConfig cfg;
+struct Score {
+  int cmd = 0, ok = 0, non = 0, fa = 0;
+  double acc() const { return cmd ? double(ok) / cmd : 0; }
+  double far() const { return non ? double(fa) / non : 0; }
+};
+
+// Decodes every item with cfg (duration rule off: applied afterwards by score()).
+std::vector<Outcome> decode_all(const std::vector<Item>& items, VoiceConfig cfg) {
   cfg.rejection = Rejection::Garbage;
-  cfg.garbage_margin = 1e9;  // compute margins, never reject here
   VoiceRecognizer rec(cfg);
   if (!rec.ok()) {
     std::fprintf(stderr, "%s\n", rec.error().c_str());
-    return 1;
+    std::exit(1);
   }
   std::vector<Outcome> out;
   for (const auto& it : items) {
@@ -73,59 +62,177 @@ int main(int argc, char** argv) {
       const double speech_s = double(best->speech_end - best->start) / kVoiceRate - cfg.preroll_s;
       const auto r =
           rec.decode(best->audio.data(), static_cast<long>(best->audio.size()), speech_s);
+      o.heard = true;
       o.hyp = r.hypothesis;
       o.command = r.command;
-      o.garbage_hyp = r.garbage_hypothesis;
       o.speech_s = speech_s;
-      o.margin = r.margin;
       o.decode_ms = r.decode_ms;
       // end of utterance (known from synthesis) -> trigger: VAD decision time + decode time.
       o.latency_ms = (double(best->decided) / kVoiceRate - it.speech_end) * 1000.0 + r.decode_ms;
     }
     out.push_back(o);
   }
-  struct Method {
-    std::string name;
-    double margin;  // reject if margin < -margin
-    bool duration;
-  };
-  std::vector<Method> methods = {{"none", 1e9, false},         {"duration", 1e9, true},
-                                 {"garbage(m=10)", 10, false}, {"garbage(m=0)", 0, false},
-                                 {"garbage(m=-5)", -5, false}, {"garbage(m=0)+duration", 0, true}};
-  nlohmann::json j;
-  std::printf("\n%-24s %9s %9s %8s %8s\n", "rejection", "accuracy", "false_tr", "cmds", "non-cmd");
-  std::string chosen = "garbage(m=0)+duration";
-  for (const auto& m : methods) {
-    int cmd = 0, ok = 0, non = 0, fa = 0;
-    for (size_t i = 0; i < items.size(); ++i) {
-      const auto& o = out[i];
-      bool accept = !o.command.empty();
-      if (m.duration && (o.speech_s > cfg.max_command_s || o.speech_s < cfg.min_command_s))
-        accept = false;
-      if (o.margin < -m.margin) accept = false;
-      if (items[i].expect == "-") {
-        ++non;
-        fa += accept;
-      } else {
-        ++cmd;
-        ok += accept && o.command == items[i].expect;
-      }
-    }
-    const double acc = cmd ? double(ok) / cmd : 0, far = non ? double(fa) / non : 0;
-    std::printf("%-24s %8.1f%% %8.1f%% %8d %8d\n", m.name.c_str(), 100 * acc, 100 * far, cmd, non);
-    j["methods"][m.name] = {{"accuracy", acc}, {"false_trigger_rate", far}};
-    if (m.name == chosen) {
-      j["accuracy"] = acc;
-      j["false_trigger_rate"] = far;
-      j["rejection"] = chosen;
-      j["commands"] = cmd;
-      j["non_commands"] = non;
+  return out;
+}
+
+Score score(const std::vector<Item>& items, const std::vector<Outcome>& out, double max_s,
+            double min_s) {
+  Score sc;
+  for (size_t i = 0; i < items.size(); ++i) {
+    const auto& o = out[i];
+    const bool accept = !o.command.empty() && o.speech_s <= max_s && o.speech_s >= min_s;
+    if (items[i].expect == "-") {
+      ++sc.non;
+      sc.fa += accept;
+    } else {
+      ++sc.cmd;
+      sc.ok += accept && o.command == items[i].expect;
     }
   }
+  return sc;
+}
+
+std::vector<double> parse_list(const std::string& s) {
+  std::vector<double> v;
+  std::stringstream ss(s);
+  for (std::string t; std::getline(ss, t, ',');) v.push_back(std::stod(t));
+  return v;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool tune = false;
+  VoiceConfig cfg;
+  std::vector<std::string> pos;
+  std::vector<double> weights = {1.0};
+  std::vector<double> wips = {0.65, 1e-2, 1e-4, 1e-6};
+  const std::vector<double> max_grid = {1.2, 1.5, 1.8, 2.2, 1e9};
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--tune")
+      tune = true;
+    else if (a == "--phrases")
+      cfg.phrases = next();
+    else if (a == "--weight")
+      cfg.filler_weight = std::stod(next());
+    else if (a == "--weights")
+      weights = parse_list(next());
+    else if (a == "--wip")
+      cfg.word_penalty = std::stod(next());
+    else if (a == "--wips")
+      wips = parse_list(next());
+    else if (a == "--max-s")
+      cfg.max_command_s = std::stod(next());
+    else
+      pos.push_back(a);
+  }
+  if (pos.size() != 2) {
+    std::fprintf(stderr,
+                 "usage: voice_bench [--tune] list.tsv out [--phrases F] [--weight W] "
+                 "[--weights a,b] [--max-s D]\n");
+    return 2;
+  }
+  std::vector<Item> items;
+  std::ifstream in(pos[0]);
+  for (std::string line; std::getline(in, line);) {
+    std::stringstream ss(line);
+    Item it;
+    std::string end;
+    std::getline(ss, it.wav, '\t');
+    std::getline(ss, it.expect, '\t');
+    std::getline(ss, it.text, '\t');
+    std::getline(ss, end, '\t');
+    it.speech_end = std::stod(end);
+    std::string err;
+    if (!read_wav(it.wav, it.audio, &err)) {
+      std::fprintf(stderr, "%s\n", err.c_str());
+      return 1;
+    }
+    items.push_back(std::move(it));
+  }
+  if (items.empty()) {
+    std::fprintf(stderr, "%s: no utterances\n", pos[0].c_str());
+    return 1;
+  }
+
+  if (tune) {
+    std::printf("\nTUNING set (%zu utterances)\n%-10s %-10s %-8s %9s %9s\n", items.size(),
+                "filler_w", "wip", "max_s", "accuracy", "false_tr");
+    double best_acc = -1, best_w = cfg.filler_weight, best_wip = cfg.word_penalty,
+           best_max = cfg.max_command_s;
+    for (double w : weights)
+      for (double p : wips) {
+        cfg.filler_weight = w;
+        cfg.word_penalty = p;
+        const auto out = decode_all(items, cfg);
+        for (double mx : max_grid) {
+          const Score sc = score(items, out, mx, cfg.min_command_s);
+          std::printf("%-10g %-10g %-8g %8.1f%% %8.1f%%\n", w, p, mx, 100 * sc.acc(),
+                      100 * sc.far());
+          if (sc.far() <= 0.01 && sc.acc() > best_acc) {
+            best_acc = sc.acc();
+            best_w = w;
+            best_wip = p;
+            best_max = mx;
+          }
+        }
+        for (size_t i = 0; i < items.size(); ++i)
+          if (out[i].command != (items[i].expect == "-" ? "" : items[i].expect))
+            std::printf("    w=%g wip=%g %s: '%s' -> '%s' (%.2f s)\n", w, p, items[i].wav.c_str(),
+                        items[i].text.c_str(), out[i].hyp.c_str(), out[i].speech_s);
+        std::fflush(stdout);
+      }
+    std::printf(
+        "chosen on the tuning set: filler_weight %g, wip %g, max_command_s %g (accuracy %.1f %%)\n",
+        best_w, best_wip, best_max, 100 * best_acc);
+    std::ofstream(pos[1]) << best_w << " " << best_wip << " " << best_max << "\n";
+    return 0;
+  }
+
+  const auto out = decode_all(items, cfg);
+  nlohmann::json j;
+  std::printf("\nTEST set: filler_weight %g, wip %g, max_command_s %g\n%-24s %9s %9s %8s %8s\n",
+              cfg.filler_weight, cfg.word_penalty, cfg.max_command_s, "rejection", "accuracy",
+              "false_tr", "cmds", "non-cmd");
+  const Score plain = score(items, out, 1e9, 0);
+  const Score dur = score(items, out, cfg.max_command_s, cfg.min_command_s);
+  for (const auto& [name, sc] : {std::pair<std::string, Score>{"filler", plain},
+                                 std::pair<std::string, Score>{"filler+duration", dur}}) {
+    std::printf("%-24s %8.1f%% %8.1f%% %8d %8d\n", name.c_str(), 100 * sc.acc(), 100 * sc.far(),
+                sc.cmd, sc.non);
+    j["methods"][name] = {{"accuracy", sc.acc()}, {"false_trigger_rate", sc.far()}};
+  }
+  j["accuracy"] = dur.acc();
+  j["false_trigger_rate"] = dur.far();
+  j["rejection"] = "filler+duration";
+  j["filler_weight"] = cfg.filler_weight;
+  j["word_penalty"] = cfg.word_penalty;
+  j["max_command_s"] = cfg.max_command_s;
+  j["commands"] = dur.cmd;
+  j["non_commands"] = dur.non;
+  std::map<std::string, int> confusions;
+  for (size_t i = 0; i < items.size(); ++i) {
+    const bool accept = !out[i].command.empty() && out[i].speech_s <= cfg.max_command_s &&
+                        out[i].speech_s >= cfg.min_command_s;
+    const std::string got = accept ? out[i].command : "(rejected)";
+    if (got != (items[i].expect == "-" ? "(rejected)" : items[i].expect)) {
+      ++confusions[items[i].expect + " -> " + got];
+      std::printf("  error: %s '%s' -> hyp '%s' (%.2f s)\n", items[i].wav.c_str(),
+                  items[i].text.c_str(), out[i].hyp.c_str(), out[i].speech_s);
+    }
+  }
+  for (const auto& [k, v] : confusions) j["confusions"][k] = v;
   std::vector<double> lat;
   double dec = 0;
   for (size_t i = 0; i < items.size(); ++i)
-    if (items[i].expect != "-" && !out[i].command.empty()) {
+    if (items[i].expect != "-" && out[i].heard) {
       lat.push_back(out[i].latency_ms);
       dec += out[i].decode_ms;
     }
@@ -138,20 +245,17 @@ int main(int argc, char** argv) {
   j["utterances"] = items.size();
   j["snr_db"] = 10;
   j["hangover_ms"] = cfg.hangover_s * 1000;
-  // Per-utterance detail for inspection.
   for (size_t i = 0; i < items.size(); ++i)
     j["detail"].push_back({{"wav", items[i].wav},
                            {"expect", items[i].expect},
                            {"hyp", out[i].hyp},
-                           {"garbage_hyp", out[i].garbage_hyp},
-                           {"margin", out[i].margin},
                            {"speech_s", out[i].speech_s},
                            {"latency_ms", out[i].latency_ms}});
   std::printf(
       "\nlatency end of utterance -> trigger: median %.0f ms, p90 %.0f ms (hangover %.0f ms "
-      "+ decode %.0f ms mean)\nutterances: %zu\n",
+      "+ decode %.0f ms mean, one pass)\nutterances: %zu\n",
       med, p90, cfg.hangover_s * 1000, j["decode_ms_mean"].get<double>(), items.size());
-  std::ofstream(argv[2]) << j.dump(2) << "\n";
-  std::printf("wrote %s\n", argv[2]);
+  std::ofstream(pos[1]) << j.dump(2) << "\n";
+  std::printf("wrote %s\n", pos[1].c_str());
   return 0;
 }

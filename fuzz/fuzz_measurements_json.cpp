@@ -10,7 +10,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   auto m = drape::sim::parse_measurements(text, "fuzz.json");
   if (m.ok()) {
     // A valid set of measurements must give a form (coarse spacing keeps the fuzzer fast).
-    auto f = drape::sim::DressForm::from_measurements(*m, 0.02);
+    auto f = drape::sim::DressForm::from_measurements(*m, 0.05);
     if (!f.ok()) __builtin_trap();
     (void)f->girth_at(m->waist_height);
   }

@@ -36,8 +36,8 @@ Fov symmetric_fov(float fov_y, float aspect);
 // The view of an eye at `pose` with `fov`.
 View make_view(const Pose& pose, const Fov& fov, float near_m = 0.05f, float far_m = 50.0f);
 // A camera at `eye` looking at `target` (stage up +y).
-View look_at(const Vec3f& eye, const Vec3f& target, float fov_y, float aspect,
-             float near_m = 0.05f, float far_m = 50.0f);
+View look_at(const Vec3f& eye, const Vec3f& target, float fov_y, float aspect, float near_m = 0.05f,
+             float far_m = 50.0f);
 // Pixel coordinates (x right, y down, pixel centres at +0.5) of a stage-space point in an image
 // of width x height; nothing when it is behind the eye.
 std::optional<Eigen::Vector2f> project_to_pixel(const View& view, const Vec3f& p, int width,

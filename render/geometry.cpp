@@ -38,8 +38,8 @@ V3 perpendicular(const V3& d) {
 
 }  // namespace
 
-void append_sphere(Mesh& out, const V3& c, float r, const std::array<float, 3>& rgb,
-                   ShadeMode mode, int slices, int stacks) {
+void append_sphere(Mesh& out, const V3& c, float r, const std::array<float, 3>& rgb, ShadeMode mode,
+                   int slices, int stacks) {
   const auto base = static_cast<uint32_t>(out.vertices.size());
   for (int i = 0; i <= stacks; ++i) {
     const float phi = kPi * i / stacks;
@@ -114,8 +114,7 @@ float form_distance(const sim::DressForm& form, const V3& p) {
   return static_cast<float>(std::sqrt(dx * dx + dz * dz) - ((1 - fj) * r0 + fj * r1));
 }
 
-void append_form(const sim::DressForm& form, float max_spacing, const DrawOptions& opt,
-                 Mesh& out) {
+void append_form(const sim::DressForm& form, float max_spacing, const DrawOptions& opt, Mesh& out) {
   const int ns = form.num_sections();
   constexpr int na = sim::DressForm::kAngles;
   if (ns < 2) return;
@@ -149,8 +148,8 @@ void append_form(const sim::DressForm& form, float max_spacing, const DrawOption
       const V3 radial(P(i, n).x() - cx, 0, P(i, n).z() - cz);
       if (nrm.dot(radial) < 0) nrm = -nrm;
       nrm = nrm.norm() > 1e-12f ? nrm.normalized() : radial.normalized();
-      out.vertices.push_back(make_vertex(P(i, n), nrm, opt.form_colour, ShadeMode::kForm, 0, 0, cx,
-                                         cz));
+      out.vertices.push_back(
+          make_vertex(P(i, n), nrm, opt.form_colour, ShadeMode::kForm, 0, 0, cx, cz));
     }
   }
   for (int i = 0; i + 1 < nr; ++i)
@@ -277,8 +276,8 @@ void append_decorations(const sim::SceneSnapshot& snap, const DrawOptions& opt, 
                   ShadeMode::kLit, 24, 16);
   for (const auto& h : snap.hands) {
     if (!h.tracked) continue;
-    const std::array<float, 3> col =
-        h.id == 0 ? std::array<float, 3>{0.15f, 0.65f, 0.65f} : std::array<float, 3>{0.9f, 0.5f, 0.15f};
+    const std::array<float, 3> col = h.id == 0 ? std::array<float, 3>{0.15f, 0.65f, 0.65f}
+                                               : std::array<float, 3>{0.9f, 0.5f, 0.15f};
     const float r = static_cast<float>(h.radius);
     append_sphere(out, f(h.position), r, col, ShadeMode::kLit);
     if ((h.tip - h.position).norm() > 1e-6) {

@@ -40,15 +40,15 @@ struct Mesh {
 // What to draw and how; everything has a sensible default.
 struct DrawOptions {
   ColourMap colour_map = ColourMap::kNone;
-  float strain_range = 0.05f;  // |strain| mapped to full colour
-  float ease_range = 0.05f;    // ease (m) mapped to the loose end of the ramp
-  bool grain = true;           // warp/weft check on the cloth
-  float grain_spacing = 0.02f; // m between grain lines (every 5th warp line is stronger)
+  float strain_range = 0.05f;   // |strain| mapped to full colour
+  float ease_range = 0.05f;     // ease (m) mapped to the loose end of the ramp
+  bool grain = true;            // warp/weft check on the cloth
+  float grain_spacing = 0.02f;  // m between grain lines (every 5th warp line is stronger)
   bool floor_grid = true;
   bool pattern_panel = true;
   Eigen::Vector3f panel_centre{0.72f, 1.25f, 0.15f};  // floating pattern panel (stage space)
-  float panel_yaw = -0.45f;    // rotation about +y; 0 faces +z (like the form's front)
-  float panel_size = 0.5f;     // edge length of the square panel (m)
+  float panel_yaw = -0.45f;         // rotation about +y; 0 faces +z (like the form's front)
+  float panel_size = 0.5f;          // edge length of the square panel (m)
   float line_half_width = 0.0025f;  // reference lines on the form (m)
   std::array<float, 4> background{0.55f, 0.60f, 0.68f, 1.0f};  // linear RGB
   std::array<float, 3> cloth_colour{0.92f, 0.89f, 0.80f};      // unbleached muslin

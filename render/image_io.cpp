@@ -110,8 +110,8 @@ sim::Result<ImageDiff> compare_images(const Image& a, const Image& b) {
     over += big;
   }
   const double mse = se / (3.0 * n);
-  d.psnr_db = mse == 0 ? std::numeric_limits<double>::infinity()
-                       : 10.0 * std::log10(255.0 * 255.0 / mse);
+  d.psnr_db =
+      mse == 0 ? std::numeric_limits<double>::infinity() : 10.0 * std::log10(255.0 * 255.0 / mse);
   d.frac_over_16 = double(over) / n;
   return d;
 }

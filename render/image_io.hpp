@@ -13,9 +13,9 @@ std::string write_png(const std::string& path, const Image& img);
 sim::Result<Image> read_png(const std::string& path);
 
 struct ImageDiff {
-  double psnr_db = 0;        // over RGB, +inf for identical images
-  int max_abs = 0;           // largest channel difference
-  double frac_over_16 = 0;   // fraction of pixels with any channel differing by more than 16
+  double psnr_db = 0;       // over RGB, +inf for identical images
+  int max_abs = 0;          // largest channel difference
+  double frac_over_16 = 0;  // fraction of pixels with any channel differing by more than 16
 };
 // Compares two images of equal size (an error when sizes differ).
 sim::Result<ImageDiff> compare_images(const Image& a, const Image& b);

@@ -72,7 +72,8 @@ struct MirrorWindow::Impl {
       vkDestroySwapchainKHR(ctx().device, swapchain, nullptr);
     }
     swapchain = created;
-    if (r != VK_SUCCESS) return Status{std::string("mirror: vkCreateSwapchainKHR: ") + vk_result_name(r)};
+    if (r != VK_SUCCESS)
+      return Status{std::string("mirror: vkCreateSwapchainKHR: ") + vk_result_name(r)};
     vkGetSwapchainImagesKHR(ctx().device, swapchain, &n, nullptr);
     images.resize(n);
     vkGetSwapchainImagesKHR(ctx().device, swapchain, &n, images.data());
@@ -95,8 +96,9 @@ sim::Result<std::vector<std::string>> MirrorWindow::prepare() {
   static bool initialised = false;
   if (!initialised) {
     if (!glfwInit())
-      return sim::Error{"mirror: cannot initialise GLFW (no display? set DISPLAY or run under "
-                        "xvfb-run); continuing without a mirror window is fine"};
+      return sim::Error{
+          "mirror: cannot initialise GLFW (no display? set DISPLAY or run under "
+          "xvfb-run); continuing without a mirror window is fine"};
     initialised = true;
   }
   if (!glfwVulkanSupported()) return sim::Error{"mirror: GLFW finds no Vulkan loader"};
@@ -150,8 +152,8 @@ Status MirrorWindow::show(const sim::SceneSnapshot& snap, const View& view,
     return Status{std::string("mirror: vkAcquireNextImageKHR: ") + vk_result_name(r)};
   vkWaitForFences(m.ctx().device, 1, &m.acquire_fence, VK_TRUE, UINT64_MAX);
   vkResetFences(m.ctx().device, 1, &m.acquire_fence);
-  ColorTarget t{m.images[index], m.format, m.extent.width, m.extent.height, 0,
-                VK_IMAGE_LAYOUT_PRESENT_SRC_KHR};
+  ColorTarget t{m.images[index], m.format, m.extent.width,
+                m.extent.height, 0,        VK_IMAGE_LAYOUT_PRESENT_SRC_KHR};
   if (Status s = m.renderer->render(snap, view, t, opt); !s) return s;
   VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
   pi.swapchainCount = 1;
@@ -159,15 +161,24 @@ Status MirrorWindow::show(const sim::SceneSnapshot& snap, const View& view,
   pi.pImageIndices = &index;
   r = vkQueuePresentKHR(m.ctx().queue, &pi);
   if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) return m.create_swapchain();
-  if (r != VK_SUCCESS) return Status{std::string("mirror: vkQueuePresentKHR: ") + vk_result_name(r)};
+  if (r != VK_SUCCESS)
+    return Status{std::string("mirror: vkQueuePresentKHR: ") + vk_result_name(r)};
   ++m.presented;
   return {};
 }
 
-bool MirrorWindow::should_close() const { return glfwWindowShouldClose(impl_->window); }
-int MirrorWindow::width() const { return static_cast<int>(impl_->extent.width); }
-int MirrorWindow::height() const { return static_cast<int>(impl_->extent.height); }
-int MirrorWindow::frames_presented() const { return impl_->presented; }
+bool MirrorWindow::should_close() const {
+  return glfwWindowShouldClose(impl_->window);
+}
+int MirrorWindow::width() const {
+  return static_cast<int>(impl_->extent.width);
+}
+int MirrorWindow::height() const {
+  return static_cast<int>(impl_->extent.height);
+}
+int MirrorWindow::frames_presented() const {
+  return impl_->presented;
+}
 
 #else  // built without GLFW
 
@@ -184,10 +195,18 @@ sim::Result<std::unique_ptr<MirrorWindow>> MirrorWindow::open(Renderer&, int, in
 Status MirrorWindow::show(const sim::SceneSnapshot&, const View&, const DrawOptions&) {
   return Status{"mirror: built without GLFW"};
 }
-bool MirrorWindow::should_close() const { return true; }
-int MirrorWindow::width() const { return 0; }
-int MirrorWindow::height() const { return 0; }
-int MirrorWindow::frames_presented() const { return 0; }
+bool MirrorWindow::should_close() const {
+  return true;
+}
+int MirrorWindow::width() const {
+  return 0;
+}
+int MirrorWindow::height() const {
+  return 0;
+}
+int MirrorWindow::frames_presented() const {
+  return 0;
+}
 
 #endif
 

@@ -17,8 +17,8 @@ class MirrorWindow {
   // RendererOptions::context.instance_extensions (and set context.swapchain) before creating the
   // renderer. Fails without a display or when built without GLFW.
   static sim::Result<std::vector<std::string>> prepare();
-  static sim::Result<std::unique_ptr<MirrorWindow>> open(Renderer& renderer, int width,
-                                                         int height, const std::string& title);
+  static sim::Result<std::unique_ptr<MirrorWindow>> open(Renderer& renderer, int width, int height,
+                                                         const std::string& title);
   ~MirrorWindow();
   MirrorWindow(const MirrorWindow&) = delete;
   MirrorWindow& operator=(const MirrorWindow&) = delete;

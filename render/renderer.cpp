@@ -245,8 +245,8 @@ struct Renderer::Impl {
     // MSAA: the largest supported count not above the request.
     VkPhysicalDeviceProperties props;
     vkGetPhysicalDeviceProperties(ctx->physical, &props);
-    const VkSampleCountFlags ok = props.limits.framebufferColorSampleCounts &
-                                  props.limits.framebufferDepthSampleCounts;
+    const VkSampleCountFlags ok =
+        props.limits.framebufferColorSampleCounts & props.limits.framebufferDepthSampleCounts;
     samples = 1;
     for (int s : {8, 4, 2})
       if (s <= want_samples && (ok & static_cast<VkSampleCountFlags>(s))) {
@@ -331,14 +331,15 @@ struct Renderer::Impl {
     deps[0].srcSubpass = VK_SUBPASS_EXTERNAL;
     deps[0].dstSubpass = 0;
     deps[0].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
-                           VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
-    deps[0].dstStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
-                           VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT;
+                           VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT |
+                           VK_PIPELINE_STAGE_TRANSFER_BIT;
+    deps[0].dstStageMask =
+        VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT;
     deps[0].srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
                             VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
                             VK_ACCESS_TRANSFER_READ_BIT;
-    deps[0].dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
-                            VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+    deps[0].dstAccessMask =
+        VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
     deps[1].srcSubpass = 0;
     deps[1].dstSubpass = VK_SUBPASS_EXTERNAL;
     deps[1].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
@@ -406,7 +407,8 @@ struct Renderer::Impl {
     VkPipelineColorBlendAttachmentState cba{};
     cba.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                          VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
-    VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    VkPipelineColorBlendStateCreateInfo cb{
+        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     cb.attachmentCount = 1;
     cb.pAttachments = &cba;
     VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
@@ -439,9 +441,9 @@ struct Renderer::Impl {
     const auto key = std::make_tuple(w, h, fmt, samples);
     if (auto it = attachments.find(key); it != attachments.end()) return &it->second;
     std::pair<Attachment, Attachment> a;
-    Status st = make_image(a.first, w, h, VK_FORMAT_D32_SFLOAT,
-                           VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
-                           samples);
+    Status st =
+        make_image(a.first, w, h, VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
+                   VK_IMAGE_ASPECT_DEPTH_BIT, samples);
     if (st && samples > 1)
       st = make_image(a.second, w, h, fmt,
                       VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT,
@@ -455,7 +457,8 @@ struct Renderer::Impl {
   }
 
   sim::Result<VkFramebuffer> framebuffer_for(const ColorTarget& t, VkRenderPass rp) {
-    const TargetKey key{t.image, t.array_layer, t.width, t.height, t.format, samples, t.final_layout};
+    const TargetKey key{t.image,  t.array_layer, t.width,       t.height,
+                        t.format, samples,       t.final_layout};
     if (auto it = targets.find(key); it != targets.end()) return it->second.framebuffer;
     auto att = attachments_for(t.width, t.height, t.format);
     if (!att) return sim::Error{att.error()};
@@ -492,8 +495,10 @@ struct Renderer::Impl {
     const VkDeviceSize ibytes = std::max<size_t>(m.indices.size(), 1) * sizeof(uint32_t);
     if (Status s = ensure_buffer(vb, vbytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT); !s) return s;
     if (Status s = ensure_buffer(ib, ibytes, VK_BUFFER_USAGE_INDEX_BUFFER_BIT); !s) return s;
-    if (!m.vertices.empty()) std::memcpy(vb.mapped, m.vertices.data(), m.vertices.size() * sizeof(Vertex));
-    if (!m.indices.empty()) std::memcpy(ib.mapped, m.indices.data(), m.indices.size() * sizeof(uint32_t));
+    if (!m.vertices.empty())
+      std::memcpy(vb.mapped, m.vertices.data(), m.vertices.size() * sizeof(Vertex));
+    if (!m.indices.empty())
+      std::memcpy(ib.mapped, m.indices.data(), m.indices.size() * sizeof(uint32_t));
     return {};
   }
 
@@ -646,17 +651,17 @@ struct Renderer::Impl {
     if (uw != off_w || uh != off_h || !offscreen.image) {
       forget_targets();
       destroy_attachment(offscreen);
-      if (Status s = make_image(offscreen, uw, uh, kFormat,
-                                VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
-                                    VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                                VK_IMAGE_ASPECT_COLOR_BIT, 1);
+      if (Status s =
+              make_image(offscreen, uw, uh, kFormat,
+                         VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                         VK_IMAGE_ASPECT_COLOR_BIT, 1);
           !s)
         return sim::Error{s.error};
       off_w = uw;
       off_h = uh;
     }
-    if (Status s = ensure_buffer(readback, VkDeviceSize(uw) * uh * 4,
-                                 VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    if (Status s =
+            ensure_buffer(readback, VkDeviceSize(uw) * uh * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
         !s)
       return sim::Error{s.error};
     ColorTarget t{offscreen.image, kFormat, uw, uh, 0, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
@@ -706,12 +711,26 @@ void Renderer::forget_targets() {
   if (!impl_->lost) vkDeviceWaitIdle(impl_->dev());
   impl_->forget_targets();
 }
-ValidationCounts Renderer::validation() const { return impl_->ctx->validation(); }
-const std::string& Renderer::device_name() const { return impl_->ctx->device_name; }
-bool Renderer::is_cpu_device() const { return impl_->ctx->is_cpu; }
-bool Renderer::device_lost() const { return impl_->lost; }
-const FrameStats& Renderer::last_frame() const { return impl_->stats; }
-VulkanContext& Renderer::context() { return *impl_->ctx; }
-void Renderer::simulate_device_lost() { impl_->lost = true; }
+ValidationCounts Renderer::validation() const {
+  return impl_->ctx->validation();
+}
+const std::string& Renderer::device_name() const {
+  return impl_->ctx->device_name;
+}
+bool Renderer::is_cpu_device() const {
+  return impl_->ctx->is_cpu;
+}
+bool Renderer::device_lost() const {
+  return impl_->lost;
+}
+const FrameStats& Renderer::last_frame() const {
+  return impl_->stats;
+}
+VulkanContext& Renderer::context() {
+  return *impl_->ctx;
+}
+void Renderer::simulate_device_lost() {
+  impl_->lost = true;
+}
 
 }  // namespace drape::render

@@ -40,10 +40,10 @@ struct Image {
 };
 
 struct FrameStats {
-  double build_ms = 0;      // CPU geometry (cloth, decorations; the form is cached)
-  double submit_ms = 0;     // upload, command recording, submission
-  double wait_ms = 0;       // waiting for the device (lavapipe: the rasterisation itself)
-  double thread_cpu_ms = 0; // CPU time of the calling thread for the whole frame
+  double build_ms = 0;       // CPU geometry (cloth, decorations; the form is cached)
+  double submit_ms = 0;      // upload, command recording, submission
+  double wait_ms = 0;        // waiting for the device (lavapipe: the rasterisation itself)
+  double thread_cpu_ms = 0;  // CPU time of the calling thread for the whole frame
   size_t triangles = 0;
 };
 

@@ -106,8 +106,10 @@ sim::Cloth panel_cloth(const json& p, const std::string& field) {
   sim::Cloth c = sim::make_panel(spec, sim::FabricParams{});
   const sim::Vec3 origin = p.contains("origin") ? vec3(p["origin"], field + ".origin")
                                                 : sim::Vec3(-0.5 * spec.width, 1.0, 0.3);
-  const sim::Vec3 au = p.contains("axis_u") ? vec3(p["axis_u"], field + ".axis_u") : sim::Vec3::UnitX();
-  const sim::Vec3 av = p.contains("axis_v") ? vec3(p["axis_v"], field + ".axis_v") : sim::Vec3::UnitY();
+  const sim::Vec3 au =
+      p.contains("axis_u") ? vec3(p["axis_u"], field + ".axis_u") : sim::Vec3::UnitX();
+  const sim::Vec3 av =
+      p.contains("axis_v") ? vec3(p["axis_v"], field + ".axis_v") : sim::Vec3::UnitY();
   if (au.norm() < 1e-9 || av.norm() < 1e-9 || au.cross(av).norm() < 1e-9 * au.norm() * av.norm())
     bad(field, "axis_u and axis_v must be non-zero and not parallel");
   sim::place_spread(c, origin, au, av);
@@ -128,9 +130,11 @@ void parse_cloth(const json& c, const std::string& base, sim::SceneSnapshot& sna
     sim::Cloth cloth = panel_cloth(c["panel"], "cloth.panel");
     if (c.contains("drape")) {
       const json& d = c["drape"];
-      const double seconds = d.contains("seconds") ? positive(d["seconds"], "cloth.drape.seconds") : 2.0;
+      const double seconds =
+          d.contains("seconds") ? positive(d["seconds"], "cloth.drape.seconds") : 2.0;
       if (seconds > 60) bad("cloth.drape.seconds", "at most 60 s");
-      const std::string solver = d.contains("solver") ? text(d["solver"], "cloth.drape.solver") : "vbd";
+      const std::string solver =
+          d.contains("solver") ? text(d["solver"], "cloth.drape.solver") : "vbd";
       if (d.contains("fabric")) {
         auto fab = sim::load_fabric(std::string(DRAPE_RENDER_ASSETS) + "/fabrics.json",
                                     text(d["fabric"], "cloth.drape.fabric"));
@@ -166,7 +170,8 @@ void parse_cloth(const json& c, const std::string& base, sim::SceneSnapshot& sna
   }
   const json& pos = array_field(c, "positions", "cloth.positions");
   for (size_t i = 0; i < pos.size(); ++i)
-    snap.positions.emplace_back(vec3(pos[i], "cloth.positions[" + std::to_string(i) + "]").cast<float>());
+    snap.positions.emplace_back(
+        vec3(pos[i], "cloth.positions[" + std::to_string(i) + "]").cast<float>());
   const json& idx = array_field(c, "indices", "cloth.indices");
   if (idx.size() % 3) bad("cloth.indices", "length must be a multiple of 3");
   for (size_t i = 0; i < idx.size(); ++i) {
@@ -180,13 +185,15 @@ void parse_cloth(const json& c, const std::string& base, sim::SceneSnapshot& sna
     const json& m = array_field(c, "material", "cloth.material");
     if (m.size() != snap.positions.size()) bad("cloth.material", "one [u, v] per position");
     for (size_t i = 0; i < m.size(); ++i)
-      snap.material.emplace_back(vec2(m[i], "cloth.material[" + std::to_string(i) + "]").cast<float>());
+      snap.material.emplace_back(
+          vec2(m[i], "cloth.material[" + std::to_string(i) + "]").cast<float>());
   }
   if (c.contains("strain")) {
     const json& s = array_field(c, "strain", "cloth.strain");
     if (s.size() != snap.positions.size()) bad("cloth.strain", "one value per position");
     for (size_t i = 0; i < s.size(); ++i)
-      snap.strain.push_back(static_cast<float>(number(s[i], "cloth.strain[" + std::to_string(i) + "]")));
+      snap.strain.push_back(
+          static_cast<float>(number(s[i], "cloth.strain[" + std::to_string(i) + "]")));
   }
 }
 
@@ -211,7 +218,8 @@ void parse_camera(const json& c, CameraSpec& cam) {
         std::abs(f.angle_up) >= 1.57f || std::abs(f.angle_down) >= 1.57f)
       bad("camera.xr.fov", "angles must satisfy left < right, down < up, |angle| < pi/2");
     cam.xr_fov = f;
-    if (x.contains("position")) cam.xr_pose.position = vec3(x["position"], "camera.xr.position").cast<float>();
+    if (x.contains("position"))
+      cam.xr_pose.position = vec3(x["position"], "camera.xr.position").cast<float>();
     if (x.contains("orientation")) {
       const json& q = x["orientation"];
       if (!q.is_array() || q.size() != 4) bad("camera.xr.orientation", "expected [x, y, z, w]");
@@ -229,18 +237,27 @@ void parse_options(const json& o, SceneDescription& d) {
   DrawOptions& opt = d.options;
   if (o.contains("colour_map")) {
     const std::string m = text(o["colour_map"], "options.colour_map");
-    if (m == "none") opt.colour_map = ColourMap::kNone;
-    else if (m == "strain") opt.colour_map = ColourMap::kStrain;
-    else if (m == "ease") opt.colour_map = ColourMap::kEase;
-    else bad("options.colour_map", "expected \"none\", \"strain\" or \"ease\"");
+    if (m == "none")
+      opt.colour_map = ColourMap::kNone;
+    else if (m == "strain")
+      opt.colour_map = ColourMap::kStrain;
+    else if (m == "ease")
+      opt.colour_map = ColourMap::kEase;
+    else
+      bad("options.colour_map", "expected \"none\", \"strain\" or \"ease\"");
   }
-  if (o.contains("strain_range")) opt.strain_range = static_cast<float>(positive(o["strain_range"], "options.strain_range"));
-  if (o.contains("ease_range")) opt.ease_range = static_cast<float>(positive(o["ease_range"], "options.ease_range"));
+  if (o.contains("strain_range"))
+    opt.strain_range = static_cast<float>(positive(o["strain_range"], "options.strain_range"));
+  if (o.contains("ease_range"))
+    opt.ease_range = static_cast<float>(positive(o["ease_range"], "options.ease_range"));
   if (o.contains("grain")) opt.grain = boolean(o["grain"], "options.grain");
-  if (o.contains("grain_spacing")) opt.grain_spacing = static_cast<float>(positive(o["grain_spacing"], "options.grain_spacing"));
+  if (o.contains("grain_spacing"))
+    opt.grain_spacing = static_cast<float>(positive(o["grain_spacing"], "options.grain_spacing"));
   if (o.contains("floor")) opt.floor_grid = boolean(o["floor"], "options.floor");
-  if (o.contains("pattern_panel")) opt.pattern_panel = boolean(o["pattern_panel"], "options.pattern_panel");
-  if (o.contains("panel_centre")) opt.panel_centre = vec3(o["panel_centre"], "options.panel_centre").cast<float>();
+  if (o.contains("pattern_panel"))
+    opt.pattern_panel = boolean(o["pattern_panel"], "options.pattern_panel");
+  if (o.contains("panel_centre"))
+    opt.panel_centre = vec3(o["panel_centre"], "options.panel_centre").cast<float>();
   if (o.contains("samples")) {
     d.samples = static_cast<int>(positive(o["samples"], "options.samples"));
     if (d.samples > 8) bad("options.samples", "at most 8");
@@ -369,14 +386,18 @@ sim::Result<SceneDescription> default_scene(double sim_seconds, const std::strin
                                             int grid) {
   // A square of muslin held flat above the shoulders and dropped: it falls over the form and
   // hangs in folds, the straight grain (v) running from front to back over the shoulders.
-  json doc = {
-      {"form", {{"size", "9AR"}}},
-      {"cloth",
-       {{"panel",
-         {{"width", 1.0}, {"height", 1.0}, {"nx", grid}, {"ny", grid},
-          {"origin", {-0.5, 1.40, 0.5}}, {"axis_u", {1, 0, 0}}, {"axis_v", {0, 0, -1}}}},
-        {"drape", {{"seconds", sim_seconds}, {"solver", solver}, {"fabric", "muslin"}}}}},
-      {"options", {{"samples", 4}}}};
+  json doc = {{"form", {{"size", "9AR"}}},
+              {"cloth",
+               {{"panel",
+                 {{"width", 1.0},
+                  {"height", 1.0},
+                  {"nx", grid},
+                  {"ny", grid},
+                  {"origin", {-0.5, 1.40, 0.5}},
+                  {"axis_u", {1, 0, 0}},
+                  {"axis_v", {0, 0, -1}}}},
+                {"drape", {{"seconds", sim_seconds}, {"solver", solver}, {"fabric", "muslin"}}}}},
+              {"options", {{"samples", 4}}}};
   return parse_scene(doc.dump(), "default scene");
 }
 

@@ -26,7 +26,7 @@ struct SceneDescription {
   sim::SceneSnapshot snapshot;
   CameraSpec camera;
   DrawOptions options;
-  int samples = 4;  // MSAA for screenshots
+  int samples = 4;      // MSAA for screenshots
   std::string summary;  // what was built (printed by the command)
 };
 
@@ -38,7 +38,6 @@ sim::Result<SceneDescription> parse_scene(const std::string& json_text, const st
 // The default scene: a 1 m square of muslin dropped over the 9AR form and simulated until it
 // hangs (`sim_seconds` of simulated time, solver `solver`), with grain lines.
 sim::Result<SceneDescription> default_scene(double sim_seconds = 2.5,
-                                            const std::string& solver = "vbd",
-                                            int grid = 81);
+                                            const std::string& solver = "vbd", int grid = 81);
 
 }  // namespace drape::render

@@ -67,21 +67,36 @@ sim::Error vk_error(const std::string& what, VkResult r) {
 
 const char* vk_result_name(VkResult r) {
   switch (r) {
-    case VK_SUCCESS: return "VK_SUCCESS";
-    case VK_NOT_READY: return "VK_NOT_READY";
-    case VK_TIMEOUT: return "VK_TIMEOUT";
-    case VK_SUBOPTIMAL_KHR: return "VK_SUBOPTIMAL_KHR";
-    case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
-    case VK_ERROR_OUT_OF_DEVICE_MEMORY: return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
-    case VK_ERROR_INITIALIZATION_FAILED: return "VK_ERROR_INITIALIZATION_FAILED";
-    case VK_ERROR_DEVICE_LOST: return "VK_ERROR_DEVICE_LOST";
-    case VK_ERROR_LAYER_NOT_PRESENT: return "VK_ERROR_LAYER_NOT_PRESENT";
-    case VK_ERROR_EXTENSION_NOT_PRESENT: return "VK_ERROR_EXTENSION_NOT_PRESENT";
-    case VK_ERROR_INCOMPATIBLE_DRIVER: return "VK_ERROR_INCOMPATIBLE_DRIVER";
-    case VK_ERROR_FORMAT_NOT_SUPPORTED: return "VK_ERROR_FORMAT_NOT_SUPPORTED";
-    case VK_ERROR_SURFACE_LOST_KHR: return "VK_ERROR_SURFACE_LOST_KHR";
-    case VK_ERROR_OUT_OF_DATE_KHR: return "VK_ERROR_OUT_OF_DATE_KHR";
-    default: return "VkResult(other)";
+    case VK_SUCCESS:
+      return "VK_SUCCESS";
+    case VK_NOT_READY:
+      return "VK_NOT_READY";
+    case VK_TIMEOUT:
+      return "VK_TIMEOUT";
+    case VK_SUBOPTIMAL_KHR:
+      return "VK_SUBOPTIMAL_KHR";
+    case VK_ERROR_OUT_OF_HOST_MEMORY:
+      return "VK_ERROR_OUT_OF_HOST_MEMORY";
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY:
+      return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+    case VK_ERROR_INITIALIZATION_FAILED:
+      return "VK_ERROR_INITIALIZATION_FAILED";
+    case VK_ERROR_DEVICE_LOST:
+      return "VK_ERROR_DEVICE_LOST";
+    case VK_ERROR_LAYER_NOT_PRESENT:
+      return "VK_ERROR_LAYER_NOT_PRESENT";
+    case VK_ERROR_EXTENSION_NOT_PRESENT:
+      return "VK_ERROR_EXTENSION_NOT_PRESENT";
+    case VK_ERROR_INCOMPATIBLE_DRIVER:
+      return "VK_ERROR_INCOMPATIBLE_DRIVER";
+    case VK_ERROR_FORMAT_NOT_SUPPORTED:
+      return "VK_ERROR_FORMAT_NOT_SUPPORTED";
+    case VK_ERROR_SURFACE_LOST_KHR:
+      return "VK_ERROR_SURFACE_LOST_KHR";
+    case VK_ERROR_OUT_OF_DATE_KHR:
+      return "VK_ERROR_OUT_OF_DATE_KHR";
+    default:
+      return "VkResult(other)";
   }
 }
 
@@ -133,8 +148,9 @@ sim::Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextO
   if (opt.validation) ici.pNext = &dbg;  // also catches messages of vkCreate/DestroyInstance
   VkResult r = vkCreateInstance(&ici, nullptr, &ctx->instance);
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
-    return sim::Error{"vulkan: no Vulkan 1.1 driver found (install mesa-vulkan-drivers for the "
-                      "lavapipe CPU device, or a GPU driver)"};
+    return sim::Error{
+        "vulkan: no Vulkan 1.1 driver found (install mesa-vulkan-drivers for the "
+        "lavapipe CPU device, or a GPU driver)"};
   if (r != VK_SUCCESS) return vk_error("vkCreateInstance", r);
   if (opt.validation) {
     auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
@@ -147,8 +163,9 @@ sim::Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextO
   std::vector<VkPhysicalDevice> devs(n);
   vkEnumeratePhysicalDevices(ctx->instance, &n, devs.data());
   if (n == 0)
-    return sim::Error{"vulkan: no Vulkan device found (no GPU driver and no lavapipe: install "
-                      "mesa-vulkan-drivers; check VK_ICD_FILENAMES)"};
+    return sim::Error{
+        "vulkan: no Vulkan device found (no GPU driver and no lavapipe: install "
+        "mesa-vulkan-drivers; check VK_ICD_FILENAMES)"};
   std::string filter = opt.device_filter;
   if (const char* env = std::getenv("DRAPE_VK_DEVICE"); env && *env && filter.empty()) filter = env;
   int best = -1, best_score = -1;
@@ -162,11 +179,20 @@ sim::Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextO
     if (opt.swapchain && !has_device_extension(devs[i], VK_KHR_SWAPCHAIN_EXTENSION_NAME)) continue;
     int score = 0;
     switch (p.deviceType) {
-      case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: score = 4; break;
-      case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: score = 3; break;
-      case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: score = 2; break;
-      case VK_PHYSICAL_DEVICE_TYPE_CPU: score = opt.prefer_cpu ? 10 : 1; break;
-      default: score = 0;
+      case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+        score = 4;
+        break;
+      case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+        score = 3;
+        break;
+      case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+        score = 2;
+        break;
+      case VK_PHYSICAL_DEVICE_TYPE_CPU:
+        score = opt.prefer_cpu ? 10 : 1;
+        break;
+      default:
+        score = 0;
     }
     if (score > best_score) best = static_cast<int>(i), best_score = score;
   }
@@ -201,8 +227,9 @@ sim::Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextO
 
 sim::Result<std::unique_ptr<VulkanContext>> VulkanContext::adopt(const ExternalDevice& ext) {
   if (!ext.instance || !ext.physical_device || !ext.device)
-    return sim::Error{"vulkan: handed-over device is incomplete (instance, physical device and "
-                      "device must all be set)"};
+    return sim::Error{
+        "vulkan: handed-over device is incomplete (instance, physical device and "
+        "device must all be set)"};
   std::unique_ptr<VulkanContext> ctx(new VulkanContext());
   ctx->owns = false;
   ctx->instance = ext.instance;

@@ -94,10 +94,12 @@ std::string Cloth::validate() const {
 }
 
 Cloth make_panel(const PanelSpec& spec, const FabricParams& fabric) {
-  const int nx = spec.nx > 0 ? spec.nx
-                             : std::max(2, static_cast<int>(std::lround(spec.width / spec.spacing)) + 1);
-  const int ny = spec.ny > 0 ? spec.ny
-                             : std::max(2, static_cast<int>(std::lround(spec.height / spec.spacing)) + 1);
+  const int nx = spec.nx > 0
+                     ? spec.nx
+                     : std::max(2, static_cast<int>(std::lround(spec.width / spec.spacing)) + 1);
+  const int ny = spec.ny > 0
+                     ? spec.ny
+                     : std::max(2, static_cast<int>(std::lround(spec.height / spec.spacing)) + 1);
   const double du = spec.width / (nx - 1);
   const double dv = spec.height / (ny - 1);
   Cloth c;
@@ -156,7 +158,7 @@ void place_rolled(Cloth& cloth, const Vec3& origin, const Vec3& axis_u, const Ve
   const int n = cloth.num_vertices();
   const Vec3 au = axis_u.normalized();
   const Vec3 w = (up - up.dot(au) * au).normalized();  // up, made perpendicular to the roll axis
-  const Vec3 t = au.cross(w);                           // horizontal, across the roll
+  const Vec3 t = au.cross(w);                          // horizontal, across the roll
   double vmax = 0;
   for (int i = 0; i < n; ++i) vmax = std::max(vmax, cloth.topo.material[i].y());
   // Archimedean spiral r(phi) = r0 + b phi, layers one pitch apart (2 cloth thicknesses plus a

@@ -114,11 +114,21 @@ double Collider::push_out(Vec3& p, const SceneObjects& scene) const {
   for (const Active& a : active_) {
     double d = 0;
     switch (a.kind) {
-      case Kind::kFloor: d = collide_floor(p, off); break;
-      case Kind::kForm: d = scene.form->push_outside(p, off); break;
-      case Kind::kPlate: d = collide_plate(p, scene.plates[a.index], off); break;
-      case Kind::kBox: d = collide_box(p, scene.boxes[a.index].centre, scene.boxes[a.index].half, off); break;
-      case Kind::kSphere: d = collide_sphere(p, scene.spheres[a.index].centre, scene.spheres[a.index].radius, off); break;
+      case Kind::kFloor:
+        d = collide_floor(p, off);
+        break;
+      case Kind::kForm:
+        d = scene.form->push_outside(p, off);
+        break;
+      case Kind::kPlate:
+        d = collide_plate(p, scene.plates[a.index], off);
+        break;
+      case Kind::kBox:
+        d = collide_box(p, scene.boxes[a.index].centre, scene.boxes[a.index].half, off);
+        break;
+      case Kind::kSphere:
+        d = collide_sphere(p, scene.spheres[a.index].centre, scene.spheres[a.index].radius, off);
+        break;
       case Kind::kHand: {
         const HandProxy& h = scene.hands[a.index];
         d = collide_capsule(p, h.position, h.tip, h.radius, off);
@@ -131,7 +141,9 @@ double Collider::push_out(Vec3& p, const SceneObjects& scene) const {
 }
 
 namespace {
-bool collidable(uint8_t f) { return (f & (kFlagKinematic | kFlagNoCollide | kFlagPinned | kFlagPinched)) == 0; }
+bool collidable(uint8_t f) {
+  return (f & (kFlagKinematic | kFlagNoCollide | kFlagPinned | kFlagPinched)) == 0;
+}
 }  // namespace
 
 CollisionStats Collider::project(ClothState& state, const SceneObjects& scene) {

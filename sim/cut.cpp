@@ -31,17 +31,14 @@ Adjacency build_adjacency(const Cloth& cloth) {
     for (int k = 0; k < 3; ++k) a.tris[fill[T[ti][k]]++] = ti;
   // Neighbours: the other corners of incident triangles, deduplicated.
   a.nb_start.assign(n + 1, 0);
-  std::vector<int32_t> tmp;
+  a.nbs.reserve(a.tris.size() * 2);
+  std::vector<int32_t> mark(n, -1);  // mark[w] == i: w already listed for i
   for (int i = 0; i < n; ++i) {
-    tmp.clear();
     for (int32_t s = a.tri_start[i]; s < a.tri_start[i + 1]; ++s) {
       const auto& t = T[a.tris[s]];
       for (int k = 0; k < 3; ++k)
-        if (t[k] != i) tmp.push_back(t[k]);
+        if (t[k] != i && mark[t[k]] != i) mark[t[k]] = i, a.nbs.push_back(t[k]);
     }
-    std::sort(tmp.begin(), tmp.end());
-    tmp.erase(std::unique(tmp.begin(), tmp.end()), tmp.end());
-    a.nbs.insert(a.nbs.end(), tmp.begin(), tmp.end());
     a.nb_start[i + 1] = static_cast<int32_t>(a.nbs.size());
   }
   return a;
@@ -299,10 +296,8 @@ CutResult cut_path_impl(Cloth& cloth, const Adjacency& a, const std::vector<int3
     if (!other) continue;  // one side only: a slit tip, not duplicated
     splits.push_back(std::move(s));
   }
-  r.components_before = count_components(cloth);
   if (splits.empty()) {
     r.reason = "the path separates nothing (along a boundary or ends only)";
-    r.components_after = r.components_before;
     return r;
   }
   for (const Split& s : splits) {
@@ -314,16 +309,16 @@ CutResult cut_path_impl(Cloth& cloth, const Adjacency& a, const std::vector<int3
   }
   cloth.relump_masses();
   cloth.topology_changed();
-  r.components_after = count_components(cloth);
   r.ok = true;
   return r;
 }
 
 // Anchors in different pieces (a stroke crossing an earlier full cut) cannot be joined by one
 // edge path: cut each run of anchors that lie in one piece separately, merging the results.
-CutResult cut_runs(Cloth& cloth, const std::vector<int32_t>& anchors) {
+CutResult cut_runs(Cloth& cloth, const std::vector<int32_t>& anchors, const Adjacency* pre) {
   CutResult total;
-  std::vector<int32_t> labels = component_labels(cloth);
+  int pieces = 0;
+  std::vector<int32_t> labels = component_labels(cloth, &pieces);
   std::vector<std::vector<int32_t>> runs;
   // The vertex of piece `label` nearest to material point q.
   auto nearest_in = [&](int32_t label, const Vec2& q) {
@@ -350,11 +345,13 @@ CutResult cut_runs(Cloth& cloth, const std::vector<int32_t>& anchors) {
     if (runs.empty()) runs.push_back({});
     if (runs.back().empty() || runs.back().back() != a) runs.back().push_back(a);
   }
-  total.components_before = count_components(cloth);
+  total.components_before = pieces;
   std::string why;
   for (const auto& run : runs) {
     if (run.size() < 2) continue;
-    const Adjacency a = build_adjacency(cloth);
+    Adjacency fresh;
+    if (!pre || total.ok) fresh = build_adjacency(cloth);  // rebuilt after a run has cut
+    const Adjacency& a = (!pre || total.ok) ? fresh : *pre;
     auto path = edge_path_impl(cloth, a, run);
     if (path.size() < 2) {
       why = "cut: no edge path joins the stroke's particles";
@@ -408,14 +405,18 @@ CutResult cut_path(Cloth& cloth, const std::vector<int32_t>& path) {
   const Adjacency a = build_adjacency(cloth);
   for (size_t j = 0; j + 1 < path.size(); ++j) {
     const int32_t u = path[j], w = path[j + 1];
-    if (!std::binary_search(a.nbs.begin() + a.nb_start[u], a.nbs.begin() + a.nb_start[u + 1], w)) {
+    if (std::find(a.nbs.begin() + a.nb_start[u], a.nbs.begin() + a.nb_start[u + 1], w) ==
+        a.nbs.begin() + a.nb_start[u + 1]) {
       CutResult r;
       r.reason = "cut path: vertices " + std::to_string(u) + " and " + std::to_string(w) +
                  " share no edge";
       return r;
     }
   }
+  const int before = count_components(cloth);
   CutResult r = cut_path_impl(cloth, a, path);
+  r.components_before = before;
+  r.components_after = r.ok ? count_components(cloth) : before;
   r.ms = ms_since(t0);
   return r;
 }
@@ -478,7 +479,7 @@ CutResult cut_along(Cloth& cloth, const std::vector<Vec3>& stroke_points,
   }
   auto stroke3 = std::move(r.smooth_stroke);
   auto stroke_uv = std::move(r.smooth_stroke_uv);
-  r = cut_runs(cloth, anchors);
+  r = cut_runs(cloth, anchors, &a);
   r.smooth_stroke = std::move(stroke3);
   r.smooth_stroke_uv = std::move(stroke_uv);
   r.ms = ms_since(t0);
@@ -528,7 +529,7 @@ CutResult cut_along_material(Cloth& cloth, const std::vector<Vec2>& stroke_uv) {
     return r;
   }
   auto uv = std::move(r.smooth_stroke_uv);
-  r = cut_runs(cloth, anchors);
+  r = cut_runs(cloth, anchors, nullptr);
   r.smooth_stroke_uv = std::move(uv);
   for (int32_t v : r.path) r.smooth_stroke.push_back(cloth.state.x[v]);
   r.ms = ms_since(t0);

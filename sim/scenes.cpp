@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <functional>
-
 #include <random>
 
 #include "sim/cut.hpp"
@@ -170,7 +169,9 @@ Vec2 elastica_tip(double l, double B, double q, int steps) {
 }
 
 double elastica_rigidity_for_drop(double l, double q, double tip_drop) {
-  double lo = std::log(1e-12), hi = std::log(1e2);
+  // Below ~q l^3 / 50 the strip hangs nearly vertical and the drop is no longer monotone in B.
+  const double ql3 = q * l * l * l;
+  double lo = std::log(ql3 / 50), hi = std::log(ql3 * 1e4);
   for (int it = 0; it < 60; ++it) {
     const double mid = 0.5 * (lo + hi);
     const double drop = elastica_tip(l, std::exp(mid), q, 1000).y();

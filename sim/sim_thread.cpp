@@ -43,7 +43,9 @@ SimThread::SimThread(World world, SimThreadOptions opt) : world_(std::move(world
   timing_ = local_timing_;
 }
 
-SimThread::~SimThread() { stop(); }
+SimThread::~SimThread() {
+  stop();
+}
 
 void SimThread::start() {
   if (running_.load()) return;
@@ -159,8 +161,8 @@ void SimThread::tick() {
       if (!world_.paused && world_.solver) {
         world_.last_step = world_.solver->step(world_.cloth, world_.scene, h);
         if (world_.last_step.diverged) {
-          world_.report("solver " + world_.solver->name() + " diverged at t = " +
-                        std::to_string(world_.cloth.state.time) +
+          world_.report("solver " + world_.solver->name() +
+                        " diverged at t = " + std::to_string(world_.cloth.state.time) +
                         (world_.last_step.retries ? " (rolled back)" : ""));
         }
       }

@@ -67,7 +67,7 @@ double VbdSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, Ste
       for (int k = nbr_off_[i]; k < nbr_off_[i + 1] && !wake; ++k) {
         const int j = nbrs_[k];
         if (!(S.flags[j] & kFlagFrozen) &&
-            (S.v[j].norm() > opt_.freeze_speed * 10 || !cloth.is_free(j))) {
+            (S.v[j].norm() > opt_.freeze_speed * 2 || !cloth.is_free(j))) {
           // A pinned/kinematic neighbour wakes only if it moved.
           if (!cloth.is_free(j) && (S.x[j] - S.x_prev[j]).norm() < 1e-9) continue;
           wake = true;

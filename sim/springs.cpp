@@ -102,7 +102,8 @@ double max_eigenvalue_bound(const Cloth& cloth, const Springs& springs) {
   }
   double bound = 0;
   for (int i = 0; i < cloth.num_vertices(); ++i) {
-    if (cloth.state.inv_mass[i] > 0) bound = std::max(bound, 2.0 * ksum[i] * cloth.state.inv_mass[i]);
+    if (cloth.state.inv_mass[i] > 0)
+      bound = std::max(bound, 2.0 * ksum[i] * cloth.state.inv_mass[i]);
   }
   return bound;
 }

@@ -15,11 +15,11 @@ enum class SpringKind : uint8_t { kStructural = 0, kDiagonal = 1 };
 
 // Structure of arrays, one entry per spring.
 struct Springs {
-  std::vector<int32_t> a, b;       // vertex indices
-  std::vector<double> rest;        // rest length (m) from material coordinates
-  std::vector<double> k;           // stiffness (N/m)
+  std::vector<int32_t> a, b;  // vertex indices
+  std::vector<double> rest;   // rest length (m) from material coordinates
+  std::vector<double> k;      // stiffness (N/m)
   std::vector<SpringKind> kind;
-  uint64_t topology_version = 0;   // of the cloth they were built from
+  uint64_t topology_version = 0;  // of the cloth they were built from
 
   int size() const { return static_cast<int>(a.size()); }
   int count(SpringKind kd) const;

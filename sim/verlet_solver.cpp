@@ -20,8 +20,7 @@ void VerletSolver::cook(const Cloth& cloth) {
 }
 
 double VerletSolver::stable_dt_bound(const Cloth& cloth) {
-  if (cooked_cloth_ != &cloth || cooked_version_ != cloth.topology_version ||
-      springs_.size() == 0)
+  if (cooked_cloth_ != &cloth || cooked_version_ != cloth.topology_version || springs_.size() == 0)
     cook(cloth);
   // Inverse masses change with pins: recompute (O(springs), cheap next to a frame).
   lambda_bound_ = max_eigenvalue_bound(cloth, springs_);
@@ -109,9 +108,13 @@ void VerletSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, St
       continue;
     }
     Vec3 xn = xm[i] + alpha * (xm[i] - xp[i]) + (h2 * inv_m[i]) * f[i];
-    if (any_contact) xn += disp_[i];
-    v[i] = (xn - xm[i]) * inv_h;
-    xp[i] = xm[i];
+    Vec3 xold = xm[i];
+    if (any_contact) {
+      xn += disp_[i];
+      if (!p_.response_as_velocity) xold += disp_[i];
+    }
+    v[i] = (xn - xold) * inv_h;
+    xp[i] = xold;
     xm[i] = xn;
   }
   st.time += h;

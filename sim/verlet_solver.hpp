@@ -19,9 +19,15 @@ struct VerletParams {
   // Damping alpha of eq. 3-4. The study gives no value; alpha <= 0 derives it from a rate per
   // second so that the damping does not change with the substep: alpha = exp(-damping_rate h).
   double alpha = 0;
-  double damping_rate = 1.0;  // 1/s
+  double damping_rate = 1.0;     // 1/s
   double stiffness_scale = 1.0;  // 1 = the fabric's stiffness (build_springs)
   bool collide = true;
+  // Exactly as published, the eq. 3-7 response is a force, so the displacement it causes also
+  // becomes velocity in the next Verlet step. Against the form's radial section lookup that
+  // pushes a vertex falling onto a shallow slope (the shoulders) far sideways and the drop blows
+  // up (measured: the drop test exploded). false (default): x_prev moves with the response, so it
+  // corrects the position without injecting velocity (a position projection).
+  bool response_as_velocity = false;
   // Not in the study: when the state turns non-finite, restore the frame's start state and
   // report `diverged` instead of leaving NaNs in the cloth.
   bool rollback_on_divergence = true;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -189,26 +190,98 @@ const char* rejection_name(Rejection r) {
     case Rejection::Duration:
       return "duration";
     case Rejection::Garbage:
-      return "garbage";
+      return "filler";
     case Rejection::Combined:
-      return "garbage+duration";
+      return "filler+duration";
   }
   return "?";
 }
 
+bool load_phrases(const std::string& path, std::vector<VoicePhrase>& out, std::string* error) {
+  std::ifstream in(path);
+  if (!in) {
+    if (error) *error = path + ": cannot open";
+    return false;
+  }
+  out.clear();
+  int ln = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++ln;
+    if (line.empty() || line[0] == '#') continue;
+    const auto tab = line.find('\t');
+    VoicePhrase p;
+    if (tab != std::string::npos) {
+      p.phrase = line.substr(0, tab);
+      p.command = line.substr(tab + 1);
+    }
+    const bool word_ok = std::all_of(p.phrase.begin(), p.phrase.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || c == ' ' || c == '\'';
+    });
+    if (p.phrase.empty() || p.command.empty() || !word_ok ||
+        p.command.find_first_of(" \t") != std::string::npos) {
+      if (error)
+        *error = path + ":" + std::to_string(ln) +
+                 ": expected 'lower-case phrase<TAB>command', got '" + line + "'";
+      return false;
+    }
+    out.push_back(std::move(p));
+  }
+  if (out.empty()) {
+    if (error) *error = path + ": no phrases";
+    return false;
+  }
+  return true;
+}
+
 VoiceRecognizer::VoiceRecognizer(VoiceConfig cfg) : cfg_(std::move(cfg)) {
   cfg_.dict = default_path(cfg_.dict, "assets/voice/commands.dict");
-  cfg_.grammar = default_path(cfg_.grammar, "assets/voice/commands.jsgf");
-  cfg_.garbage_grammar = default_path(cfg_.garbage_grammar, "assets/voice/garbage.jsgf");
-  for (const auto& f : {cfg_.model_dir + "/mdef", cfg_.dict, cfg_.grammar, cfg_.garbage_grammar}) {
+  cfg_.phrases = default_path(cfg_.phrases, "assets/voice/phrases.tsv");
+  cfg_.filler = default_path(cfg_.filler, "assets/voice/filler.txt");
+  for (const auto& f : {cfg_.model_dir + "/mdef", cfg_.dict, cfg_.phrases, cfg_.filler}) {
     if (!std::ifstream(f)) {
       error_ = "voice: missing " + f;
       return;
     }
   }
-  cmd_ln_t* c =
-      cmd_ln_init(nullptr, ps_args(), TRUE, "-hmm", cfg_.model_dir.c_str(), "-dict",
-                  cfg_.dict.c_str(), "-logfn", "/dev/null", "-remove_silence", "no", nullptr);
+  std::string err;
+  if (!load_phrases(cfg_.phrases, phrases_, &err)) {
+    error_ = "voice: " + err;
+    return;
+  }
+  const bool garbage =
+      cfg_.rejection == Rejection::Garbage || cfg_.rejection == Rejection::Combined;
+  // Grammar: <command> = the phrases; with garbage rejection, a weighted filler-word loop.
+  std::ostringstream g;
+  g << "#JSGF V1.0;\ngrammar drape;\n<command> = ";
+  for (size_t i = 0; i < phrases_.size(); ++i) g << (i ? " | " : "") << phrases_[i].phrase;
+  g << ";\n";
+  if (garbage) {
+    std::ifstream fin(cfg_.filler);
+    std::vector<std::string> fw;
+    for (std::string w; fin >> w;) fw.push_back(w);
+    if (fw.empty()) {
+      error_ = "voice: " + cfg_.filler + ": no filler words";
+      return;
+    }
+    g << "<filler> = ";
+    for (size_t i = 0; i < fw.size(); ++i) g << (i ? " | " : "") << fw[i];
+    // No Kleene '+' / '*': with this sphinxbase, the loop's null transitions join the start of
+    // the public rule, so the FSG can run from fillers into <command> ("it move cloth") and the
+    // branch weights have no effect. Up to 12 filler words as nested optionals instead (longer
+    // speech fails the duration limit anyway).
+    g << ";\n<fillers> = <filler>";
+    for (int k = 1; k < 12; ++k) g << " [<filler>";
+    for (int k = 1; k < 12; ++k) g << "]";
+    g << ";\npublic <utterance> = /1/ <command> | /" << cfg_.filler_weight << "/ <fillers>;\n";
+  } else {
+    g << "public <utterance> = <command>;\n";
+  }
+  grammar_ = g.str();
+  char wip[32];
+  std::snprintf(wip, sizeof wip, "%g", cfg_.word_penalty);
+  cmd_ln_t* c = cmd_ln_init(nullptr, ps_args(), TRUE, "-hmm", cfg_.model_dir.c_str(), "-dict",
+                            cfg_.dict.c_str(), "-logfn", "/dev/null", "-remove_silence", "no",
+                            "-wip", wip, nullptr);
   if (!c) {
     error_ = "voice: pocketsphinx rejected the configuration";
     return;
@@ -219,9 +292,9 @@ VoiceRecognizer::VoiceRecognizer(VoiceConfig cfg) : cfg_(std::move(cfg)) {
     error_ = "voice: pocketsphinx failed to load " + cfg_.model_dir;
     return;
   }
-  if (ps_set_jsgf_file(ps, "commands", cfg_.grammar.c_str()) < 0 ||
-      ps_set_jsgf_file(ps, "garbage", cfg_.garbage_grammar.c_str()) < 0) {
-    error_ = "voice: bad grammar " + cfg_.grammar + " or " + cfg_.garbage_grammar;
+  if (ps_set_jsgf_string(ps, "drape", grammar_.c_str()) < 0 || ps_set_search(ps, "drape") < 0) {
+    error_ = "voice: bad grammar from " + cfg_.phrases + " / " + cfg_.filler +
+             " (a word missing from " + cfg_.dict + "?)";
     ps_free(ps);
     return;
   }
@@ -241,28 +314,13 @@ VoiceResult VoiceRecognizer::decode(const int16_t* s, long n, double speech_s) {
   }
   auto* ps = static_cast<ps_decoder_t*>(ps_);
   const double t0 = now_s();
-  auto pass = [&](const char* search, int32& score) {
-    ps_set_search(ps, search);
-    ps_start_utt(ps);
-    ps_process_raw(ps, s, static_cast<size_t>(n), FALSE, TRUE);
-    ps_end_utt(ps);
-    score = 0;
-    const char* hyp = ps_get_hyp(ps, &score);
-    return std::string(hyp ? hyp : "");
-  };
-  int32 score = 0, gscore = 0;
-  r.hypothesis = pass("commands", score);
-  const bool garbage =
-      cfg_.rejection == Rejection::Garbage || cfg_.rejection == Rejection::Combined;
-  if (garbage && !r.hypothesis.empty()) {
-    const int frames = std::max(1, ps_get_n_frames(ps));
-    r.garbage_hypothesis = pass("garbage", gscore);
-    r.margin = double(score - gscore) / frames;
-  }
+  ps_start_utt(ps);
+  ps_process_raw(ps, s, static_cast<size_t>(n), FALSE, TRUE);
+  ps_end_utt(ps);
+  int32 score = 0;
+  const char* hyp = ps_get_hyp(ps, &score);
+  r.hypothesis = hyp ? hyp : "";
   r.decode_ms = (now_s() - t0) * 1000.0;
-  std::vector<std::string> words;
-  std::istringstream ss(r.hypothesis);
-  for (std::string w; ss >> w;) words.push_back(w);
   const bool dur = cfg_.rejection == Rejection::Duration || cfg_.rejection == Rejection::Combined;
   if (dur && speech_s > cfg_.max_command_s) {
     r.reason = "too long for a command";
@@ -272,17 +330,13 @@ VoiceResult VoiceRecognizer::decode(const int16_t* s, long n, double speech_s) {
     r.reason = "too short";
     return r;
   }
-  if (garbage && r.margin < -cfg_.garbage_margin) {
-    r.reason = "garbage model wins (" + r.garbage_hypothesis + ")";
+  if (r.hypothesis.empty()) {
+    r.reason = "nothing recognised";
     return r;
   }
-  if (words.size() != 1) {
-    r.reason = words.empty() ? "nothing recognised" : "not a lone command";
-    return r;
-  }
-  for (const auto& c : cfg_.commands)
-    if (c == words[0]) r.command = c;
-  if (r.command.empty()) r.reason = "out of grammar: " + words[0];
+  for (const auto& p : phrases_)
+    if (p.phrase == r.hypothesis) r.command = p.command;
+  if (r.command.empty()) r.reason = "out of grammar (filler: " + r.hypothesis + ")";
   return r;
 }
 

@@ -18,19 +18,20 @@ namespace {
 using namespace drape::render;
 
 void usage() {
-  std::fprintf(stderr,
-               "usage: drape render [--scene FILE] --out shot.png [--size WxH] [options]\n"
-               "  --scene FILE        scene JSON (docs/rendering.md); default: muslin on the 9AR form\n"
-               "  --out FILE          PNG to write (default shot.png)\n"
-               "  --size WxH          image size (default 1024x1024)\n"
-               "  --samples N         MSAA samples (default from the scene, 4)\n"
-               "  --colour-map M      none | strain | ease\n"
-               "  --eye X,Y,Z         camera position (look-at camera)\n"
-               "  --target X,Y,Z      camera target\n"
-               "  --sim-seconds S     default scene: simulated draping time (default 2.5)\n"
-               "  --solver NAME       default scene: solver (default vbd)\n"
-               "  --window [N]        also show N frames (default: until closed) in a mirror window\n"
-               "  --validation        enable the Vulkan validation layer (counts messages)\n");
+  std::fprintf(
+      stderr,
+      "usage: drape render [--scene FILE] --out shot.png [--size WxH] [options]\n"
+      "  --scene FILE        scene JSON (docs/rendering.md); default: muslin on the 9AR form\n"
+      "  --out FILE          PNG to write (default shot.png)\n"
+      "  --size WxH          image size (default 1024x1024)\n"
+      "  --samples N         MSAA samples (default from the scene, 4)\n"
+      "  --colour-map M      none | strain | ease\n"
+      "  --eye X,Y,Z         camera position (look-at camera)\n"
+      "  --target X,Y,Z      camera target\n"
+      "  --sim-seconds S     default scene: simulated draping time (default 2.5)\n"
+      "  --solver NAME       default scene: solver (default vbd)\n"
+      "  --window [N]        also show N frames (default: until closed) in a mirror window\n"
+      "  --validation        enable the Vulkan validation layer (counts messages)\n");
 }
 
 bool parse_vec(const char* s, Eigen::Vector3f& v) {
@@ -97,10 +98,14 @@ int run_render(int argc, char** argv) {
   }
   SceneDescription& d = *scene;
   if (!cmap.empty()) {
-    if (cmap == "none") d.options.colour_map = ColourMap::kNone;
-    else if (cmap == "strain") d.options.colour_map = ColourMap::kStrain;
-    else if (cmap == "ease") d.options.colour_map = ColourMap::kEase;
-    else return std::fprintf(stderr, "drape render: --colour-map: none, strain or ease\n"), 2;
+    if (cmap == "none")
+      d.options.colour_map = ColourMap::kNone;
+    else if (cmap == "strain")
+      d.options.colour_map = ColourMap::kStrain;
+    else if (cmap == "ease")
+      d.options.colour_map = ColourMap::kEase;
+    else
+      return std::fprintf(stderr, "drape render: --colour-map: none, strain or ease\n"), 2;
   }
   if (have_eye) d.camera.eye = eye, d.camera.xr_fov.reset();
   if (have_target) d.camera.target = target, d.camera.xr_fov.reset();
@@ -135,9 +140,9 @@ int run_render(int argc, char** argv) {
     return 1;
   }
   const FrameStats& fs = (*r)->last_frame();
-  std::printf("wrote %s (%dx%d, %d samples) on %s: %s; %zu triangles, %.1f ms frame\n",
-              out.c_str(), w, h, ro.samples, (*r)->device_name().c_str(), d.summary.c_str(),
-              fs.triangles, fs.build_ms + fs.submit_ms + fs.wait_ms);
+  std::printf("wrote %s (%dx%d, %d samples) on %s: %s; %zu triangles, %.1f ms frame\n", out.c_str(),
+              w, h, ro.samples, (*r)->device_name().c_str(), d.summary.c_str(), fs.triangles,
+              fs.build_ms + fs.submit_ms + fs.wait_ms);
   if (want_window) {
     auto win = MirrorWindow::open(**r, std::min(w, 1024), std::min(h, 1024), "drape render");
     if (!win) {

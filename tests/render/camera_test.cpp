@@ -1,9 +1,9 @@
 // Projection maths: XR field-of-view edges land on the image edges, look-at centres its target.
+#include "render/camera.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "render/camera.hpp"
 
 namespace drape::render {
 namespace {

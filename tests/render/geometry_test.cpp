@@ -1,10 +1,11 @@
 // CPU geometry: form normals point outward, cloth normals and strain from material coordinates,
 // distance to the form, malformed snapshots.
+#include "render/geometry.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "render/geometry.hpp"
 #include "sim/dress_form.hpp"
 #include "test_scenes.hpp"
 

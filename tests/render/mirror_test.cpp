@@ -35,8 +35,8 @@ TEST(MirrorWindow, PresentsFramesOrFailsCleanly) {
       const Status st = (*win)->show(s, v);
       ASSERT_TRUE(st.ok()) << st.error;
     }
-    std::printf("presented %d frames at %dx%d on %s\n", (*win)->frames_presented(),
-                (*win)->width(), (*win)->height(), (*r)->device_name().c_str());
+    std::printf("presented %d frames at %dx%d on %s\n", (*win)->frames_presented(), (*win)->width(),
+                (*win)->height(), (*r)->device_name().c_str());
     EXPECT_EQ((*win)->frames_presented(), 3);
     EXPECT_EQ((*win)->width(), 160);
   }

@@ -1,9 +1,9 @@
 // Scene files: every element parsed; bad input gives errors that name the file and field.
+#include "render/scene_file.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
-
-#include "render/scene_file.hpp"
 
 namespace drape::render {
 namespace {
@@ -81,7 +81,8 @@ TEST(SceneFile, BadInputNamesTheField) {
   expect_error(R"({"spheres": [{"radius": 0}]})", "spheres[0].radius");
   expect_error(R"({"camera": {"eye": [0, 1, 0], "target": [0, 1, 0]}})", "camera");
   expect_error(R"({"camera": {"xr": {"fov": {"angleLeft": 0.5, "angleRight": -0.5,
-       "angleUp": 0.5, "angleDown": -0.5}}}})", "camera.xr.fov");
+       "angleUp": 0.5, "angleDown": -0.5}}}})",
+               "camera.xr.fov");
   expect_error(R"({"options": {"colour_map": "rainbow"}})", "options.colour_map");
   expect_error(R"({"candidates": [{"hand": 0, "vertex": 3}]})", "candidates[0].vertex");
   expect_error(R"({"form": {"size": "99XX"}})", "form.size");

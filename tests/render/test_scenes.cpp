@@ -18,7 +18,8 @@ std::shared_ptr<const sim::DressForm> analytic_form() {
     const double y = y0 + j * dy;
     // Half-width and half-depth: hip 0.17/0.12, waist 0.12/0.09, bust 0.15/0.11, neck 0.06.
     const double t = (y - y0) / (y1 - y0);
-    const double a = 0.16 - 0.1 * std::sin(3.1 * t) * t + 0.05 * std::exp(-std::pow((y - 1.15) / 0.06, 2)) -
+    const double a = 0.16 - 0.1 * std::sin(3.1 * t) * t +
+                     0.05 * std::exp(-std::pow((y - 1.15) / 0.06, 2)) -
                      0.06 * std::pow(std::max(0.0, (y - 1.22) / 0.12), 2);
     const double b = 0.75 * a;
     for (int n = 0; n < sim::DressForm::kAngles; ++n) {

@@ -46,9 +46,12 @@ TEST(Cloth, MassesSumToPanelWeight) {
   const double expect = 0.5 * 0.4 * f.areal_density;
   std::printf("panel mass %.9f kg, expected %.9f\n", m, expect);
   EXPECT_NEAR(m, expect, 1e-12);
-  // Interior vertex: 6 triangles of a 2 cm grid -> one cell's mass.
+  // Criss-cross interior vertices alternate between 8 and 4 triangles (a third of each):
+  // two neighbours together carry two cells' mass.
   const int nx = c.topo.grid_nx;
-  EXPECT_NEAR(c.state.mass[5 * nx + 5], 0.02 * 0.02 * f.areal_density, 1e-12);
+  EXPECT_NEAR(c.state.mass[5 * nx + 5], 8.0 / 6 * 0.02 * 0.02 * f.areal_density, 1e-12);
+  EXPECT_NEAR(c.state.mass[5 * nx + 5] + c.state.mass[5 * nx + 6],
+              2 * 0.02 * 0.02 * f.areal_density, 1e-12);
   // Pinned vertices get zero inverse mass after relumping.
   c.state.flags[0] |= kFlagPinned;
   c.relump_masses();

@@ -46,11 +46,14 @@ TEST(Panel, GridAndSlitDuplication) {
   // of its duplicated vertices, and no triangle references both a node and its twin.
   for (int ti = 0; ti < t.num_triangles(); ++ti) {
     const auto& tri = t.triangles[ti];
-    for (int v : tri)
+    for (int v : tri) {
       if (t.vertex_origin[v] != v) EXPECT_EQ(t.triangle_zone[ti], t.vertex_zone[v]);
-    for (int a : tri)
-      for (int b : tri)
+    }
+    for (int a : tri) {
+      for (int b : tri) {
         if (a != b) EXPECT_NE(t.vertex_origin[a], t.vertex_origin[b]);
+      }
+    }
   }
   // Zones from the slit extensions: left of column 5 zone 0, 5..11 zone 1, 12.. zone 2.
   EXPECT_EQ(t.triangle_zone[p->cell_triangle(2, 3, 0)], 0);

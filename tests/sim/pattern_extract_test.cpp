@@ -11,19 +11,19 @@
 using namespace drape::sim;
 
 namespace {
-struct Setup {
+struct ExtractScene {
   DressForm form;
   Panel panel;
   PieceMapping pm;
   PieceLines lines;
 };
 
-Setup make(bool darts, double spacing) {
+ExtractScene make(bool darts, double spacing) {
   auto m = measurements_for_size("9AR");
   EXPECT_TRUE(m.ok());
   auto f = DressForm::from_measurements(*m);
   EXPECT_TRUE(f.ok());
-  Setup s{std::move(*f), {}, {}, {}};
+  ExtractScene s{std::move(*f), {}, {}, {}};
   PanelDesign d;
   d.width = 0.28;
   d.height = 0.50;
@@ -41,7 +41,7 @@ Setup make(bool darts, double spacing) {
 }  // namespace
 
 TEST(PatternExtract, PlainPanelOutlineIsTheMappedRegion) {
-  Setup s = make(false, 0.01);
+  ExtractScene s = make(false, 0.01);
   const MappingSurface surf(s.form);
   const auto& lm = s.form.landmarks();
   s.pm = make_piece_mapping(s.panel, surf, 0.0, -1, lm.right_side_theta, lm.waist_y);
@@ -69,7 +69,7 @@ TEST(PatternExtract, PlainPanelOutlineIsTheMappedRegion) {
 }
 
 TEST(PatternExtract, DartsFromSlitEnds) {
-  Setup s = make(true, 0.01);
+  ExtractScene s = make(true, 0.01);
   const MappingSurface surf(s.form);
   const auto& lm = s.form.landmarks();
   s.pm = make_piece_mapping(s.panel, surf, 0.0, -1, lm.right_side_theta, lm.waist_y);
@@ -106,7 +106,7 @@ TEST(PatternExtract, DartsFromSlitEnds) {
 }
 
 TEST(PatternExtract, MissingClothNamesTheLine) {
-  Setup s = make(false, 0.02);
+  ExtractScene s = make(false, 0.02);
   const MappingSurface surf(s.form);
   const auto& lm = s.form.landmarks();
   s.pm = make_piece_mapping(s.panel, surf, 0.0, -1, lm.right_side_theta, lm.waist_y);

@@ -1,11 +1,12 @@
 // XPBD on the same energy: chain support force, sheet close to the Newton reference.
+#include "sim/solver_xpbd.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
 
 #include "sim/scenes.hpp"
 #include "sim/solver_newton.hpp"
-#include "sim/solver_xpbd.hpp"
 
 using namespace drape::sim;
 

@@ -12,8 +12,8 @@ using namespace drape::sim;
 TEST(Stress, DefaultSolverHasNoFailures) {
   for (const auto& name : stress_case_names()) {
     StressResult r = run_stress_case(name, "vbd", 1);
-    std::printf("%-16s steps %4d failures %d rollbacks %d vertices %d %s\n", name.c_str(),
-                r.steps, r.failures, r.rollbacks, r.vertices, r.note.c_str());
+    std::printf("%-16s steps %4d failures %d rollbacks %d vertices %d %s\n", name.c_str(), r.steps,
+                r.failures, r.rollbacks, r.vertices, r.note.c_str());
     EXPECT_GT(r.steps, 0) << name;
     EXPECT_EQ(r.failures, 0) << name;
   }

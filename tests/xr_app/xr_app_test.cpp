@@ -1,6 +1,8 @@
 // End-to-end runs of the drape OpenXR app on the mock runtime: the lifecycle to EXITING, the
 // core validation layer with zero messages, hand tracking and controller input from a
 // scenario, a scripted session loss (the session is re-created), and a missing runtime.
+#include "xr_app/app/xr_app.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -8,16 +10,14 @@
 #include <fstream>
 #include <string>
 
-#include "xr_app/app/xr_app.hpp"
-
 namespace {
 
 const std::string kManifest = std::string(DRAPE_BINARY_DIR) + "/bin/drape_mock_runtime.json";
 
 void base_env() {
-  for (const char* v : {"DRAPE_MOCK_SCENARIO", "DRAPE_MOCK_END_AFTER_FRAMES",
-                        "DRAPE_MOCK_WRITE_FRAMES", "DRAPE_MOCK_LOSE_SESSION_AT_FRAME",
-                        "XR_ENABLE_API_LAYERS"})
+  for (const char* v :
+       {"DRAPE_MOCK_SCENARIO", "DRAPE_MOCK_END_AFTER_FRAMES", "DRAPE_MOCK_WRITE_FRAMES",
+        "DRAPE_MOCK_LOSE_SESSION_AT_FRAME", "XR_ENABLE_API_LAYERS"})
     unsetenv(v);
   setenv("XR_RUNTIME_JSON", kManifest.c_str(), 1);
   setenv("DRAPE_MOCK_FAST", "1", 1);
@@ -82,7 +82,7 @@ TEST(XrApp, HandsAndControllersFromTheScenario) {
   EXPECT_TRUE(r.hand_tracking);
   EXPECT_EQ(r.hand_frames_tracked, 100);
   EXPECT_NEAR(r.min_pinch_gap_m, 0.005f, 1e-4);  // pinch = 1 in frames 45..60
-  EXPECT_GT(r.max_trigger, 0.99f);  // the left trigger ramps to 1 at frame 90
+  EXPECT_GT(r.max_trigger, 0.99f);               // the left trigger ramps to 1 at frame 90
 }
 
 TEST(XrApp, SessionLossIsAnOrdinaryState) {

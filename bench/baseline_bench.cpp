@@ -1,0 +1,220 @@
+// Baseline benchmark (issue 2): the study's mass-spring + damped Verlet with dress-form collision
+// at the study's sizes 21^2, 42^2, 81^2 and at 128^2. Measures ms of compute per 1/90 s frame,
+// the largest stable dt at muslin stiffness (bisection) and the substeps per frame it implies,
+// and the section-lookup collision cost per vertex. Writes out/bench/baseline.csv.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+
+#include "sim/dress_form.hpp"
+#include "sim/verlet_solver.hpp"
+
+namespace {
+
+using namespace drape::sim;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kSizes[] = {21, 42, 81, 128};
+constexpr double kFrame = 1.0 / 90;
+constexpr double kPanel = 0.6;  // m: a 0.6 m x 0.6 m muslin panel at every resolution
+
+struct Row {
+  double ms_per_frame = NAN, max_stable_dt = NAN, collision_ns = NAN;
+  int auto_substeps = 0;
+};
+std::map<int, Row> g_rows;
+
+std::shared_ptr<const DressForm> form_9ar() {
+  static std::shared_ptr<const DressForm> f = [] {
+    auto r = DressForm::from_measurements(FormMeasurements{});
+    if (!r) {
+      std::fprintf(stderr, "baseline_bench: %s\n", r.error().c_str());
+      std::exit(1);
+    }
+    return std::make_shared<const DressForm>(std::move(r.value()));
+  }();
+  return f;
+}
+
+// The scene of `drape run`: the panel spread 1 cm above the form, centre pinned over the neck.
+Cloth shoulder_panel(int n) {
+  PanelSpec spec;
+  spec.width = spec.height = kPanel;
+  spec.nx = spec.ny = n;
+  Cloth c = make_panel(spec, FabricParams{});
+  const DressForm& f = *form_9ar();
+  const Vec2 top = f.centre_at(f.max_y());
+  place_spread(c, Vec3(top.x() - kPanel / 2, f.max_y() + 0.01, top.y() - kPanel / 2), Vec3::UnitX(),
+               Vec3::UnitZ());
+  for (int i = 0; i < c.num_vertices(); ++i) {
+    const Vec3& p = c.state.x[i];
+    if (std::hypot(p.x() - top.x(), p.z() - top.y()) < 0.035) c.state.flags[i] |= kFlagPinned;
+  }
+  c.relump_masses();
+  return c;
+}
+
+SceneObjects form_scene() {
+  SceneObjects s;
+  s.form = form_9ar();
+  s.offset = 0.003;
+  return s;
+}
+
+// ms of compute per 1/90 s of simulated time, substeps chosen automatically (Gershgorin bound,
+// safety 0.9), after 10 frames of settling so the cloth is in contact with the form.
+void BM_BaselineFrame(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  Cloth c = shoulder_panel(n);
+  SceneObjects scene = form_scene();
+  VerletSolver solver{VerletParams{}};
+  for (int k = 0; k < 10; ++k) solver.step(c, scene, kFrame);
+  double total_ms = 0, coll_ms = 0;
+  int frames = 0, substeps = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    StepStats st = solver.step(c, scene, kFrame);
+    total_ms += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    coll_ms += st.collision_ms;
+    substeps = st.substeps;
+    ++frames;
+    benchmark::DoNotOptimize(c.state.x.data());
+  }
+  state.counters["substeps"] = substeps;
+  state.counters["collision_ms"] = coll_ms / frames;
+  state.SetItemsProcessed(static_cast<int64_t>(frames) * substeps * c.num_vertices());
+  g_rows[n].ms_per_frame = total_ms / frames;
+  g_rows[n].auto_substeps = substeps;
+}
+
+// Section-lookup collision (DressForm::push_outside through the Collider) per vertex, on a cloth
+// draped on the form (half the vertices in contact).
+void BM_FormCollision(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  Cloth c = shoulder_panel(n);
+  SceneObjects scene = form_scene();
+  scene.floor = false;
+  VerletSolver solver{VerletParams{}};
+  for (int k = 0; k < 20; ++k) solver.step(c, scene, kFrame);
+  Collider col;
+  ClothState work = c.state;
+  double ns = 0;
+  int64_t verts = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::copy(c.state.x.begin(), c.state.x.end(), work.x.begin());
+    state.ResumeTiming();
+    const auto t0 = Clock::now();
+    CollisionStats cs = col.project(work, scene);
+    ns += std::chrono::duration<double, std::nano>(Clock::now() - t0).count();
+    verts += c.num_vertices();
+    benchmark::DoNotOptimize(cs);
+  }
+  state.SetItemsProcessed(verts);
+  g_rows[n].collision_ns = ns / static_cast<double>(verts);
+}
+
+// Stability at a fixed substep h: the panel hanging from its top edge, released flat with a
+// 0.1 mm random perturbation (exciting every mode), 1500 substeps without collision. Stable when
+// the state stays finite, no spring stretches beyond 50 % and the kinetic energy stays below the
+// potential energy the cloth could release by falling 1 m.
+bool stable_at(int n, double h) {
+  PanelSpec spec;
+  spec.width = spec.height = kPanel;
+  spec.nx = spec.ny = n;
+  Cloth c = make_panel(spec, FabricParams{});
+  place_spread(c, Vec3(0, 1.5, 0), Vec3::UnitX(), Vec3::UnitZ());
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1e-4, 1e-4);
+  for (auto& p : c.state.x) p += Vec3(u(rng), u(rng), u(rng));
+  c.state.x_prev = c.state.x;
+  const int nx = c.topo.grid_nx;
+  for (int i = 0; i < nx; ++i) c.state.flags[(c.topo.grid_ny - 1) * nx + i] |= kFlagPinned;
+  c.relump_masses();
+  VerletParams p;
+  p.substeps = 1;
+  p.collide = false;
+  p.rollback_on_divergence = false;
+  VerletSolver s(p);
+  SceneObjects none;
+  none.floor = false;
+  double mass = 0;
+  for (double m : c.state.mass) mass += m;
+  const double e_max = mass * kGravity * 1.0;
+  for (int k = 0; k < 1500; ++k) {
+    s.step(c, none, h);
+    if (k % 100 == 99 || k == 1499) {
+      double ke = 0;
+      for (int i = 0; i < c.num_vertices(); ++i) {
+        if (!c.state.x[i].allFinite()) return false;
+        ke += 0.5 * c.state.mass[i] * c.state.v[i].squaredNorm();
+      }
+      if (!(ke < e_max)) return false;
+      const Springs& sp = s.springs();
+      for (int q = 0; q < sp.size(); ++q) {
+        if ((c.state.x[sp.b[q]] - c.state.x[sp.a[q]]).norm() > 1.5 * sp.rest[q]) return false;
+      }
+    }
+  }
+  return true;
+}
+
+double max_stable_dt(int n) {
+  double lo = 1e-7, hi = 1e-3;  // stable, unstable
+  if (!stable_at(n, lo)) return NAN;
+  while (hi / lo > 1.01) {  // bisection in log space to 1 %
+    const double mid = std::sqrt(lo * hi);
+    (stable_at(n, mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+}  // namespace
+
+BENCHMARK(BM_BaselineFrame)
+    ->Arg(21)
+    ->Arg(42)
+    ->Arg(81)
+    ->Arg(128)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5);
+BENCHMARK(BM_FormCollision)->Arg(21)->Arg(42)->Arg(81)->Arg(128)->Unit(benchmark::kMicrosecond);
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  std::printf("\nbisection of the largest stable dt (muslin, %.1f m panel)...\n", kPanel);
+  for (int n : kSizes) {
+    g_rows[n].max_stable_dt = max_stable_dt(n);
+    std::printf("  %3d^2: %.3e s\n", n, g_rows[n].max_stable_dt);
+  }
+  std::filesystem::create_directories("out/bench");
+  std::ofstream csv("out/bench/baseline.csv");
+  csv << "resolution,ms_per_frame,max_stable_dt,substeps_per_frame,collision_ns_per_vertex\n";
+  std::printf(
+      "\nbaseline (study's mass-spring + damped Verlet, 9AR form collision), 1/90 s frames\n"
+      "%-10s %12s %10s %14s %10s %12s %14s %10s\n",
+      "resolution", "ms/frame", "x 21^2", "max stable dt", "substeps", "auto substeps",
+      "coll ns/vert", "real time?");
+  const double base = g_rows[21].ms_per_frame;
+  for (int n : kSizes) {
+    const Row& r = g_rows[n];
+    const int sub =
+        std::isfinite(r.max_stable_dt) ? static_cast<int>(std::ceil(kFrame / r.max_stable_dt)) : -1;
+    csv << n << "," << r.ms_per_frame << "," << r.max_stable_dt << "," << sub << ","
+        << r.collision_ns << "\n";
+    std::printf("%-10s %12.3f %10.1f %14.3e %10d %12d %14.2f %10s\n",
+                (std::to_string(n) + "^2").c_str(), r.ms_per_frame, r.ms_per_frame / base,
+                r.max_stable_dt, sub, r.auto_substeps, r.collision_ns,
+                r.ms_per_frame <= 1000.0 * kFrame ? "yes" : "no");
+  }
+  std::printf("wrote out/bench/baseline.csv\n");
+  return 0;
+}
