@@ -19,7 +19,35 @@ double wrap_positive(double a) {
 }  // namespace
 
 MappingSurface::MappingSurface(const DressForm& form, double ease, bool hip_shape_below_hip)
-    : form_(&form), ease_(ease), offset_(ease / kTwoPi), hip_below_(hip_shape_below_hip) {}
+    : form_(&form), ease_(ease), offset_(ease / kTwoPi), hip_below_(hip_shape_below_hip) {
+  // A radial offset of ease / 2pi adds exactly `ease` only to a circle. Per form section solve
+  // (secant) for the radial offset whose polygon perimeter is the section's plus `ease`.
+  const int ns = form.num_sections();
+  section_offset_.assign(static_cast<size_t>(std::max(ns, 1)), offset_);
+  if (ease == 0.0) return;
+  auto perim = [&](int j, double d) {
+    double g = 0;
+    for (int n = 0; n < kN; ++n) {
+      const double r0 = form.radius(j, n) + d, r1 = form.radius(j, (n + 1) % kN) + d;
+      const double t0 = n * kStep, t1 = (n + 1) * kStep;
+      g += std::hypot(r1 * std::sin(t1) - r0 * std::sin(t0),
+                      r1 * std::cos(t1) - r0 * std::cos(t0));
+    }
+    return g;
+  };
+  for (int j = 0; j < ns; ++j) {
+    const double target = perim(j, 0.0) + ease;
+    double d0 = 0.0, p0 = target - ease, d1 = offset_, p1 = perim(j, d1);
+    for (int it = 0; it < 8 && std::abs(p1 - target) > 1e-10 && p1 != p0; ++it) {
+      const double d2 = d1 + (target - p1) * (d1 - d0) / (p1 - p0);
+      d0 = d1;
+      p0 = p1;
+      d1 = d2;
+      p1 = perim(j, d1);
+    }
+    section_offset_[static_cast<size_t>(j)] = d1;
+  }
+}
 
 double MappingSurface::shape_y(double y) const {
   const double hip = form_->landmarks().hip_y;
@@ -31,11 +59,13 @@ double MappingSurface::sample_radius(double y, int n) const {
   const double ys = shape_y(y);
   const int ns = form_->num_sections();
   n = ((n % kN) + kN) % kN;
-  if (ns < 2) return form_->radius(0, n) + offset_;
+  if (ns < 2) return form_->radius(0, n) + section_offset_[0];
   const double f = (ys - form_->min_y()) / form_->section_spacing();
   const int j = std::clamp(static_cast<int>(std::floor(f)), 0, ns - 2);
   const double rh = std::clamp(f - j, 0.0, 1.0);  // eq. 2-2
-  return form_->radius(j, n) + (form_->radius(j + 1, n) - form_->radius(j, n)) * rh + offset_;
+  const double r0 = form_->radius(j, n) + section_offset_[static_cast<size_t>(j)];
+  const double r1 = form_->radius(j + 1, n) + section_offset_[static_cast<size_t>(j) + 1];
+  return r0 + (r1 - r0) * rh;
 }
 
 Vec2 MappingSurface::centre(double y) const {
@@ -102,10 +132,11 @@ double ArcTable::theta_at(double l) const {
 
 double ArcTable::arc_at(double theta) const {
   double t = dir * (theta - theta0);
-  // Angles just "behind" the centre line stay negative (a small overshoot), others wrap.
+  // Angles just "behind" the centre line (up to 1/16 turn) stay negative (a small overshoot);
+  // all others wrap into [0, 15/16 turn).
   t = std::fmod(t, kTwoPi);
-  if (t < -0.5 * kTwoPi) t += kTwoPi;
-  if (t > 0.75 * kTwoPi) t -= kTwoPi;
+  if (t < -kTwoPi / 16) t += kTwoPi;
+  if (t >= kTwoPi - kTwoPi / 16) t -= kTwoPi;
   const double f = t / kStep;
   if (f < 0) return f * (cum[1] - cum[0]);
   const int k = std::min(static_cast<int>(std::floor(f)), kN - 1);

@@ -12,15 +12,15 @@ namespace drape::sim {
 
 class DressForm;
 
-// The surface the cloth is mapped onto: the form's section model, offset outward by
-// ease / (2 pi) (a convex section's perimeter then grows by exactly `ease`), and, when
+// The surface the cloth is mapped onto: the form's section model, offset radially per section
+// by the amount that makes that section's perimeter grow by exactly `ease`, and, when
 // hip_shape_below_hip, the hip section's shape for every height below the hip.
 class MappingSurface {
  public:
   MappingSurface(const DressForm& form, double ease = 0.0, bool hip_shape_below_hip = true);
   const DressForm& form() const { return *form_; }
   double ease() const { return ease_; }
-  double offset() const { return offset_; }
+  double offset() const { return offset_; }  // nominal ease / 2pi (collision margin)
   // Height whose section shape is used at height y (the hip's below the hip).
   double shape_y(double y) const;
   double sample_radius(double y, int n) const;  // r of angle sample n (eq. 2-7), offset included
@@ -33,6 +33,7 @@ class MappingSurface {
   const DressForm* form_;
   double ease_, offset_;
   bool hip_below_;
+  std::vector<double> section_offset_;  // radial offset per form section
 };
 
 // Cumulative chord lengths around one section from angle sample n0 in direction dir

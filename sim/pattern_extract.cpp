@@ -123,6 +123,27 @@ Hit cast(const Panel& panel, const MappingSurface& surf, const RayGrid& grid, do
   return best;
 }
 
+// The point at height y on one edge of a slit (tip + near or far nodes), in 3D and flat.
+Hit slit_edge_at(const Panel& panel, int slit, bool near, double y) {
+  const PanelSlit& ps = panel.slits[static_cast<size_t>(slit)];
+  const auto& x = panel.cloth.state.x;
+  const auto& mat = panel.cloth.topo.material;
+  std::vector<int> nodes{ps.tip_node};
+  const auto& side = near ? ps.near_nodes : ps.far_nodes;
+  nodes.insert(nodes.end(), side.begin(), side.end());
+  Hit h;
+  for (size_t k = 0; k + 1 < nodes.size(); ++k) {
+    const double y0 = x[nodes[k]].y(), y1 = x[nodes[k + 1]].y();
+    if ((y - y0) * (y - y1) > 0 || y0 == y1) continue;
+    const double f = (y - y0) / (y1 - y0);
+    h.ok = true;
+    h.world = x[nodes[k]] + f * (x[nodes[k + 1]] - x[nodes[k]]);
+    h.flat = mat[nodes[k]] + f * (mat[nodes[k + 1]] - mat[nodes[k]]);
+    return h;
+  }
+  return h;
+}
+
 struct RefPoint {
   double y, theta;
   int zone;
@@ -203,6 +224,8 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
   struct Run {
     std::string label;
     std::vector<RefPoint> pts;
+    int slit = -1;     // dart legs: the slit whose edge bounds this leg
+    bool near = true;  // leg on the slit's near (centre-side) edge
   };
   std::vector<Run> runs;
   const auto vertical = [&](double th, int zone, double y0, double y1) {
@@ -261,6 +284,8 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
       for (auto it = dart_line[z - 1].rbegin(); it != dart_line[z - 1].rend(); ++it)
         leg2.pts.push_back({it->y, it->theta, z});
       for (const RefPoint& r : dart_line[z - 1]) leg1.pts.push_back({r.y, r.theta, z - 1});
+      leg2.slit = leg1.slit = z - 1;
+      leg2.near = false;
       runs.push_back(leg2);
       runs.push_back(leg1);
     }
@@ -285,6 +310,9 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
     for (size_t k = first; k < last; ++k) {
       const RefPoint& rp = runs[r].pts[k];
       Hit h = cast(panel, surf, grid, rp.y, rp.theta, rp.zone);
+      // Near a dart tip the relaxed layers may part: where this leg's layer does not reach the
+      // dart line, the leg is that layer's own slit edge (interpolated at the height).
+      if (!h.ok && runs[r].slit >= 0) h = slit_edge_at(panel, runs[r].slit, runs[r].near, rp.y);
       if (!h.ok) {
         std::ostringstream e;
         e << "line '" << runs[r].label << "': no cloth in zone " << rp.zone << " at height "

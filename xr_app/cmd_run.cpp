@@ -1,6 +1,10 @@
-// `drape run`: the headless main job until the XR app exists. Builds the 9AR form, drops a
-// muslin panel over its shoulders on the simulation thread (lock step, or real time), then
-// writes the draped cloth and the form as glTF and prints where, with the max penetration.
+// `drape run`: the main job. With an OpenXR runtime (a headset, or else the headless mock
+// runtime built next to the executable) it runs the XR app on the default draping scenario
+// (assets/scenarios/default.json) and writes screenshots, the session log, the draped cloth and
+// the pattern to out/ (see docs/xr.md). `drape run --headless` (or no XR build / no runtime)
+// is the sim-core job: builds the 9AR form, drops a muslin panel over its shoulders on the
+// simulation thread (lock step, or real time), then writes the draped cloth and the form as
+// glTF and prints where, with the max penetration.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -8,14 +12,22 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "sim/dress_form.hpp"
 #include "sim/mesh_io.hpp"
+#include "sim/pattern_pipeline.hpp"
 #include "sim/sim_thread.hpp"
 #include "sim/verlet_solver.hpp"
 #include "xr_app/command.hpp"
+#ifdef DRAPE_HAVE_XR_APP
+#include <nlohmann/json.hpp>
+
+#include "xr_app/app/xr_app.hpp"
+#endif
 
 namespace {
 
@@ -23,7 +35,13 @@ using namespace drape::sim;
 
 void usage() {
   std::printf(
-      "usage: drape run [--seconds S] [--out DIR] [--resolution N] [--fabric NAME]\n"
+      "usage: drape run [--scenario FILE] [--frames N] [--out DIR] [--eye-size PX]\n"
+      "                 [--cloth-res N] [--no-voice] [--no-pattern] [--every K]\n"
+      "Runs the OpenXR app (headset, or the mock runtime when none is configured) on a draping\n"
+      "scenario (default assets/scenarios/default.json): pinch, pin (a spoken 'pin here' made\n"
+      "with espeak-ng), a cut stroke; then the pattern export. Writes DIR/frames/*.png,\n"
+      "DIR/session_log.json, DIR/xr_session.txt, DIR/drape_cloth.gltf, DIR/pattern/.\n\n"
+      "       drape run --headless [--seconds S] [--out DIR] [--resolution N] [--fabric NAME]\n"
       "                 [--size 9AR] [--realtime] [--stiffness-scale K]\n"
       "Drops a 0.6 m x 0.7 m panel (N vertices across, default 31: 2 cm) over the dress form's\n"
       "shoulders, its centre pinned above the neck, and simulates S seconds (default 3) with the\n"
@@ -37,7 +55,7 @@ std::string fabrics_path() {
   return std::string(DRAPE_SOURCE_DIR) + "/assets/fabrics.json";
 }
 
-int run(int argc, char** argv) {
+int run_headless(int argc, char** argv) {
   double seconds = 3.0, stiffness_scale = 1.0;
   std::string out = "out", fabric_name = "muslin", size = "9AR";
   int resolution = 31;
@@ -225,7 +243,186 @@ int run(int argc, char** argv) {
   return 0;
 }
 
+#ifdef DRAPE_HAVE_XR_APP
+std::string source_path(const std::string& rel) {
+  if (std::filesystem::exists(rel)) return rel;
+  return std::string(DRAPE_SOURCE_DIR) + "/" + rel;
+}
+
+// A 16 kHz mono WAV of `text` made with espeak-ng (resampled by sox). Empty on failure.
+std::string make_voice_wav(const std::string& dir, const std::string& name,
+                           const std::string& text) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  const std::string raw = dir + "/" + name + "_22k.wav", wav = dir + "/" + name + ".wav";
+  const std::string cmd = "espeak-ng -s 140 -w '" + raw + "' '" + text + "' >/dev/null 2>&1 && " +
+                          "sox '" + raw + "' -r 16000 -c 1 -b 16 '" + wav +
+                          "' pad 0.3 0.5 >/dev/null 2>&1";
+  if (std::system(cmd.c_str()) != 0) return "";
+  std::filesystem::remove(raw, ec);
+  return std::filesystem::absolute(wav).string();
+}
+
+int run_xr(int argc, char** argv) {
+  std::string scenario = source_path("assets/scenarios/default.json"), out = "out";
+  drape::app::XrAppOptions opt;
+  opt.eye_size = 256;
+  opt.cloth_res = 16;
+  bool pattern = true;
+  int every = 30;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&](const char* what) -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "drape run: %s needs a value\n", what);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      usage();
+      return 0;
+    } else if (a == "--scenario") {
+      scenario = next("--scenario");
+    } else if (a == "--frames") {
+      opt.max_frames = std::atoll(next("--frames"));
+    } else if (a == "--out") {
+      out = next("--out");
+    } else if (a == "--eye-size") {
+      opt.eye_size = std::atoi(next("--eye-size"));
+    } else if (a == "--cloth-res") {
+      opt.cloth_res = std::atoi(next("--cloth-res"));
+    } else if (a == "--every") {
+      every = std::max(1, std::atoi(next("--every")));
+    } else if (a == "--no-voice") {
+      opt.voice = false;
+    } else if (a == "--no-pattern") {
+      pattern = false;
+    } else if (a == "-v") {
+      opt.verbose = true;
+    } else {
+      std::fprintf(stderr, "drape run: unknown option '%s'\n", a.c_str());
+      usage();
+      return 2;
+    }
+  }
+  if (opt.eye_size < 16 || opt.eye_size > 4096 || opt.cloth_res < 4 || opt.cloth_res > 256) {
+    std::fprintf(stderr, "drape run: --eye-size must be in [16, 4096], --cloth-res in [4, 256]\n");
+    return 2;
+  }
+  const auto wall0 = std::chrono::steady_clock::now();
+  std::error_code ec;
+  std::filesystem::create_directories(out + "/frames", ec);
+  if (ec) {
+    std::fprintf(stderr, "drape run: cannot create '%s': %s\n", out.c_str(), ec.message().c_str());
+    return 1;
+  }
+  // The scenario, with its audio cues generated: every cue's "text" is spoken by espeak-ng into
+  // DIR/voice/ and the copy DIR/scenario.json points at those WAVs.
+  std::ifstream in(scenario);
+  nlohmann::json sc = nlohmann::json::parse(in, nullptr, false);
+  if (!in.good() && !in.eof()) sc = nlohmann::json();
+  if (sc.is_discarded() || !sc.is_object()) {
+    std::fprintf(stderr, "drape run: %s: cannot read or parse the scenario (JSON object)\n",
+                 scenario.c_str());
+    return 1;
+  }
+  if (sc.contains("audio") && sc["audio"].is_array()) {
+    int k = 0;
+    for (auto& a : sc["audio"]) {
+      if (!a.is_object() || !a.contains("text") || !a["text"].is_string()) continue;
+      std::string speak = a["text"].get<std::string>();
+      if (a.contains("say") && a["say"].is_string()) speak = a["say"].get<std::string>();
+      const std::string wav =
+          opt.voice ? make_voice_wav(out + "/voice", "cue" + std::to_string(k++), speak) : "";
+      if (wav.empty()) {
+        if (opt.voice)
+          std::fprintf(stderr, "drape run: espeak-ng/sox failed; voice cue '%s' skipped\n",
+                       speak.c_str());
+        a["wav"] = "/nonexistent/voice_disabled.wav";
+      } else {
+        a["wav"] = wav;
+        std::printf("wrote %s (espeak-ng: \"%s\")\n", wav.c_str(), speak.c_str());
+      }
+      a.erase("say");
+    }
+  }
+  const std::string sc_path = std::filesystem::absolute(out + "/scenario.json").string();
+  {
+    std::ofstream o(sc_path);
+    o << sc.dump(2) << "\n";
+  }
+  setenv("DRAPE_MOCK_SCENARIO", sc_path.c_str(), 1);
+  const std::string frames_dir = std::filesystem::absolute(out + "/frames").string();
+  setenv("DRAPE_MOCK_WRITE_FRAMES", frames_dir.c_str(), 1);
+  setenv("DRAPE_MOCK_WRITE_EVERY", std::to_string(every).c_str(), 1);
+  opt.out_dir = out;
+  const std::string manifest = drape::app::select_runtime();
+  std::printf("drape run: runtime manifest %s, scenario %s\n",
+              manifest.empty() ? "(system active runtime)" : manifest.c_str(), scenario.c_str());
+  auto r = drape::app::run_xr_app(opt);
+  for (const auto& l : r.log)
+    if (l.rfind("voice", 0) == 0 || l.rfind("cut", 0) == 0) std::printf("  %s\n", l.c_str());
+  for (const auto& t : r.triggers) std::printf("  trigger %s\n", t.c_str());
+  std::printf(
+      "drape run: %s, runtime '%s', %lld frames (%lld rendered), pinched in %lld frames, "
+      "%d vertices pinned, %d cut(s) splitting the cloth (%d -> %d parts), voice commands %zu\n",
+      drape::app::to_string(r.final_state), r.runtime_name.c_str(),
+      static_cast<long long>(r.frames), static_cast<long long>(r.frames_rendered),
+      static_cast<long long>(r.frames_pinched), r.pinned_added, r.cuts_ok, r.components_before,
+      r.components_after, r.voice_commands.size());
+  if (!r.error.empty()) std::fprintf(stderr, "drape run: error: %s\n", r.error.c_str());
+  if (r.exit_code != 0) return r.exit_code;
+  for (const auto& e : std::filesystem::directory_iterator(frames_dir, ec))
+    std::printf("wrote %s\n", e.path().c_str());
+  for (const auto& w : r.written) std::printf("wrote %s\n", std::filesystem::absolute(w).c_str());
+  if (pattern) {
+    // The pattern export of the bundled design on the same form (sim/pattern_pipeline.hpp).
+    auto d = drape::sim::load_design(source_path("assets/designs/tight-skirt.json"));
+    auto m = drape::sim::measurements_for_size("9AR");
+    if (!d || !m) {
+      std::fprintf(stderr, "drape run: pattern: %s\n", !d ? d.error().c_str() : m.error().c_str());
+      return 1;
+    }
+    auto form = drape::sim::DressForm::from_measurements(*m);
+    auto fab = drape::sim::load_fabric(fabrics_path(), d->fabric);
+    if (!form || !fab) {
+      std::fprintf(stderr, "drape run: pattern: %s\n",
+                   !form ? form.error().c_str() : fab.error().c_str());
+      return 1;
+    }
+    drape::sim::PipelineOptions po;
+    po.out_dir = out + "/pattern";
+    auto pr = drape::sim::run_pattern_pipeline(*d, *form, *fab, po);
+    if (!pr) {
+      std::fprintf(stderr, "drape run: pattern: %s\n", pr.error().c_str());
+      return 1;
+    }
+    for (const auto& f : pr->report.files)
+      std::printf("wrote %s\n", std::filesystem::absolute(f).c_str());
+  }
+  std::printf("drape run: done in %.1f s\n",
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count());
+  return 0;
+}
+#endif
+
+int run(int argc, char** argv) {
+  bool headless = false;
+  for (int i = 1; i < argc; ++i) headless = headless || std::strcmp(argv[i], "--headless") == 0;
+#ifdef DRAPE_HAVE_XR_APP
+  if (!headless) return run_xr(argc, argv);
+#endif
+  // The headless job: drop "--headless" and run the sim-core path.
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i)
+    if (std::strcmp(argv[i], "--headless") != 0) args.push_back(argv[i]);
+  if (!headless)
+    std::fprintf(stderr, "drape run: built without the XR app; running the headless job\n");
+  return run_headless(static_cast<int>(args.size()), args.data());
+}
+
 }  // namespace
 
-DRAPE_COMMAND(run, "headless main job: drop a muslin panel on the 9AR form, write glTF to out/",
+DRAPE_COMMAND(run, "main job: the XR app on the default draping scenario (--headless: sim only)",
               run);

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 namespace {
@@ -83,6 +84,56 @@ TEST(XrApp, HandsAndControllersFromTheScenario) {
   EXPECT_EQ(r.hand_frames_tracked, 100);
   EXPECT_NEAR(r.min_pinch_gap_m, 0.005f, 1e-4);  // pinch = 1 in frames 45..60
   EXPECT_GT(r.max_trigger, 0.99f);               // the left trigger ramps to 1 at frame 90
+}
+
+// The default draping scenario end to end: the thumb-index pinch of the right hand pinches the
+// cloth, a spoken "pin here" (espeak-ng WAV, decoded by the voice recogniser) pins it, the
+// left controller's trigger sweep is a cut stroke that splits it.
+TEST(XrApp, DefaultScenarioPinchesPinsAndCutsTheCloth) {
+  base_env();
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(DRAPE_BINARY_DIR) / "xr_test_out" / "app_default";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string raw = (dir / "pin_22k.wav").string(), wav = (dir / "pin.wav").string();
+  const std::string cmd = "espeak-ng -s 140 -w '" + raw + "' 'pin here' && sox '" + raw +
+                          "' -r 16000 -c 1 -b 16 '" + wav + "' pad 0.3 0.5";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  // The bundled scenario with its audio cue pointing at the generated WAV.
+  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/assets/scenarios/default.json");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = "../../out/voice/cue0.wav";
+  const size_t at = text.find(key);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, key.size(), wav);
+  const std::string sc = (dir / "scenario.json").string();
+  std::ofstream(sc) << text;
+  setenv("DRAPE_MOCK_SCENARIO", sc.c_str(), 1);
+  auto o = small();
+  o.eye_size = 64;
+  o.cloth_res = 16;
+  o.out_dir = dir.string();
+  auto r = drape::app::run_xr_app(o);
+  print(r);
+  for (const auto& t : r.triggers) std::printf("trigger %s\n", t.c_str());
+  for (const auto& l : r.log)
+    if (l.rfind("voice", 0) == 0 || l.rfind("cut", 0) == 0) std::printf("%s\n", l.c_str());
+  for (const auto& m : r.sim_messages) std::printf("sim: %s\n", m.c_str());
+  std::printf("pinched in %lld frames, pinned +%d, cuts %d (%d -> %d components)\n",
+              static_cast<long long>(r.frames_pinched), r.pinned_added, r.cuts_ok,
+              r.components_before, r.components_after);
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.frames, 300);
+  // Pinch: closed at frame ~72 (gap < 25 mm, 80 ms debounce), held until the pin (~frame 140)
+  // and the release at ~frame 160.
+  EXPECT_GT(r.frames_pinched, 40);
+  ASSERT_EQ(r.voice_commands.size(), 1u);
+  EXPECT_EQ(r.voice_commands[0], "pin");
+  EXPECT_GE(r.pinned_added, 1);
+  EXPECT_EQ(r.cuts_ok, 1);
+  EXPECT_GT(r.components_after, r.components_before);
+  for (const char* f : {"session_log.json", "drape_cloth.gltf", "xr_session.txt"})
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
 }
 
 TEST(XrApp, SessionLossIsAnOrdinaryState) {

@@ -14,16 +14,23 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <mutex>
 #include <thread>
 
 #ifdef DRAPE_XR_WITH_RENDER
 #include "render/camera.hpp"
 #include "render/renderer.hpp"
+#include "sim/mesh_io.hpp"
+#include "sim/operation_controller.hpp"
 #include "sim/scenes.hpp"
 #include "sim/sim_thread.hpp"
 #include "sim/solver_factory.hpp"
+#include "tracking/gestures.hpp"
+#include "tracking/voice.hpp"
 #endif
+#include <nlohmann/json.hpp>
 
 namespace drape::app {
 
@@ -143,6 +150,13 @@ class App {
   void teardown_all();
   bool handle_events();
   bool frame();
+#ifdef DRAPE_XR_WITH_RENDER
+  void start_sim();
+  void load_cues();
+  void interact(const XrFrameState& fs, XrHandJointLocationEXT (*joints)[XR_HAND_JOINT_COUNT_EXT],
+                const bool* joints_active);
+  void finish_sim();
+#endif
 
   XrAppOptions opt_;
   XrAppResult& r_;
@@ -179,8 +193,255 @@ class App {
   std::unique_ptr<render::Renderer> renderer_;
   std::unique_ptr<sim::SimThread> sim_;
   sim::SnapshotReader reader_;
+  std::shared_ptr<sim::OperationController> ops_;
+  tracking::GestureRecognizer gestures_;
+  struct Cue {
+    int64_t frame = 0;
+    std::string wav, text;
+    bool done = false;
+  };
+  std::vector<Cue> cues_;
+  std::unique_ptr<tracking::VoiceRecognizer> voice_;
+  bool trigger_on_[2] = {false, false}, menu_on_[2] = {false, false};
+  int pinned_at_start_ = 0;
+  std::vector<std::pair<int64_t, sim::Vec3>> posted_;  // right-hand pose posted per frame
+  std::mutex tick_mu_;
+  std::vector<std::chrono::steady_clock::time_point> tick_starts_;
 #endif
+  int64_t session_frame_ = 0;  // xrWaitFrame calls in this session (the scenario's frame index)
 };
+
+int count_pinned(const sim::Cloth& c) {
+  int n = 0;
+  for (uint8_t f : c.state.flags) n += (f & sim::kFlagPinned) != 0;
+  return n;
+}
+
+#ifdef DRAPE_XR_WITH_RENDER
+void App::start_sim() {
+  sim::World& w = sim_->world();  // the thread is not started yet
+  pinned_at_start_ = count_pinned(w.cloth);
+  if (opt_.operations) {
+    ops_ = std::make_shared<sim::OperationController>();
+    ops_->install(w);
+    ops_->start_recording(w);
+    load_cues();
+  }
+  if (!opt_.sim_lock_step) {
+    // Tick start times, for the jitter of the free-running sim clock under rendering load.
+    auto inner = w.before_step;
+    w.before_step = [this, inner](sim::World& world, double dt) {
+      {
+        std::lock_guard<std::mutex> lk(tick_mu_);
+        if (tick_starts_.size() < 100000) tick_starts_.push_back(std::chrono::steady_clock::now());
+      }
+      if (inner) inner(world, dt);
+    };
+  }
+  sim_->start();
+}
+
+// The scenario's audio cues (the mock runtime's documented voice side channel, docs/xr.md).
+void App::load_cues() {
+  const char* path = std::getenv("DRAPE_MOCK_SCENARIO");
+  if (!opt_.voice || !path || !*path) return;
+  std::ifstream in(path);
+  if (!in) return;  // the runtime reports an unreadable scenario itself
+  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.contains("audio") || !j["audio"].is_array()) return;
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  for (const auto& a : j["audio"]) {
+    if (!a.is_object() || !a.contains("frame") || !a.contains("wav")) continue;
+    Cue c;
+    c.frame = a["frame"].get<int64_t>();
+    std::filesystem::path wav = a["wav"].get<std::string>();
+    c.wav = (wav.is_absolute() ? wav : dir / wav).string();
+    if (a.contains("text") && a["text"].is_string()) c.text = a["text"].get<std::string>();
+    cues_.push_back(c);
+  }
+  if (!cues_.empty()) note("voice: " + std::to_string(cues_.size()) + " audio cue(s)");
+}
+
+void App::interact(const XrFrameState& fs,
+                   XrHandJointLocationEXT (*joints)[XR_HAND_JOINT_COUNT_EXT],
+                   const bool* joints_active) {
+  if (!sim_) return;
+  const int64_t frame_idx = session_frame_ - 1;  // this frame's index (the scenario's)
+  const double t = static_cast<double>(frame_idx) / 90.0;
+  std::array<sim::HandProxy, 2> hands{};
+  std::vector<tracking::Trigger> trig;
+  for (int h = 0; h < 2; ++h) {
+    hands[h].id = h;
+    if (joints_active[h]) {
+      tracking::HandFrame f;
+      f.hand = static_cast<tracking::Hand>(h);
+      f.time = t;
+      f.tracked = true;
+      f.confidence = 1;
+      f.has_joints = true;
+      for (int k = 0; k < tracking::kJointCount; ++k) {
+        const auto& p = joints[h][k].pose.position;
+        f.joints[k] = tracking::Vec3(p.x, p.y, p.z);
+      }
+      const auto& q = joints[h][XR_HAND_JOINT_PALM_EXT].pose.orientation;
+      f.palm.position = f.joints[XR_HAND_JOINT_PALM_EXT];
+      f.palm.orientation = tracking::Quat(q.w, q.x, q.y, q.z);
+      gestures_.update(f, trig);
+      hands[h].tracked = true;
+      // The pinch point: between the thumb and index tips.
+      hands[h].position =
+          0.5 * (f.joints[XR_HAND_JOINT_THUMB_TIP_EXT] + f.joints[XR_HAND_JOINT_INDEX_TIP_EXT]);
+      hands[h].orientation = f.palm.orientation;
+      hands[h].tip = hands[h].position;
+      hands[h].radius = 0.02;
+    } else if (hand_spaces_[h] != XR_NULL_HANDLE) {
+      XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+      if (XR_SUCCEEDED(xrLocateSpace(hand_spaces_[h], space_, fs.predictedDisplayTime, &loc)) &&
+          (loc.locationFlags & XR_SPACE_LOCATION_POSITION_VALID_BIT)) {
+        hands[h].tracked = true;
+        hands[h].position =
+            sim::Vec3(loc.pose.position.x, loc.pose.position.y, loc.pose.position.z);
+        hands[h].orientation = Eigen::Quaterniond(loc.pose.orientation.w, loc.pose.orientation.x,
+                                                  loc.pose.orientation.y, loc.pose.orientation.z);
+        hands[h].tip = hands[h].position;
+        hands[h].radius = 0.03;
+      }
+    }
+    // Controllers: trigger held = a cut stroke with that hand; menu click = pin.
+    XrActionStateGetInfo gi{XR_TYPE_ACTION_STATE_GET_INFO};
+    gi.action = pinch_;
+    gi.subactionPath = hand_paths_[h];
+    XrActionStateFloat fv{XR_TYPE_ACTION_STATE_FLOAT};
+    if (XR_SUCCEEDED(xrGetActionStateFloat(session_, &gi, &fv)) && fv.isActive) {
+      const bool on = trigger_on_[h] ? fv.currentState > 0.4f : fv.currentState > 0.6f;
+      if (on != trigger_on_[h])
+        trig.push_back({"cut", "controller", t, static_cast<tracking::Hand>(h), on});
+      trigger_on_[h] = on;
+    }
+    gi.action = menu_;
+    XrActionStateBoolean bv{XR_TYPE_ACTION_STATE_BOOLEAN};
+    if (XR_SUCCEEDED(xrGetActionStateBoolean(session_, &gi, &bv)) && bv.isActive) {
+      const bool on = bv.currentState == XR_TRUE;
+      if (on && !menu_on_[h])
+        trig.push_back({"pin", "controller", t, static_cast<tracking::Hand>(h), true});
+      menu_on_[h] = on;
+    }
+  }
+  // Voice: the scenario's audio cues, decoded when their frame is reached.
+  for (auto& c : cues_) {
+    if (c.done || frame_idx < c.frame) continue;
+    c.done = true;
+    if (!voice_) {
+      voice_ = std::make_unique<tracking::VoiceRecognizer>(tracking::VoiceConfig{});
+      if (!voice_->ok()) note("voice: recogniser unavailable: " + voice_->error());
+    }
+    std::vector<int16_t> pcm;
+    std::string err;
+    if (!voice_->ok()) continue;
+    if (!tracking::read_wav(c.wav, pcm, &err)) {
+      note("voice: " + err);
+      continue;
+    }
+    auto vr = voice_->decode(pcm.data(), static_cast<long>(pcm.size()),
+                             static_cast<double>(pcm.size()) / tracking::kVoiceRate);
+    note("voice: frame " + std::to_string(frame_idx) + " '" + c.wav + "' heard '" + vr.hypothesis +
+         "' -> " + (vr.command.empty() ? "(rejected: " + vr.reason + ")" : vr.command));
+    if (!vr.command.empty()) {
+      r_.voice_commands.push_back(vr.command);
+      trig.push_back({vr.command, "voice", t, tracking::Hand::Right, true});
+    }
+  }
+  // Gestures: a thumb-index pinch begins/ends the pinch operation; other gestures are shown only.
+  std::vector<tracking::Trigger> use;
+  for (const auto& tr : trig) {
+    if (tr.source == "gesture" && tr.command != "pinch") continue;
+    use.push_back(tr);
+    r_.triggers.push_back("frame " + std::to_string(frame_idx) + ": " + tr.source + " " +
+                          tr.command + (tr.begin ? " begin" : " end") + " hand " +
+                          tracking::hand_name(tr.hand));
+    if (opt_.verbose) note("trigger " + r_.triggers.back());
+  }
+  if (hands[1].tracked) {
+    posted_.emplace_back(frame_idx, hands[1].position);
+    if (posted_.size() > 256) posted_.erase(posted_.begin());
+  }
+  bool cut_end = false;
+  for (const auto& tr : use) cut_end = cut_end || (tr.command == "cut" && !tr.begin);
+  if (ops_) {
+    auto ops = ops_;
+    sim_->post([ops, hands, use](sim::World& w) {
+      ops->set_hands(w, hands);
+      w.scene.hands.assign(hands.begin(), hands.end());  // into the snapshot (latency probe)
+      for (const auto& tr : use)
+        ops->trigger(w, tr.command, tr.begin ? sim::TriggerPhase::kBegin : sim::TriggerPhase::kEnd,
+                     static_cast<int>(tr.hand));
+    });
+  }
+  if (opt_.sim_lock_step) {
+    sim_->advance(1);  // orders the sim's writes before these reads (sim_thread.hpp)
+    if (ops_) {
+      const auto& st = ops_->state();
+      if (st.pinched[0] >= 0 || st.pinched[1] >= 0) ++r_.frames_pinched;
+      if (cut_end) {
+        if (st.last_cut.ok && st.last_cut.components_after > st.last_cut.components_before) {
+          ++r_.cuts_ok;
+          r_.components_before = st.last_cut.components_before;
+          r_.components_after = st.last_cut.components_after;
+        }
+        note("cut: " + std::string(st.last_cut.ok ? "ok" : "failed: " + st.last_cut.reason) +
+             ", components " + std::to_string(st.last_cut.components_before) + " -> " +
+             std::to_string(st.last_cut.components_after));
+      }
+    }
+  }
+}
+
+void App::finish_sim() {
+  if (!sim_) return;
+  sim_->stop();
+  sim::World& w = sim_->world();
+  r_.pinned_added = count_pinned(w.cloth) - pinned_at_start_;
+  for (const auto& m : w.messages) r_.sim_messages.push_back(m);
+  {
+    std::lock_guard<std::mutex> lk(tick_mu_);
+    if (tick_starts_.size() > 10) {
+      std::vector<double> d;
+      for (size_t i = 1; i < tick_starts_.size(); ++i)
+        d.push_back(std::chrono::duration<double, std::milli>(tick_starts_[i] - tick_starts_[i - 1])
+                        .count());
+      double mean = 0, var = 0;
+      for (double x : d) mean += x;
+      mean /= static_cast<double>(d.size());
+      for (double x : d) var += (x - mean) * (x - mean);
+      r_.sim_tick_jitter_ms = std::sqrt(var / static_cast<double>(d.size()));
+    }
+  }
+  if (ops_ && !opt_.out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(opt_.out_dir, ec);
+    sim::SessionLog log = ops_->stop_recording(w);
+    const std::string lp = opt_.out_dir + "/session_log.json";
+    if (std::string e = sim::save_session(lp, log); e.empty())
+      r_.written.push_back(lp);
+    else
+      note("session log: " + e);
+    const std::string cp = opt_.out_dir + "/drape_cloth.gltf";
+    if (std::string e = sim::write_meshes(cp, {sim::cloth_to_mesh(w.cloth, "cloth")}); e.empty())
+      r_.written.push_back(cp);
+    else
+      note("glTF: " + e);
+    const std::string tp = opt_.out_dir + "/xr_session.txt";
+    std::ofstream o(tp);
+    for (const auto& l : r_.log) o << l << "\n";
+    for (const auto& l : r_.triggers) o << "trigger " << l << "\n";
+    for (const auto& l : r_.sim_messages) o << "sim: " << l << "\n";
+    o << "frames " << r_.frames << " pinched_frames " << r_.frames_pinched << " pinned_added "
+      << r_.pinned_added << " cuts " << r_.cuts_ok << " components " << r_.components_before
+      << " -> " << r_.components_after << "\n";
+    if (o) r_.written.push_back(tp);
+  }
+}
+#endif
 
 bool App::create_instance() {
   uint32_t n = 0;
@@ -360,9 +621,11 @@ bool App::create_vulkan() {
     w.cloth = std::move(scene.cloth);
     w.scene = std::move(scene.objects);
     w.solver = std::move(solver.value());
-    sim_ = std::make_unique<sim::SimThread>(std::move(w));
+    sim::SimThreadOptions so;
+    so.lock_step = opt_.sim_lock_step;
+    sim_ = std::make_unique<sim::SimThread>(std::move(w), so);
     reader_ = sim_->make_reader();
-    sim_->start();
+    start_sim();
   }
 #endif
   return true;
@@ -428,6 +691,7 @@ bool App::create_session() {
   ci.systemId = system_;
   if (!ok(xrCreateSession(instance_, &ci, &session_), "xrCreateSession")) return false;
   ++r_.sessions;
+  session_frame_ = 0;
   xr_state_ = XR_SESSION_STATE_UNKNOWN;
   set_state(XrAppState::kSessionIdle);
   // STAGE (floor at y = 0) when offered, LOCAL otherwise.
@@ -542,7 +806,7 @@ void App::destroy_session() {
 void App::teardown_all() {
   destroy_session();
 #ifdef DRAPE_XR_WITH_RENDER
-  if (sim_) sim_->stop();
+  finish_sim();
   reader_ = sim::SnapshotReader();
   sim_.reset();
   renderer_.reset();
@@ -615,6 +879,8 @@ bool App::frame() {
   XrResult x = xrWaitFrame(session_, nullptr, &fs);
   if (x == XR_ERROR_SESSION_LOST) return true;  // LOSS_PENDING arrives through the event queue
   if (!ok(x, "xrWaitFrame")) return false;
+  const auto t0 = std::chrono::steady_clock::now();
+  const int64_t this_frame = session_frame_++;
   x = xrBeginFrame(session_, nullptr);
   if (x == XR_ERROR_SESSION_LOST) return true;
   if (!ok(x, "xrBeginFrame")) return false;
@@ -634,15 +900,24 @@ bool App::frame() {
         r_.max_trigger = std::max(r_.max_trigger, f.currentState);
     }
   }
-  if (locate_joints_ && trackers_[1]) {
-    XrHandJointLocationEXT j[XR_HAND_JOINT_COUNT_EXT];
+  XrHandJointLocationEXT joints[2][XR_HAND_JOINT_COUNT_EXT];
+  bool joints_active[2] = {false, false};
+  for (int h = 0; h < 2 && locate_joints_; ++h) {
+    if (!trackers_[h]) continue;
     XrHandJointLocationsEXT loc{XR_TYPE_HAND_JOINT_LOCATIONS_EXT};
     loc.jointCount = XR_HAND_JOINT_COUNT_EXT;
-    loc.jointLocations = j;
+    loc.jointLocations = joints[h];
     XrHandJointsLocateInfoEXT li{XR_TYPE_HAND_JOINTS_LOCATE_INFO_EXT};
     li.baseSpace = space_;
     li.time = fs.predictedDisplayTime;
-    if (XR_SUCCEEDED(locate_joints_(trackers_[1], &li, &loc)) && loc.isActive) {
+    joints_active[h] = XR_SUCCEEDED(locate_joints_(trackers_[h], &li, &loc)) && loc.isActive;
+  }
+#ifdef DRAPE_XR_WITH_RENDER
+  if (running_) interact(fs, joints, joints_active);
+#endif
+  {
+    const XrHandJointLocationEXT* j = joints[1];
+    if (joints_active[1]) {
       ++r_.hand_frames_tracked;
       auto& a = j[XR_HAND_JOINT_THUMB_TIP_EXT].pose.position;
       auto& b = j[XR_HAND_JOINT_INDEX_TIP_EXT].pose.position;
@@ -672,6 +947,15 @@ bool App::frame() {
     if (located) {
 #ifdef DRAPE_XR_WITH_RENDER
       const sim::SceneSnapshot* snap = renderer_ ? &reader_.latest() : nullptr;
+      // Pose-to-photon probe: which frame's right-hand pose is in the snapshot drawn now.
+      if (snap && ops_)
+        for (const auto& hp : snap->hands)
+          if (hp.id == 1 && hp.tracked)
+            for (auto it = posted_.rbegin(); it != posted_.rend(); ++it)
+              if (it->second == hp.position) {
+                r_.latency_frames.push_back(static_cast<int>(this_frame - it->first));
+                break;
+              }
 #endif
       for (int e = 0; e < 2; ++e) {
         uint32_t idx = 0;
@@ -720,6 +1004,8 @@ bool App::frame() {
   x = xrEndFrame(session_, &ei);
   if (x == XR_ERROR_SESSION_LOST) return true;
   if (!ok(x, "xrEndFrame")) return false;
+  r_.frame_ms.push_back(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   ++r_.frames;
   if (layer_count) ++r_.frames_rendered;
   if (opt_.max_frames > 0 && r_.frames >= opt_.max_frames && !exit_requested_) {

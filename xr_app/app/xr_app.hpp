@@ -29,6 +29,13 @@ struct XrAppOptions {
   int cloth_res = 24;       // cloth resolution of the default scene
   int max_session_restarts = 3;
   bool verbose = false;
+  // Interaction (needs the renderer/sim build): hands (XR joints, else controller grips) and
+  // triggers (thumb-index pinch gesture, controller trigger = cut stroke, controller menu = pin,
+  // the scenario's audio cues decoded by the voice recogniser) drive the sim operations.
+  bool operations = true;
+  bool voice = true;          // decode the scenario's audio cues (DRAPE_MOCK_SCENARIO)
+  bool sim_lock_step = true;  // one sim tick per rendered frame; false: sim on its own 90 Hz clock
+  std::string out_dir;        // when set: session_log.json and drape_cloth.gltf written there
 };
 
 struct XrAppResult {
@@ -46,6 +53,20 @@ struct XrAppResult {
   float max_trigger = 0.f;           // largest "pinch" action value seen
   uint32_t validation_messages = 0;  // XR_EXT_debug_utils errors/warnings (validation layer)
   std::vector<std::string> log;      // state transitions and notable events
+  // Interaction outcomes (lock-step runs; see XrAppOptions::operations).
+  std::vector<std::string> triggers;                // "frame F: source command begin|end hand"
+  int64_t frames_pinched = 0;                       // frames in which a hand held a cloth particle
+  int pinned_added = 0;                             // pinned vertices at the end minus at the start
+  int cuts_ok = 0;                                  // cut strokes that split the cloth mesh
+  int components_before = 0, components_after = 0;  // of the last successful cut
+  std::vector<std::string> voice_commands;          // commands the recogniser accepted
+  std::vector<std::string> sim_messages;            // World::messages at the end
+  std::vector<std::string> written;                 // files written to out_dir
+  std::vector<double> frame_ms;                     // wall time per frame (wait → end)
+  double sim_tick_jitter_ms = -1;                   // free-running sim: stddev of tick period
+  // Pose-to-photon, per rendered frame: frames between the frame whose right-hand pose the
+  // drawn snapshot holds and the frame drawing it (only where a unique pose was matched).
+  std::vector<int> latency_frames;
 };
 
 // Points XR_RUNTIME_JSON at the mock runtime next to the executable when no runtime is

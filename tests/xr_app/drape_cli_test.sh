@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# The `drape` executable on the mock runtime, as a user runs it:
+#   xr         `drape xr --frames N` with XR_RUNTIME_JSON unset falls back to the mock runtime
+#              next to the executable, renders, exits 0; the runtime's frame count matches.
+#   validation the same under the OpenXR core validation layer: zero validation messages.
+#   run        `drape run` (the default draping scenario) writes frames, the session log, the
+#              cloth glTF and the pattern to its out dir, exits 0, well under 2 minutes.
+# usage: drape_cli_test.sh DRAPE_EXE MODE WORKDIR
+set -u
+exe=$1 mode=$2 work=$3
+rm -rf "$work" && mkdir -p "$work"
+log=$work/log.txt
+fail() { echo "FAIL: $*"; echo "--- log:"; cat "$log"; exit 1; }
+# No configured runtime: no XR_RUNTIME_JSON, an empty config home.
+unset XR_RUNTIME_JSON DRAPE_MOCK_SCENARIO DRAPE_MOCK_END_AFTER_FRAMES DRAPE_MOCK_WRITE_FRAMES
+export HOME=$work/home XDG_CONFIG_HOME=$work/home/.config XDG_CONFIG_DIRS=$work/none
+export DRAPE_MOCK_FAST=1
+case $mode in
+  xr|validation)
+    [ "$mode" = validation ] && export XR_ENABLE_API_LAYERS=XR_APILAYER_LUNARG_core_validation
+    "$exe" xr --frames 20 --eye-size 64 --cloth-res 12 >"$log" 2>&1
+    rc=$?
+    [ $rc -eq 0 ] || fail "exit code $rc"
+    grep -q "runtime manifest: .*/drape_mock_runtime.json" "$log" || fail "did not fall back to the mock runtime"
+    line=$(grep "^drape xr: exiting" "$log") || fail "no 'exiting' summary"
+    echo "$line"
+    app=$(sed -n "s/.*frames \([0-9]*\) (rendered \([0-9]*\)).*/\1 \2/p" <<<"$line")
+    read -r frames rendered <<<"$app"
+    composed=$(sed -n 's/^frames composed: \([0-9]*\)/\1/p' "$log")
+    echo "app frames $frames, rendered $rendered, runtime composed $composed"
+    [ "$frames" -ge 20 ] || fail "fewer than 20 frames"
+    [ "$rendered" = "$frames" ] || fail "not every frame rendered"
+    [ "$composed" = "$frames" ] || fail "runtime composed $composed != app frames $frames"
+    grep -q "validation messages 0" "$line" 2>/dev/null || grep -q "validation messages 0" <<<"$line" || fail "validation messages"
+    if [ "$mode" = validation ]; then
+      grep -qi "VALID_ERROR\|VUID-" "$log" && fail "validation errors in the log"
+    fi
+    ;;
+  run)
+    cd "$work" || exit 1
+    start=$(date +%s.%N)
+    "$exe" run --out "$work/out" --eye-size 128 >"$log" 2>&1
+    rc=$?
+    end=$(date +%s.%N)
+    secs=$(echo "$end - $start" | bc)
+    echo "drape run: exit $rc in $secs s"
+    [ $rc -eq 0 ] || fail "exit code $rc"
+    (( $(echo "$secs < 100" | bc) )) || fail "took $secs s"
+    for f in session_log.json drape_cloth.gltf xr_session.txt scenario.json voice/cue0.wav; do
+      [ -s "$work/out/$f" ] || fail "missing out/$f"
+    done
+    n=$(ls "$work/out/frames"/frame_*.png 2>/dev/null | wc -l)
+    echo "$n screenshots"
+    [ "$n" -ge 5 ] || fail "only $n screenshots"
+    grep -q "wrote .*/pattern/" "$log" || fail "no pattern files"
+    summary=$(grep "^drape run: exiting" "$log") || fail "no summary"
+    echo "$summary"
+    grep -q "voice commands 1" <<<"$summary" || fail "voice pin not heard"
+    grep -q "1 cut(s) splitting" <<<"$summary" || fail "the cut did not split the cloth"
+    ;;
+  *) echo "unknown mode $mode"; exit 2 ;;
+esac
+echo PASS
