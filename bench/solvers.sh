@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
-# ./drape bench solvers: the solver study (pass --quick for the short version).
+# ./drape bench solvers: the solver study, quick version by default (a few minutes);
+# SOLVERS_FULL=1 ./drape bench solvers runs the full grid up to 128^2 (much longer).
 set -euo pipefail
 ROOT="${1:-.}"; shift || true
 cd "$ROOT"
 BIN=build/bin/solvers_bench
 [ -x "$BIN" ] || BIN=$(ls build*/bin/solvers_bench 2>/dev/null | head -1)
-exec "$BIN" --max-res 128 "$@"
+if [ "${SOLVERS_FULL:-0}" = 1 ]; then
+  exec "$BIN" --max-res 128 "$@"
+fi
+exec "$BIN" --quick "$@"

@@ -4,7 +4,7 @@
 #   TUNING set: 4 voices x 2 speeds x the command phrases + 16 non-command sentences x 3 voices;
 #   TEST set:   5 OTHER voices x 3 other speeds x the phrases + 20 other sentences x 5 voices,
 #               noise taken from another part of the noise recording.
-# build/bin/voice_bench --tune picks the word insertion penalty and the duration limit on the tuning set
+# build/bin/voice_bench --tune picks the word insertion penalty, the minimum filler-path length and the duration limit on the tuning set
 # only; the test set is then decoded once with that fixed configuration -> out/bench/voice.json.
 # VOICE_PHRASES=assets/voice/words.tsv measures the old one-word commands.
 set -euo pipefail
@@ -92,7 +92,7 @@ for t in "${TEST_SENT[@]}"; do
   done
 done
 "$BUILD/bin/voice_bench" --tune "$TUNE" "$SET/tuned.txt" --phrases "$PHRASES" \
-  --wips "${VOICE_WIPS:-0.65,1e-1,1e-2,1e-3,1e-4}" ${VOICE_WEIGHTS:+--weights "$VOICE_WEIGHTS"}
-read -r W WIP MAXS < "$SET/tuned.txt"
+  --wips "${VOICE_WIPS:-0.65}" --min-fillers-grid "${VOICE_MIN_FILLERS:-1}" ${VOICE_SINGLE:+--single}
+read -r MINF WIP MARGIN MAXS < "$SET/tuned.txt"
 exec "$BUILD/bin/voice_bench" "$TEST" "${VOICE_OUT:-out/bench/voice.json}" --phrases "$PHRASES" \
-  --weight "$W" --wip "$WIP" --max-s "$MAXS"
+  --min-fillers "$MINF" --wip "$WIP" --margin "$MARGIN" --max-s "$MAXS" ${VOICE_SINGLE:+--single}

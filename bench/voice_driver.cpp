@@ -1,9 +1,9 @@
 // Voice benchmark driver (bench/voice_driver.cpp, run by bench/voice.sh): reads a list "wav \t
 // expected \t text \t speech_end_s" and decodes every file through the same path as the app
 // (energy VAD -> one pocketsphinx pass over command phrases + filler loop).
-//   voice_bench --tune list.tsv tuned.txt [--phrases F]: grid over the filler weight and the
+//   voice_bench --tune list.tsv tuned.txt [--phrases F]: grid over wip, filler margin and the
 //     duration limit; picks the best accuracy with false triggers <= 1 % and writes
-//     "filler_weight max_command_s" to tuned.txt. Only the tuning set is used here.
+//     "min_fillers wip margin max_command_s" to tuned.txt. Only the tuning set is used here.
 //   voice_bench list.tsv out.json [--weight W] [--max-s D] [--phrases F]: evaluates one fixed
 //     configuration on the (separate) test set and writes out/bench/voice.json.
 #include <algorithm>
@@ -29,7 +29,7 @@ struct Item {
 
 struct Outcome {
   std::string hyp, command;
-  double speech_s = 0, latency_ms = 0, decode_ms = 0;
+  double speech_s = 0, latency_ms = 0, decode_ms = 0, margin = 0;
   bool heard = false;
 };
 
@@ -41,7 +41,8 @@ struct Score {
 
 // Decodes every item with cfg (duration rule off: applied afterwards by score()).
 std::vector<Outcome> decode_all(const std::vector<Item>& items, VoiceConfig cfg) {
-  cfg.rejection = Rejection::Garbage;
+  if (cfg.rejection != Rejection::Single) cfg.rejection = Rejection::Garbage;
+  cfg.filler_margin = 1e9;  // margins computed, applied afterwards by score()
   VoiceRecognizer rec(cfg);
   if (!rec.ok()) {
     std::fprintf(stderr, "%s\n", rec.error().c_str());
@@ -67,6 +68,7 @@ std::vector<Outcome> decode_all(const std::vector<Item>& items, VoiceConfig cfg)
       o.command = r.command;
       o.speech_s = speech_s;
       o.decode_ms = r.decode_ms;
+      o.margin = r.margin;
       // end of utterance (known from synthesis) -> trigger: VAD decision time + decode time.
       o.latency_ms = (double(best->decided) / kVoiceRate - it.speech_end) * 1000.0 + r.decode_ms;
     }
@@ -76,11 +78,12 @@ std::vector<Outcome> decode_all(const std::vector<Item>& items, VoiceConfig cfg)
 }
 
 Score score(const std::vector<Item>& items, const std::vector<Outcome>& out, double max_s,
-            double min_s) {
+            double min_s, double margin) {
   Score sc;
   for (size_t i = 0; i < items.size(); ++i) {
     const auto& o = out[i];
-    const bool accept = !o.command.empty() && o.speech_s <= max_s && o.speech_s >= min_s;
+    const bool accept =
+        !o.command.empty() && o.speech_s <= max_s && o.speech_s >= min_s && o.margin >= -margin;
     if (items[i].expect == "-") {
       ++sc.non;
       sc.fa += accept;
@@ -106,6 +109,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> pos;
   std::vector<double> weights = {1.0};
   std::vector<double> wips = {0.65, 1e-2, 1e-4, 1e-6};
+  std::vector<int> minf;
   const std::vector<double> max_grid = {1.2, 1.5, 1.8, 2.2, 1e9};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -126,6 +130,14 @@ int main(int argc, char** argv) {
       weights = parse_list(next());
     else if (a == "--wip")
       cfg.word_penalty = std::stod(next());
+    else if (a == "--single")
+      cfg.rejection = Rejection::Single;
+    else if (a == "--margin")
+      cfg.filler_margin = std::stod(next());
+    else if (a == "--min-fillers")
+      cfg.min_filler_words = std::stoi(next());
+    else if (a == "--min-fillers-grid")
+      for (double m : parse_list(next())) minf.push_back(static_cast<int>(m));
     else if (a == "--wips")
       wips = parse_list(next());
     else if (a == "--max-s")
@@ -165,54 +177,73 @@ int main(int argc, char** argv) {
   if (tune) {
     std::printf("\nTUNING set (%zu utterances)\n%-10s %-10s %-8s %9s %9s\n", items.size(),
                 "filler_w", "wip", "max_s", "accuracy", "false_tr");
-    double best_acc = -1, best_w = cfg.filler_weight, best_wip = cfg.word_penalty,
-           best_max = cfg.max_command_s;
-    for (double w : weights)
+    double best_acc = -1, best_wip = cfg.word_penalty, best_max = cfg.max_command_s;
+    if (minf.empty()) minf.push_back(cfg.min_filler_words);
+    double best_minf = cfg.min_filler_words, best_margin = 1e9;
+    const std::vector<double> margin_grid = cfg.rejection == Rejection::Single
+                                                ? std::vector<double>{1e9}
+                                                : std::vector<double>{0, 2, 5, 10, 20, 40, 1e9};
+    for (int mf : minf)
       for (double p : wips) {
+        const double w = weights.front();
+        cfg.min_filler_words = mf;
         cfg.filler_weight = w;
         cfg.word_penalty = p;
         const auto out = decode_all(items, cfg);
-        for (double mx : max_grid) {
-          const Score sc = score(items, out, mx, cfg.min_command_s);
-          std::printf("%-10g %-10g %-8g %8.1f%% %8.1f%%\n", w, p, mx, 100 * sc.acc(),
-                      100 * sc.far());
-          if (sc.far() <= 0.01 && sc.acc() > best_acc) {
-            best_acc = sc.acc();
-            best_w = w;
-            best_wip = p;
-            best_max = mx;
+        for (double mg : margin_grid)
+          for (double mx : max_grid) {
+            const Score sc = score(items, out, mx, cfg.min_command_s, mg);
+            std::printf("min_fill %d  %-10g margin %-6g %-8g %8.1f%% %8.1f%%\n", mf, p, mg, mx,
+                        100 * sc.acc(), 100 * sc.far());
+            if (sc.far() <= 0.01 && sc.acc() > best_acc) {
+              best_acc = sc.acc();
+              best_wip = p;
+              best_minf = mf;
+              best_max = mx;
+              best_margin = mg;
+            }
           }
-        }
         for (size_t i = 0; i < items.size(); ++i)
           if (out[i].command != (items[i].expect == "-" ? "" : items[i].expect))
-            std::printf("    w=%g wip=%g %s: '%s' -> '%s' (%.2f s)\n", w, p, items[i].wav.c_str(),
-                        items[i].text.c_str(), out[i].hyp.c_str(), out[i].speech_s);
+            std::printf("    minf=%d wip=%g %s: '%s' -> '%s' (%.2f s)\n", mf, p,
+                        items[i].wav.c_str(), items[i].text.c_str(), out[i].hyp.c_str(),
+                        out[i].speech_s);
         std::fflush(stdout);
       }
     std::printf(
-        "chosen on the tuning set: filler_weight %g, wip %g, max_command_s %g (accuracy %.1f %%)\n",
-        best_w, best_wip, best_max, 100 * best_acc);
-    std::ofstream(pos[1]) << best_w << " " << best_wip << " " << best_max << "\n";
+        "chosen on the tuning set: min_filler_words %g, wip %g, margin %g, max_command_s %g "
+        "(accuracy %.1f %%, false triggers <= 1 %%)\n",
+        best_minf, best_wip, best_margin, best_max, 100 * best_acc);
+    std::ofstream(pos[1]) << best_minf << " " << best_wip << " " << best_margin << " " << best_max
+                          << "\n";
     return 0;
   }
 
   const auto out = decode_all(items, cfg);
   nlohmann::json j;
-  std::printf("\nTEST set: filler_weight %g, wip %g, max_command_s %g\n%-24s %9s %9s %8s %8s\n",
-              cfg.filler_weight, cfg.word_penalty, cfg.max_command_s, "rejection", "accuracy",
-              "false_tr", "cmds", "non-cmd");
-  const Score plain = score(items, out, 1e9, 0);
-  const Score dur = score(items, out, cfg.max_command_s, cfg.min_command_s);
-  for (const auto& [name, sc] : {std::pair<std::string, Score>{"filler", plain},
-                                 std::pair<std::string, Score>{"filler+duration", dur}}) {
+  std::printf(
+      "\nTEST set: min_filler_words %d, wip %g, margin %g, max_command_s %g\n%-24s %9s %9s %8s "
+      "%8s\n",
+      cfg.min_filler_words, cfg.word_penalty, cfg.filler_margin, cfg.max_command_s, "rejection",
+      "accuracy", "false_tr", "cmds", "non-cmd");
+  const Score plain = score(items, out, 1e9, 0, 1e9);
+  const Score durs = score(items, out, cfg.max_command_s, cfg.min_command_s, 1e9);
+  const Score marg = score(items, out, 1e9, 0, cfg.filler_margin);
+  const Score dur = score(items, out, cfg.max_command_s, cfg.min_command_s, cfg.filler_margin);
+  for (const auto& [name, sc] : {std::pair<std::string, Score>{"grammar only", plain},
+                                 std::pair<std::string, Score>{"duration", durs},
+                                 std::pair<std::string, Score>{"filler margin", marg},
+                                 std::pair<std::string, Score>{"margin+duration", dur}}) {
     std::printf("%-24s %8.1f%% %8.1f%% %8d %8d\n", name.c_str(), 100 * sc.acc(), 100 * sc.far(),
                 sc.cmd, sc.non);
     j["methods"][name] = {{"accuracy", sc.acc()}, {"false_trigger_rate", sc.far()}};
   }
   j["accuracy"] = dur.acc();
   j["false_trigger_rate"] = dur.far();
-  j["rejection"] = "filler+duration";
-  j["filler_weight"] = cfg.filler_weight;
+  j["rejection"] =
+      rejection_name(cfg.rejection == Rejection::Single ? Rejection::Single : Rejection::Combined);
+  j["filler_margin"] = cfg.filler_margin;
+  j["min_filler_words"] = cfg.min_filler_words;
   j["word_penalty"] = cfg.word_penalty;
   j["max_command_s"] = cfg.max_command_s;
   j["commands"] = dur.cmd;
@@ -220,7 +251,7 @@ int main(int argc, char** argv) {
   std::map<std::string, int> confusions;
   for (size_t i = 0; i < items.size(); ++i) {
     const bool accept = !out[i].command.empty() && out[i].speech_s <= cfg.max_command_s &&
-                        out[i].speech_s >= cfg.min_command_s;
+                        out[i].speech_s >= cfg.min_command_s && out[i].margin >= -cfg.filler_margin;
     const std::string got = accept ? out[i].command : "(rejected)";
     if (got != (items[i].expect == "-" ? "(rejected)" : items[i].expect)) {
       ++confusions[items[i].expect + " -> " + got];

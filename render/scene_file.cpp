@@ -1,6 +1,7 @@
 // Scene files and the default scene (render/scene_file.hpp).
 #include "render/scene_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,7 +11,9 @@
 #include "sim/cloth.hpp"
 #include "sim/dress_form.hpp"
 #include "sim/fabric.hpp"
+#include "sim/mapping.hpp"
 #include "sim/mesh_io.hpp"
+#include "sim/panel.hpp"
 #include "sim/solver_factory.hpp"
 #include "sim/world.hpp"
 
@@ -125,7 +128,62 @@ void cloth_to_snapshot(const sim::Cloth& c, sim::SceneSnapshot& snap) {
   snap.form = form;
 }
 
+// Geometric draping (method 2.4, sim/mapping.hpp): four quarter panels of muslin, one waist dart
+// each, mapped onto the form along the grain (centre front/back to the side lines), `ease` metres
+// of ease round the body. The panels are merged into one cloth mesh with their flat (u, v).
+void mapped_cloth(const json& m, sim::SceneSnapshot& snap) {
+  if (!snap.form) bad("cloth.mapped", "needs a form");
+  const sim::DressForm& form = *snap.form;
+  const sim::FormLandmarks& lm = form.landmarks();
+  const double ease = m.contains("ease") ? number(m["ease"], "cloth.mapped.ease") : 0.02;
+  if (ease < 0 || ease > 0.2) bad("cloth.mapped.ease", "expected 0 .. 0.2 m");
+  const sim::MappingSurface surf(form, ease);
+  const double hip = surf.girth(lm.hip_y), waist = surf.girth(lm.waist_y);
+  sim::PanelDesign pd;
+  pd.width = hip / 4;
+  pd.height = m.contains("height") ? positive(m["height"], "cloth.mapped.height") : 0.62;
+  pd.spacing = m.contains("spacing") ? positive(m["spacing"], "cloth.mapped.spacing") : 0.008;
+  if (pd.spacing < 0.002) bad("cloth.mapped.spacing", "at least 0.002 m");
+  pd.top_above_waist = m.contains("top_above_waist")
+                           ? number(m["top_above_waist"], "cloth.mapped.top_above_waist")
+                           : 0.03;
+  pd.slits.push_back({0.45 * pd.width, 0.14, std::max(0.0, (hip - waist) / 4 - 0.004)});
+  const double top_y = lm.waist_y + pd.top_above_waist;
+  if (std::string e = sim::validate_panel(pd, "cloth.mapped", &form, ease, top_y); !e.empty())
+    bad("cloth.mapped", e);
+  const struct {
+    double centre, side;
+  } pieces[] = {{lm.centre_front_theta, lm.right_side_theta},
+                {lm.centre_front_theta, lm.left_side_theta},
+                {lm.centre_back_theta, lm.right_side_theta},
+                {lm.centre_back_theta, lm.left_side_theta}};
+  constexpr double kPi = 3.14159265358979323846;
+  for (const auto& pc : pieces) {
+    auto panel = sim::build_panel(pd, sim::FabricParams{}, "cloth.mapped");
+    if (!panel) bad("cloth.mapped", panel.error());
+    const double delta = std::fmod(pc.side - pc.centre + 3 * kPi, 2 * kPi) - kPi;
+    const int dir = delta < 0 ? -1 : 1;
+    const sim::PieceMapping pm =
+        sim::make_piece_mapping(*panel, surf, pc.centre, dir, pc.side, lm.waist_y);
+    sim::map_panel(*panel, surf, pm);
+    sim::SceneSnapshot part;
+    part.form = snap.form;
+    cloth_to_snapshot(panel->cloth, part);
+    const auto base = static_cast<uint32_t>(snap.positions.size());
+    snap.positions.insert(snap.positions.end(), part.positions.begin(), part.positions.end());
+    snap.normals.insert(snap.normals.end(), part.normals.begin(), part.normals.end());
+    snap.material.insert(snap.material.end(), part.material.begin(), part.material.end());
+    snap.flags.insert(snap.flags.end(), part.flags.begin(), part.flags.end());
+    snap.strain.insert(snap.strain.end(), part.strain.begin(), part.strain.end());
+    for (uint32_t i : part.indices) snap.indices.push_back(base + i);
+  }
+}
+
 void parse_cloth(const json& c, const std::string& base, sim::SceneSnapshot& snap) {
+  if (c.contains("mapped")) {
+    mapped_cloth(c["mapped"], snap);
+    return;
+  }
   if (c.contains("panel")) {
     sim::Cloth cloth = panel_cloth(c["panel"], "cloth.panel");
     if (c.contains("drape")) {
@@ -384,6 +442,14 @@ sim::Result<SceneDescription> load_scene(const std::string& path) {
 
 sim::Result<SceneDescription> default_scene(double sim_seconds, const std::string& solver,
                                             int grid) {
+  if (solver == "mapping") {
+    // Geometric draping: four quarter panels mapped onto the form (a fitted skirt block with a
+    // waist dart each), the straight grain vertical on centre front and back.
+    json doc = {{"form", {{"size", "9AR"}}},
+                {"cloth", {{"mapped", {{"ease", 0.02}, {"height", 0.62}, {"spacing", 0.008}}}}},
+                {"options", {{"samples", 4}}}};
+    return parse_scene(doc.dump(), "default scene");
+  }
   // A square of muslin held flat above the shoulders and dropped: it falls over the form and
   // hangs in folds, the straight grain (v) running from front to back over the shoulders.
   json doc = {{"form", {{"size", "9AR"}}},

@@ -30,7 +30,8 @@ DropScene make_front_drop(std::shared_ptr<const DressForm> form, int n, double s
   place_spread(d.cloth, Vec3(c.x() - size / 2, d.hinge_y, d.hinge_z + size), Vec3::UnitX(),
                -Vec3::UnitZ());
   const int nx = d.cloth.topo.grid_nx;
-  for (int i = 0; i < nx; ++i) d.cloth.state.flags[(d.cloth.topo.grid_ny - 1) * nx + i] |= kFlagPinned;
+  for (int i = 0; i < nx; ++i)
+    d.cloth.state.flags[(d.cloth.topo.grid_ny - 1) * nx + i] |= kFlagPinned;
   d.cloth.relump_masses();
   return d;
 }

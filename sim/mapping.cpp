@@ -132,11 +132,11 @@ double ArcTable::theta_at(double l) const {
 
 double ArcTable::arc_at(double theta) const {
   double t = dir * (theta - theta0);
-  // Angles just "behind" the centre line (up to 1/16 turn) stay negative (a small overshoot);
-  // all others wrap into [0, 15/16 turn).
+  // Angles just "behind" the centre line (up to 1/8 turn) stay negative (an overshoot, e.g. a
+  // dart's zone start while solving for its constant); all others wrap into [0, 7/8 turn).
   t = std::fmod(t, kTwoPi);
-  if (t < -kTwoPi / 16) t += kTwoPi;
-  if (t >= kTwoPi - kTwoPi / 16) t -= kTwoPi;
+  if (t < -kTwoPi / 8) t += kTwoPi;
+  if (t >= kTwoPi - kTwoPi / 8) t -= kTwoPi;
   const double f = t / kStep;
   if (f < 0) return f * (cum[1] - cum[0]);
   const int k = std::min(static_cast<int>(std::floor(f)), kN - 1);
@@ -189,7 +189,9 @@ PieceMapping make_piece_mapping(const Panel& panel, const MappingSurface& surf, 
     const double c_prev = pm.shift(static_cast<int>(s), waist_y, Tw);
     const double rise = waist_y - d.y_tip;
     if (rise <= 0 || d.intake <= 0) continue;
-    double lo = 0, hi = 3.0 / rise;
+    // The zone start turns back toward the centre by at most 1/8 turn (an intake of ~0.1 m at
+    // the waist): inside the range where arc_at is continuous, so the bisection is monotonic.
+    double lo = 0, hi = (kTwoPi / 8) / rise;
     for (int it = 0; it < 60; ++it) {
       const double mid = 0.5 * (lo + hi);
       pm.darts.back().a = mid;

@@ -84,9 +84,11 @@ void VerletSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, St
     f[A[s]] += fs;
     f[B[s]] -= fs;
   }
-  // eq. 3-7: F_resp dt^2 / m = -(eps - d) n, evaluated at x(t) like the other forces.
+  // eq. 3-7 as published (response_as_velocity): F_resp dt^2 / m = -(eps - d) n, evaluated at
+  // x(t) like the other forces and added to the step.
+  const bool published = p_.collide && p_.response_as_velocity;
   bool any_contact = false;
-  if (p_.collide) {
+  if (published) {
     const auto t0 = std::chrono::steady_clock::now();
     const CollisionStats cs = collider_.response_displacements(st, scene, disp_);
     stats.collision_ms +=
@@ -108,14 +110,26 @@ void VerletSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, St
       continue;
     }
     Vec3 xn = xm[i] + alpha * (xm[i] - xp[i]) + (h2 * inv_m[i]) * f[i];
-    Vec3 xold = xm[i];
-    if (any_contact) {
-      xn += disp_[i];
-      if (!p_.response_as_velocity) xold += disp_[i];
-    }
-    v[i] = (xn - xold) * inv_h;
-    xp[i] = xold;
+    if (any_contact) xn += disp_[i];
+    xp[i] = xm[i];
     xm[i] = xn;
+  }
+  // Default (not in the study): the same response as a projection of the predicted x(t+h) to
+  // the offset surface, with x(t) kept as the previous position. The velocity (x(t+h) - x(t)) / h
+  // then loses its component into the object, so neither the response nor the velocity that
+  // carried the vertex inside survives into the next step. (Moving x(t) and x(t-h) together, as
+  // before, kept the inward velocity: springs and gravity kept accelerating vertices in contact
+  // into the form, by more each substep, and the cloth ended centimetres inside it.)
+  if (p_.collide && !p_.response_as_velocity) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const CollisionStats cs = collider_.project(st, scene);
+    stats.collision_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    stats.max_penetration = std::max(stats.max_penetration, cs.max_penetration);
+  }
+  for (int i = 0; i < n; ++i) {
+    if (inv_m[i] == 0 || !cloth.is_free(i)) continue;
+    v[i] = (xm[i] - xp[i]) * inv_h;
   }
   st.time += h;
 }

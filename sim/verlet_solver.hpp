@@ -25,8 +25,9 @@ struct VerletParams {
   // Exactly as published, the eq. 3-7 response is a force, so the displacement it causes also
   // becomes velocity in the next Verlet step. Against the form's radial section lookup that
   // pushes a vertex falling onto a shallow slope (the shoulders) far sideways and the drop blows
-  // up (measured: the drop test exploded). false (default): x_prev moves with the response, so it
-  // corrects the position without injecting velocity (a position projection).
+  // up (measured: the drop test exploded). false (default): the predicted x(t+h) is projected to
+  // the offset surface after the Verlet update and x(t) stays the previous position, so the
+  // velocity loses its component into the object (a position projection; docs/sim-core.md).
   bool response_as_velocity = false;
   // Not in the study: when the state turns non-finite, restore the frame's start state and
   // report `diverged` instead of leaving NaNs in the cloth.

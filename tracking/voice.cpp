@@ -190,9 +190,11 @@ const char* rejection_name(Rejection r) {
     case Rejection::Duration:
       return "duration";
     case Rejection::Garbage:
-      return "filler";
+      return "filler-margin";
     case Rejection::Combined:
-      return "filler+duration";
+      return "filler-margin+duration";
+    case Rejection::Single:
+      return "single-pass";
   }
   return "?";
 }
@@ -248,35 +250,44 @@ VoiceRecognizer::VoiceRecognizer(VoiceConfig cfg) : cfg_(std::move(cfg)) {
     error_ = "voice: " + err;
     return;
   }
-  const bool garbage =
-      cfg_.rejection == Rejection::Garbage || cfg_.rejection == Rejection::Combined;
-  // Grammar: <command> = the phrases; with garbage rejection, a weighted filler-word loop.
-  std::ostringstream g;
+  // Command grammar: the phrases (with Single, also the filler branch). Filler grammar (Garbage,
+  // Combined): the filler words only, for the second pass.
+  std::ifstream fin(cfg_.filler);
+  std::vector<std::string> fw;
+  for (std::string w; fin >> w;) fw.push_back(w);
+  if (fw.empty()) {
+    error_ = "voice: " + cfg_.filler + ": no filler words";
+    return;
+  }
+  // No Kleene '+' / '*': with this sphinxbase, the loop's null transitions join the start of
+  // the public rule, so the FSG can run from fillers into <command> ("it move cloth") and JSGF
+  // branch weights have no effect. min_filler_words..12 filler words as nested optionals
+  // instead (longer speech fails the duration limit anyway).
+  auto fillers = [&](std::ostringstream& g) {
+    g << "<filler> = ";
+    for (size_t i = 0; i < fw.size(); ++i) g << (i ? " | " : "") << fw[i];
+    const int need = std::clamp(cfg_.min_filler_words, 1, 6);
+    g << ";\n<fillers> =";
+    for (int k = 0; k < need; ++k) g << " <filler>";
+    for (int k = need; k < 12; ++k) g << " [<filler>";
+    for (int k = need; k < 12; ++k) g << "]";
+    g << ";\n";
+  };
+  std::ostringstream g, gf;
   g << "#JSGF V1.0;\ngrammar drape;\n<command> = ";
   for (size_t i = 0; i < phrases_.size(); ++i) g << (i ? " | " : "") << phrases_[i].phrase;
   g << ";\n";
-  if (garbage) {
-    std::ifstream fin(cfg_.filler);
-    std::vector<std::string> fw;
-    for (std::string w; fin >> w;) fw.push_back(w);
-    if (fw.empty()) {
-      error_ = "voice: " + cfg_.filler + ": no filler words";
-      return;
-    }
-    g << "<filler> = ";
-    for (size_t i = 0; i < fw.size(); ++i) g << (i ? " | " : "") << fw[i];
-    // No Kleene '+' / '*': with this sphinxbase, the loop's null transitions join the start of
-    // the public rule, so the FSG can run from fillers into <command> ("it move cloth") and the
-    // branch weights have no effect. Up to 12 filler words as nested optionals instead (longer
-    // speech fails the duration limit anyway).
-    g << ";\n<fillers> = <filler>";
-    for (int k = 1; k < 12; ++k) g << " [<filler>";
-    for (int k = 1; k < 12; ++k) g << "]";
-    g << ";\npublic <utterance> = /1/ <command> | /" << cfg_.filler_weight << "/ <fillers>;\n";
+  if (cfg_.rejection == Rejection::Single) {
+    fillers(g);
+    g << "public <utterance> = <command> | <fillers>;\n";
   } else {
     g << "public <utterance> = <command>;\n";
   }
   grammar_ = g.str();
+  gf << "#JSGF V1.0;\ngrammar filler;\n";
+  fillers(gf);
+  gf << "public <utterance> = <fillers>;\n";
+  const std::string filler_grammar = gf.str();
   char wip[32];
   std::snprintf(wip, sizeof wip, "%g", cfg_.word_penalty);
   cmd_ln_t* c = cmd_ln_init(nullptr, ps_args(), TRUE, "-hmm", cfg_.model_dir.c_str(), "-dict",
@@ -292,7 +303,8 @@ VoiceRecognizer::VoiceRecognizer(VoiceConfig cfg) : cfg_(std::move(cfg)) {
     error_ = "voice: pocketsphinx failed to load " + cfg_.model_dir;
     return;
   }
-  if (ps_set_jsgf_string(ps, "drape", grammar_.c_str()) < 0 || ps_set_search(ps, "drape") < 0) {
+  if (ps_set_jsgf_string(ps, "drape", grammar_.c_str()) < 0 ||
+      ps_set_jsgf_string(ps, "filler", filler_grammar.c_str()) < 0) {
     error_ = "voice: bad grammar from " + cfg_.phrases + " / " + cfg_.filler +
              " (a word missing from " + cfg_.dict + "?)";
     ps_free(ps);
@@ -314,12 +326,24 @@ VoiceResult VoiceRecognizer::decode(const int16_t* s, long n, double speech_s) {
   }
   auto* ps = static_cast<ps_decoder_t*>(ps_);
   const double t0 = now_s();
-  ps_start_utt(ps);
-  ps_process_raw(ps, s, static_cast<size_t>(n), FALSE, TRUE);
-  ps_end_utt(ps);
-  int32 score = 0;
-  const char* hyp = ps_get_hyp(ps, &score);
-  r.hypothesis = hyp ? hyp : "";
+  auto pass = [&](const char* search, int32& score) {
+    ps_set_search(ps, search);
+    ps_start_utt(ps);
+    ps_process_raw(ps, s, static_cast<size_t>(n), FALSE, TRUE);
+    ps_end_utt(ps);
+    score = 0;
+    const char* hyp = ps_get_hyp(ps, &score);
+    return std::string(hyp ? hyp : "");
+  };
+  int32 score = 0, fscore = 0;
+  r.hypothesis = pass("drape", score);
+  const bool garbage =
+      cfg_.rejection == Rejection::Garbage || cfg_.rejection == Rejection::Combined;
+  if (garbage && !r.hypothesis.empty()) {
+    const int frames = std::max(1, ps_get_n_frames(ps));
+    r.filler_hypothesis = pass("filler", fscore);
+    r.margin = double(score - fscore) / frames;
+  }
   r.decode_ms = (now_s() - t0) * 1000.0;
   const bool dur = cfg_.rejection == Rejection::Duration || cfg_.rejection == Rejection::Combined;
   if (dur && speech_s > cfg_.max_command_s) {
@@ -332,6 +356,10 @@ VoiceResult VoiceRecognizer::decode(const int16_t* s, long n, double speech_s) {
   }
   if (r.hypothesis.empty()) {
     r.reason = "nothing recognised";
+    return r;
+  }
+  if (garbage && r.margin < -cfg_.filler_margin) {
+    r.reason = "filler path wins (" + r.filler_hypothesis + ")";
     return r;
   }
   for (const auto& p : phrases_)

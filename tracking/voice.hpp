@@ -37,10 +37,11 @@ bool read_wav(const std::string& path, std::vector<int16_t>& samples, std::strin
 enum class Rejection {
   None,      // command grammar only: every utterance maps to some command
   Duration,  // command grammar; reject speech longer than max_command_s or shorter than min
-  Garbage,   // one pass over "<command phrase> | /filler_weight/ <filler word>+": the utterance
-             // is a command only when the command branch wins (out-of-grammar speech is
-             // absorbed by the filler loop)
+  Garbage,   // two passes: the command-phrase grammar and a filler-word grammar; reject when the
+             // filler path beats the command path by more than filler_margin per frame
   Combined,  // Garbage + Duration
+  Single,    // one pass over "<command phrase> | <filler words>": a command only when the
+             // command branch wins (faster, but absorbs many commands: see docs/tracking.md)
 };
 const char* rejection_name(Rejection r);
 
@@ -61,6 +62,12 @@ struct VoiceConfig {
   // pocketsphinx word insertion penalty (-wip, probability per word; default 0.65). Smaller
   // values make the many-short-words filler path expensive against a two-word phrase.
   double word_penalty = 0.65;
+  // The filler path needs at least this many words: a two-word command phrase then never
+  // competes with a one- or two-word filler path (sentences are longer).
+  int min_filler_words = 1;
+  // Garbage/Combined: reject when (filler score - command score) per 10 ms frame exceeds this
+  // (log base 1.0001). Tuned on the tuning set of bench/voice.sh.
+  double filler_margin = 0;
   double max_command_s = 1.8;  // speech longer than this is not a single command
   double min_command_s = 0.15;
   // Energy VAD (10 ms frames).
@@ -79,6 +86,8 @@ struct VoiceResult {
   std::string command;     // accepted command, empty when rejected
   std::string reason;      // why rejected
   double speech_s = 0;     // VAD speech duration
+  double margin = 0;       // (command score - filler score) per frame (Garbage/Combined)
+  std::string filler_hypothesis;
   double decode_ms = 0;
 };
 
@@ -94,7 +103,7 @@ class VoiceRecognizer {
   VoiceResult decode(const int16_t* samples, long n, double speech_s);
   const VoiceConfig& config() const { return cfg_; }
   const std::vector<VoicePhrase>& phrases() const { return phrases_; }
-  const std::string& grammar() const { return grammar_; }  // the generated JSGF
+  const std::string& grammar() const { return grammar_; }  // the generated JSGF (commands)
 
  private:
   VoiceConfig cfg_;

@@ -79,11 +79,11 @@ TEST(Drop, PanelOnFormStaysOutside) {
       "height range, lowest y %.3f, collision %.1f ms total\n",
       substeps, pen, min_dist, d.scene.offset, std::max(0.0, inside), max_inside_during, touching,
       in_range, c.num_vertices(), lowest, coll_ms);
-  EXPECT_EQ(in_range, c.num_vertices());     // the scene never leaves the section model
-  EXPECT_LT(lowest, d.hinge_y - 0.3);        // it did fall (hangs down, not held up)
-  EXPECT_GT(touching, 10);                   // it did land against the form
-  EXPECT_GE(min_dist, 0.0);                  // no vertex inside the form
+  EXPECT_EQ(in_range, c.num_vertices());       // the scene never leaves the section model
+  EXPECT_LT(lowest, d.hinge_y - 0.3);          // it did fall (hangs down, not held up)
+  EXPECT_GT(touching, 10);                     // it did land against the form
+  EXPECT_GE(min_dist, 0.0);                    // no vertex inside the form
   EXPECT_GT(min_dist, d.scene.offset - 1e-3);  // nor deeper than 1 mm into the offset shell
-  EXPECT_LT(pen, 0.01);                      // no vertex ever got 1 cm into the shell
-  EXPECT_LT(max_inside_during, 0.005);       // nor 5 mm inside the surface at a frame end
+  EXPECT_LT(pen, 0.01);                        // no vertex ever got 1 cm into the shell
+  EXPECT_LT(max_inside_during, 0.005);         // nor 5 mm inside the surface at a frame end
 }

@@ -47,11 +47,15 @@ TEST(Panel, GridAndSlitDuplication) {
   for (int ti = 0; ti < t.num_triangles(); ++ti) {
     const auto& tri = t.triangles[ti];
     for (int v : tri) {
-      if (t.vertex_origin[v] != v) EXPECT_EQ(t.triangle_zone[ti], t.vertex_zone[v]);
+      if (t.vertex_origin[v] != v) {
+        EXPECT_EQ(t.triangle_zone[ti], t.vertex_zone[v]);
+      }
     }
     for (int a : tri) {
       for (int b : tri) {
-        if (a != b) EXPECT_NE(t.vertex_origin[a], t.vertex_origin[b]);
+        if (a != b) {
+          EXPECT_NE(t.vertex_origin[a], t.vertex_origin[b]);
+        }
       }
     }
   }

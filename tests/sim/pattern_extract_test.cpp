@@ -61,6 +61,8 @@ TEST(PatternExtract, PlainPanelOutlineIsTheMappedRegion) {
   // Widths: hip line flat length = the quarter arc from centre front to the side line.
   const ArcTable T = ArcTable::build(surf, lm.hip_y, 0.0, -1);
   const double quarter = T.arc_at(lm.right_side_theta);
+  std::printf("DEBUG cum %zu theta %.17g back %.6f q %.6g\n", T.cum.size(), lm.right_side_theta,
+              T.cum.back(), quarter);
   std::printf("hip width %.3f mm vs arc %.3f mm\n", piece->hip_width() * 1000, quarter * 1000);
   EXPECT_NEAR(piece->hip_width(), quarter, 1e-4);
   EXPECT_GT(piece->area(), 0);  // counter-clockwise

@@ -111,7 +111,7 @@ TEST(XrApp, DefaultScenarioPinchesPinsAndCutsTheCloth) {
   setenv("DRAPE_MOCK_SCENARIO", sc.c_str(), 1);
   auto o = small();
   o.eye_size = 64;
-  o.cloth_res = 16;
+  o.cloth_res = 12;
   o.out_dir = dir.string();
   auto r = drape::app::run_xr_app(o);
   print(r);
