@@ -107,7 +107,6 @@ int main(int argc, char** argv) {
   bool tune = false;
   VoiceConfig cfg;
   std::vector<std::string> pos;
-  std::vector<double> weights = {1.0};
   std::vector<double> wips = {0.65, 1e-2, 1e-4, 1e-6};
   std::vector<int> minf;
   const std::vector<double> max_grid = {1.2, 1.5, 1.8, 2.2, 1e9};
@@ -124,10 +123,6 @@ int main(int argc, char** argv) {
       tune = true;
     else if (a == "--phrases")
       cfg.phrases = next();
-    else if (a == "--weight")
-      cfg.filler_weight = std::stod(next());
-    else if (a == "--weights")
-      weights = parse_list(next());
     else if (a == "--wip")
       cfg.word_penalty = std::stod(next());
     else if (a == "--single")
@@ -147,8 +142,8 @@ int main(int argc, char** argv) {
   }
   if (pos.size() != 2) {
     std::fprintf(stderr,
-                 "usage: voice_bench [--tune] list.tsv out [--phrases F] [--weight W] "
-                 "[--weights a,b] [--max-s D]\n");
+                 "usage: voice_bench [--tune] list.tsv out [--phrases F] [--wip P] [--wips a,b] "
+                 "[--margin M] [--single] [--max-s D]\n");
     return 2;
   }
   std::vector<Item> items;
@@ -180,14 +175,12 @@ int main(int argc, char** argv) {
     double best_acc = -1, best_wip = cfg.word_penalty, best_max = cfg.max_command_s;
     if (minf.empty()) minf.push_back(cfg.min_filler_words);
     double best_minf = cfg.min_filler_words, best_margin = 1e9;
-    const std::vector<double> margin_grid = cfg.rejection == Rejection::Single
-                                                ? std::vector<double>{1e9}
-                                                : std::vector<double>{0, 2, 5, 10, 20, 40, 1e9};
+    const std::vector<double> margin_grid =
+        cfg.rejection == Rejection::Single ? std::vector<double>{1e9}
+                                           : std::vector<double>{-30, -20, -15, -10, -7, -5, -3, 0};
     for (int mf : minf)
       for (double p : wips) {
-        const double w = weights.front();
         cfg.min_filler_words = mf;
-        cfg.filler_weight = w;
         cfg.word_penalty = p;
         const auto out = decode_all(items, cfg);
         for (double mg : margin_grid)

@@ -123,27 +123,6 @@ Hit cast(const Panel& panel, const MappingSurface& surf, const RayGrid& grid, do
   return best;
 }
 
-// The point at height y on one edge of a slit (tip + near or far nodes), in 3D and flat.
-Hit slit_edge_at(const Panel& panel, int slit, bool near, double y) {
-  const PanelSlit& ps = panel.slits[static_cast<size_t>(slit)];
-  const auto& x = panel.cloth.state.x;
-  const auto& mat = panel.cloth.topo.material;
-  std::vector<int> nodes{ps.tip_node};
-  const auto& side = near ? ps.near_nodes : ps.far_nodes;
-  nodes.insert(nodes.end(), side.begin(), side.end());
-  Hit h;
-  for (size_t k = 0; k + 1 < nodes.size(); ++k) {
-    const double y0 = x[nodes[k]].y(), y1 = x[nodes[k + 1]].y();
-    if ((y - y0) * (y - y1) > 0 || y0 == y1) continue;
-    const double f = (y - y0) / (y1 - y0);
-    h.ok = true;
-    h.world = x[nodes[k]] + f * (x[nodes[k + 1]] - x[nodes[k]]);
-    h.flat = mat[nodes[k]] + f * (mat[nodes[k + 1]] - mat[nodes[k]]);
-    return h;
-  }
-  return h;
-}
-
 struct RefPoint {
   double y, theta;
   int zone;
@@ -299,20 +278,26 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
   }
   // Cast the rays; consecutive runs share their corner point.
   std::vector<int> notch_ref;
+  int skipped_leg_points = 0;
   for (size_t r = 0; r < runs.size(); ++r) {
     int li = piece.label_index(runs[r].label);
     if (li < 0) {
       piece.labels.push_back(runs[r].label);
       li = static_cast<int>(piece.labels.size()) - 1;
     }
+    skipped_leg_points = 0;
     const size_t first = r == 0 ? 0 : 1;
     const size_t last = r + 1 == runs.size() ? runs[r].pts.size() - 1 : runs[r].pts.size();
     for (size_t k = first; k < last; ++k) {
       const RefPoint& rp = runs[r].pts[k];
       Hit h = cast(panel, surf, grid, rp.y, rp.theta, rp.zone);
-      // Near a dart tip the relaxed layers may part: where this leg's layer does not reach the
-      // dart line, the leg is that layer's own slit edge (interpolated at the height).
-      if (!h.ok && runs[r].slit >= 0) h = slit_edge_at(panel, runs[r].slit, runs[r].near, rp.y);
+      // Near a dart tip the relaxed layers may part: where the overlapping layer (leg 1) does
+      // not reach the dart line, the dart has no width yet (its two legs are the same slit edge
+      // there); such points are left out, leg 1 runs straight from the tip to its first hit.
+      // At most half of a leg may be left out.
+      if (!h.ok && runs[r].slit >= 0 && runs[r].near && k + 1 < last &&
+          ++skipped_leg_points <= static_cast<int>(runs[r].pts.size()) / 2)
+        continue;
       if (!h.ok) {
         std::ostringstream e;
         e << "line '" << runs[r].label << "': no cloth in zone " << rp.zone << " at height "

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <map>
 
 namespace drape::sim {
@@ -60,9 +61,14 @@ Result<RemeshedPiece> remesh_piece(const PatternPiece& piece, const RemeshOption
   std::vector<CDT::Vertex_handle> vh(n);
   for (int i = 0; i < n; ++i)
     vh[i] = cdt.insert(CDT::Point(piece.outline[i].x(), piece.outline[i].y()));
-  for (int i = 0; i < n; ++i)
-    if (vh[i] != vh[(i + 1) % n]) cdt.insert_constraint(vh[i], vh[(i + 1) % n]);
-  CGAL::refine_Delaunay_mesh_2(cdt, Criteria(opt.shape_bound, opt.max_edge));
+  try {  // CGAL throws on crossing constraints (a self-intersecting outline)
+    for (int i = 0; i < n; ++i)
+      if (vh[i] != vh[(i + 1) % n]) cdt.insert_constraint(vh[i], vh[(i + 1) % n]);
+    CGAL::refine_Delaunay_mesh_2(cdt, Criteria(opt.shape_bound, opt.max_edge));
+  } catch (const std::exception& e) {
+    return Error{"remesh: piece '" + piece.name +
+                 "': outline is not a simple polygon (CGAL: " + e.what() + ")"};
+  }
 
   RemeshedPiece out;
   std::map<CDT::Vertex_handle, int> index;

@@ -56,9 +56,6 @@ struct VoiceConfig {
   std::string phrases = "";  // default: <source>/assets/voice/phrases.tsv ("phrase\tcommand")
   std::string filler = "";   // default: <source>/assets/voice/filler.txt (one word a line)
   Rejection rejection = Rejection::Combined;
-  // JSGF weight of the filler branch (the command branch has weight 1). Tuned on the tuning set
-  // of bench/voice.sh (never on its test set); see docs/tracking.md.
-  double filler_weight = 1.0;
   // pocketsphinx word insertion penalty (-wip, probability per word; default 0.65). Smaller
   // values make the many-short-words filler path expensive against a two-word phrase.
   double word_penalty = 0.65;
@@ -66,9 +63,10 @@ struct VoiceConfig {
   // competes with a one- or two-word filler path (sentences are longer).
   int min_filler_words = 1;
   // Garbage/Combined: reject when (filler score - command score) per 10 ms frame exceeds this
-  // (log base 1.0001). Tuned on the tuning set of bench/voice.sh.
-  double filler_margin = 0;
-  double max_command_s = 1.8;  // speech longer than this is not a single command
+  // (log base 1.0001); -5 = the phrase path must win by 5 per frame. Tuned (with max_command_s)
+  // on the tuning set of bench/voice.sh, never on its test set.
+  double filler_margin = -5;
+  double max_command_s = 1.2;  // speech longer than this is not a single command
   double min_command_s = 0.15;
   // Energy VAD (10 ms frames).
   double vad_on_db = 9.0;    // dB above the noise floor to start speech

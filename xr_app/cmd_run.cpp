@@ -366,11 +366,11 @@ int run_xr(int argc, char** argv) {
   for (const auto& t : r.triggers) std::printf("  trigger %s\n", t.c_str());
   std::printf(
       "drape run: %s, runtime '%s', %lld frames (%lld rendered), pinched in %lld frames, "
-      "%d vertices pinned, %d cut(s) splitting the cloth (%d -> %d parts), voice commands %zu\n",
+      "%d vertices pinned, %d cut(s) (%d particles split; %d -> %d parts), voice commands %zu\n",
       drape::app::to_string(r.final_state), r.runtime_name.c_str(),
       static_cast<long long>(r.frames), static_cast<long long>(r.frames_rendered),
-      static_cast<long long>(r.frames_pinched), r.pinned_added, r.cuts_ok, r.components_before,
-      r.components_after, r.voice_commands.size());
+      static_cast<long long>(r.frames_pinched), r.pinned_added, r.cuts_ok, r.cut_new_vertices,
+      r.components_before, r.components_after, r.voice_commands.size());
   if (!r.error.empty()) std::fprintf(stderr, "drape run: error: %s\n", r.error.c_str());
   if (r.exit_code != 0) return r.exit_code;
   for (const auto& e : std::filesystem::directory_iterator(frames_dir, ec))

@@ -85,6 +85,7 @@ TEST(SimThread, ReaderNeverBlocksAndTimingReported) {
   std::promise<void> blocked, release;
   std::shared_future<void> released = release.get_future().share();
   std::atomic<int> calls{0};
+  std::atomic<bool> command_ran{false};
   w.before_step = [&blocked, released, &calls](World&, double) {
     const int k = ++calls;
     if (k <= 2) std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -95,10 +96,20 @@ TEST(SimThread, ReaderNeverBlocksAndTimingReported) {
   };
   SimThread t(std::move(w));  // real time, 90 Hz
   SnapshotReader reader = t.make_reader();
+  // Releases the sim thread on every exit path (a failed ASSERT must not leave it blocked while
+  // the SimThread destructor joins it).
+  struct Releaser {
+    std::promise<void>& p;
+    bool done = false;
+    void operator()() {
+      if (!done) p.set_value();
+      done = true;
+    }
+    ~Releaser() { (*this)(); }
+  } releaser{release};
   t.start();
   blocked.get_future().wait();  // the sim thread is now stuck in tick 3
 
-  std::atomic<bool> command_ran{false};
   t.post([&command_ran](World&) { command_ran = true; });
   int reads = 0;
   for (int r = 0; r < 1000; ++r) {
@@ -116,7 +127,7 @@ TEST(SimThread, ReaderNeverBlocksAndTimingReported) {
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
   EXPECT_EQ(reader.latest().tick, 2u);  // still blocked, still readable
   EXPECT_FALSE(command_ran.load());     // commands wait for the next tick
-  release.set_value();
+  releaser();
 
   uint64_t last_tick = 0;
   while (last_tick < 5) {  // the thread runs on: terminates without a time limit

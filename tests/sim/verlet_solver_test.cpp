@@ -111,3 +111,32 @@ TEST(Verlet, DropOnFloorStaysAboveOffset) {
   EXPECT_GT(ymin, 0.0);                  // never inside the floor
   EXPECT_GT(ymin, scene.offset - 5e-4);  // at most a step's travel into the offset shell
 }
+
+// Regression (drop test, 2026-11-22): a cloth resting on the floor must not keep a velocity into
+// it. The response used to move x(t) and x(t-h) together, which kept the inward velocity, so
+// gravity accelerated resting vertices into the floor by g h more each substep. With the
+// projection default, resting on the floor the vertical velocity stays ~0 (at most g h from the
+// last substep's gravity) and every vertex ends exactly at the offset.
+TEST(Verlet, RestingContactKeepsNoVelocityIntoTheObject) {
+  Cloth c = make_panel(PanelSpec{0.1, 0.1, 0.02}, FabricParams{});
+  place_spread(c, Vec3(0, 0.004, 0), Vec3::UnitX(), Vec3::UnitZ());
+  SceneObjects scene;
+  scene.offset = 0.003;
+  VerletSolver s{VerletParams{}};
+  int substeps = 0;
+  for (int k = 0; k < 90; ++k) substeps = s.step(c, scene, 1.0 / 90).substeps;
+  const double h = 1.0 / 90 / substeps;
+  double vmin = 0, ymin = 1, ymax = -1;
+  for (int i = 0; i < c.num_vertices(); ++i) {
+    vmin = std::min(vmin, c.state.v[i].y());
+    ymin = std::min(ymin, c.state.x[i].y());
+    ymax = std::max(ymax, c.state.x[i].y());
+  }
+  std::printf(
+      "resting on the floor after 1 s: y in [%.6f, %.6f] m (offset %.3f), most negative "
+      "v_y %.3e m/s (g h = %.3e)\n",
+      ymin, ymax, scene.offset, vmin, kGravity * h);
+  EXPECT_NEAR(ymin, scene.offset, 1e-9);
+  EXPECT_NEAR(ymax, scene.offset, 1e-9);
+  EXPECT_GE(vmin, -1.01 * kGravity * h);  // old response: -g (1 - e^-1) / (1/s), metres/s
+}

