@@ -4,7 +4,8 @@
 #   TUNING set: 4 voices x 2 speeds x the command phrases + 16 non-command sentences x 3 voices;
 #   TEST set:   5 OTHER voices x 3 other speeds x the phrases + 20 other sentences x 5 voices,
 #               noise taken from another part of the noise recording.
-# build/bin/voice_bench --tune picks the word insertion penalty, the minimum filler-path length and the duration limit on the tuning set
+# build/bin/voice_bench --tune picks the filler margin and the duration limit (optionally wip and
+# the filler-path length) on the tuning set
 # only; the test set is then decoded once with that fixed configuration -> out/bench/voice.json.
 # VOICE_PHRASES=assets/voice/words.tsv measures the old one-word commands.
 set -euo pipefail

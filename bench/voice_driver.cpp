@@ -277,7 +277,7 @@ int main(int argc, char** argv) {
                            {"latency_ms", out[i].latency_ms}});
   std::printf(
       "\nlatency end of utterance -> trigger: median %.0f ms, p90 %.0f ms (hangover %.0f ms "
-      "+ decode %.0f ms mean, one pass)\nutterances: %zu\n",
+      "+ decode %.0f ms mean)\nutterances: %zu\n",
       med, p90, cfg.hangover_s * 1000, j["decode_ms_mean"].get<double>(), items.size());
   std::ofstream(pos[1]) << j.dump(2) << "\n";
   std::printf("wrote %s\n", pos[1].c_str());

@@ -58,13 +58,37 @@ Result<RemeshedPiece> remesh_piece(const PatternPiece& piece, const RemeshOption
   if (!(opt.max_edge > 0) || !(opt.shape_bound > 0))
     return Error{"remesh: max_edge and shape_bound must be positive"};
   CDT cdt;
-  std::vector<CDT::Vertex_handle> vh(n);
-  for (int i = 0; i < n; ++i)
-    vh[i] = cdt.insert(CDT::Point(piece.outline[i].x(), piece.outline[i].y()));
+  // Outline points closer than min_sep to the previously kept one are left out of the input
+  // (near-duplicates make the refinement chase sub-micrometre features); seam labels below are
+  // still taken from the full outline.
+  const double min_sep = 0.05 * opt.max_edge;
+  std::vector<CDT::Vertex_handle> vh;
+  Vec2 last_kept(1e30, 1e30);
+  for (int i = 0; i < n; ++i) {
+    if ((piece.outline[i] - last_kept).norm() < min_sep) continue;
+    if (!vh.empty() && i == n - 1 && (piece.outline[i] - piece.outline[0]).norm() < min_sep)
+      continue;
+    vh.push_back(cdt.insert(CDT::Point(piece.outline[i].x(), piece.outline[i].y())));
+    last_kept = piece.outline[i];
+  }
+  const int nk = static_cast<int>(vh.size());
+  if (nk < 3) return Error{"remesh: piece '" + piece.name + "' outline collapses to < 3 points"};
   try {  // CGAL throws on crossing constraints (a self-intersecting outline)
-    for (int i = 0; i < n; ++i)
-      if (vh[i] != vh[(i + 1) % n]) cdt.insert_constraint(vh[i], vh[(i + 1) % n]);
-    CGAL::refine_Delaunay_mesh_2(cdt, Criteria(opt.shape_bound, opt.max_edge));
+    for (int i = 0; i < nk; ++i)
+      if (vh[i] != vh[(i + 1) % nk]) cdt.insert_constraint(vh[i], vh[(i + 1) % nk]);
+    // Step by step with a cap, so that a pathological outline gives an error, never a hang.
+    CGAL::Delaunay_mesher_2<CDT, Criteria> mesher(cdt, Criteria(opt.shape_bound, opt.max_edge));
+    mesher.init();
+    const double a = std::abs(piece.area());
+    const long cap = 10000 + static_cast<long>(50 * a / (opt.max_edge * opt.max_edge));
+    long steps = 0;
+    while (!mesher.is_refinement_done() && steps < cap) {
+      mesher.step_by_step_refine_mesh();
+      ++steps;
+    }
+    if (!mesher.is_refinement_done())
+      return Error{"remesh: piece '" + piece.name + "': refinement did not finish in " +
+                   std::to_string(cap) + " steps (degenerate outline?)"};
   } catch (const std::exception& e) {
     return Error{"remesh: piece '" + piece.name +
                  "': outline is not a simple polygon (CGAL: " + e.what() + ")"};

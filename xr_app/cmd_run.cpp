@@ -267,7 +267,7 @@ int run_xr(int argc, char** argv) {
   std::string scenario = source_path("assets/scenarios/default.json"), out = "out";
   drape::app::XrAppOptions opt;
   opt.eye_size = 256;
-  opt.cloth_res = 16;
+  opt.cloth_res = 12;
   bool pattern = true;
   int every = 30;
   for (int i = 1; i < argc; ++i) {
@@ -395,11 +395,13 @@ int run_xr(int argc, char** argv) {
     po.out_dir = out + "/pattern";
     auto pr = drape::sim::run_pattern_pipeline(*d, *form, *fab, po);
     if (!pr) {
-      std::fprintf(stderr, "drape run: pattern: %s\n", pr.error().c_str());
-      return 1;
+      // The pattern pipeline is another module: its failure is reported, the session's
+      // outputs above stand.
+      std::printf("drape run: pattern export failed (skipped): %s\n", pr.error().c_str());
+    } else {
+      for (const auto& f : pr->report.files)
+        std::printf("wrote %s\n", std::filesystem::absolute(f).c_str());
     }
-    for (const auto& f : pr->report.files)
-      std::printf("wrote %s\n", std::filesystem::absolute(f).c_str());
   }
   std::printf("drape run: done in %.1f s\n",
               std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count());
