@@ -30,8 +30,7 @@ MappingSurface::MappingSurface(const DressForm& form, double ease, bool hip_shap
     for (int n = 0; n < kN; ++n) {
       const double r0 = form.radius(j, n) + d, r1 = form.radius(j, (n + 1) % kN) + d;
       const double t0 = n * kStep, t1 = (n + 1) * kStep;
-      g += std::hypot(r1 * std::sin(t1) - r0 * std::sin(t0),
-                      r1 * std::cos(t1) - r0 * std::cos(t0));
+      g += std::hypot(r1 * std::sin(t1) - r0 * std::sin(t0), r1 * std::cos(t1) - r0 * std::cos(t0));
     }
     return g;
   };

@@ -295,6 +295,12 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
       // not reach the dart line, the dart has no width yet (its two legs are the same slit edge
       // there); such points are left out, leg 1 runs straight from the tip to its first hit.
       // At most half of a leg may be left out.
+      // A leg-1 hit clamped onto the slit column itself lies on leg 2 (the same flat line):
+      // the layers have parted there, count it as a miss.
+      if (h.ok && runs[r].slit >= 0 && runs[r].near && k + 1 < last) {
+        const int tip = panel.slits[static_cast<size_t>(runs[r].slit)].tip_node;
+        if (std::abs(h.flat.x() - panel.cloth.topo.material[tip].x()) < 2e-4) h.ok = false;
+      }
       if (!h.ok && runs[r].slit >= 0 && runs[r].near && k + 1 < last &&
           ++skipped_leg_points <= static_cast<int>(runs[r].pts.size()) / 2)
         continue;

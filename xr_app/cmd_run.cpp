@@ -399,8 +399,12 @@ int run_xr(int argc, char** argv) {
       // outputs above stand.
       std::printf("drape run: pattern export failed (skipped): %s\n", pr.error().c_str());
     } else {
-      for (const auto& f : pr->report.files)
-        std::printf("wrote %s\n", std::filesystem::absolute(f).c_str());
+      for (const auto& f : pr->report.files) {
+        const std::filesystem::path fp = std::filesystem::exists(f)
+                                             ? std::filesystem::path(f)
+                                             : std::filesystem::path(po.out_dir) / f;
+        std::printf("wrote %s\n", std::filesystem::absolute(fp).c_str());
+      }
     }
   }
   std::printf("drape run: done in %.1f s\n",

@@ -83,17 +83,18 @@ TEST(Mapping, GeneralMappingKeepsWeftLengthAndGrain) {
   for (const Vec3& q : x) {
     const Vec2 c = s.centre(q.y());
     const double dx = q.x() - c.x(), dz = q.z() - c.y();
-    worst_surf = std::max(worst_surf,
-                          std::abs(std::hypot(dx, dz) - s.radius(q.y(), std::atan2(dx, dz))));
+    worst_surf =
+        std::max(worst_surf, std::abs(std::hypot(dx, dz) - s.radius(q.y(), std::atan2(dx, dz))));
     const double sd = form.signed_distance(q);
     if (q.y() >= lm.hip_y)
       worst_above = std::max(worst_above, std::abs(sd));
     else
       deepest_below = std::min(deepest_below, sd);
   }
-  std::printf("off the mapping surface %.2e m, off the form above the hip %.2e m, deepest inside "
-              "the form below the hip %.2f mm\n",
-              worst_surf, worst_above, deepest_below * 1000);
+  std::printf(
+      "off the mapping surface %.2e m, off the form above the hip %.2e m, deepest inside "
+      "the form below the hip %.2f mm\n",
+      worst_surf, worst_above, deepest_below * 1000);
   EXPECT_LT(worst_surf, 1e-9);
   EXPECT_LT(worst_above, 5e-4);
 }
