@@ -38,10 +38,10 @@ struct ClothTopology {
 
 // What a step changes.
 struct ClothState {
-  std::vector<Vec3> x;       // positions (m, stage space)
-  std::vector<Vec3> x_prev;  // positions at the previous step (Verlet, velocity estimates)
-  std::vector<Vec3> v;       // velocities (m/s)
-  std::vector<double> mass;  // lumped mass (kg)
+  std::vector<Vec3> x;           // positions (m, stage space)
+  std::vector<Vec3> x_prev;      // positions at the previous step (Verlet, velocity estimates)
+  std::vector<Vec3> v;           // velocities (m/s)
+  std::vector<double> mass;      // lumped mass (kg)
   std::vector<double> inv_mass;  // 0 for fixed vertices
   std::vector<uint8_t> flags;    // VertexFlag bits
   double time = 0.0;             // simulated time (s)

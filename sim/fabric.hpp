@@ -17,9 +17,10 @@ struct FabricParams {
   double stretch_warp = 8000;   // N/m: force per unit width per unit strain along warp
   double stretch_weft = 5000;   // N/m
   double shear = 60;            // N/m per radian of shear angle
-  double bending_warp = 8.0e-6; // N*m: moment per unit width per unit curvature (bending along warp)
-  double bending_weft = 5.0e-6; // N*m
-  double damping = 0.0;         // dimensionless Rayleigh factor used by solvers that support it
+  double bending_warp =
+      8.0e-6;  // N*m: moment per unit width per unit curvature (bending along warp)
+  double bending_weft = 5.0e-6;  // N*m
+  double damping = 0.0;          // dimensionless Rayleigh factor used by solvers that support it
 };
 
 // Loads every preset of a fabrics JSON file. Each value is checked: present, finite, positive

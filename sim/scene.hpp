@@ -35,11 +35,11 @@ struct Sphere {
 struct HandProxy {
   int id = 0;
   bool tracked = false;
-  Vec3 position{0, 0, 0};                                  // palm or pinch point (m)
+  Vec3 position{0, 0, 0};  // palm or pinch point (m)
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
-  Vec3 tip{0, 0, 0};                                       // capsule end (= position: a sphere)
-  double radius = 0.04;                                    // collision radius (m)
-  bool collides = false;                                   // push cloth away (hand as obstacle)
+  Vec3 tip{0, 0, 0};      // capsule end (= position: a sphere)
+  double radius = 0.04;   // collision radius (m)
+  bool collides = false;  // push cloth away (hand as obstacle)
 };
 
 // Everything the cloth can touch.
@@ -49,8 +49,8 @@ struct SceneObjects {
   std::vector<Box> boxes;
   std::vector<Sphere> spheres;
   std::vector<HandProxy> hands;
-  bool floor = true;       // the stage floor y = 0
-  double offset = 0.002;   // cloth thickness / collision offset (m): kept-out distance
+  bool floor = true;      // the stage floor y = 0
+  double offset = 0.002;  // cloth thickness / collision offset (m): kept-out distance
 };
 
 }  // namespace drape::sim

@@ -19,7 +19,7 @@ using Vec2f = Eigen::Vector2f;
 struct SimTiming {
   double step_ms_p50 = 0, step_ms_p95 = 0, step_ms_p99 = 0, step_ms_max = 0;
   uint64_t ticks = 0;
-  uint64_t missed_ticks = 0;   // ticks whose deadline passed before they started
+  uint64_t missed_ticks = 0;  // ticks whose deadline passed before they started
   double tick_rate_hz = 90;
   int substeps = 1;
 };
@@ -31,11 +31,11 @@ struct SceneSnapshot {
 
   // Cloth
   std::vector<Vec3f> positions;
-  std::vector<Vec3f> normals;             // area-weighted vertex normals
-  std::vector<Vec2f> material;            // (u weft, v warp) in metres: grain lines / check
-  std::vector<uint32_t> indices;          // 3 per triangle
-  std::vector<uint8_t> flags;             // VertexFlag bits
-  std::vector<float> strain;              // optional per-vertex colour value (may be empty)
+  std::vector<Vec3f> normals;     // area-weighted vertex normals
+  std::vector<Vec2f> material;    // (u weft, v warp) in metres: grain lines / check
+  std::vector<uint32_t> indices;  // 3 per triangle
+  std::vector<uint8_t> flags;     // VertexFlag bits
+  std::vector<float> strain;      // optional per-vertex colour value (may be empty)
 
   // Scene
   std::shared_ptr<const class DressForm> form;  // static: shared, never mutated

@@ -17,8 +17,10 @@ namespace {
 void print_usage() {
   auto cmds = drape::app::command_registry();
   std::sort(cmds.begin(), cmds.end(), [](auto& a, auto& b) { return a.name < b.name; });
-  std::fprintf(stderr, "usage: drape <command> [options]   (drape <command> --help)\n\ncommands:\n");
-  for (const auto& c : cmds) std::fprintf(stderr, "  %-12s %s\n", c.name.c_str(), c.summary.c_str());
+  std::fprintf(stderr,
+               "usage: drape <command> [options]   (drape <command> --help)\n\ncommands:\n");
+  for (const auto& c : cmds)
+    std::fprintf(stderr, "  %-12s %s\n", c.name.c_str(), c.summary.c_str());
 }
 }  // namespace
 
