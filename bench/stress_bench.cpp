@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include "sim/scenes.hpp"
 
@@ -14,8 +15,12 @@ using namespace drape::sim;
 
 int main(int argc, char** argv) {
   int scale = 3;
-  for (int i = 1; i + 1 < argc; ++i)
+  std::string only_case, only_solver;  // --case NAME / --solver NAME: run a subset
+  for (int i = 1; i + 1 < argc; ++i) {
     if (!std::strcmp(argv[i], "--scale")) scale = std::max(1, std::atoi(argv[i + 1]));
+    if (!std::strcmp(argv[i], "--case")) only_case = argv[i + 1];
+    if (!std::strcmp(argv[i], "--solver")) only_solver = argv[i + 1];
+  }
   std::filesystem::create_directories("out/bench");
   std::ofstream csv("out/bench/stress.csv");
   csv << "case,solver,steps,failures\n";
@@ -23,6 +28,8 @@ int main(int argc, char** argv) {
               "vertices");
   for (const auto& c : stress_case_names())
     for (const char* s : {"vbd", "xpbd", "newton", "verlet"}) {
+      if ((!only_case.empty() && c != only_case) || (!only_solver.empty() && only_solver != s))
+        continue;
       StressResult r = run_stress_case(c, s, scale);
       std::printf("%-16s %-8s %6d %8d %9d %8d %s\n", c.c_str(), s, r.steps, r.failures, r.rollbacks,
                   r.vertices, r.note.c_str());

@@ -24,5 +24,13 @@ function(drape_add_test name)
     DRAPE_SOURCE_DIR="${CMAKE_SOURCE_DIR}" DRAPE_BINARY_DIR="${CMAKE_BINARY_DIR}")
   gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST
     WORKING_DIRECTORY ${CMAKE_BINARY_DIR}
-    PROPERTIES LABELS "${T_LABELS}" TIMEOUT 600)
+    PROPERTIES TIMEOUT 600)
+  # Labels are set by a second include file that runs after discovery: gtest_discover_tests
+  # flattens a list passed in PROPERTIES, so a second label would be read as a property name.
+  if(T_LABELS)
+    set(labels_file "${CMAKE_CURRENT_BINARY_DIR}/${name}_labels.cmake")
+    file(WRITE "${labels_file}"
+      "if(${name}_TESTS)\n  set_tests_properties(\${${name}_TESTS} PROPERTIES LABELS \"${T_LABELS}\")\nendif()\n")
+    set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${labels_file}")
+  endif()
 endfunction()

@@ -276,6 +276,9 @@ void append_decorations(const sim::SceneSnapshot& snap, const DrawOptions& opt, 
                   ShadeMode::kLit, 24, 16);
   for (const auto& h : snap.hands) {
     if (!h.tracked) continue;
+    bool live = false;  // drawn from the frame's own pose instead (append_hand_overlays)
+    for (const auto& o : opt.hands) live = live || o.id == h.id;
+    if (live) continue;
     const std::array<float, 3> col = h.id == 0 ? std::array<float, 3>{0.15f, 0.65f, 0.65f}
                                                : std::array<float, 3>{0.9f, 0.5f, 0.15f};
     const float r = static_cast<float>(h.radius);
@@ -335,6 +338,55 @@ void append_decorations(const sim::SceneSnapshot& snap, const DrawOptions& opt, 
                    ShadeMode::kUnlit);
         }
     }
+  }
+}
+
+void append_hand_overlays(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& out) {
+  // Bones of the XR_EXT_hand_tracking skeleton: wrist -> each finger's chain to its tip.
+  static const int kChains[5][6] = {{1, 2, 3, 4, 5, -1},
+                                    {1, 6, 7, 8, 9, 10},
+                                    {1, 11, 12, 13, 14, 15},
+                                    {1, 16, 17, 18, 19, 20},
+                                    {1, 21, 22, 23, 24, 25}};
+  for (const auto& h : opt.hands) {
+    if (h.id != 0 && h.id != 1) continue;
+    const std::array<float, 3> col = h.id == 0 ? std::array<float, 3>{0.15f, 0.65f, 0.65f}
+                                               : std::array<float, 3>{0.9f, 0.5f, 0.15f};
+    bool finite = h.pointer.allFinite();
+    if (h.has_joints)
+      for (const auto& j : h.joints) finite = finite && j.allFinite();
+    if (!finite) continue;  // a bad pose is not drawn
+    if (h.has_joints) {
+      for (const auto& chain : kChains)
+        for (int k = 0; k + 1 < 6 && chain[k + 1] >= 0; ++k) {
+          const V3 &a = h.joints[chain[k]], &b = h.joints[chain[k + 1]];
+          if ((b - a).norm() > 1e-5f) append_tube(out, a, b, 0.0035f, col, ShadeMode::kLit, 6);
+        }
+      for (int j = 1; j < 26; ++j)
+        append_sphere(out, h.joints[j], 0.005f, col, ShadeMode::kLit, 8, 5);
+      append_sphere(out, h.joints[0], 0.012f, col, ShadeMode::kLit, 10, 6);  // palm
+    } else {
+      // A controller: a short grip with the pointer at its front.
+      append_tube(out, h.pointer + V3(0, -0.03f, 0.05f), h.pointer, 0.012f, col, ShadeMode::kLit,
+                  8);
+    }
+    // The pointer: where an operation acts. White (unlit) while one is held.
+    const std::array<float, 3> pc =
+        h.active ? std::array<float, 3>{1.0f, 1.0f, 1.0f} : std::array<float, 3>{1.0f, 0.85f, 0.2f};
+    append_sphere(out, h.pointer, h.active ? 0.008f : 0.006f, pc, ShadeMode::kUnlit, 10, 6);
+    // Join the pointer to the hand's candidate (the particle or form point it would take).
+    const int32_t v = snap.candidate_vertex[h.id];
+    V3 target;
+    bool has = false;
+    if (v >= 0 && static_cast<size_t>(v) < snap.positions.size()) {
+      target = snap.positions[v];
+      has = true;
+    } else if (snap.candidate_is_form[h.id]) {
+      target = snap.candidate_point[h.id];
+      has = true;
+    }
+    if (has && target.allFinite() && (target - h.pointer).norm() > 1e-4f)
+      append_tube(out, h.pointer, target, 0.0012f, {0.1f, 1.0f, 0.2f}, ShadeMode::kUnlit, 4);
   }
 }
 

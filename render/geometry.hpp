@@ -37,6 +37,17 @@ struct Mesh {
   }
 };
 
+// A hand drawn from the XR frame's own located pose (XR_EXT_hand_tracking joints or a controller
+// grip), not from the snapshot: the user sees the hand where it is in the frame being displayed,
+// while the sim's copy of the hand (snapshot.hands) may be a tick or two behind.
+struct HandOverlay {
+  int id = 1;                                         // 0 left, 1 right
+  bool has_joints = false;                            // joints[] valid (26, XrHandJointEXT order)
+  std::array<Eigen::Vector3f, 26> joints{};           // stage space (m)
+  Eigen::Vector3f pointer = Eigen::Vector3f::Zero();  // where operations act: pinch point / grip
+  bool active = false;  // an operation is held (pinch closed, cutting)
+};
+
 // What to draw and how; everything has a sensible default.
 struct DrawOptions {
   ColourMap colour_map = ColourMap::kNone;
@@ -54,6 +65,9 @@ struct DrawOptions {
   std::array<float, 3> cloth_colour{0.92f, 0.89f, 0.80f};      // unbleached muslin
   std::array<float, 3> form_colour{0.62f, 0.52f, 0.40f};       // linen-covered form
   float form_section_spacing = 0.008f;  // decimation of the form's sections for drawing (m)
+  // Live hands (see HandOverlay). A hand given here replaces the snapshot's proxy of the same
+  // id; the candidate highlight of that hand is joined to its pointer by a thin line.
+  std::vector<HandOverlay> hands;
 };
 
 // The dress form as a smooth grid of its sections (normals from the grid), capped, in form mode.
@@ -64,6 +78,9 @@ void append_form(const sim::DressForm& form, float max_section_spacing, const Dr
 void append_cloth(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& out);
 // Plates, boxes, spheres, hands, pins, candidates, cut strokes, pattern panel.
 void append_decorations(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& out);
+// The live hands of DrawOptions::hands: joints as small spheres joined by bones (or a controller
+// marker), the pointer as a ring-like sphere (bright when active).
+void append_hand_overlays(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& out);
 // The floor quad (grid in the shader).
 void append_floor(Mesh& out);
 

@@ -532,6 +532,7 @@ struct Renderer::Impl {
     mesh.clear();
     append_cloth(snap, opt, mesh);
     append_decorations(snap, opt, mesh);
+    append_hand_overlays(snap, opt, mesh);
     const auto dyn_count = static_cast<uint32_t>(mesh.indices.size());
     stats.triangles = (static_count + dyn_count) / 3;
     stats.build_ms = ms_since(t0);

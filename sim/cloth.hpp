@@ -47,11 +47,27 @@ struct ClothState {
   double time = 0.0;             // simulated time (s)
 };
 
+// Vertex → incident triangles and component labels, kept with the cloth so topology edits
+// need not rebuild them (sim/cut.cpp builds it on demand with ensure_incidence() and updates it
+// in place on each split). Valid only while `version == Cloth::topology_version` and the sizes
+// match: any other edit bumps topology_version and so invalidates it (it is rebuilt when next
+// needed). Nothing else needs to maintain it.
+struct ClothIncidence {
+  bool built = false;
+  uint64_t version = 0;       // topology_version it describes
+  int32_t num_triangles = 0;  // triangle count it describes
+  // Triangles of vertex v: tris[start[v] .. start[v] + count[v]), ascending (tris has slack).
+  std::vector<int32_t> start, count, tris;
+  std::vector<int32_t> component;  // connected-component label per vertex (-1: in no triangle)
+  int32_t components = 0;          // number of labels
+};
+
 struct Cloth {
   ClothTopology topo;
   ClothState state;
   FabricParams fabric;
   uint64_t topology_version = 1;  // incremented on each topology edit (solvers re-cook then)
+  ClothIncidence incidence;       // kept adjacency (see above); may be stale (not built)
 
   int num_vertices() const { return topo.num_vertices(); }
   // True when vertex i takes part in dynamics (not pinned, pinched, kinematic or frozen).

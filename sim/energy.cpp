@@ -104,7 +104,15 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
             if (ha < 1e-12 || hb < 1e-12) continue;
             std::array<double, 4> K{-(1 - sa) / ha - (1 - sb) / hb, -sa / ha - sb / hb, 1 / ha,
                                     1 / hb};
-            const double area = tri_area_[it->second.first] + tri_area_[ti];
+            // Dual area: a rigid (fully fixed) triangle does not bend and is left out.
+            auto rigid = [&](int tj) {
+              const auto& tv = tri_v_[tj];
+              return opt_.rigid_boundary_hinges && !cloth.is_free(tv[0]) && !cloth.is_free(tv[1]) &&
+                     !cloth.is_free(tv[2]);
+            };
+            const int t1 = it->second.first;
+            double area = (rigid(t1) ? 0.0 : tri_area_[t1]) + (rigid(ti) ? 0.0 : tri_area_[ti]);
+            if (area <= 0) area = tri_area_[t1] + tri_area_[ti];
             // In-plane normal of the edge (direction of curvature the hinge resists).
             const double nu = -dir.y(), nv = dir.x();
             const double B = fab.bending_warp * nv * nv + fab.bending_weft * nu * nu;
@@ -264,20 +272,87 @@ void ClothEnergy::tri_vertex_block(int t, int a, const std::vector<Vec3>& x, Vec
 }
 
 // ---------------------------------------------------------------------------------------------
-// Bending hinges: E = 1/2 w |sum K_k x_k|^2.
+// Bending hinges. kDihedral: E = 1/2 w theta^2; kLinear: E = 1/2 w |sum K_k x_k|^2.
+//
+// Dihedral angle: e = x1 - x0, N_A = e x (x2 - x0), N_B = (x3 - x0) x e (equal directions when
+// flat), theta = atan2((n_B x n_A) . e/|e|, n_A . n_B). Its gradient (Bridson et al. 2003 form)
+// with the heights h = |N|/|e| and foot parameters s = (x_opp - x0).e/|e|^2 of the opposite
+// vertices: dtheta/dx2 = n_A/h_A = N_A |e|/|N_A|^2 (G_A), dtheta/dx3 = G_B,
+// dtheta/dx0 = -(1-s_A) G_A - (1-s_B) G_B, dtheta/dx1 = -s_A G_A - s_B G_B.
+
+namespace {
+
+struct HingeGeo {
+  Vec3 e, a, b, NA, NB, GA, GB;
+  double L = 0, nA2 = 0, nB2 = 0, sA = 0, sB = 0;
+};
+
+bool hinge_geo(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3, HingeGeo& g) {
+  g.e = x1 - x0;
+  g.a = x2 - x0;
+  g.b = x3 - x0;
+  g.L = g.e.norm();
+  g.NA = g.e.cross(g.a);
+  g.NB = g.b.cross(g.e);
+  g.nA2 = g.NA.squaredNorm();
+  g.nB2 = g.NB.squaredNorm();
+  const double L2 = g.L * g.L;
+  if (!(g.L > 1e-14) || !(g.nA2 > 1e-12 * L2 * L2) || !(g.nB2 > 1e-12 * L2 * L2)) return false;
+  g.GA = g.NA * (g.L / g.nA2);
+  g.GB = g.NB * (g.L / g.nB2);
+  g.sA = g.a.dot(g.e) / L2;
+  g.sB = g.b.dot(g.e) / L2;
+  return true;
+}
+
+double hinge_theta(const HingeGeo& g) {
+  const Vec3 nA = g.NA / std::sqrt(g.nA2), nB = g.NB / std::sqrt(g.nB2);
+  return std::atan2(nB.cross(nA).dot(g.e) / g.L, nA.dot(nB));
+}
+
+}  // namespace
+
+bool ClothEnergy::hinge_angle(int h, const std::vector<Vec3>& x, double& theta,
+                              Vec3 dtheta[4]) const {
+  const auto& v = hinge_v_[h];
+  HingeGeo g;
+  if (!hinge_geo(x[v[0]], x[v[1]], x[v[2]], x[v[3]], g)) {
+    theta = 0;
+    for (int k = 0; k < 4; ++k) dtheta[k].setZero();
+    return false;
+  }
+  theta = hinge_theta(g);
+  dtheta[0] = -(1 - g.sA) * g.GA - (1 - g.sB) * g.GB;
+  dtheta[1] = -g.sA * g.GA - g.sB * g.GB;
+  dtheta[2] = g.GA;
+  dtheta[3] = g.GB;
+  return true;
+}
 
 double ClothEnergy::hinge_energy(int h, const std::vector<Vec3>& x) const {
   const auto& v = hinge_v_[h];
-  const auto& K = hinge_k_[h];
-  const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
-  return 0.5 * hinge_w_[h] * s.squaredNorm();
+  if (opt_.bending_model == EnergyOptions::Bending::kLinear) {
+    const auto& K = hinge_k_[h];
+    const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
+    return 0.5 * hinge_w_[h] * s.squaredNorm();
+  }
+  HingeGeo g;
+  if (!hinge_geo(x[v[0]], x[v[1]], x[v[2]], x[v[3]], g)) return 0.0;
+  const double th = hinge_theta(g);
+  return 0.5 * hinge_w_[h] * th * th;
 }
 
 void ClothEnergy::hinge_gradient(int h, const std::vector<Vec3>& x, Vec3 g[4]) const {
   const auto& v = hinge_v_[h];
-  const auto& K = hinge_k_[h];
-  const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
-  for (int k = 0; k < 4; ++k) g[k] = hinge_w_[h] * K[k] * s;
+  if (opt_.bending_model == EnergyOptions::Bending::kLinear) {
+    const auto& K = hinge_k_[h];
+    const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
+    for (int k = 0; k < 4; ++k) g[k] = hinge_w_[h] * K[k] * s;
+    return;
+  }
+  double th;
+  hinge_angle(h, x, th, g);
+  for (int k = 0; k < 4; ++k) g[k] *= hinge_w_[h] * th;
 }
 
 void ClothEnergy::hinge_hessian(int h, Mat12& H) const {
@@ -285,6 +360,82 @@ void ClothEnergy::hinge_hessian(int h, Mat12& H) const {
   for (int a = 0; a < 4; ++a)
     for (int b = 0; b < 4; ++b)
       H.block<3, 3>(3 * a, 3 * b) = hinge_w_[h] * K[a] * K[b] * Mat3::Identity();
+}
+
+void ClothEnergy::hinge_hessian(int h, const std::vector<Vec3>& x, Mat12& H, bool project) const {
+  if (opt_.bending_model == EnergyOptions::Bending::kLinear) {
+    hinge_hessian(h, H);
+    return;
+  }
+  const auto& v = hinge_v_[h];
+  HingeGeo g;
+  if (!hinge_geo(x[v[0]], x[v[1]], x[v[2]], x[v[3]], g)) {
+    H.setZero();
+    return;
+  }
+  const double th = hinge_theta(g);
+  Eigen::Matrix<double, 12, 1> d;
+  // Flat hinge: the curvature term vanishes and w d d^T is PSD as it is. No eigensolve then:
+  // its round-off would couple the out-of-plane direction to the in-plane ones and seed
+  // buckling of a planar equilibrium (the hanging sheet) that is exact otherwise.
+  d.segment<3>(0) = -(1 - g.sA) * g.GA - (1 - g.sB) * g.GB;
+  d.segment<3>(3) = -g.sA * g.GA - g.sB * g.GB;
+  d.segment<3>(6) = g.GA;
+  d.segment<3>(9) = g.GB;
+  if (th == 0.0) {
+    H = hinge_w_[h] * d * d.transpose();
+    return;
+  }
+  // Second derivative of theta, one column per coordinate: directional derivatives of the
+  // gradient formula (product rule through N_A, N_B, |e|, s_A, s_B).
+  const double L = g.L, L2 = L * L;
+  const Vec3 eh = g.e / L;
+  Mat12 D2;
+  for (int j = 0; j < 4; ++j)
+    for (int c = 0; c < 3; ++c) {
+      const Vec3 u = Vec3::Unit(c);
+      const Vec3 de = j == 1 ? u : (j == 0 ? Vec3(-u) : Vec3::Zero());
+      const Vec3 da = j == 2 ? u : (j == 0 ? Vec3(-u) : Vec3::Zero());
+      const Vec3 db = j == 3 ? u : (j == 0 ? Vec3(-u) : Vec3::Zero());
+      const Vec3 dNA = de.cross(g.a) + g.e.cross(da);
+      const Vec3 dNB = db.cross(g.e) + g.b.cross(de);
+      const double dL = eh.dot(de);
+      const Vec3 dGA =
+          (dNA * L + g.NA * dL) / g.nA2 - 2 * g.NA * L * g.NA.dot(dNA) / (g.nA2 * g.nA2);
+      const Vec3 dGB =
+          (dNB * L + g.NB * dL) / g.nB2 - 2 * g.NB * L * g.NB.dot(dNB) / (g.nB2 * g.nB2);
+      const double dsA = (da.dot(g.e) + g.a.dot(de)) / L2 - 2 * g.a.dot(g.e) * dL / (L2 * L);
+      const double dsB = (db.dot(g.e) + g.b.dot(de)) / L2 - 2 * g.b.dot(g.e) * dL / (L2 * L);
+      const int col = 3 * j + c;
+      D2.block<3, 1>(0, col) = dsA * g.GA - (1 - g.sA) * dGA + dsB * g.GB - (1 - g.sB) * dGB;
+      D2.block<3, 1>(3, col) = -dsA * g.GA - g.sA * dGA - dsB * g.GB - g.sB * dGB;
+      D2.block<3, 1>(6, col) = dGA;
+      D2.block<3, 1>(9, col) = dGB;
+    }
+  H = hinge_w_[h] * (d * d.transpose() + th * 0.5 * (D2 + D2.transpose()));
+  if (project) {
+    Eigen::SelfAdjointEigenSolver<Mat12> es(H);
+    const Eigen::Matrix<double, 12, 1> ev = es.eigenvalues().cwiseMax(0.0);
+    H = es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+  }
+}
+
+void ClothEnergy::hinge_vertex_block(int h, int a, const std::vector<Vec3>& x, Vec3& g,
+                                     Mat3& H) const {
+  const auto& v = hinge_v_[h];
+  const double w = hinge_w_[h];
+  if (opt_.bending_model == EnergyOptions::Bending::kLinear) {
+    const auto& K = hinge_k_[h];
+    const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
+    g = w * K[a] * s;
+    H = w * K[a] * K[a] * Mat3::Identity();
+    return;
+  }
+  double th;
+  Vec3 d[4];
+  hinge_angle(h, x, th, d);
+  g = w * th * d[a];
+  H = w * d[a] * d[a].transpose();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -508,12 +659,11 @@ void ClothEnergy::vertex_force_hessian(int i, const std::vector<Vec3>& x, double
     H += Hb;
   }
   for (int e = vh_off_[i]; e < vh_off_[i + 1]; ++e) {
-    const int h = vh_[e] / 4, a = vh_[e] % 4;
-    const auto& v = hinge_v_[h];
-    const auto& K = hinge_k_[h];
-    const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
-    f -= hinge_w_[h] * K[a] * s;
-    H.diagonal().array() += hinge_w_[h] * K[a] * K[a];
+    Vec3 g;
+    Mat3 Hb;
+    hinge_vertex_block(vh_[e] / 4, vh_[e] % 4, x, g, Hb);
+    f -= g;
+    H += Hb;
   }
   for (int e = vs_off_[i]; e < vs_off_[i + 1]; ++e) {
     const int s = vs_[e] / 2, a = vs_[e] % 2;

@@ -1,6 +1,7 @@
 // The cloth energy every solver minimises (docs/solvers.md):
 //   E(x) = membrane (anisotropic StVK on material coordinates: warp, weft, shear)
-//        + bending (quadratic discrete-shell hinges, warp/weft rigidity)
+//        + bending (discrete-shell dihedral-angle hinges, warp/weft rigidity; the former
+//          quadratic linear-operator hinge stays available as EnergyOptions::Bending::kLinear)
 //        + gravity + optional weak pressure toward the form + contact penalty,
 // or, as a second model, the study's 8-neighbour springs (method eq. 3-1) + gravity + contact.
 // Everything is cooked once per topology_version into flat arrays (no allocation per step).
@@ -26,6 +27,17 @@ struct EnergyOptions {
   Vec3 g{0, -kGravity, 0};
   double pressure = 0.0;  // Pa: weak pressure pushing the cloth toward the form's axis
   bool bending = true;
+  // Bending hinge model. kDihedral (default): E = 1/2 w theta^2 with theta the dihedral angle
+  // between the two triangles' normals (discrete shells, Grinspun et al. 2003; rest angle 0:
+  // the material is flat). kLinear: E = 1/2 w |sum_k K_k x_k|^2 with the rest-state weights
+  // (Bergou et al. 2006 form; constant Hessian). Both use the same w and K.
+  enum class Bending { kDihedral, kLinear };
+  Bending bending_model = Bending::kDihedral;
+  // A hinge between a deformable triangle and a rigid one (all three vertices pinned or
+  // kinematic when the energy is built) takes only the deformable triangle's area as its dual
+  // area: the clamped side does not bend, so the hinge's curvature theta/width lives on half
+  // the usual strip. Without it a clamped edge is first-order wrong (docs/solvers.md).
+  bool rigid_boundary_hinges = true;
   double contact_stiffness = 0;   // N/m per vertex; 0 = automatic (from mass and dt)
   double contact_margin = 0.005;  // m: contacts detected within offset + margin
   bool cull_by_bounds = true;     // test only objects whose bounds touch the cloth's bounds
@@ -65,12 +77,33 @@ class ClothEnergy {
   // The 3x3 block of vertex slot a (0..2) and that slot's gradient (for VBD).
   void tri_vertex_block(int t, int a, const std::vector<Vec3>& x, Vec3& g, Mat3& H) const;
 
-  // --- bending hinges (quadratic: E = 1/2 w |sum_k K_k x_k|^2, constant PSD Hessian) ---------
+  // --- bending hinges ------------------------------------------------------------------------
+  // Hinge h: edge (0, 1), opposite vertices 2 (first triangle) and 3 (second triangle).
+  // kDihedral: E = 1/2 w theta^2, theta = signed dihedral angle (0 when flat, in (-pi, pi]);
+  // kLinear:   E = 1/2 w |sum_k K_k x_k|^2.
+  // w = B(n) |e|^2 / (A_1 + A_2) (rest areas; A of a rigid triangle left out, see
+  // EnergyOptions::rigid_boundary_hinges), B(n) = bending_warp n_v^2 + bending_weft n_u^2 with
+  // n the edge's in-plane normal in material space (the direction of curvature it resists).
   int num_hinges() const { return static_cast<int>(hinge_v_.size()); }
   const std::array<int32_t, 4>& hinge(int h) const { return hinge_v_[h]; }
   double hinge_energy(int h, const std::vector<Vec3>& x) const;
   void hinge_gradient(int h, const std::vector<Vec3>& x, Vec3 g[4]) const;
-  void hinge_hessian(int h, Mat12& H) const;  // exact, PSD
+  // Model Hessian (12x12). kDihedral: exact w (dtheta dtheta^T + theta d2theta) when
+  // `project` is false; with `project` its eigenvalues are clamped at 0 (PSD). kLinear: the
+  // constant w K K^T (x) I (exact and PSD, `project` ignored).
+  void hinge_hessian(int h, const std::vector<Vec3>& x, Mat12& H, bool project = true) const;
+  // The linear model's constant Hessian w K K^T (x) I (exact for kLinear; for kDihedral the
+  // rest-state stiffness with the tangential directions added; kept for callers without x).
+  void hinge_hessian(int h, Mat12& H) const;
+  // Gradient and 3x3 Hessian block of vertex slot a (0..3), for block descent (VBD).
+  // kDihedral: g = w theta dtheta_a, H = w dtheta_a dtheta_a^T (Gauss-Newton, PSD);
+  // kLinear: g = w K_a s, H = w K_a^2 I.
+  void hinge_vertex_block(int h, int a, const std::vector<Vec3>& x, Vec3& g, Mat3& H) const;
+  // Dihedral angle of hinge h and its gradient (d theta / d x_k for the four slots); false
+  // (theta = 0, zero gradient) when a triangle is degenerate in x.
+  bool hinge_angle(int h, const std::vector<Vec3>& x, double& theta, Vec3 dtheta[4]) const;
+  // Rest-state linear weights K (sum_k K_k x_k ~ theta n for isometric bending near flat) and
+  // the weight w; used by the linear model and by XPBD's hinge constraints.
   const std::array<double, 4>& hinge_K(int h) const { return hinge_k_[h]; }
   double hinge_w(int h) const { return hinge_w_[h]; }
 

@@ -24,7 +24,50 @@ MappingSurface::MappingSurface(const DressForm& form, double ease, bool hip_shap
   // (secant) for the radial offset whose polygon perimeter is the section's plus `ease`.
   const int ns = form.num_sections();
   section_offset_.assign(static_cast<size_t>(std::max(ns, 1)), offset_);
-  if (ease == 0.0) return;
+  if (ease != 0.0) solve_offsets();
+  if (!hip_below_ || ns < 2) return;
+  // Envelope below the hip: per angle the outermost of the hip shape and the form's section
+  // polygon along the ray from the hip centre (the polygons' centres differ by millimetres, so
+  // only edges within +-24 samples of the ray's angle can be hit).
+  const double hip = form.landmarks().hip_y;
+  hip_below_ = false;  // sample the plain form shape at the hip
+  hip_r_.resize(kN);
+  for (int n = 0; n < kN; ++n) hip_r_[n] = sample_radius(hip, n);
+  hip_below_ = true;
+  const Vec2 ch = centre(hip);
+  env_.assign(static_cast<size_t>(ns) * kN, 0.0);
+  for (int j = 0; j < ns && form.section_y(j) < hip; ++j) {
+    const Vec2 cj = form.centre(j);
+    const double off = section_offset_[static_cast<size_t>(j)];
+    const auto corner = [&](int k) {
+      const int kk = ((k % kN) + kN) % kN;
+      const double r = form.radius(j, kk) + off, t = kk * kStep;
+      return Vec2(cj.x() + r * std::sin(t), cj.y() + r * std::cos(t));
+    };
+    for (int n = 0; n < kN; ++n) {
+      const Vec2 d(std::sin(n * kStep), std::cos(n * kStep));
+      double best = hip_r_[n];
+      for (int k = n - 24; k < n + 24; ++k) {
+        const Vec2 a = corner(k), e = corner(k + 1) - a, w = a - ch;
+        const double den = d.x() * e.y() - d.y() * e.x();
+        if (std::abs(den) < 1e-15) continue;
+        const double t = (w.x() * e.y() - w.y() * e.x()) / den;
+        const double sg = (w.x() * d.y() - w.y() * d.x()) / den;
+        if (sg >= 0 && sg <= 1 && t > best) best = t;
+      }
+      env_[static_cast<size_t>(j) * kN + n] = best;
+    }
+  }
+}
+
+double MappingSurface::env_radius(int j, int n) const {
+  return env_[static_cast<size_t>(j) * kN + n];
+}
+
+void MappingSurface::solve_offsets() {
+  const DressForm& form = *form_;
+  const int ns = form.num_sections();
+  const double ease = ease_;
   auto perim = [&](int j, double d) {
     double g = 0;
     for (int n = 0; n < kN; ++n) {
@@ -55,9 +98,22 @@ double MappingSurface::shape_y(double y) const {
 }
 
 double MappingSurface::sample_radius(double y, int n) const {
-  const double ys = shape_y(y);
   const int ns = form_->num_sections();
   n = ((n % kN) + kN) % kN;
+  const double hip = form_->landmarks().hip_y;
+  if (hip_below_ && y < hip && !env_.empty()) {
+    if (y <= form_->min_y()) return env_radius(0, n);  // straight down from the form's end
+    const int j = std::min(
+        static_cast<int>(std::floor((y - form_->min_y()) / form_->section_spacing())), ns - 2);
+    const double yj = form_->section_y(j);
+    if (form_->section_y(j + 1) < hip) {
+      const double rh = (y - yj) / form_->section_spacing();
+      return env_radius(j, n) + (env_radius(j + 1, n) - env_radius(j, n)) * rh;
+    }
+    const double rh = (y - yj) / (hip - yj);
+    return env_radius(j, n) + (hip_r_[n] - env_radius(j, n)) * rh;
+  }
+  const double ys = shape_y(y);
   if (ns < 2) return form_->radius(0, n) + section_offset_[0];
   const double f = (ys - form_->min_y()) / form_->section_spacing();
   const int j = std::clamp(static_cast<int>(std::floor(f)), 0, ns - 2);
@@ -188,9 +244,11 @@ PieceMapping make_piece_mapping(const Panel& panel, const MappingSurface& surf, 
     const double c_prev = pm.shift(static_cast<int>(s), waist_y, Tw);
     const double rise = waist_y - d.y_tip;
     if (rise <= 0 || d.intake <= 0) continue;
-    // The zone start turns back toward the centre by at most 1/8 turn (an intake of ~0.1 m at
-    // the waist): inside the range where arc_at is continuous, so the bisection is monotonic.
-    double lo = 0, hi = (kTwoPi / 8) / rise;
+    // The zone start turns by at most 1/8 turn either way (an intake of ~0.1 m at the waist):
+    // inside the range where arc_at is continuous, so the bisection is monotonic. a may be
+    // negative: the form's taper alone (a = 0) already gives an overlap (the arc to the tip's
+    // angle is shorter at the narrower waist), which can exceed a small wanted intake.
+    double lo = -(kTwoPi / 8) / rise, hi = (kTwoPi / 8) / rise;
     for (int it = 0; it < 60; ++it) {
       const double mid = 0.5 * (lo + hi);
       pm.darts.back().a = mid;

@@ -14,7 +14,9 @@ class DressForm;
 
 // The surface the cloth is mapped onto: the form's section model, offset radially per section
 // by the amount that makes that section's perimeter grow by exactly `ease`, and, when
-// hip_shape_below_hip, the hip section's shape for every height below the hip.
+// hip_shape_below_hip, the hip section's shape for every height below the hip (a tight skirt
+// falls straight down from the hip), pushed out to the form's own section wherever the form is
+// wider than that below the hip, so the skirt never cuts into the seat or thighs.
 class MappingSurface {
  public:
   MappingSurface(const DressForm& form, double ease = 0.0, bool hip_shape_below_hip = true);
@@ -34,6 +36,11 @@ class MappingSurface {
   double ease_, offset_;
   bool hip_below_;
   std::vector<double> section_offset_;  // radial offset per form section
+  // Below the hip: the hip section's shape pushed out wherever the form is wider (seat,
+  // thighs), seen from the hip centre: env_[j * 256 + n] for sections j below the hip.
+  std::vector<double> hip_r_, env_;
+  double env_radius(int j, int n) const;
+  void solve_offsets();  // per-section radial offsets for the ease
 };
 
 // Cumulative chord lengths around one section from angle sample n0 in direction dir

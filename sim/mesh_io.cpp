@@ -19,8 +19,44 @@ namespace drape::sim {
 
 namespace {
 
-constexpr unsigned kImportFlags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                  aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+// Post-processing runs in two passes (see postprocess()): assimp 5.2's Triangulate step aborts
+// the process (ai_assert) on a face with no indices, which a malformed PLY produces (found by
+// fuzz_mesh), and in one ReadFile call the validation does not run before it.
+constexpr unsigned kImportFlags =
+    aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType;
+
+// Validates the raw scene (assimp's own checks, then face sizes and indices) before any step
+// that assumes a valid scene; returns the post-processed scene or nullptr with `error` set.
+const aiScene* postprocess(Assimp::Importer& imp, const aiScene* scene, std::string& error) {
+  if (!scene) {
+    error = imp.GetErrorString();
+    return nullptr;
+  }
+  scene = imp.ApplyPostProcessing(aiProcess_ValidateDataStructure);
+  if (!scene) {
+    error = imp.GetErrorString();
+    return nullptr;
+  }
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* mesh = scene->mMeshes[m];
+    for (unsigned i = 0; i < mesh->mNumFaces; ++i) {
+      const aiFace& face = mesh->mFaces[i];
+      if (face.mNumIndices == 0 || !face.mIndices) {
+        error = "mesh " + std::to_string(m) + " face " + std::to_string(i) + " has no vertices";
+        return nullptr;
+      }
+      for (unsigned k = 0; k < face.mNumIndices; ++k)
+        if (face.mIndices[k] >= mesh->mNumVertices) {
+          error = "mesh " + std::to_string(m) + " face " + std::to_string(i) +
+                  " refers to a vertex out of range";
+          return nullptr;
+        }
+    }
+  }
+  scene = imp.ApplyPostProcessing(kImportFlags);
+  if (!scene) error = imp.GetErrorString();
+  return scene;
+}
 
 void configure(Assimp::Importer& imp) {
   // Drop point and line primitives (SortByPType): a form is made of faces.
@@ -111,11 +147,13 @@ Result<TriMesh> load_mesh(const std::string& path) {
   configure(imp);
   const aiScene* scene = nullptr;
   try {
-    scene = imp.ReadFile(path, kImportFlags);
+    scene = imp.ReadFile(path, 0);
   } catch (const std::exception& e) {  // assimp reports through the return value; be safe
     return make_error(path, std::string("cannot be read as a mesh: ") + e.what());
   }
-  return convert(scene, path, scene ? std::string() : imp.GetErrorString());
+  std::string error;
+  scene = postprocess(imp, scene, error);
+  return convert(scene, path, error);
 }
 
 Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char* hint,
@@ -125,11 +163,13 @@ Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char*
   configure(imp);
   const aiScene* scene = nullptr;
   try {
-    scene = imp.ReadFileFromMemory(data, size, kImportFlags, hint ? hint : "");
+    scene = imp.ReadFileFromMemory(data, size, 0, hint ? hint : "");
   } catch (const std::exception& e) {
     return make_error(name, std::string("cannot be read as a mesh: ") + e.what());
   }
-  return convert(scene, name, scene ? std::string() : imp.GetErrorString());
+  std::string error;
+  scene = postprocess(imp, scene, error);
+  return convert(scene, name, error);
 }
 
 std::string write_meshes(const std::string& path, const std::vector<TriMesh>& meshes) {

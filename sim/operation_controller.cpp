@@ -77,9 +77,10 @@ void OperationController::apply_stroke(World& w, int hand, const std::vector<Vec
   e.hand = hand;
   e.points = points;
   log(std::move(e));
-  Cloth before = w.cloth;
+  Cloth before = history_.take_copy(w.cloth);
   OperationsState ops_before = state_;
-  if (ops_cut_stroke(w, state_, params_, points)) history_.push("cut", before, ops_before);
+  if (ops_cut_stroke(w, state_, params_, points))
+    history_.push("cut", std::move(before), ops_before);
 }
 
 void OperationController::apply_trigger(World& w, const std::string& name, TriggerPhase phase,
@@ -119,7 +120,7 @@ void OperationController::apply_trigger(World& w, const std::string& name, Trigg
   Cloth before;
   OperationsState ops_before;
   if (changes) {
-    before = w.cloth;
+    before = history_.take_copy(w.cloth);
     ops_before = state_;
   }
   bool done = false;
@@ -142,7 +143,7 @@ void OperationController::apply_trigger(World& w, const std::string& name, Trigg
     done = begin ? ops_smooth_begin(w, state_, hand) : ops_smooth_end(w, state_, hand);
     if (!begin) done = false;  // the state before smoothing began is the undo point
   }
-  if (done) history_.push(name, before, ops_before);
+  if (done) history_.push(name, std::move(before), ops_before);
 }
 
 void OperationController::start_recording(const World& w) {
@@ -229,6 +230,7 @@ void OperationController::before_step(World& w, double dt) {
 
 void OperationController::after_step(World& w, double dt) {
   ops_after_step(w, state_, params_, dt);
+  history_.prepare_spare(w.cloth);  // the next operation's undo copy allocates nothing
   ++step_;
   if (replaying_ && step_ >= log_.final_step && replay_pos_ >= log_.events.size()) {
     replaying_ = false;

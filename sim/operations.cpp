@@ -339,8 +339,12 @@ bool ops_move_begin(World& w, OperationsState& s) {
   }
   s.moving = true;
   s.move_vertex = mv;
-  for (int h = 0; h < 2; ++h)
+  for (int h = 0; h < 2; ++h) {
+    // The grab offset: the corner keeps its place relative to the hand (no jump).
+    s.move_grabbed[h] = mv[h] >= 0 && s.hand_valid[h];
+    s.move_offset[h] = s.move_grabbed[h] ? Vec3(x[mv[h]] - s.hands[h].position) : Vec3::Zero();
     if (mv[h] >= 0) set_vertex_flags(w.cloth, mv[h], kFlagKinematic, 0);
+  }
   return true;
 }
 
@@ -350,6 +354,8 @@ bool ops_move_end(World& w, OperationsState& s) {
   for (int h = 0; h < 2; ++h) {
     const int32_t v = s.move_vertex[h];
     s.move_vertex[h] = -1;
+    s.move_grabbed[h] = false;
+    s.move_offset[h].setZero();
     if (v < 0 || v >= w.cloth.num_vertices()) continue;
     // Kept fixed where they are (the study: otherwise the cloth falls).
     set_vertex_flags(w.cloth, v, kFlagPinned, kFlagKinematic);
@@ -521,17 +527,22 @@ void ops_before_step(World& w, OperationsState& s, const OperationParams& p, dou
     }
     if (s.moving && s.move_vertex[h] >= 0 && s.move_vertex[h] < n) {
       const int32_t m = s.move_vertex[h];
+      if (!s.move_grabbed[h]) {  // untracked at move begin: grabbed now, where it is
+        s.move_offset[h] = st.x[m] - hp;
+        s.move_grabbed[h] = true;
+      }
       st.x_prev[m] = st.x[m];
-      st.x[m] = hp;
+      st.x[m] = hp + s.move_offset[h];
       st.v[m] = dt > 0 ? Vec3((st.x[m] - st.x_prev[m]) / dt) : Vec3::Zero();
     }
     if (s.cutting[h]) s.stroke[h].push_back(hp);
     if (s.smoothing[h] && w.scene.form) {
-      // Weak pressure toward the form: a displacement of a·dt² per tick (a = pressure / areal
-      // density) along the inward radial direction, never past the surface + offset.
+      // Weak pressure toward the form: a force per area (a = pressure / areal density) along
+      // the inward radial direction, applied as a velocity change a·dt per tick (Verlet's
+      // x_prev shifted to match), so it accumulates like the study's pressure term; the inward
+      // speed is capped so that one tick never carries a particle past the surface + offset.
       const DressForm& f = *w.scene.form;
       const double a = p.smooth_pressure / std::max(1e-6, c.fabric.areal_density);
-      const double step = a * dt * dt;
       for (int32_t i = 0; i < n; ++i) {
         if (!c.is_free(i) || (st.x[i] - hp).norm() > p.smooth_radius) continue;
         const double sd = f.signed_distance(st.x[i]);
@@ -540,15 +551,21 @@ void ops_before_step(World& w, OperationsState& s, const OperationParams& p, dou
         Vec3 inward(cc.x() - st.x[i].x(), 0, cc.y() - st.x[i].z());
         if (inward.norm() < 1e-9) continue;
         inward.normalize();
-        const Vec3 d = inward * std::min(step, sd - w.scene.offset);
-        st.x[i] += d;
-        st.x_prev[i] += d;
+        const double vin = st.v[i].dot(inward);
+        const double cap = dt > 0 ? (sd - w.scene.offset) / dt : 0.0;
+        const double dv = std::max(0.0, std::min(a * dt, cap - vin));
+        st.v[i] += dv * inward;
+        st.x_prev[i] -= dv * dt * inward;
       }
     }
   }
 }
 
 void ops_after_step(World& w, OperationsState& s, const OperationParams& p, double /*dt*/) {
+  // Keep the cloth ready for a cut (kept incidence, array headroom): the O(V) work happens
+  // here, in a tick, only after a load, an undo or a cut used the headroom — never inside the
+  // cut command.
+  prepare_for_cuts(w.cloth);
   auto& st = w.cloth.state;
   for (auto it = s.settling.begin(); it != s.settling.end();) {
     if (it->vertex >= w.cloth.num_vertices() || !(st.flags[it->vertex] & kFlagPinned)) {

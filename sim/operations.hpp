@@ -71,6 +71,10 @@ struct OperationsState {
   std::array<bool, 2> smoothing{false, false};
   bool moving = false;
   std::array<int32_t, 2> move_vertex{-1, -1};  // per hand
+  // Corner − hand at grab time (move keeps it: the corner does not jump to the hand); taken
+  // at move begin, or at the first tracked frame for a hand untracked then.
+  std::array<Vec3, 2> move_offset{Vec3::Zero(), Vec3::Zero()};
+  std::array<bool, 2> move_grabbed{false, false};
   std::vector<SettlingPin> settling;
   std::array<int, 2> selected{0, 0};
   std::array<HandCandidates, 2> candidates{};

@@ -211,4 +211,34 @@ int Panel::locate(const Vec2& m, Vec3* bary) const {
   return best;
 }
 
+int Panel::locate_in_zone(const Vec2& m, int zone, Vec3* bary) const {
+  const auto& t = cloth.topo;
+  const int ci0 = std::clamp(static_cast<int>(std::floor(m.x() / dx)), 0, nx - 2);
+  const int cj0 = std::clamp(static_cast<int>(std::floor(m.y() / dy)), 0, ny - 2);
+  int best = -1;
+  double best_min = -1e300;
+  Vec3 best_b(1.0 / 3, 1.0 / 3, 1.0 / 3);
+  for (int ci = std::max(0, ci0 - 1); ci <= std::min(nx - 2, ci0 + 1); ++ci)
+    for (int cj = std::max(0, cj0 - 1); cj <= std::min(ny - 2, cj0 + 1); ++cj)
+      for (int k = 0; k < 2; ++k) {
+        const int ti = cell_triangle(ci, cj, k);
+        if (t.triangle_zone[ti] != zone) continue;
+        const auto& tri = t.triangles[ti];
+        const Vec2 a = t.material[tri[0]], b = t.material[tri[1]], c = t.material[tri[2]];
+        const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+        const Vec2 q = m - a;
+        const double l1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
+        const double l2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
+        const Vec3 bc(1 - l1 - l2, l1, l2);
+        if (bc.minCoeff() > best_min) {
+          best_min = bc.minCoeff();
+          best = ti;
+          best_b = bc;
+        }
+      }
+  if (best < 0 || best_min < -0.5) return locate(m, bary);
+  if (bary) *bary = best_b;
+  return best;
+}
+
 }  // namespace drape::sim

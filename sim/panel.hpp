@@ -56,6 +56,9 @@ struct Panel {
   int cell_triangle(int i, int j, int k) const { return 2 * (j * (nx - 1) + i) + k; }
   // Triangle of the flat panel containing material point m (or -1), with barycentrics.
   int locate(const Vec2& m, Vec3* bary) const;
+  // Same, among the triangles of one zone only (a point on a slit lies on both of its sides;
+  // the zone says which layer). Falls back to locate() when no triangle of that zone is near.
+  int locate_in_zone(const Vec2& m, int zone, Vec3* bary) const;
 };
 
 // Checks a panel description; `where` prefixes field names in errors ("pieces[0].panel").

@@ -3,8 +3,10 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <sstream>
 
 #include "sim/dress_form.hpp"
@@ -52,6 +54,7 @@ class RayGrid {
     }
   }
   double angle(double theta) const { return wrap_pi(pm_.dir * (theta - pm_.theta_centre)); }
+  const PieceMapping& mapping() const { return pm_; }
   const std::vector<int>& cell(double y, double theta) const {
     return cells_[static_cast<size_t>(ybin(y)) * kNa + abin(angle(theta))];
   }
@@ -69,6 +72,87 @@ class RayGrid {
   std::vector<std::vector<int>> cells_;
 };
 
+// The cloth as a curved surface: the mapping M of a material point (eqs. 2-1..2-10) plus the
+// displacement of the cloth nodes from their mapped positions, interpolated linearly over each
+// triangle: X(m) = M(m) + sum_i b_i(m) (x_i - M(m_i)). Before relaxation the displacements are
+// zero and X is the mapping itself, so extraction inverts the mapping exactly (not the planar
+// triangles' chords of it); after relaxation only the small, smooth displacement is linear.
+class CurvedCloth {
+ public:
+  CurvedCloth(const Panel& panel, const MappingSurface& surf, const PieceMapping& pm)
+      : panel_(panel), surf_(surf), pm_(pm) {
+    rows_.resize(panel.ny);
+    for (int j = 0; j < panel.ny; ++j)
+      rows_[j] = ArcTable::build(surf, pm.y_of_v(j * panel.dy), pm.theta_centre, pm.dir);
+  }
+  Vec3 mapped(const Vec2& m, int zone) const {
+    const double y = pm_.y_of_v(m.y());
+    return surf_.point(y, pm_.theta(zone, panel_.centre_distance(m.x()), y, table(m.y())));
+  }
+  // X(m) on the triangle of grid cell column ci (the row from m) that contains m best.
+  Vec3 at_cell(int ci, const Vec2& m) const {
+    const int cj = std::clamp(static_cast<int>(std::floor(m.y() / panel_.dy)), 0, panel_.ny - 2);
+    int best = -1;
+    Vec3 bb;
+    double best_min = -1e300;
+    for (int k = 0; k < 2; ++k) {
+      const int t = panel_.cell_triangle(ci, cj, k);
+      const Vec3 b = bary(t, m);
+      if (b.minCoeff() > best_min) {
+        best_min = b.minCoeff();
+        best = t;
+        bb = b;
+      }
+    }
+    return at(best, bb, m);
+  }
+  Vec3 bary(int tri, const Vec2& m) const {
+    const auto& mat = panel_.cloth.topo.material;
+    const auto& t = panel_.cloth.topo.triangles[tri];
+    const Vec2 a = mat[t[0]], b = mat[t[1]], c = mat[t[2]];
+    const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    const Vec2 q = m - a;
+    const double l1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
+    const double l2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
+    return Vec3(1 - l1 - l2, l1, l2);
+  }
+  Vec3 at(int tri, const Vec3& b, const Vec2& m) const {
+    const auto& topo = panel_.cloth.topo;
+    const auto& t = topo.triangles[tri];
+    const int z = topo.triangle_zone[tri];
+    Vec3 p = mapped(m, z);
+    for (int k = 0; k < 3; ++k)
+      p += b[k] * (panel_.cloth.state.x[t[k]] - mapped(topo.material[t[k]], z));
+    return p;
+  }
+
+ private:
+  const ArcTable& table(double v) const {
+    const double f = v / panel_.dy;
+    const int j = static_cast<int>(std::lround(f));
+    if (j >= 0 && j < panel_.ny && std::abs(f - j) < 1e-9) return rows_[j];
+    auto it = cache_.find(v);
+    if (it != cache_.end()) return it->second;
+    if (cache_.size() > 4096) cache_.clear();
+    return cache_.emplace(v, ArcTable::build(surf_, pm_.y_of_v(v), pm_.theta_centre, pm_.dir))
+        .first->second;
+  }
+  const Panel& panel_;
+  const MappingSurface& surf_;
+  const PieceMapping& pm_;
+  std::vector<ArcTable> rows_;
+  mutable std::map<double, ArcTable> cache_;
+};
+
+Vec3 bary_of(const std::vector<Vec2>& mat, const std::array<int32_t, 3>& tri, const Vec2& m) {
+  const Vec2 a = mat[tri[0]], b = mat[tri[1]], c = mat[tri[2]];
+  const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  const Vec2 q = m - a;
+  const double l1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
+  const double l2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
+  return Vec3(1 - l1 - l2, l1, l2);
+}
+
 struct Hit {
   bool ok = false;
   int tri = -1;
@@ -80,8 +164,8 @@ struct Hit {
 // Ray from the section centre at height y toward angle theta against the cloth triangles of the
 // allowed zone (-1: any). Tolerant: the least-violating triangle within 4 mm counts as hit
 // (near a dart tip the relaxed layers may part by a little: the point is clamped onto the edge).
-Hit cast(const Panel& panel, const MappingSurface& surf, const RayGrid& grid, double y,
-         double theta, int zone) {
+Hit cast(const Panel& panel, const MappingSurface& surf, const RayGrid& grid,
+         const CurvedCloth& curved, double y, double theta, int zone) {
   const auto& x = panel.cloth.state.x;
   const auto& topo = panel.cloth.topo;
   const Vec2 c2 = surf.centre(y);
@@ -120,6 +204,41 @@ Hit cast(const Panel& panel, const MappingSurface& surf, const RayGrid& grid, do
   best.flat = bc[0] * topo.material[tri[0]] + bc[1] * topo.material[tri[1]] +
               bc[2] * topo.material[tri[2]];  // barycentrics do not depend on the deformation
   best.world = bc[0] * x[tri[0]] + bc[1] * x[tri[1]] + bc[2] * x[tri[2]];
+  if (best_viol > 1e-4) return best;  // clamped onto an edge: keep the planar hit
+  // Refine on the curved cloth (Newton in material space, the planar triangle's Jacobian):
+  // find m with X(m) on the ray, i.e. height y and angle theta about the section centre.
+  const auto& mat = topo.material;
+  Eigen::Matrix<double, 3, 2> A;
+  {
+    Eigen::Matrix2d M;
+    M << (mat[tri[1]] - mat[tri[0]]).x(), (mat[tri[2]] - mat[tri[0]]).x(),
+        (mat[tri[1]] - mat[tri[0]]).y(), (mat[tri[2]] - mat[tri[0]]).y();
+    Eigen::Matrix<double, 3, 2> E;
+    E.col(0) = x[tri[1]] - x[tri[0]];
+    E.col(1) = x[tri[2]] - x[tri[0]];
+    A = E * M.inverse();
+  }
+  Vec2 m = best.flat;
+  Vec3 X = curved.at(best.tri, bary_of(mat, tri, m), m);
+  for (int it = 0; it < 8; ++it) {
+    const Vec2 c = surf.centre(X.y());
+    const double dx = X.x() - c.x(), dz = X.z() - c.y(), rho2 = dx * dx + dz * dz;
+    if (rho2 < 1e-12) break;
+    Eigen::Matrix<double, 2, 3> G;
+    G << 0, 1, 0, dz / rho2, 0, -dx / rho2;
+    const Eigen::Matrix2d J = G * A;
+    const Eigen::Vector2d r(X.y() - y, wrap_pi(std::atan2(dx, dz) - theta));
+    if (std::abs(J.determinant()) < 1e-14) break;
+    const Eigen::Vector2d dm = J.inverse() * r;
+    m -= Vec2(dm.x(), dm.y());
+    X = curved.at(best.tri, bary_of(mat, tri, m), m);
+    if (dm.norm() < 1e-11) break;
+  }
+  if ((m - best.flat).norm() < 0.5 * (mat[tri[1]] - mat[tri[0]]).norm()) {
+    best.flat = m;
+    best.world = X;
+    best.bary = bary_of(mat, tri, m);
+  }
   return best;
 }
 
@@ -133,6 +252,72 @@ int steps_for(double len, double step) {
 }
 
 }  // namespace
+
+// Removes self-intersection loops of the outline (a relaxed cloth may fold a few outline points
+// back over a seam near a dart tip or a corner): where segment i properly crosses a later,
+// non-adjacent segment j, the points between them (the shorter way round) are dropped and the
+// crossing point is inserted. Notch indices follow. Returns the number of loops removed.
+int remove_outline_loops(PatternPiece& pc) {
+  int loops = 0;
+  for (int guard = 0; guard < 1000; ++guard) {
+    const int n = static_cast<int>(pc.outline.size());
+    if (n < 4) break;
+    int fi = -1, fj = -1;
+    double fs = 0;
+    for (int i = 0; i < n && fi < 0; ++i) {
+      const Vec2 a = pc.outline[i], b = pc.outline[(i + 1) % n];
+      for (int k = 2; k <= n / 2 && fi < 0; ++k) {
+        const int j = (i + k) % n;
+        if ((j + 1) % n == i) continue;
+        const Vec2 c = pc.outline[j], d = pc.outline[(j + 1) % n];
+        const Vec2 r = b - a, q = d - c;
+        const double den = r.x() * q.y() - r.y() * q.x();
+        if (std::abs(den) < 1e-20) continue;
+        const Vec2 w = c - a;
+        const double s = (w.x() * q.y() - w.y() * q.x()) / den;
+        const double t = (w.x() * r.y() - w.y() * r.x()) / den;
+        if (s > 1e-9 && s < 1 - 1e-9 && t > 1e-9 && t < 1 - 1e-9) {
+          fi = i;
+          fj = j;
+          fs = s;
+        }
+      }
+    }
+    if (fi < 0) break;
+    ++loops;
+    const int i1 = (fi + 1) % n;
+    const auto removed = [&](int m) {  // cyclic range i + 1 .. j
+      return ((m - i1 + n) % n) <= ((fj - i1 + n) % n);
+    };
+    PatternPiece out = pc;
+    out.outline.clear();
+    out.outline3d.clear();
+    out.ref.clear();
+    out.seg_label.clear();
+    std::vector<int> map(n, -1);
+    int at_cross = -1;
+    for (int m = 0; m < n; ++m) {
+      if (removed(m)) continue;
+      map[m] = static_cast<int>(out.outline.size());
+      out.outline.push_back(pc.outline[m]);
+      out.outline3d.push_back(pc.outline3d[m]);
+      out.ref.push_back(pc.ref[m]);
+      out.seg_label.push_back(pc.seg_label[m]);
+      if (m == fi) {
+        at_cross = static_cast<int>(out.outline.size());
+        out.outline.push_back(pc.outline[fi] + fs * (pc.outline[i1] - pc.outline[fi]));
+        out.outline3d.push_back(pc.outline3d[fi] + fs * (pc.outline3d[i1] - pc.outline3d[fi]));
+        out.ref.push_back(pc.ref[fi] + fs * (pc.ref[i1] - pc.ref[fi]));
+        out.ref.back().z() = pc.ref[fi].z();
+        out.seg_label.push_back(pc.seg_label[fj]);
+      }
+    }
+    out.notches.clear();
+    for (int v : pc.notches) out.notches.push_back(map[v] >= 0 ? map[v] : at_cross);
+    pc = std::move(out);
+  }
+  return loops;
+}
 
 int PatternPiece::label_index(const std::string& n) const {
   for (size_t i = 0; i < labels.size(); ++i)
@@ -194,7 +379,6 @@ bool inside_polygon(const std::vector<Vec2>& poly, const Vec2& p) {
 Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& surf,
                                    const PieceMapping& pm, const PieceLines& L,
                                    const ExtractOptions& opt) {
-  const RayGrid grid(panel, surf, pm);
   const int nz = panel.num_zones();
   const double span = std::abs(wrap_pi(pm.dir * (pm.theta_side - pm.theta_centre)));
   const double r_avg = surf.girth(L.hip_y) / (2 * kPi);
@@ -219,6 +403,8 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
     for (int k = 0; k <= n; ++k) v.push_back({y, theta_at(f0 + (f1 - f0) * k / n), zone});
     return v;
   };
+  const RayGrid grid(panel, surf, pm);
+  const CurvedCloth curved(panel, surf, pm);
   // Dart lines from the slit ends: the 3D line of each slit's far edge (zone z + 1's boundary).
   const auto& x = panel.cloth.state.x;
   std::vector<std::vector<RefPoint>> dart_line(panel.slits.size());
@@ -238,7 +424,24 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
       while (seg + 2 < edge.size() && edge[seg + 1].y() < y) ++seg;
       const double f =
           std::clamp((y - edge[seg].y()) / (edge[seg + 1].y() - edge[seg].y()), 0.0, 1.0);
-      const Vec3 p = edge[seg] + f * (edge[seg + 1] - edge[seg]);
+      Vec3 p = edge[seg] + f * (edge[seg + 1] - edge[seg]);
+      // On the curved cloth: the point of the slit's far edge at height y (secant on v from
+      // the polyline's guess; the chord polyline itself lies inside the curved surface).
+      if (k > 0 && k < n) {
+        const int far_cell = panel.design.centre_edge_left ? ps.column : ps.column - 1;
+        const double u = panel.cloth.topo.material[ps.tip_node].x();
+        double v0 = ps.v_tip + (seg + f) * panel.dy, v1 = v0 + 1e-4;
+        const auto at = [&](double v) { return curved.at_cell(far_cell, Vec2(u, v)); };
+        Vec3 p0 = at(v0), p1 = at(v1);
+        for (int it = 0; it < 8 && std::abs(p1.y() - y) > 1e-12 && p1.y() != p0.y(); ++it) {
+          const double v2 = v1 - (p1.y() - y) * (v1 - v0) / (p1.y() - p0.y());
+          v0 = v1;
+          p0 = p1;
+          v1 = v2;
+          p1 = at(v1);
+        }
+        if (std::abs(p1.y() - y) < 1e-7) p = p1;
+      }
       const Vec2 c = surf.centre(y);
       dart_line[s].push_back({y, std::atan2(p.x() - c.x(), p.z() - c.y()), 0});
     }
@@ -290,7 +493,7 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
     const size_t last = r + 1 == runs.size() ? runs[r].pts.size() - 1 : runs[r].pts.size();
     for (size_t k = first; k < last; ++k) {
       const RefPoint& rp = runs[r].pts[k];
-      Hit h = cast(panel, surf, grid, rp.y, rp.theta, rp.zone);
+      Hit h = cast(panel, surf, grid, curved, rp.y, rp.theta, rp.zone);
       // Near a dart tip the relaxed layers may part: where the overlapping layer (leg 1) does
       // not reach the dart line, the dart has no width yet (its two legs are the same slit edge
       // there); such points are left out, leg 1 runs straight from the tip to its first hit.
@@ -322,13 +525,16 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
   }
   // Segment labels: the segment leaving point i belongs to the run of point i + 1 except at run
   // starts, so shift: a point's label is the run that contains the segment after it.
-  const int n = static_cast<int>(piece.outline.size());
   {
-    std::vector<int> lab(n);
-    for (int i = 0; i + 1 < n; ++i) lab[i] = piece.seg_label[i + 1];
-    lab[n - 1] = piece.seg_label[n - 1];  // the closing segment belongs to the last run
+    const int n0 = static_cast<int>(piece.outline.size());
+    std::vector<int> lab(n0);
+    for (int i = 0; i + 1 < n0; ++i) lab[i] = piece.seg_label[i + 1];
+    lab[n0 - 1] = piece.seg_label[n0 - 1];  // the closing segment belongs to the last run
     piece.seg_label = lab;
   }
+  // A simple polygon for cutting and remeshing (method §2.7): no self-crossings.
+  piece.loops_removed = remove_outline_loops(piece);
+  const int n = static_cast<int>(piece.outline.size());
   // Darts: tip and leg tops from the labels.
   for (int z = 1; z < nz; ++z) {
     const std::string dn = "dart" + std::to_string(z);
@@ -346,7 +552,7 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
   }
   // Hip line (for the width measurement) and the grain line.
   for (const RefPoint& rp : horizontal(L.hip_y, 0, 1, -1)) {
-    Hit h = cast(panel, surf, grid, rp.y, rp.theta, -1);
+    Hit h = cast(panel, surf, grid, curved, rp.y, rp.theta, -1);
     if (!h.ok) return Error{"line 'hip': no cloth at angle " + std::to_string(rp.theta)};
     piece.hip_line.push_back(h.flat);
   }

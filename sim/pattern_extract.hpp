@@ -29,6 +29,7 @@ struct PatternPiece {
   std::vector<Dart> darts;
   std::vector<Vec2> hip_line;         // flat points along the hip line, centre -> side
   Vec2 grain_a{0, 0}, grain_b{0, 0};  // grain line (parallel to the warp)
+  int loops_removed = 0;              // self-crossing loops cut out of the extracted outline
 
   int label_index(const std::string& name) const;
   double area() const;                                 // polygon area (m^2)
@@ -66,6 +67,10 @@ double outline_error_vs_mapping(const PatternPiece& piece, const Panel& panel,
 // Area of the draped 3D cloth inside the piece outline (m^2): the flat/3D area ratio of the
 // cloth triangles, weighted by how much of each lies inside the outline, times the piece area.
 double draped_area(const PatternPiece& piece, const Panel& panel);
+
+// Cuts self-crossing loops out of a closed outline (the shorter way round, the crossing point
+// inserted; notches follow). extract_piece calls it; returns the number of loops removed.
+int remove_outline_loops(PatternPiece& piece);
 
 // Point-in-polygon by crossing parity (method §2.7.1).
 bool inside_polygon(const std::vector<Vec2>& poly, const Vec2& p);

@@ -367,6 +367,7 @@ Result<PipelineResult> run_pattern_pipeline(const Design& design_in, const Dress
   SewOptions so;
   so.mirror_x = surf.centre(lm.waist_y).x();
   so.relax_iterations = d.relax_iterations;
+  so.waist_y = lm.waist_y;
   auto garment = sew_garment(in, surf, so);
   if (!garment) return Error{garment.error()};
   R.garment = std::move(*garment);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <utility>
 
 #include "sim/dress_form.hpp"
 #include "sim/scene.hpp"
@@ -86,6 +87,16 @@ RelaxStats relax_gauss_seidel(RelaxProblem& p, const MappingSurface& surf,
       x[g[1]] += 0.5 * ((0.5 * (x[g[0]] + x[g[2]]) - x[g[1]]).dot(t)) * t;
     }
     for (const PlaneTie& pl : p.planes) x[pl.v] -= pl.n.dot(x[pl.v] - pl.p) * pl.n;
+    for (int i : p.on_surface) {
+      const Vec2 c = surf.centre(x[i].y());
+      const double dx = x[i].x() - c.x(), dz = x[i].z() - c.y();
+      const double rn = std::hypot(dx, dz);
+      const double rs = surf.radius(x[i].y(), std::atan2(dx, dz)) + opt.collision_offset;
+      if (rn > 1e-9) {
+        x[i].x() = c.x() + dx * rs / rn;
+        x[i].z() = c.y() + dz * rs / rn;
+      }
+    }
     // Collision by section lookup (method §2.2), on the mapping surface (ease, hip shape).
     if (opt.collide)
       for (int i = 0; i < nv; ++i) {
@@ -110,20 +121,35 @@ RelaxStats relax_gauss_seidel(RelaxProblem& p, const MappingSurface& surf,
 
 namespace {
 
-// Fixed lines of a mapped panel: the hip row, the centre column, the node nearest the side line
-// in every row. Returns per-vertex role: 1 hip, 2 centre, 3 side.
+// Grid rows holding a horizontal reference line at height y: the row on it, or both rows
+// around it when it falls between rows.
+std::pair<int, int> rows_of_line(const Panel& panel, const PieceMapping& pm, double y) {
+  const double f = pm.v_of_y(y) / panel.dy;
+  const int lo = static_cast<int>(std::floor(f + 1e-6)), hi = static_cast<int>(std::ceil(f - 1e-6));
+  return {std::clamp(lo, 0, panel.ny - 1), std::clamp(hi, 0, panel.ny - 1)};
+}
+
+// Fixed lines of a mapped panel: the hip rows (pinned), the waist rows (held on the surface and
+// on their meridian planes but free to slide up or down: pinned at their mapped heights the
+// warp threads between waist and hip stay stretched by the form's slope, eq. 2-1 maps by height
+// not by surface distance; left free the cloth bridges the waist hollow and the waist widths grow
+// by ~18 mm), the centre column, the node nearest the side line in every row. Returns per-vertex
+// role: 1 pinned, 2 centre, 3 side, 4 waist.
 std::vector<uint8_t> fixed_line_roles(const Panel& panel, const MappingSurface& surf,
                                       const PieceMapping& pm) {
   const auto& topo = panel.cloth.topo;
   std::vector<uint8_t> role(topo.num_vertices(), 0);
-  const double hip_y = surf.form().landmarks().hip_y;
-  const int j_hip = static_cast<int>(std::lround(pm.v_of_y(hip_y) / panel.dy));
+  const auto [h0, h1] = rows_of_line(panel, pm, surf.form().landmarks().hip_y);
+  const auto [w0, w1] = rows_of_line(panel, pm, surf.form().landmarks().waist_y);
   const int centre_i = panel.design.centre_edge_left ? 0 : panel.nx - 1;
   const int last_zone = panel.num_zones() - 1;
+  for (int v = 0; v < topo.num_vertices(); ++v) {
+    const int j = static_cast<int>(std::lround(topo.material[v].y() / panel.dy));
+    if (j == h0 || j == h1) role[v] = 1;
+    if ((j == w0 || j == w1) && !role[v]) role[v] = 4;
+  }
   for (int j = 0; j < panel.ny; ++j) {
     const double y = pm.y_of_v(j * panel.dy);
-    if (j == j_hip)
-      for (int i = 0; i < panel.nx; ++i) role[j * panel.nx + i] = 1;
     if (!role[j * panel.nx + centre_i]) role[j * panel.nx + centre_i] = 2;
     const ArcTable T = ArcTable::build(surf, y, pm.theta_centre, pm.dir);
     const double l_side = pm.l_at(last_zone, y, pm.theta_side, T);
@@ -178,13 +204,19 @@ RelaxStats relax_panel(Panel& panel, const MappingSurface& surf, const PieceMapp
   p.x = cloth.state.x;
   add_triangle_edges(cloth.topo.triangles, cloth.topo.material, 0, p);
   p.fixed.assign(nv, 0);
-  const auto tangent = [](double th) { return Vec3(std::cos(th), 0, -std::sin(th)); };
-  const Vec2 cw = surf.centre(surf.form().landmarks().waist_y);
-  const Vec3 axis_pt(cw.x(), 0, cw.y());
+  // Centre and side line nodes slide on the vertical plane through their own section centre
+  // and their mapped angle (a plane through one common axis point conflicts with the pinned
+  // hip row where the section centres move with height; the side node nearest the side line
+  // is up to half a spacing off it, so it keeps its own meridian rather than the side line's).
   for (int i = 0; i < nv; ++i) {
     if (role[i] == 1) p.fixed[i] = 1;
-    if (role[i] == 2) p.planes.push_back({i, axis_pt, tangent(pm.theta_centre)});
-    if (role[i] == 3) p.planes.push_back({i, axis_pt, tangent(pm.theta_side)});
+    if (role[i] == 4) p.on_surface.push_back(i);
+    if (role[i] >= 2) {
+      const Vec3& xi = p.x[i];
+      const Vec2 c = surf.centre(xi.y());
+      const double th = std::atan2(xi.x() - c.x(), xi.z() - c.y());
+      p.planes.push_back({i, Vec3(c.x(), 0, c.y()), Vec3(std::cos(th), 0, -std::sin(th))});
+    }
   }
   if (opt.grain_control) {
     const int nx = panel.nx;

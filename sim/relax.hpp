@@ -33,6 +33,7 @@ struct RelaxProblem {
   std::vector<PlaneTie> planes;
   std::vector<SeamTie> seams;
   std::vector<std::array<int, 3>> grain;  // consecutive warp nodes kept straight tangentially
+  std::vector<int> on_surface;  // vertices held on the mapping surface (pulled in and pushed out)
 };
 
 // Unique triangle edges with rest lengths from material coordinates.

@@ -32,8 +32,10 @@ StudyScene make_chain(int particles = 20, double mass = 1.0, double k = 1e5);
 StudyScene make_cantilever(double overhang, double spacing, double width = 0.01,
                            const FabricParams& fabric = {});
 // A res x res muslin panel 0.5 x 0.5 m whose top edge is pinned across the upper chest of
-// the parametric 9AR form; the rest falls over the bust (form collision).
-StudyScene make_form_drape(int res, const FabricParams& fabric = {});
+// the parametric 9AR form (form collision). fall = false (the app's default scenario): it
+// hangs straight down from the chest line, 1.5 s. fall = true (the study's "form" scene): it
+// starts horizontal, sticking forward, falls over the bust and drapes against it, 3 s.
+StudyScene make_form_drape(int res, const FabricParams& fabric = {}, bool fall = false);
 // A res x res panel 0.6 x 0.6 m dropped flat onto a sphere (r = 0.15 m) with its centre
 // vertex pinned on the sphere's top.
 StudyScene make_sphere_drape(int res, const FabricParams& fabric = {});

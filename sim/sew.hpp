@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -28,13 +29,15 @@ struct Garment {
   std::vector<int> vertex_piece;         // index into piece_names
   std::vector<std::string> piece_names;  // "Front (right)", "Front (left)", ...
   std::vector<SeamTie> ties;
-  int merged_vertices = 0;         // vertices identified on mirrored centre seams
-  std::vector<std::string> seams;  // human-readable list of the joins made
+  std::vector<int> waist_vertices;  // held at the waist height on the form while relaxing
+  int merged_vertices = 0;          // vertices identified on mirrored centre seams
+  std::vector<std::string> seams;   // human-readable list of the joins made
 };
 
 struct SewOptions {
   double mirror_x = 0.0;  // the mirror plane x = mirror_x (the form's centre plane)
   int relax_iterations = 200;
+  double waist_y = std::numeric_limits<double>::quiet_NaN();  // waist height (NaN: start heights)
 };
 
 Result<Garment> sew_garment(const std::vector<SewInput>& right, const MappingSurface& surf,

@@ -21,12 +21,14 @@ Result<std::unique_ptr<Solver>> make_solver(const std::string& name, const Solve
     o.freeze = cfg.freeze;
     o.chebyshev = cfg.chebyshev;
     o.threads = cfg.threads;
+    if (cfg.air_damping >= 0) o.air_damping = cfg.air_damping;
     s = std::make_unique<VbdSolver>(o);
   } else if (name == "xpbd") {
     XpbdOptions o;
     o.energy = eo;
     if (cfg.substeps > 0) o.substeps = cfg.substeps;
     if (cfg.iterations > 0) o.iterations = cfg.iterations;
+    if (cfg.air_damping >= 0) o.damping = cfg.air_damping;
     s = std::make_unique<XpbdSolver>(o);
   } else if (name == "newton") {
     NewtonOptions o;

@@ -19,6 +19,7 @@ struct SolverConfig {
   bool chebyshev = false;      // VBD
   bool springs_model = false;  // the study's 8-spring energy instead of FEM + bending
   int threads = 2;
+  double air_damping = -1;  // 1/s, VBD and XPBD; < 0: the solver's default (1/s, as Verlet)
 };
 
 // Names: "vbd" (default real-time), "xpbd", "newton", "verlet" (the study's baseline).

@@ -54,6 +54,8 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
   dx_.resize(3 * nd);
   xtrial_.resize(n);
   double mu = 0;  // Levenberg-Marquardt shift (static mode only)
+  double best_res = std::numeric_limits<double>::infinity();
+  int best_it = 0;
   int it = 0;
   for (; it < max_iterations; ++it) {
     energy_.gradient(S.x, S.mass, grad_);
@@ -71,6 +73,14 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
     }
     residual = gmax / wscale;
     if (residual < tolerance) break;
+    // Stalled near the round-off floor (residual already below 1e-5 of a vertex weight and no
+    // 1 % progress in 10 iterations): stop. Far from it a plateau is normal (large rotations).
+    if (residual < 0.99 * best_res) {
+      best_res = residual;
+      best_it = it;
+    } else if (residual < 1e-5 && it - best_it >= 10) {
+      break;
+    }
     // Assemble H = M/h^2 + sum PSD element Hessians (+ mu M).
     trip_.clear();
     auto add_block = [&](int a, int b, const Mat3& B) {
@@ -97,12 +107,12 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) add_block(v[a], v[b], H9.block<3, 3>(3 * a, 3 * b));
     }
+    Mat12 H12;
     for (int hh = 0; hh < energy_.num_hinges(); ++hh) {
+      energy_.hinge_hessian(hh, S.x, H12, true);
       const auto& v = energy_.hinge(hh);
-      const auto& K = energy_.hinge_K(hh);
       for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b)
-          add_block(v[a], v[b], energy_.hinge_w(hh) * K[a] * K[b] * Mat3::Identity());
+        for (int b = 0; b < 4; ++b) add_block(v[a], v[b], H12.block<3, 3>(3 * a, 3 * b));
     }
     Eigen::Matrix<double, 6, 6> H6;
     for (int s = 0; s < energy_.num_springs(); ++s) {
@@ -138,6 +148,21 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
         break;
       }
       alpha *= 0.5;
+    }
+    if (!accepted && std::abs(slope) < 1e-12 * std::max(std::abs(g0), 1e-30)) {
+      // The predicted decrease is below the round-off of G itself: the Armijo test cannot
+      // decide. Take the full step when it lowers the gradient residual.
+      for (int i = 0; i < n; ++i)
+        xtrial_[i] = dof_[i] >= 0 ? Vec3(S.x[i] + dx_.segment<3>(3 * dof_[i])) : S.x[i];
+      energy_.gradient(xtrial_, S.mass, grad_);
+      double gtrial = 0;
+      for (int i = 0; i < n; ++i) {
+        if (dof_[i] < 0) continue;
+        Vec3 gi = grad_[i];
+        if (inv_h2 > 0) gi += inv_h2 * S.mass[i] * (xtrial_[i] - (*y)[i]);
+        gtrial = std::max(gtrial, gi.cwiseAbs().maxCoeff());
+      }
+      accepted = std::isfinite(gtrial) && gtrial < gmax;
     }
     if (!accepted) {
       // No decrease: the step is at round-off level or the model is indefinite; regularise.
@@ -211,13 +236,17 @@ StaticResult relax_static(Cloth& cloth, const SceneObjects& scene, const StaticO
   solver.energy().set_contact_stiffness(opt.contact_stiffness > 0 ? opt.contact_stiffness : 1e4);
   // Contacts are linearised: redetect a few times as the cloth moves.
   int total = 0;
-  double res = 0;
+  double res = 0, prev_res = std::numeric_limits<double>::infinity();
   for (int round = 0; round < 8; ++round) {
     if (opt.contacts) solver.energy().detect_contacts(cloth, scene);
     const int it =
         solver.minimise(cloth, scene, 0.0, nullptr, opt.tolerance, opt.max_iterations - total, res);
     total += it;
     if (!opt.contacts || total >= opt.max_iterations) break;
+    // A round that stalled (round-off floor of the line search) without any contact to
+    // re-linearise: another round cannot do better.
+    if (res >= opt.tolerance && solver.energy().contacts().empty() && res > 0.99 * prev_res) break;
+    prev_res = res;
     // Done when no vertex violates a freshly detected contact by more than 0.1 mm.
     std::vector<Vec3> before = S.x;
     solver.energy().detect_contacts(cloth, scene);

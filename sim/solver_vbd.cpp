@@ -7,6 +7,10 @@
 
 namespace drape::sim {
 
+namespace {
+constexpr double kG2 = kGravity * kGravity;
+}  // namespace
+
 VbdSolver::VbdSolver(VbdOptions opt)
     : opt_(opt), pool_(std::make_unique<ThreadPool>(std::max(1, opt.threads))) {}
 VbdSolver::~VbdSolver() = default;
@@ -20,8 +24,21 @@ void VbdSolver::cook(const Cloth& cloth) {
   xt_.resize(n);
   xprev_iter_.resize(n);
   xprev2_iter_.resize(n);
+  vprev_.assign(cloth.state.v.begin(), cloth.state.v.end());
   rest_count_.assign(n, 0);
-  worker_max_.assign(pool_->size() * 8, 0.0);
+  worker_max_.assign(pool_->size() * 16, 0.0);
+  // Per-vertex step limit from the shortest incident rest edge (material space).
+  max_step_.assign(n, 0.0);
+  for (const auto& t : cloth.topo.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      const double l = (cloth.topo.material[a] - cloth.topo.material[b]).norm();
+      for (int v : {a, b})
+        if (l > 0 && (max_step_[v] == 0 || l < max_step_[v])) max_step_[v] = l;
+    }
+  const double fallback = cloth.topo.spacing > 0 ? cloth.topo.spacing : 0.01;
+  for (int i = 0; i < n; ++i)
+    max_step_[i] = opt_.max_step * (max_step_[i] > 0 ? max_step_[i] : fallback);
 }
 
 StepStats VbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
@@ -79,11 +96,27 @@ double VbdSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, Ste
       }
     }
   }
+  const double gn = g.norm();
+  const Vec3 gdir = gn > 0 ? Vec3(g / gn) : Vec3::Zero();
+  const double h_prev = h_prev_ > 0 ? h_prev_ : h;
+  const double drag = std::exp(-opt_.air_damping * h);
   for (int i = 0; i < n; ++i) {
     xt_[i] = S.x[i];
     if (cloth.is_free(i) && !(S.flags[i] & kFlagFrozen)) {
-      y_[i] = S.x[i] + h * S.v[i];
-      S.x[i] = y_[i] + h * h * g;  // initial guess: inertia + gravity
+      y_[i] = S.x[i] + (h * drag) * S.v[i];
+      switch (opt_.init) {
+        case VbdOptions::Init::kInertia:
+          S.x[i] = y_[i];
+          break;
+        case VbdOptions::Init::kInertiaGravity:
+          S.x[i] = y_[i] + h * h * g;
+          break;
+        case VbdOptions::Init::kAdaptive: {
+          const double a = std::clamp((S.v[i] - vprev_[i]).dot(gdir) / h_prev, 0.0, gn);
+          S.x[i] = y_[i] + (h * h * a) * gdir;
+          break;
+        }
+      }
     } else {
       y_[i] = S.x[i];
     }
@@ -104,7 +137,7 @@ double VbdSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, Ste
       const int* items = colour_items_.data() + colour_off_[c];
       const int count = colour_off_[c + 1] - colour_off_[c];
       pool_->parallel_for(count, [&](int b, int e, int w) {
-        double local = 0;
+        double local = 0, local_f = 0;
         for (int k = b; k < e; ++k) {
           const int i = items[k];
           if (!cloth.is_free(i) || (S.flags[i] & kFlagFrozen)) continue;
@@ -120,18 +153,28 @@ double VbdSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, Ste
           H.diagonal().array() += m;
           const double det = H.determinant();
           if (!(std::abs(det) > 1e-30)) continue;
+          local_f = std::max(local_f, f.squaredNorm() / (S.mass[i] * S.mass[i] * kG2));
           Eigen::LLT<Mat3> llt(H);
-          const Vec3 dx = llt.info() == Eigen::Success ? Vec3(llt.solve(f)) : Vec3(H.inverse() * f);
+          Vec3 dx = llt.info() == Eigen::Success ? Vec3(llt.solve(f)) : Vec3(H.inverse() * f);
+          const double len2 = dx.squaredNorm();
+          if (len2 > max_step_[i] * max_step_[i]) dx *= max_step_[i] / std::sqrt(len2);
+          if (!dx.allFinite()) continue;
           S.x[i] += dx;
           local = std::max(local, dx.squaredNorm());
         }
-        worker_max_[w * 8] = std::max(worker_max_[w * 8], local);
+        worker_max_[w * 16] = std::max(worker_max_[w * 16], local);
+        worker_max_[w * 16 + 8] = std::max(worker_max_[w * 16 + 8], local_f);
       });
     }
     ++st.iterations;
     residual = 0;
-    for (int w = 0; w < pool_->size(); ++w) residual = std::max(residual, worker_max_[w * 8]);
-    residual = std::sqrt(residual);
+    double moved = 0;
+    for (int w = 0; w < pool_->size(); ++w) {
+      moved = std::max(moved, worker_max_[w * 16]);
+      residual = std::max(residual, worker_max_[w * 16 + 8]);
+    }
+    moved = std::sqrt(moved);
+    residual = std::sqrt(residual);  // largest |f_i| / (m_i g) before the update
     if (opt_.chebyshev && it > 0) {
       omega = it == 1 ? 2.0 / (2.0 - opt_.chebyshev_rho * opt_.chebyshev_rho)
                       : 4.0 / (4.0 - opt_.chebyshev_rho * opt_.chebyshev_rho * omega);
@@ -139,11 +182,13 @@ double VbdSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, Ste
         if (cloth.is_free(i) && !(S.flags[i] & kFlagFrozen))
           S.x[i] = omega * (S.x[i] - xprev2_iter_[i]) + xprev2_iter_[i];
     }
-    if (residual < opt_.tolerance) break;
+    if (moved < opt_.tolerance && residual < opt_.force_tolerance) break;
   }
   frozen_count_ = 0;
+  h_prev_ = h;
   for (int i = 0; i < n; ++i) {
     S.x_prev[i] = xt_[i];
+    vprev_[i] = S.v[i];
     if (cloth.is_free(i) && !(S.flags[i] & kFlagFrozen)) {
       S.v[i] = (S.x[i] - xt_[i]) / h;
       if (opt_.freeze) {

@@ -15,7 +15,7 @@ struct XpbdOptions {
   int substeps = 10;
   int iterations = 1;  // per substep (small steps: 1)
   EnergyOptions energy;
-  double damping = 0.0;  // velocity damping rate (1/s)
+  double damping = 1.0;  // velocity damping rate (1/s), air drag as in Verlet and VBD
 };
 
 class XpbdSolver : public Solver {

@@ -36,8 +36,11 @@ int cmd_xr(int argc, char** argv) {
     if (a == "--help" || a == "-h") {
       std::printf(
           "usage: drape xr [--frames N] [--scenario FILE] [--eye-size PX] [--no-render]\n"
-          "                [--cloth-res N] [--sim-free] [--no-ops] [--out DIR] [--json FILE] [-v]\n"
+          "                [--cloth-res N] [--sim-free] [--pose-wait-ms MS] [--commands FILE]\n"
+          "                [--no-ops] [--out DIR] [--json FILE] [-v]\n"
           "--sim-free: the sim on its own 90 Hz clock (default: one tick per frame);\n"
+          "--pose-wait-ms: (free sim) how long a frame waits for the tick that took its hand\n"
+          "pose (default 6); --commands: the command map (default assets/commands.json);\n"
           "--json: frame-time percentiles, pose-to-photon frames, sim tick jitter.\n"
           "Runs the OpenXR app. Without XR_RUNTIME_JSON or an active_runtime.json it uses the\n"
           "mock runtime (build/bin/drape_mock_runtime.json); --scenario sets DRAPE_MOCK_SCENARIO.\n"
@@ -53,6 +56,10 @@ int cmd_xr(int argc, char** argv) {
       opt.cloth_res = std::atoi(next("--cloth-res"));
     } else if (a == "--sim-free") {
       opt.sim_lock_step = false;
+    } else if (a == "--pose-wait-ms") {
+      opt.pose_wait_ms = std::atof(next("--pose-wait-ms"));
+    } else if (a == "--commands") {
+      opt.commands_path = next("--commands");
     } else if (a == "--no-ops") {
       opt.operations = false;
     } else if (a == "--out") {
@@ -89,21 +96,28 @@ int cmd_xr(int argc, char** argv) {
   std::vector<double> ft(r.frame_ms.begin() + std::min<size_t>(10, r.frame_ms.size()),
                          r.frame_ms.end());
   std::vector<double> lat(r.latency_frames.begin(), r.latency_frames.end());
+  std::vector<double> clat(r.cloth_latency_frames.begin(), r.cloth_latency_frames.end());
   const double p50 = pct(ft, 0.5), p99 = pct(ft, 0.99), lat50 = pct(lat, 0.5),
-               latmax = lat.empty() ? -1 : *std::max_element(lat.begin(), lat.end());
+               latmax = lat.empty() ? -1 : *std::max_element(lat.begin(), lat.end()),
+               clat50 = pct(clat, 0.5),
+               clatmax = clat.empty() ? -1 : *std::max_element(clat.begin(), clat.end());
   std::fprintf(stderr,
                "drape xr: frame time (wait -> end, %zu frames) p50 %.2f ms, p99 %.2f ms; "
-               "pose-to-photon %.0f frames (median of %zu, max %.0f); sim tick jitter %.3f ms\n",
-               ft.size(), p50, p99, lat50, lat.size(), latmax, r.sim_tick_jitter_ms);
+               "pose-to-photon: hand %.0f frames (median of %zu, max %.0f), cloth response "
+               "%.0f frames (median of %zu, max %.0f); sim tick jitter %.3f ms\n",
+               ft.size(), p50, p99, lat50, lat.size(), latmax, clat50, clat.size(), clatmax,
+               r.sim_tick_jitter_ms);
   for (const auto& w : r.written) std::fprintf(stderr, "wrote %s\n", w.c_str());
   if (!json_path.empty()) {
     std::ofstream o(json_path);
     o << "{\"latency_frames\": " << lat50 << ", \"latency_frames_max\": " << latmax
-      << ", \"latency_samples\": " << lat.size() << ", \"frame_ms_p50\": " << p50
+      << ", \"latency_samples\": " << lat.size() << ", \"cloth_latency_frames\": " << clat50
+      << ", \"cloth_latency_frames_max\": " << clatmax
+      << ", \"cloth_latency_samples\": " << clat.size() << ", \"frame_ms_p50\": " << p50
       << ", \"frame_ms_p99\": " << p99 << ", \"sim_tick_jitter_ms\": " << r.sim_tick_jitter_ms
       << ", \"frames\": " << r.frames << ", \"eye_size\": " << opt.eye_size
-      << ", \"cloth_res\": " << opt.cloth_res << ", \"sim\": \""
-      << (opt.sim_lock_step ? "lock_step" : "free_90hz") << "\"}\n";
+      << ", \"cloth_res\": " << opt.cloth_res << ", \"pose_wait_ms\": " << opt.pose_wait_ms
+      << ", \"sim\": \"" << (opt.sim_lock_step ? "lock_step" : "free_90hz") << "\"}\n";
     if (!o) {
       std::fprintf(stderr, "drape xr: cannot write %s\n", json_path.c_str());
       return 1;

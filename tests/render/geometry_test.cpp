@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "sim/dress_form.hpp"
 #include "test_scenes.hpp"
@@ -90,6 +92,58 @@ TEST(Geometry, DecorationsForEveryElement) {
   append_decorations(s, opt, none);
   EXPECT_GT(all.indices.size(), none.indices.size());
   for (uint32_t i : all.indices) ASSERT_LT(i, all.vertices.size());
+}
+
+// Live hands (DrawOptions::hands): the 26-joint skeleton around its joints, the pointer marker
+// at the pointer, a line to the hand's candidate particle; the snapshot's proxy of the same hand
+// is not drawn twice; a non-finite pose is skipped.
+TEST(Geometry, HandOverlaysDrawSkeletonPointerAndCandidateLine) {
+  sim::SceneSnapshot s;
+  s.positions = {{0.0f, 1.0f, 0.2f}, {0.1f, 1.0f, 0.2f}, {0.0f, 1.1f, 0.2f}};
+  s.candidate_vertex = {-1, 2};
+  sim::HandProxy proxy;
+  proxy.id = 1;
+  proxy.tracked = true;
+  proxy.position = sim::Vec3(0.3, 1.0, 0.4);
+  s.hands.push_back(proxy);
+  DrawOptions opt;
+  Mesh none, with;
+  append_decorations(s, opt, none);
+  append_hand_overlays(s, opt, none);
+  const size_t proxy_only = none.indices.size();
+  EXPECT_GT(proxy_only, 0u);  // the snapshot's hand sphere
+  HandOverlay h;
+  h.id = 1;
+  h.has_joints = true;
+  for (int j = 0; j < 26; ++j) h.joints[j] = Eigen::Vector3f(0.2f + 0.004f * j, 1.0f, 0.5f);
+  h.pointer = Eigen::Vector3f(0.25f, 1.0f, 0.45f);
+  opt.hands = {h};
+  append_decorations(s, opt, with);
+  // The proxy sphere of hand 1 is replaced by the overlay (the candidate highlight stays).
+  EXPECT_LT(with.indices.size(), proxy_only);
+  EXPECT_GT(with.indices.size(), 0u);
+  append_hand_overlays(s, opt, with);
+  EXPECT_GT(with.indices.size(), 26u * 3u * 10u);  // 26 joint spheres + bones + pointer + line
+  for (uint32_t i : with.indices) ASSERT_LT(i, with.vertices.size());
+  // Vertices of the overlay alone: at the pointer (its marker) and at the candidate particle
+  // (the end of the line from the pointer).
+  Mesh only;
+  append_hand_overlays(s, opt, only);
+  float near_pointer = 1e9f, near_candidate = 1e9f;
+  for (const Vertex& v : only.vertices) {
+    const Eigen::Vector3f p(v.pos[0], v.pos[1], v.pos[2]);
+    near_pointer = std::min(near_pointer, (p - h.pointer).norm());
+    near_candidate = std::min(near_candidate, (p - s.positions[2]).norm());
+  }
+  std::printf("nearest overlay vertex to the pointer %.4f m, to the candidate %.4f m\n",
+              near_pointer, near_candidate);
+  EXPECT_LT(near_pointer, 0.0085f);
+  EXPECT_LT(near_candidate, 0.002f);
+  // A non-finite pose draws nothing.
+  opt.hands[0].joints[3].x() = std::numeric_limits<float>::quiet_NaN();
+  Mesh bad;
+  append_hand_overlays(s, opt, bad);
+  EXPECT_EQ(bad.indices.size(), 0u);
 }
 
 }  // namespace

@@ -4,9 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <random>
+
+#include "sim/scenes.hpp"
+#include "sim/solver_vbd.hpp"
 
 namespace drape::sim {
 namespace {
@@ -220,6 +225,165 @@ TEST(Cut, ManyRandomCutsKeepAValidMesh) {
   EXPECT_NEAR(total_mass(c), m0, 1e-12);
   std::printf("30 random cuts: %d applied, %d pieces, %d vertices\n", ok, count_components(c),
               c.num_vertices());
+}
+
+// The incidence kept with the cloth and updated in place by each split must equal a rebuild
+// from scratch: same triangles per vertex, same partition into components, and the masses
+// re-lumped only at the split vertices equal a full relump_masses() bit for bit.
+void expect_incidence_consistent(const Cloth& c) {
+  const ClothIncidence& I = c.incidence;
+  ASSERT_TRUE(I.built);
+  ASSERT_EQ(I.version, c.topology_version);
+  Cloth fresh = c;
+  fresh.incidence = ClothIncidence{};
+  ensure_incidence(fresh);
+  const ClothIncidence& F = fresh.incidence;
+  ASSERT_EQ(I.start.size(), F.start.size());
+  for (int v = 0; v < c.num_vertices(); ++v) {
+    std::vector<int32_t> a(I.tris.begin() + I.start[v], I.tris.begin() + I.start[v] + I.count[v]);
+    std::vector<int32_t> b(F.tris.begin() + F.start[v], F.tris.begin() + F.start[v] + F.count[v]);
+    ASSERT_EQ(a, b) << "vertex " << v;  // same triangles, same (ascending) order
+  }
+  int n_full = 0;
+  const std::vector<int32_t> full = component_labels(c, &n_full);
+  ASSERT_EQ(I.components, n_full);
+  std::map<int32_t, int32_t> kept_to_full, full_to_kept;
+  for (int v = 0; v < c.num_vertices(); ++v) {
+    ASSERT_EQ(I.component[v] < 0, full[v] < 0) << v;
+    if (full[v] < 0) continue;
+    auto [i1, new1] = kept_to_full.emplace(I.component[v], full[v]);
+    auto [i2, new2] = full_to_kept.emplace(full[v], I.component[v]);
+    ASSERT_EQ(i1->second, full[v]) << "vertex " << v;  // a bijection between the labellings
+    ASSERT_EQ(i2->second, I.component[v]) << "vertex " << v;
+  }
+  Cloth relumped = c;
+  relumped.relump_masses();
+  for (int v = 0; v < c.num_vertices(); ++v) {
+    ASSERT_EQ(c.state.mass[v], relumped.state.mass[v]) << "vertex " << v;
+    ASSERT_EQ(c.state.inv_mass[v], relumped.state.inv_mass[v]) << "vertex " << v;
+  }
+}
+
+TEST(Cut, KeptIncidenceEqualsARebuildAfterManyCuts) {
+  Cloth c = flat(17);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> U(0, 0.4);
+  for (int i = 0; i < 25; ++i) {
+    if (i % 3 == 2) {  // a 3D stroke now and then
+      const double y = U(rng);
+      cut_along(c, {Vec3(-0.05, y, 0.01), Vec3(0.2, y + 0.05, 0.01), Vec3(0.45, y, 0.01)});
+    } else {
+      cut_along_material(c, {Vec2(U(rng), U(rng)), Vec2(U(rng), U(rng))});
+    }
+    ASSERT_NO_FATAL_FAILURE(expect_incidence_consistent(c)) << "after cut " << i;
+  }
+  // The other edits bump topology_version: the incidence is then stale and rebuilt on demand.
+  c.topology_changed();
+  EXPECT_TRUE(ensure_incidence(c));
+  EXPECT_FALSE(ensure_incidence(c));
+  std::printf("25 cuts: %d pieces, %d vertices, kept incidence = rebuild\n", count_components(c),
+              c.num_vertices());
+}
+
+// A stroke drawn across the cloth from beyond one edge to beyond the other, whose ends are far
+// from the surface (more than max_distance: dropped as off the cloth), must still reach both
+// edges and separate the cloth into exactly two pieces.
+void expect_split_in_two(Cloth& c, const std::vector<Vec3>& stroke, const char* what) {
+  const double m0 = total_mass(c), a0 = material_area(c);
+  const int before = count_components(c);
+  CutResult r = cut_along(c, stroke);
+  ASSERT_TRUE(r.ok) << what << ": " << r.reason;
+  EXPECT_TRUE(r.extended[0] && r.extended[1]) << what;
+  EXPECT_EQ(count_components(c), before + 1) << what;
+  EXPECT_EQ(r.components_after, before + 1) << what;
+  EXPECT_NEAR(total_mass(c), m0, 1e-12) << what;
+  EXPECT_NEAR(material_area(c), a0, 1e-12) << what;
+  EXPECT_TRUE(c.validate().empty()) << c.validate();
+  expect_material_kept(c, r);
+  // The smooth stroke kept for the pattern outline reaches the edges too.
+  double umin = 1e9, umax = -1e9;
+  for (const Vec2& q : r.smooth_stroke_uv)
+    umin = std::min(umin, q.x()), umax = std::max(umax, q.x());
+  std::printf("%s: %zu path vertices, %zu new, %d -> %d pieces, stroke u in [%.3f, %.3f] m\n", what,
+              r.path.size(), r.new_vertices.size(), before, count_components(c), umin, umax);
+}
+
+TEST(Cut, StrokeFromBeyondTheEdgesSplitsASpreadCloth) {
+  Cloth c = flat(17);  // x = u in [0, 0.4], y = v, z = 0
+  // Hovering 8 cm in front of the cloth beyond its edges, touching it only in the middle third.
+  std::vector<Vec3> stroke;
+  for (int i = 0; i <= 80; ++i) {
+    const double x = -0.15 + 0.7 * i / 80.0;
+    const double z = std::clamp(0.08 - 0.5 * (0.13 - std::abs(x - 0.2)), 0.01, 0.08);
+    stroke.emplace_back(x, 0.21 + 0.02 * x, z);
+  }
+  expect_split_in_two(c, stroke, "spread");
+  expect_incidence_consistent(c);
+}
+
+TEST(Cut, StrokeFromBeyondTheEdgesSplitsARolledCloth) {
+  Cloth c = flat(17);
+  place_rolled(c, Vec3(0, 1.0, 0), Vec3::UnitX(), Vec3::UnitY(), 0.02);
+  // Along the outer turn (grid row j, all its vertices share y and z), 5 mm outside it in the
+  // middle and 8 cm outside beyond the edges (x < 0, x > 0.4).
+  const int n = 17, j = n - 4;
+  Vec3 centroid = Vec3::Zero();
+  for (const Vec3& p : c.state.x) centroid += p / c.num_vertices();
+  const Vec3 p0 = c.state.x[j * n + n / 2];
+  const Vec3 e_u = c.state.x[j * n + n / 2 + 1] - p0, e_v = c.state.x[(j + 1) * n + n / 2] - p0;
+  Vec3 out = e_u.cross(e_v).normalized();
+  if (out.dot(p0 - centroid) < 0) out = -out;
+  std::vector<Vec3> stroke;
+  for (int i = 0; i <= 80; ++i) {
+    const double x = -0.15 + 0.7 * i / 80.0;
+    const double lift = std::clamp(0.08 - 0.5 * (0.13 - std::abs(x - 0.2)), 0.005, 0.08);
+    stroke.push_back(Vec3(x, p0.y(), p0.z()) + lift * out);
+  }
+  expect_split_in_two(c, stroke, "rolled");
+}
+
+// The app's default scenario: a 12 x 12 panel pinned across the chest of the 9AR form drapes
+// over the bust; the stroke goes straight across at 22 cm below the top edge, 13 cm in front
+// of the form's centre line, from 25 cm beyond the left edge to 25 cm beyond the right edge.
+TEST(Cut, ScenarioStrokeAcrossADrapedClothSplitsIt) {
+  StudyScene sc = make_form_drape(12);
+  ASSERT_TRUE(sc.objects.form);
+  VbdOptions o;
+  o.threads = 1;
+  VbdSolver solver(o);
+  for (int i = 0; i < 90; ++i) solver.step(sc.cloth, sc.objects, 1.0 / 90);
+  double top = -1e9;
+  for (const Vec3& p : sc.cloth.state.x) top = std::max(top, p.y());
+  std::vector<Vec3> stroke;
+  for (int i = 0; i <= 60; ++i) stroke.emplace_back(-0.5 + i / 60.0, top - 0.22, 0.13);
+  expect_split_in_two(sc.cloth, stroke, "draped (default scenario stroke)");
+  // Both pieces keep their material coordinates: the upper piece is every vertex above the
+  // cut in material space (v), the lower every vertex below.
+  const auto lab = component_labels(sc.cloth);
+  int upper = -1, lower = -1;
+  for (int v = 0; v < sc.cloth.num_vertices(); ++v) {
+    const double m = sc.cloth.topo.material[v].y();
+    if (m > 0.49) upper = lab[v];
+    if (m < 0.01) lower = lab[v];
+  }
+  EXPECT_NE(upper, lower);
+}
+
+// A stroke that begins hovering above the middle of the cloth and comes down onto it is a
+// slit from where it touches, not a cut from the edge: nothing is extended, one piece stays.
+TEST(Cut, StrokeStartingAboveTheInteriorIsNotExtended) {
+  Cloth c = flat(17);
+  std::vector<Vec3> stroke;
+  for (int i = 0; i <= 40; ++i) {  // from 10 cm above (0.1, 0.2) down and along +x
+    const double x = 0.1 + 0.15 * i / 40.0;
+    stroke.emplace_back(x, 0.2, std::max(0.005, 0.1 - 0.6 * (x - 0.1)));
+  }
+  CutResult r = cut_along(c, stroke);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_FALSE(r.extended[0]);
+  EXPECT_FALSE(r.extended[1]);
+  EXPECT_EQ(count_components(c), 1);
+  expect_incidence_consistent(c);
 }
 
 }  // namespace

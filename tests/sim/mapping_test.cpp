@@ -65,8 +65,9 @@ TEST(Mapping, GeneralMappingKeepsWeftLengthAndGrain) {
     for (int i = 0; i + 1 < p->nx; ++i) {
       const double len = (x[j * p->nx + i + 1] - x[j * p->nx + i]).norm();
       // eq. 2-8 interpolates r linearly in theta, so the mapped curve bulges by well under a
-      // micrometre from the section polygon whose chords define the arc length: float-level noise.
-      EXPECT_LE(len, p->dx + 1e-6);
+      // micrometre from the section polygon whose chords define the arc length (up to 1.7 um
+      // below the hip, where the envelope switches between the hip shape and the form's).
+      EXPECT_LE(len, p->dx + 2e-6);
       worst_chord = std::max(worst_chord, p->dx - len);
     }
   }
@@ -97,14 +98,27 @@ TEST(Mapping, GeneralMappingKeepsWeftLengthAndGrain) {
       worst_surf, worst_above, deepest_below * 1000);
   EXPECT_LT(worst_surf, 1e-9);
   EXPECT_LT(worst_above, 5e-4);
+  EXPECT_GT(deepest_below, -5e-4);  // the envelope below the hip keeps the cloth on/outside
 }
 
 TEST(Mapping, HipShapeBelowHipAndEase) {
   const DressForm form = form9();
   const double hip = form.landmarks().hip_y;
   const MappingSurface s(form, 0.05);
-  for (double th : {0.0, 1.0, 2.5, 4.0})
-    EXPECT_NEAR(s.radius(hip - 0.2, th), s.radius(hip, th), 1e-12);
+  // Below the hip: the hip section's shape, pushed out only where the form itself is wider.
+  int pushed = 0;
+  for (int n = 0; n < DressForm::kAngles; ++n) {
+    const double th = DressForm::theta(n);
+    const double below = s.radius(hip - 0.2, th), at_hip = s.radius(hip, th);
+    EXPECT_GE(below, at_hip - 1e-12);
+    const Vec2 c = s.centre(hip - 0.2);
+    const Vec3 q(c.x() + below * std::sin(th), hip - 0.2, c.y() + below * std::cos(th));
+    if (below > at_hip + 1e-6) {
+      ++pushed;
+      EXPECT_GT(form.signed_distance(q), -2e-4) << n;  // on the form where pushed out
+    }
+  }
+  std::printf("hip - 0.2 m: %d of 256 angles pushed out to the form\n", pushed);
   const MappingSurface s0(form);
   const double g0 = s0.girth(hip), g1 = s.girth(hip);
   std::printf("ease 50 mm: girth %.3f -> %.3f mm (+%.3f)\n", g0 * 1000, g1 * 1000,
@@ -120,7 +134,8 @@ TEST(Mapping, DartMappingIntakeAtWaist) {
   d.width = 0.26;
   d.height = 0.40;
   d.spacing = 0.01;
-  d.slits = {{0.08, 0.12, 0.012}, {0.15, 0.13, 0.015}};
+  // Dart 2 wants less than the form's taper alone gives (~15 mm with a = 0): a < 0.
+  d.slits = {{0.08, 0.12, 0.012}, {0.15, 0.13, 0.008}};
   auto p = build_panel(d, FabricParams{});
   ASSERT_TRUE(p.ok());
   const PieceMapping pm = make_piece_mapping(*p, s, 0.0, -1, lm.right_side_theta, lm.waist_y);

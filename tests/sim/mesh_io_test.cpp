@@ -134,6 +134,26 @@ TEST(MeshIo, BadFiles) {
   EXPECT_EQ(ok->triangles.size(), 4u);
 }
 
+// Regression (found by fuzz_mesh): a PLY face with no indices made assimp 5.2's Triangulate
+// step abort the whole process; it must be a clear error instead.
+TEST(MeshIo, PlyFaceWithoutIndicesIsAnErrorNotAnAbort) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0\n";
+  auto m = drape::sim::load_mesh_from_memory(ply.data(), ply.size(), "ply", "empty_face.ply");
+  ASSERT_FALSE(m.ok());
+  std::printf("error: %s\n", m.error().c_str());
+  EXPECT_NE(m.error().find("empty_face.ply"), std::string::npos);
+  // A valid PLY still loads.
+  const std::string good = ply.substr(0, ply.find("element face 2")) + "element face 1" +
+                           ply.substr(ply.find("\nproperty list"), std::string::npos);
+  const std::string good_body = good.substr(0, good.rfind("0\n"));
+  auto g = drape::sim::load_mesh_from_memory(good_body.data(), good_body.size(), "ply", "ok.ply");
+  ASSERT_TRUE(g.ok()) << g.error();
+  EXPECT_EQ(g->triangles.size(), 1u);
+}
+
 TEST(MeshIo, ClothToMesh) {
   Cloth c;
   c.topo.material = {Vec2(0, 0), Vec2(0.1, 0), Vec2(0, 0.1), Vec2(0.1, 0.1)};

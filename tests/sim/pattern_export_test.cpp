@@ -41,20 +41,9 @@ struct Fixture : ::testing::Test {
     PipelineOptions opt;
     opt.spacing = 0.01;
     auto r = run_pattern_pipeline(*d, *form, FabricParams{}, opt);
-    if (!r.ok() && r.error().rfind("remesh:", 0) == 0) {
-      skip_reason() = "KNOWN GAP (docs/draping.md, issue 4): " + r.error();
-      return;
-    }
     ASSERT_TRUE(r.ok()) << r.error();
     pieces() = r->pieces;
     std::filesystem::create_directories(dir());
-  }
-  static std::string& skip_reason() {
-    static std::string s;
-    return s;
-  }
-  void SetUp() override {
-    if (!skip_reason().empty()) GTEST_SKIP() << skip_reason();
   }
   static std::vector<PatternPiece>& pieces() {
     static std::vector<PatternPiece> p;

@@ -33,10 +33,6 @@ void check_must_show(double ease_m) {
   opt.ease = ease_m;
   opt.spacing = 0.01;
   auto r = run_pattern_pipeline(*d, form, FabricParams{}, opt);
-  if (!r.ok() && r.error().rfind("remesh:", 0) == 0)
-    GTEST_SKIP() << "KNOWN GAP (docs/draping.md, issue 4): the relaxed tight-skirt outline is not "
-                    "yet a simple polygon, remesh refuses it: "
-                 << r.error();
   ASSERT_TRUE(r.ok()) << r.error();
   const PipelineReport& rep = r->report;
   std::printf(
@@ -45,23 +41,22 @@ void check_must_show(double ease_m) {
       ease_m * 1000, rep.outline_error_before_relax_mm, rep.hip_width_error_mm,
       rep.waist_width_error_mm, rep.area_error_pct, rep.garment_hip_girth_error_pct,
       rep.relax_backend.c_str(), rep.pipeline_ms);
-  // Must-show bounds: hip ±2 mm is met. The others are KNOWN GAPS (docs/draping.md): the bounds
-  // below are what the 10 mm pipeline achieves (measured 2026-11-22: outline 0.175 mm, waist
-  // +15..+18 mm, area 4.7..4.9 %, garment hip girth +2.0..+2.2 %), not the issue's targets
-  // (outline ~0, waist ±2 mm, area 1 %, girth 1 %).
-  EXPECT_LT(rep.outline_error_before_relax_mm, 0.2);
+  // The issue's Must-show bounds (measured 2026-11-22 03:40 UTC: outline 0.0000 mm, hip +0.000,
+  // waist -1.2 mm, area 0.74 %, garment hip girth -0.03 %; ease 40 mm see docs/draping.md).
+  EXPECT_LT(rep.outline_error_before_relax_mm, 1e-3);
   EXPECT_NEAR(rep.hip_width_error_mm, 0.0, 2.0);
-  EXPECT_NEAR(rep.waist_width_error_mm, 0.0, 20.0);
-  EXPECT_LT(rep.area_error_pct, 5.5);
-  EXPECT_LT(std::abs(rep.garment_hip_girth_error_pct), 2.5);
+  EXPECT_NEAR(rep.waist_width_error_mm, 0.0, 2.0);
+  EXPECT_LT(rep.area_error_pct, 1.0);
+  EXPECT_LT(std::abs(rep.garment_hip_girth_error_pct), 1.0);
   ASSERT_EQ(r->pieces.size(), 2u);
   for (const auto& p : rep.pieces) {
     ASSERT_EQ(p.dart_intake_mm.size(), 2u);
     for (size_t k = 0; k < 2; ++k) {
       std::printf("  %s dart %zu: intake %.2f mm (wanted %.2f)\n", p.name.c_str(), k + 1,
                   p.dart_intake_mm[k], p.dart_intake_wanted_mm[k]);
-      // KNOWN GAP: measured up to 6.0 mm off (issue target: the wanted intake).
-      EXPECT_NEAR(p.dart_intake_mm[k], p.dart_intake_wanted_mm[k], 7.0);
+      // The mapping gives the wanted intake exactly (sim_pattern_extract_test); after relaxation
+      // the waist row slides up the form and the back dart 2 opens by ~3 mm (GAP, docs/draping.md).
+      EXPECT_NEAR(p.dart_intake_mm[k], p.dart_intake_wanted_mm[k], 3.5);
     }
   }
 }
@@ -81,14 +76,28 @@ TEST(PatternPipeline, WritesReportAndFiles) {
   auto d = load_design(kDesign);
   ASSERT_TRUE(d.ok()) << d.error();
   PipelineOptions opt;
-  opt.spacing = 0.01;  // at 20 mm the relaxed dart legs lose their overlap (extraction fails)
+  opt.spacing = 0.02;  // the coarse mesh runs end to end too (extraction, remesh, sew)
   opt.out_dir = std::string(DRAPE_BINARY_DIR) + "/test_out/pattern_pipeline";
   auto r = run_pattern_pipeline(*d, form, FabricParams{}, opt);
-  if (!r.ok() && r.error().rfind("remesh:", 0) == 0)
-    GTEST_SKIP() << "KNOWN GAP (docs/draping.md, issue 4): the relaxed tight-skirt outline is not "
-                    "yet a simple polygon, remesh refuses it: "
-                 << r.error();
   ASSERT_TRUE(r.ok()) << r.error();
+  // Every outline is a simple polygon (remeshing needs one): no two non-adjacent segments cross.
+  for (const PatternPiece& pc : r->pieces) {
+    const auto& o = pc.outline;
+    const int n = static_cast<int>(o.size());
+    int crossings = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 2; j < n; ++j) {
+        if ((j + 1) % n == i) continue;
+        const Vec2 a = o[i], b = o[(i + 1) % n], c = o[j], d = o[(j + 1) % n];
+        const auto side = [](const Vec2& p, const Vec2& q, const Vec2& x) {
+          return (q.x() - p.x()) * (x.y() - p.y()) - (q.y() - p.y()) * (x.x() - p.x());
+        };
+        if (side(a, b, c) * side(a, b, d) < 0 && side(c, d, a) * side(c, d, b) < 0) ++crossings;
+      }
+    std::printf("%s: %d outline points, %d loops cut, %d crossings\n", pc.name.c_str(), n,
+                pc.loops_removed, crossings);
+    EXPECT_EQ(crossings, 0) << pc.name;
+  }
   std::ifstream f(opt.out_dir + "/report.json");
   ASSERT_TRUE(f.good());
   const auto j = nlohmann::json::parse(f);

@@ -98,3 +98,59 @@ TEST(Vbd, FreezingSkipsRestingVerticesAndWakes) {
               (sc.cloth.state.x[0] - before).norm() * 1e3, s.frozen_count());
   EXPECT_LT(s.frozen_count(), sc.cloth.num_vertices() / 2);
 }
+
+// The adaptive initial guess (Chen et al. 2024, sec. 3.6) makes a cloth at rest a fixed point
+// of an under-converged VBD step; the full-gravity guess drags it down by the solver's lag.
+TEST(Vbd, AdaptiveInitialGuessKeepsAClothAtRest) {
+  StudyScene ref = make_hanging_sheet(12);
+  StaticOptions so;
+  so.tolerance = 1e-9;
+  relax_static(ref.cloth, ref.objects, so);
+  double drift[2];
+  const VbdOptions::Init inits[2] = {VbdOptions::Init::kAdaptive,
+                                     VbdOptions::Init::kInertiaGravity};
+  for (int k = 0; k < 2; ++k) {
+    StudyScene sc = make_hanging_sheet(12);
+    sc.cloth.state.x = ref.cloth.state.x;  // start at the static minimum, at rest
+    VbdOptions o;
+    o.substeps = 1;
+    o.iterations = 5;
+    o.init = inits[k];
+    o.threads = 1;
+    VbdSolver s(o);
+    for (int f = 0; f < 90; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+    double rms, mx;
+    position_error(sc.cloth.state.x, ref.cloth.state.x, rms, mx);
+    drift[k] = rms;
+  }
+  std::printf(
+      "1 s at rest, 1 substep x 5 iterations: RMS drift adaptive %.4f mm, full-gravity "
+      "guess %.4f mm\n",
+      drift[0] * 1e3, drift[1] * 1e3);
+  EXPECT_LT(drift[0], 0.05e-3);
+  EXPECT_GT(drift[1], 5 * drift[0]);
+}
+
+// Early stop on the force residual: a stiff sheet starting flat must not stop after one
+// iteration because every Gauss-Seidel step is tiny (the old displacement-only test did).
+TEST(Vbd, EarlyStopUsesTheForceResidual) {
+  StudyScene sc = make_hanging_sheet(12);
+  VbdOptions o;
+  o.substeps = 1;
+  o.iterations = 30;
+  o.threads = 1;
+  VbdSolver s(o);
+  StepStats st = s.step(sc.cloth, sc.objects, 1.0 / 90);
+  std::printf("first frame: %d iterations, residual |f|/mg %.3g\n", st.iterations, st.residual);
+  EXPECT_GT(st.iterations, 1);
+  // At rest at the static minimum the residual is met at once.
+  StaticOptions so;
+  so.tolerance = 1e-10;
+  relax_static(sc.cloth, sc.objects, so);
+  for (auto& v : sc.cloth.state.v) v.setZero();
+  VbdSolver s2(o);
+  s2.step(sc.cloth, sc.objects, 1.0 / 90);  // warm up the adaptive guess (a = 0)
+  st = s2.step(sc.cloth, sc.objects, 1.0 / 90);
+  std::printf("at rest: %d iterations, residual %.3g\n", st.iterations, st.residual);
+  EXPECT_LE(st.iterations, 2);
+}

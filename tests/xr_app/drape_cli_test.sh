@@ -63,6 +63,8 @@ case $mode in
     grep -q "pinched in [1-9][0-9]* frames" <<<"$summary" || fail "the pinch took nothing"
     grep -q " [1-9][0-9]* vertices pinned" <<<"$summary" || fail "nothing pinned"
     grep -q " 1 cut(s)" <<<"$summary" || fail "the cut stroke was not applied"
+    grep -q "; 1 -> 2 parts" <<<"$summary" || fail "the cut did not split the cloth in two"
+    grep -q "command map: .*commands.json" "$work/out/xr_session.txt" || fail "command map not loaded"
     ;;
   *) echo "unknown mode $mode"; exit 2 ;;
 esac

@@ -27,7 +27,9 @@
 #include "sim/scenes.hpp"
 #include "sim/sim_thread.hpp"
 #include "sim/solver_factory.hpp"
+#include "tracking/command_map.hpp"
 #include "tracking/gestures.hpp"
+#include "tracking/hand_source.hpp"
 #include "tracking/voice.hpp"
 #endif
 #include <nlohmann/json.hpp>
@@ -178,7 +180,7 @@ class App {
   XrSpace space_ = XR_NULL_HANDLE;
   XrActionSet action_set_ = XR_NULL_HANDLE;
   XrAction pinch_ = XR_NULL_HANDLE, grab_ = XR_NULL_HANDLE, pose_ = XR_NULL_HANDLE,
-           menu_ = XR_NULL_HANDLE, haptic_ = XR_NULL_HANDLE;
+           primary_ = XR_NULL_HANDLE, secondary_ = XR_NULL_HANDLE, haptic_ = XR_NULL_HANDLE;
   XrPath hand_paths_[2] = {XR_NULL_PATH, XR_NULL_PATH};
   XrSpace hand_spaces_[2] = {XR_NULL_HANDLE, XR_NULL_HANDLE};
   XrHandTrackerEXT trackers_[2] = {XR_NULL_HANDLE, XR_NULL_HANDLE};
@@ -202,7 +204,10 @@ class App {
   };
   std::vector<Cue> cues_;
   std::unique_ptr<tracking::VoiceRecognizer> voice_;
-  bool trigger_on_[2] = {false, false}, menu_on_[2] = {false, false};
+  tracking::XrHandSource xr_source_;           // the tracking XR adapter: joints + controllers
+  tracking::CommandMap commands_;              // triggers -> operations (assets/commands.json)
+  std::vector<render::HandOverlay> overlays_;  // this frame's hands, drawn from its own pose
+  bool ops_busy_[2] = {false, false}, cutting_[2] = {false, false};
   int pinned_at_start_ = 0;
   std::vector<std::pair<int64_t, sim::Vec3>> posted_;  // right-hand pose posted per frame
   std::mutex tick_mu_;
@@ -226,6 +231,25 @@ void App::start_sim() {
     ops_->install(w);
     ops_->start_recording(w);
     load_cues();
+    // The command map: triggers -> operations.
+    std::string path = opt_.commands_path;
+    if (path.empty()) {
+      path = "assets/commands.json";
+      if (!std::filesystem::exists(path)) path = std::string(DRAPE_SOURCE_DIR) + "/" + path;
+    }
+    std::string err;
+    if (auto m = tracking::CommandMap::load(path, &err)) {
+      commands_ = *m;
+      r_.commands_file = path;
+    } else if (!opt_.commands_path.empty()) {
+      r_.error = "command map: " + err;  // an explicit file that does not load is an error
+      note(r_.error);
+    } else {
+      commands_ = tracking::CommandMap::defaults();
+      r_.commands_file = "(built-in defaults)";
+    }
+    note("command map: " + r_.commands_file + " (" + std::to_string(commands_.bindings().size()) +
+         " bindings)");
   }
   if (!opt_.sim_lock_step) {
     // Tick start times, for the jitter of the free-running sim clock under rendering load.
@@ -271,61 +295,97 @@ void App::interact(const XrFrameState& fs,
   const double t = static_cast<double>(frame_idx) / 90.0;
   std::array<sim::HandProxy, 2> hands{};
   std::vector<tracking::Trigger> trig;
+  overlays_.clear();
+  // Every hand input goes through the tracking XR adapter (tracking::XrHandSource): the joints
+  // of XR_EXT_hand_tracking and the controller (grip pose, trigger, squeeze, a/b buttons).
   for (int h = 0; h < 2; ++h) {
+    const auto hand = static_cast<tracking::Hand>(h);
     hands[h].id = h;
-    if (joints_active[h]) {
-      tracking::HandFrame f;
-      f.hand = static_cast<tracking::Hand>(h);
-      f.time = t;
-      f.tracked = true;
-      f.confidence = 1;
-      f.has_joints = true;
+    tracking::HandFrame joint_frame;
+    bool have_joint_frame = false;
+    if (trackers_[h] != XR_NULL_HANDLE) {
+      tracking::XrJointInput in;
+      in.active = joints_active[h];
+      in.time = t;
       for (int k = 0; k < tracking::kJointCount; ++k) {
-        const auto& p = joints[h][k].pose.position;
-        f.joints[k] = tracking::Vec3(p.x, p.y, p.z);
+        const auto& jl = joints[h][k];
+        const auto& p = jl.pose.position;
+        const auto& q = jl.pose.orientation;
+        in.joints[k].position = tracking::Vec3(p.x, p.y, p.z);
+        in.joints[k].orientation = tracking::Quat(q.w, q.x, q.y, q.z);
+        if (in.joints[k].orientation.norm() > 0.5) in.joints[k].orientation.normalize();
+        in.valid[k] = joints_active[h] && (jl.locationFlags & XR_SPACE_LOCATION_POSITION_VALID_BIT);
       }
-      const auto& q = joints[h][XR_HAND_JOINT_PALM_EXT].pose.orientation;
-      f.palm.position = f.joints[XR_HAND_JOINT_PALM_EXT];
-      f.palm.orientation = tracking::Quat(q.w, q.x, q.y, q.z);
-      gestures_.update(f, trig);
+      xr_source_.feed_joints(hand, in);
+      for (const auto& f : xr_source_.poll()) {
+        gestures_.update(f, trig);  // joint frames only: pinch / grab / open palm
+        if (f.tracked && f.has_joints) {
+          joint_frame = f;
+          have_joint_frame = true;
+        }
+      }
+    }
+    tracking::XrControllerInput ci;
+    ci.time = t;
+    XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+    if (hand_spaces_[h] != XR_NULL_HANDLE &&
+        XR_SUCCEEDED(xrLocateSpace(hand_spaces_[h], space_, fs.predictedDisplayTime, &loc)) &&
+        (loc.locationFlags & XR_SPACE_LOCATION_POSITION_VALID_BIT)) {
+      ci.active = true;
+      ci.grip.position =
+          tracking::Vec3(loc.pose.position.x, loc.pose.position.y, loc.pose.position.z);
+      ci.grip.orientation = tracking::Quat(loc.pose.orientation.w, loc.pose.orientation.x,
+                                           loc.pose.orientation.y, loc.pose.orientation.z);
+    }
+    XrActionStateGetInfo gi{XR_TYPE_ACTION_STATE_GET_INFO};
+    gi.subactionPath = hand_paths_[h];
+    gi.action = pinch_;
+    XrActionStateFloat fv{XR_TYPE_ACTION_STATE_FLOAT};
+    if (XR_SUCCEEDED(xrGetActionStateFloat(session_, &gi, &fv)) && fv.isActive)
+      ci.trigger = fv.currentState;
+    auto boolean = [&](XrAction a) {
+      gi.action = a;
+      XrActionStateBoolean bv{XR_TYPE_ACTION_STATE_BOOLEAN};
+      return a != XR_NULL_HANDLE && XR_SUCCEEDED(xrGetActionStateBoolean(session_, &gi, &bv)) &&
+             bv.isActive && bv.currentState == XR_TRUE;
+    };
+    ci.squeeze = boolean(grab_);
+    ci.a = boolean(primary_);
+    ci.b = boolean(secondary_);
+    xr_source_.feed_controller(hand, ci);
+    tracking::HandFrame ctrl_frame;
+    bool have_ctrl = false;
+    for (const auto& f : xr_source_.poll())
+      if (f.tracked) {
+        ctrl_frame = f;
+        have_ctrl = true;
+      }
+    for (auto& tr : xr_source_.take_triggers()) trig.push_back(tr);
+    render::HandOverlay ov;
+    ov.id = h;
+    if (have_joint_frame) {
+      // The hand proxy: the pinch point between the thumb and index tips (palm orientation).
+      const auto& J = joint_frame.joints;
       hands[h].tracked = true;
-      // The pinch point: between the thumb and index tips.
-      hands[h].position =
-          0.5 * (f.joints[XR_HAND_JOINT_THUMB_TIP_EXT] + f.joints[XR_HAND_JOINT_INDEX_TIP_EXT]);
-      hands[h].orientation = f.palm.orientation;
+      hands[h].position = 0.5 * (J[static_cast<int>(tracking::Joint::ThumbTip)] +
+                                 J[static_cast<int>(tracking::Joint::IndexTip)]);
+      hands[h].orientation = joint_frame.palm.orientation;
       hands[h].tip = hands[h].position;
       hands[h].radius = 0.02;
-    } else if (hand_spaces_[h] != XR_NULL_HANDLE) {
-      XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
-      if (XR_SUCCEEDED(xrLocateSpace(hand_spaces_[h], space_, fs.predictedDisplayTime, &loc)) &&
-          (loc.locationFlags & XR_SPACE_LOCATION_POSITION_VALID_BIT)) {
-        hands[h].tracked = true;
-        hands[h].position =
-            sim::Vec3(loc.pose.position.x, loc.pose.position.y, loc.pose.position.z);
-        hands[h].orientation = Eigen::Quaterniond(loc.pose.orientation.w, loc.pose.orientation.x,
-                                                  loc.pose.orientation.y, loc.pose.orientation.z);
-        hands[h].tip = hands[h].position;
-        hands[h].radius = 0.03;
-      }
+      ov.has_joints = true;
+      for (int k = 0; k < tracking::kJointCount; ++k) ov.joints[k] = J[k].cast<float>();
+    } else if (have_ctrl) {
+      // No hand tracking for this hand: the controller's grip pose is the hand.
+      hands[h].tracked = true;
+      hands[h].position = ctrl_frame.palm.position;
+      hands[h].orientation = ctrl_frame.palm.orientation;
+      hands[h].tip = hands[h].position;
+      hands[h].radius = 0.03;
     }
-    // Controllers: trigger held = a cut stroke with that hand; menu click = pin.
-    XrActionStateGetInfo gi{XR_TYPE_ACTION_STATE_GET_INFO};
-    gi.action = pinch_;
-    gi.subactionPath = hand_paths_[h];
-    XrActionStateFloat fv{XR_TYPE_ACTION_STATE_FLOAT};
-    if (XR_SUCCEEDED(xrGetActionStateFloat(session_, &gi, &fv)) && fv.isActive) {
-      const bool on = trigger_on_[h] ? fv.currentState > 0.4f : fv.currentState > 0.6f;
-      if (on != trigger_on_[h])
-        trig.push_back({"cut", "controller", t, static_cast<tracking::Hand>(h), on});
-      trigger_on_[h] = on;
-    }
-    gi.action = menu_;
-    XrActionStateBoolean bv{XR_TYPE_ACTION_STATE_BOOLEAN};
-    if (XR_SUCCEEDED(xrGetActionStateBoolean(session_, &gi, &bv)) && bv.isActive) {
-      const bool on = bv.currentState == XR_TRUE;
-      if (on && !menu_on_[h])
-        trig.push_back({"pin", "controller", t, static_cast<tracking::Hand>(h), true});
-      menu_on_[h] = on;
+    if (hands[h].tracked) {
+      ov.pointer = hands[h].position.cast<float>();
+      ov.active = gestures_.pinching(hand) || ops_busy_[h];
+      overlays_.push_back(ov);
     }
   }
   // Voice: the scenario's audio cues, decoded when their frame is reached.
@@ -362,30 +422,55 @@ void App::interact(const XrFrameState& fs,
       trig.push_back({vr.command, "voice", t, tracking::Hand::Right, true});
     }
   }
-  // Gestures: a thumb-index pinch begins/ends the pinch operation; other gestures are shown only.
-  std::vector<tracking::Trigger> use;
+  // Triggers -> the command map (assets/commands.json) -> operations of the sim.
+  struct Op {
+    std::string name;
+    sim::TriggerPhase phase;
+    int hand;
+  };
+  std::vector<Op> use;
   for (const auto& tr : trig) {
-    if (tr.source == "gesture" && tr.command != "pinch") continue;
-    use.push_back(tr);
-    r_.triggers.push_back("frame " + std::to_string(frame_idx) + ": " + tr.source + " " +
-                          tr.command + (tr.begin ? " begin" : " end") + " hand " +
-                          tracking::hand_name(tr.hand));
-    if (opt_.verbose) note("trigger " + r_.triggers.back());
+    const auto act = commands_.lookup(tr);
+    std::string line = "frame " + std::to_string(frame_idx) + ": " + tr.source + " " + tr.command +
+                       (tr.begin ? " begin" : " end") + " hand " + tracking::hand_name(tr.hand);
+    if (!act) {
+      if (opt_.verbose) note("unmapped trigger " + line);
+      continue;
+    }
+    Op op{act->operation, sim::TriggerPhase::kBegin, static_cast<int>(tr.hand)};
+    switch (act->phase) {
+      case tracking::Phase::Begin:
+      case tracking::Phase::Once:
+        op.phase = sim::TriggerPhase::kBegin;
+        break;
+      case tracking::Phase::End:
+        op.phase = sim::TriggerPhase::kEnd;
+        break;
+      case tracking::Phase::Toggle:
+        op.phase = sim::TriggerPhase::kToggle;
+        break;
+    }
+    if (op.name == "*") {  // "stop": ends whatever is in progress
+      op.name = "stop";
+      op.phase = sim::TriggerPhase::kBegin;
+    }
+    line += " -> " + op.name + " " + tracking::phase_name(act->phase);
+    r_.triggers.push_back(line);
+    if (opt_.verbose) note("trigger " + line);
+    use.push_back(op);
   }
   if (hands[1].tracked) {
     posted_.emplace_back(frame_idx, hands[1].position);
     if (posted_.size() > 256) posted_.erase(posted_.begin());
   }
-  bool cut_end = false;
-  for (const auto& tr : use) cut_end = cut_end || (tr.command == "cut" && !tr.begin);
+  bool cut_trigger = false;
+  for (const auto& op : use) cut_trigger = cut_trigger || op.name == "cut" || op.name == "stop";
   if (ops_) {
     auto ops = ops_;
     sim_->post([ops, hands, use](sim::World& w) {
       ops->set_hands(w, hands);
       w.scene.hands.assign(hands.begin(), hands.end());  // into the snapshot (latency probe)
-      for (const auto& tr : use)
-        ops->trigger(w, tr.command, tr.begin ? sim::TriggerPhase::kBegin : sim::TriggerPhase::kEnd,
-                     static_cast<int>(tr.hand));
+      for (const auto& op : use) ops->trigger(w, op.name, op.phase, op.hand);
     });
   }
   if (opt_.sim_lock_step) {
@@ -393,6 +478,12 @@ void App::interact(const XrFrameState& fs,
     if (ops_) {
       const auto& st = ops_->state();
       if (st.pinched[0] >= 0 || st.pinched[1] >= 0) ++r_.frames_pinched;
+      bool cut_end = false;
+      for (int h = 0; h < 2; ++h) {
+        cut_end = cut_end || (cut_trigger && cutting_[h] && !st.cutting[h]);
+        cutting_[h] = st.cutting[h];
+        ops_busy_[h] = st.pinched[h] >= 0 || st.cutting[h];
+      }
       if (cut_end) {
         if (st.last_cut.ok) {
           ++r_.cuts_ok;
@@ -638,6 +729,7 @@ bool App::create_vulkan() {
     sim_ = std::make_unique<sim::SimThread>(std::move(w), so);
     reader_ = sim_->make_reader();
     start_sim();
+    if (!r_.error.empty()) return false;  // e.g. a command map file that does not load
   }
 #endif
   return true;
@@ -664,26 +756,39 @@ void App::create_actions() {
   pinch_ = make("pinch", "Pinch", XR_ACTION_TYPE_FLOAT_INPUT);
   grab_ = make("grab", "Grab", XR_ACTION_TYPE_BOOLEAN_INPUT);
   pose_ = make("hand_pose", "Hand pose", XR_ACTION_TYPE_POSE_INPUT);
-  menu_ = make("menu", "Menu", XR_ACTION_TYPE_BOOLEAN_INPUT);
+  primary_ = make("primary", "Primary button", XR_ACTION_TYPE_BOOLEAN_INPUT);
+  secondary_ = make("secondary", "Secondary button", XR_ACTION_TYPE_BOOLEAN_INPUT);
   haptic_ = make("haptic", "Haptic", XR_ACTION_TYPE_VIBRATION_OUTPUT);
   for (const char* prof : kProfiles) {
     std::string p = prof;
     std::vector<XrActionSuggestedBinding> b;
+    const bool simple = p.find("simple") != std::string::npos;
+    const bool oculus = p.find("oculus") != std::string::npos;
+    const bool index = p.find("index") != std::string::npos;
     for (const char* side : {"left", "right"}) {
-      std::string h = std::string("/user/hand/") + side;
-      bool simple = p.find("simple") != std::string::npos;
-      bool oculus = p.find("oculus") != std::string::npos;
-      bool index = p.find("index") != std::string::npos;
-      b.push_back(
-          {pinch_, path((h + (simple ? "/input/select/click" : "/input/trigger/value")).c_str())});
-      if (!simple)
-        b.push_back(
-            {grab_, path((h + (oculus || index ? "/input/squeeze/value" : "/input/squeeze/click"))
-                             .c_str())});
-      b.push_back({pose_, path((h + "/input/grip/pose").c_str())});
-      if (!index && !(oculus && std::string(side) == "right"))
-        b.push_back({menu_, path((h + "/input/menu/click").c_str())});
-      b.push_back({haptic_, path((h + "/output/haptic").c_str())});
+      const std::string h = std::string("/user/hand/") + side;
+      const bool left = std::string(side) == "left";
+      auto bind = [&](XrAction a, const std::string& comp) {
+        b.push_back({a, path((h + comp).c_str())});
+      };
+      bind(pinch_, simple ? "/input/select/click" : "/input/trigger/value");
+      if (!simple) bind(grab_, oculus || index ? "/input/squeeze/value" : "/input/squeeze/click");
+      bind(pose_, "/input/grip/pose");
+      // Primary / secondary buttons ("button.a" / "button.b" of the command map): A/B (X/Y on
+      // the left Touch controller); trackpad click / menu on Vive and WMR; menu on simple.
+      if (oculus) {
+        bind(primary_, left ? "/input/x/click" : "/input/a/click");
+        bind(secondary_, left ? "/input/y/click" : "/input/b/click");
+      } else if (index) {
+        bind(primary_, "/input/a/click");
+        bind(secondary_, "/input/b/click");
+      } else if (simple) {
+        bind(secondary_, "/input/menu/click");
+      } else {
+        bind(primary_, "/input/trackpad/click");
+        bind(secondary_, "/input/menu/click");
+      }
+      bind(haptic_, "/output/haptic");
     }
     XrInteractionProfileSuggestedBinding sb{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
     sb.interactionProfile = path(prof);
@@ -959,15 +1064,42 @@ bool App::frame() {
     if (located) {
 #ifdef DRAPE_XR_WITH_RENDER
       const sim::SceneSnapshot* snap = renderer_ ? &reader_.latest() : nullptr;
-      // Pose-to-photon probe: which frame's right-hand pose is in the snapshot drawn now.
-      if (snap && ops_)
+      // Free-running sim: wait a bounded time for the tick that consumed this frame's hand pose
+      // (posted in interact()), so the cloth drawn now reacts to the hand drawn now.
+      if (snap && ops_ && !opt_.sim_lock_step && opt_.pose_wait_ms > 0 && !posted_.empty() &&
+          posted_.back().first == this_frame) {
+        const auto deadline =
+            std::chrono::steady_clock::now() +
+            std::chrono::microseconds(static_cast<int64_t>(opt_.pose_wait_ms * 1e3));
+        auto holds_pose = [&](const sim::SceneSnapshot& s) {
+          for (const auto& hp : s.hands)
+            if (hp.id == 1 && hp.tracked && hp.position == posted_.back().second) return true;
+          return false;
+        };
+        while (!holds_pose(*snap) && std::chrono::steady_clock::now() < deadline) {
+          std::this_thread::sleep_for(std::chrono::microseconds(250));
+          snap = &reader_.latest();
+        }
+      }
+      // Pose-to-photon probes. Cloth (sim) latency: which frame's right-hand pose is in the
+      // snapshot drawn now. Hand latency: which frame's pose the drawn hand has.
+      if (snap && ops_) {
+        auto frames_back = [&](const sim::Vec3& pos) {
+          for (auto it = posted_.rbegin(); it != posted_.rend(); ++it)
+            if (it->second == pos) return static_cast<int>(this_frame - it->first);
+          return -1;
+        };
         for (const auto& hp : snap->hands)
           if (hp.id == 1 && hp.tracked)
+            if (int k = frames_back(hp.position); k >= 0) r_.cloth_latency_frames.push_back(k);
+        for (const auto& ov : overlays_)
+          if (ov.id == 1)
             for (auto it = posted_.rbegin(); it != posted_.rend(); ++it)
-              if (it->second == hp.position) {
+              if (it->second.cast<float>() == ov.pointer) {
                 r_.latency_frames.push_back(static_cast<int>(this_frame - it->first));
                 break;
               }
+      }
 #endif
       for (int e = 0; e < 2; ++e) {
         uint32_t idx = 0;
@@ -990,7 +1122,26 @@ bool App::frame() {
           t.format = static_cast<VkFormat>(format_);
           t.width = eyes_[e].width;
           t.height = eyes_[e].height;
-          auto st = renderer_->render(*snap, render::make_view(pose, fov), t);
+          render::DrawOptions dopt;
+          dopt.hands = overlays_;
+          const render::View view = render::make_view(pose, fov);
+          if (e == 0 && opt_.pointer_probe && ops_) {
+            // Left eye: where the right-hand pointer of this and the 3 previous frames projects.
+            XrAppResult::PointerProbe pr;
+            pr.frame = this_frame;
+            int n = 0;
+            for (auto it = posted_.rbegin(); it != posted_.rend() && n < 4; ++it, ++n) {
+              auto px =
+                  render::project_to_pixel(view, it->second.cast<float>(),
+                                           static_cast<int>(t.width), static_cast<int>(t.height));
+              pr.frames_back[n] = static_cast<int>(this_frame - it->first);
+              pr.px[n] =
+                  px ? std::array<float, 2>{px->x(), px->y()} : std::array<float, 2>{-1e9f, -1e9f};
+            }
+            pr.count = n;
+            r_.pointer_probe.push_back(pr);
+          }
+          auto st = renderer_->render(*snap, view, t, dopt);
           if (!st) note("render: " + st.error);
         }
 #endif

@@ -4,6 +4,7 @@
 // simulation's latest snapshot into the runtime's swapchains. See docs/xr.md.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -36,6 +37,13 @@ struct XrAppOptions {
   bool voice = true;          // decode the scenario's audio cues (DRAPE_MOCK_SCENARIO)
   bool sim_lock_step = true;  // one sim tick per rendered frame; false: sim on its own 90 Hz clock
   std::string out_dir;        // when set: session_log.json and drape_cloth.gltf written there
+  // Triggers -> operations: this command map file ("" = assets/commands.json from the working
+  // directory or the source tree, else tracking::CommandMap::defaults()).
+  std::string commands_path;
+  // Free-running sim: how long a frame may wait for the tick that consumed its hand pose
+  // before drawing (0 = never wait: draw the newest snapshot at once).
+  double pose_wait_ms = 6.0;
+  bool pointer_probe = false;  // record XrAppResult::pointer_probe (tests)
 };
 
 struct XrAppResult {
@@ -65,9 +73,24 @@ struct XrAppResult {
   std::vector<std::string> written;                 // files written to out_dir
   std::vector<double> frame_ms;                     // wall time per frame (wait → end)
   double sim_tick_jitter_ms = -1;                   // free-running sim: stddev of tick period
-  // Pose-to-photon, per rendered frame: frames between the frame whose right-hand pose the
-  // drawn snapshot holds and the frame drawing it (only where a unique pose was matched).
+  // Pose-to-photon, per rendered frame (only where a unique pose was matched): frames between
+  // the frame whose right-hand pose the drawn hand has and the frame drawing it (the hand is
+  // drawn from the frame's own located pose) ...
   std::vector<int> latency_frames;
+  // ... and frames between the frame whose right-hand pose the drawn snapshot (the cloth's
+  // response) holds and the frame drawing it.
+  std::vector<int> cloth_latency_frames;
+  // Per rendered frame (XrAppOptions::pointer_probe): left-eye pixel positions of the right-hand
+  // pointer as located in this frame (frames_back 0) and the previous ones, for a pixel check of
+  // the pose-to-photon latency against the runtime's screenshots.
+  struct PointerProbe {
+    int64_t frame = 0;
+    int count = 0;
+    std::array<int, 4> frames_back{};
+    std::array<std::array<float, 2>, 4> px{};
+  };
+  std::vector<PointerProbe> pointer_probe;
+  std::string commands_file;  // the command map used
 };
 
 // Points XR_RUNTIME_JSON at the mock runtime next to the executable when no runtime is
