@@ -13,6 +13,6 @@ for t in $targets; do
   corpus="fuzz/corpus/${t#fuzz_}"
   mkdir -p "build-fuzz/corpus/$t"
   echo "-- $t for ${secs}s"
-  ./build-fuzz/bin/$t -max_total_time="$secs" -rss_limit_mb=2048 -print_final_stats=0 \
+  ./build-fuzz/bin/$t -max_total_time="$secs" -timeout=30 -rss_limit_mb=2048 -print_final_stats=0 \
     "build-fuzz/corpus/$t" $( [ -d "$corpus" ] && echo "$corpus" ) 2>&1 | tail -n 3
 done
