@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <utility>
@@ -104,7 +105,14 @@ std::vector<HandFrame> HandSegmenter::process_raw11(const uint16_t* raw, int wid
   cv::Mat mm(height, width, CV_16UC1);
   const size_t n = static_cast<size_t>(width) * height;
   auto* out = mm.ptr<uint16_t>();
-  for (size_t i = 0; i < n; ++i) out[i] = lut_[raw[i] & 2047];
+  // Read through bytes: libfreenect's fakenect hands over a buffer at an odd address (UBSan:
+  // misaligned uint16_t load), and a real device's buffer alignment is not promised either.
+  const auto* bytes = reinterpret_cast<const unsigned char*>(raw);
+  for (size_t i = 0; i < n; ++i) {
+    uint16_t v;
+    std::memcpy(&v, bytes + 2 * i, sizeof v);
+    out[i] = lut_[v & 2047];
+  }
   auto hands = detect(mm);
   std::vector<HandFrame> frames;
   for (size_t i = 0; i < hands.size(); ++i) {

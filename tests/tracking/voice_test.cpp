@@ -18,12 +18,13 @@ const std::string kDir = std::string(DRAPE_BINARY_DIR) + "/voice_test";
 // Speech at 16 kHz with 0.4 s / 0.7 s of padding and pink noise 20 dB below the speech.
 std::string synth(const std::string& name, const std::string& text, const std::string& voice) {
   const std::string out = kDir + "/" + name + ".wav";
-  const std::string cmd =
-      "set -e; cd '" + kDir + "'; espeak-ng -v " + voice + " -s 150 -w " + name + ".raw.wav '" +
-      text + "'; sox " + name + ".raw.wav -r 16000 -c 1 -b 16 " + name +
-      ".s.wav norm -6 pad 0.4 0.7; d=$(soxi -D " + name + ".s.wav); sox -n -r 16000 -c 1 -b 16 " +
-      name + ".n.wav synth $d pinknoise vol 0.02; sox -m -v 1 " + name + ".s.wav -v 1 " + name +
-      ".n.wav " + name + ".wav";
+  const std::string cmd = "set -e; cd '" + kDir + "'; espeak-ng -v " + voice + " -s 150 -w " +
+                          name + ".raw.wav '" + text + "'; sox " + name +
+                          ".raw.wav -r 16000 -c 1 -b 16 " + name +
+                          ".s.wav norm -6 pad 0.4 0.7; d=$(soxi -D " + name +
+                          ".s.wav); sox -R -n -r 16000 -c 1 -b 16 " + name +
+                          ".n.wav synth $d pinknoise vol 0.02; sox -m -v 1 " + name +
+                          ".s.wav -v 1 " + name + ".n.wav " + name + ".wav";
   if (std::system(cmd.c_str()) != 0) return "";
   return out;
 }
