@@ -1,22 +1,19 @@
 // Bullet soft-body peer on the hanging sheet (see bullet_peer.hpp for the matching).
 #include "bench/bullet_peer.hpp"
 
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <map>
-#include <utility>
-
-#include "sim/scenes.hpp"
-
-#ifndef DRAPE_NO_BULLET
 #include <BulletSoftBody/btSoftBody.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 #include <btBulletDynamicsCommon.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
 #include <memory>
-#endif
+#include <utility>
+
+#include "sim/scenes.hpp"
 
 namespace drape::bench {
 
@@ -26,19 +23,6 @@ using drape::sim::Vec3;
 PeerRow run_bullet_sheet(int res, int substeps, int iterations) {
   return run_bullet_sheet(res, substeps, iterations, PeerOptions{});
 }
-
-#ifdef DRAPE_NO_BULLET
-
-PeerRow run_bullet_sheet(int res, int substeps, int iterations, const PeerOptions&) {
-  PeerRow row;
-  row.resolution = res;
-  row.dt = 1.0 / 90 / std::max(1, substeps);
-  row.iterations = iterations;
-  row.stable = false;  // Bullet not available at build time
-  return row;
-}
-
-#else
 
 namespace {
 
@@ -179,7 +163,5 @@ PeerRow run_bullet_sheet(int res, int substeps, int iterations, const PeerOption
   }
   return row;
 }
-
-#endif
 
 }  // namespace drape::bench

@@ -1,33 +1,29 @@
 # Solver study (issue 3): the Bullet soft-body peer (bench/bullet_peer.cpp) is linked into
-# solvers_bench and into its standalone driver bullet_peer_bench. Without Bullet the peer
-# compiles to a stub that reports stable = false (the study then has no valid bullet rows).
+# solvers_bench and into its standalone driver bullet_peer_bench. Bullet (libbullet-dev) is
+# required: `./drape setup` installs it, and a study without its peer would be incomplete.
 find_path(DRAPE_BULLET_INCLUDE btSoftBody.h PATHS /usr/include/bullet/BulletSoftBody
           NO_DEFAULT_PATH)
 find_library(DRAPE_BULLET_SOFT BulletSoftBody)
 find_library(DRAPE_BULLET_DYN BulletDynamics)
 find_library(DRAPE_BULLET_COLL BulletCollision)
 find_library(DRAPE_BULLET_MATH LinearMath)
-set(DRAPE_HAVE_BULLET OFF)
-if(DRAPE_BULLET_INCLUDE AND DRAPE_BULLET_SOFT AND DRAPE_BULLET_DYN AND DRAPE_BULLET_COLL
-   AND DRAPE_BULLET_MATH)
-  set(DRAPE_HAVE_BULLET ON)
+if(NOT (DRAPE_BULLET_INCLUDE AND DRAPE_BULLET_SOFT AND DRAPE_BULLET_DYN AND DRAPE_BULLET_COLL
+        AND DRAPE_BULLET_MATH))
+  message(FATAL_ERROR "Bullet soft body not found (Debian package libbullet-dev; `./drape setup` "
+                      "installs it), needed by the solver study's peer (bench/bullet_peer.cpp)")
 endif()
 foreach(tgt solvers_bench bullet_peer_bench)
   if(TARGET ${tgt})
     target_sources(${tgt} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/bullet_peer.cpp)
-    if(DRAPE_HAVE_BULLET)
-      # System headers: Bullet's own warnings are not ours (-Werror in CI).
-      target_include_directories(${tgt} SYSTEM PRIVATE /usr/include/bullet)
-      target_link_libraries(${tgt} PRIVATE ${DRAPE_BULLET_SOFT} ${DRAPE_BULLET_DYN}
-                                           ${DRAPE_BULLET_COLL} ${DRAPE_BULLET_MATH})
-    else()
-      target_compile_definitions(${tgt} PRIVATE DRAPE_NO_BULLET=1)
-    endif()
+    # System headers: Bullet's own warnings are not ours (-Werror in CI).
+    target_include_directories(${tgt} SYSTEM PRIVATE /usr/include/bullet)
+    target_link_libraries(${tgt} PRIVATE ${DRAPE_BULLET_SOFT} ${DRAPE_BULLET_DYN}
+                                         ${DRAPE_BULLET_COLL} ${DRAPE_BULLET_MATH})
   endif()
 endforeach()
 # Smoke check of the peer (ctest, label "bench"): Bullet on an 8x8 sheet at 40 substeps, every
 # position finite and the RMS error against the static Newton minimum under 2 mm.
-if(TARGET bullet_peer_bench AND DRAPE_HAVE_BULLET)
+if(TARGET bullet_peer_bench)
   add_test(NAME bench_bullet_peer_smoke
            COMMAND bullet_peer_bench --res 8 --runs 40x1 --check-rms 2
            WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})

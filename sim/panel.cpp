@@ -18,6 +18,17 @@ int grid_count(double len, double spacing) {
   return std::max(2, static_cast<int>(std::lround(len / spacing)) + 1);
 }
 
+// Barycentric coordinates of material point m in triangle ti (negative outside).
+Vec3 material_barycentric(const ClothTopology& t, int ti, const Vec2& m) {
+  const auto& tri = t.triangles[ti];
+  const Vec2 a = t.material[tri[0]], b = t.material[tri[1]], c = t.material[tri[2]];
+  const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  const Vec2 q = m - a;
+  const double l1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
+  const double l2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
+  return Vec3(1 - l1 - l2, l1, l2);
+}
+
 }  // namespace
 
 std::string validate_panel(const PanelDesign& d, const std::string& where, const DressForm* form,
@@ -194,13 +205,7 @@ int Panel::locate(const Vec2& m, Vec3* bary) const {
   Vec3 best_b(1.0 / 3, 1.0 / 3, 1.0 / 3);
   for (int k = 0; k < 2; ++k) {
     const int ti = cell_triangle(ci, cj, k);
-    const auto& tri = t.triangles[ti];
-    const Vec2 a = t.material[tri[0]], b = t.material[tri[1]], c = t.material[tri[2]];
-    const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-    const Vec2 q = m - a;
-    const double l1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
-    const double l2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
-    const Vec3 bc(1 - l1 - l2, l1, l2);
+    const Vec3 bc = material_barycentric(t, ti, m);
     if (bc.minCoeff() > best_min) {
       best_min = bc.minCoeff();
       best = ti;
@@ -223,13 +228,7 @@ int Panel::locate_in_zone(const Vec2& m, int zone, Vec3* bary) const {
       for (int k = 0; k < 2; ++k) {
         const int ti = cell_triangle(ci, cj, k);
         if (t.triangle_zone[ti] != zone) continue;
-        const auto& tri = t.triangles[ti];
-        const Vec2 a = t.material[tri[0]], b = t.material[tri[1]], c = t.material[tri[2]];
-        const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-        const Vec2 q = m - a;
-        const double l1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
-        const double l2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
-        const Vec3 bc(1 - l1 - l2, l1, l2);
+        const Vec3 bc = material_barycentric(t, ti, m);
         if (bc.minCoeff() > best_min) {
           best_min = bc.minCoeff();
           best = ti;
