@@ -114,9 +114,25 @@ float form_distance(const sim::DressForm& form, const V3& p) {
   return static_cast<float>(std::sqrt(dx * dx + dz * dz) - ((1 - fj) * r0 + fj * r1));
 }
 
+FormLod form_lod_for_pixels(float rad_per_pixel, float quad_px) {
+  FormLod lod;
+  if (!(rad_per_pixel > 0) || !(quad_px > 0)) return lod;
+  const float quad_m = quad_px * rad_per_pixel;  // at 1 m
+  lod.section_spacing = std::clamp(quad_m, 0.008f, 0.03f);
+  constexpr float kGirth = 1.3f;  // m, a generous bust girth
+  lod.angle_step = 1;
+  while (lod.angle_step < 32 &&
+         kGirth / (sim::DressForm::kAngles / (2.0f * lod.angle_step)) <= lod.section_spacing)
+    lod.angle_step *= 2;
+  return lod;
+}
+
 void append_form(const sim::DressForm& form, float max_spacing, const DrawOptions& opt, Mesh& out) {
   const int ns = form.num_sections();
-  constexpr int na = sim::DressForm::kAngles;
+  // Every astep-th of the form's angles (a power of two dividing kAngles).
+  int astep = 1;
+  while (astep < 32 && 2 * astep <= opt.form_angle_step) astep *= 2;
+  const int na = sim::DressForm::kAngles / astep;
   if (ns < 2) return;
   // Keep every step-th section (and the last) so the drawn grid is about max_spacing apart.
   const int step = std::max(1, static_cast<int>(max_spacing / form.section_spacing()));
@@ -129,7 +145,7 @@ void append_form(const sim::DressForm& form, float max_spacing, const DrawOption
     const int j = rows[i];
     const sim::Vec2 c = form.centre(j);
     for (int n = 0; n < na; ++n) {
-      const double th = sim::DressForm::theta(n), r = form.radius(j, n);
+      const double th = sim::DressForm::theta(n * astep), r = form.radius(j, n * astep);
       pts[static_cast<size_t>(i) * na + n] =
           V3(static_cast<float>(c.x() + r * std::sin(th)), static_cast<float>(form.section_y(j)),
              static_cast<float>(c.y() + r * std::cos(th)));
@@ -167,10 +183,10 @@ void append_form(const sim::DressForm& form, float max_spacing, const DrawOption
     out.vertices.push_back(make_vertex(centre, n, opt.form_colour, ShadeMode::kLit));
     for (int k = 0; k < na; ++k)
       out.vertices.push_back(make_vertex(P(i, k), n, opt.form_colour, ShadeMode::kLit));
-    for (int k = 0; k < na; ++k) {
+    for (int k = 0; k < na; ++k) {  // counter-clockwise seen from outside (below / above)
       out.indices.push_back(cb);
-      out.indices.push_back(cb + 1 + k);
-      out.indices.push_back(cb + 1 + (k + 1) % na);
+      out.indices.push_back(cb + 1 + (cap == 0 ? (k + 1) % na : k));
+      out.indices.push_back(cb + 1 + (cap == 0 ? k : (k + 1) % na));
     }
   }
 }

@@ -65,12 +65,27 @@ struct DrawOptions {
   std::array<float, 3> cloth_colour{0.92f, 0.89f, 0.80f};      // unbleached muslin
   std::array<float, 3> form_colour{0.62f, 0.52f, 0.40f};       // linen-covered form
   float form_section_spacing = 0.008f;  // decimation of the form's sections for drawing (m)
+  // Decimation of the form's 256 angles for drawing: every form_angle_step-th angle (1, 2, 4, 8,
+  // 16 or 32; others round down to one of these). The XR app picks both from its eyes' pixel size
+  // (form_lod_for_pixels): lavapipe's cost is dominated by vertices, not pixels.
+  int form_angle_step = 1;
   // Live hands (see HandOverlay). A hand given here replaces the snapshot's proxy of the same
   // id; the candidate highlight of that hand is joined to its pointer by a thin line.
   std::vector<HandOverlay> hands;
 };
 
+// Level of detail of the drawn form for a view whose pixels subtend `rad_per_pixel` (radians):
+// grid quads about `quad_px` pixels on a surface 1 m away (the form stands ~1 m from the head),
+// sections 8 mm to 30 mm apart, angle step so that a 1.3 m girth keeps that size.
+struct FormLod {
+  float section_spacing = 0.008f;
+  int angle_step = 1;
+};
+FormLod form_lod_for_pixels(float rad_per_pixel, float quad_px = 8.0f);
+
 // The dress form as a smooth grid of its sections (normals from the grid), capped, in form mode.
+// Every opt.form_angle_step-th angle is used. The grid and both caps are wound counter-clockwise
+// seen from outside (back faces may be culled).
 void append_form(const sim::DressForm& form, float max_section_spacing, const DrawOptions& opt,
                  Mesh& out);
 // The cloth (two-sided in the shader) with the snapshot's normals (recomputed here when the

@@ -100,7 +100,7 @@ struct Renderer::Impl {
   VkShaderModule vs = VK_NULL_HANDLE, fs = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
   std::map<std::tuple<VkFormat, int, VkImageLayout>, VkRenderPass> passes;
-  std::map<std::pair<VkFormat, int>, VkPipeline> pipelines;
+  std::map<std::tuple<VkFormat, int, uint32_t>, VkPipeline> pipelines;  // + modes mask
   std::map<std::tuple<uint32_t, uint32_t, VkFormat, int>, std::pair<Attachment, Attachment>>
       attachments;  // (depth, msaa colour) per size/format/samples
   std::map<TargetKey, TargetFb> targets;
@@ -111,14 +111,31 @@ struct Renderer::Impl {
   Buffer readback;
 
   // Geometry: the static part (form, floor) is rebuilt only when the form or options change.
-  Buffer static_vb, static_ib, dyn_vb, dyn_ib;
+  Buffer static_vb, static_ib, cloth_vb, cloth_ib, dyn_vb, dyn_ib;
   uint32_t static_count = 0;
+  uint32_t static_split = 0;  // indices [0, split): the form; [split, count): the floor
+  uint32_t static_modes[2] = {0, 0}, cloth_modes = 0;
   const sim::DressForm* cached_form = nullptr;
   std::shared_ptr<const sim::DressForm> form_ref;  // keeps the cached form alive
   bool cached_floor = false;
   float cached_spacing = -1;
+  int cached_angle_step = -1;
   std::array<float, 3> cached_colour{-1, -1, -1};
   Mesh mesh;
+  // The cloth's vertices are kept while the snapshot's cloth and the options colouring it are
+  // unchanged (a free-running sim publishes slower than the frames are drawn).
+  struct ClothInputs {
+    std::vector<sim::Vec3f> positions, normals;
+    std::vector<sim::Vec2f> material;
+    std::vector<uint32_t> indices;
+    std::vector<float> strain;
+    const sim::DressForm* form = nullptr;
+    ColourMap colour_map = ColourMap::kNone;
+    float strain_range = 0, ease_range = 0;
+    std::array<float, 3> colour{};
+  } cloth_in;
+  bool cloth_valid = false;
+  uint32_t cloth_count = 0;
 
   ~Impl() { destroy(); }
 
@@ -266,7 +283,9 @@ struct Renderer::Impl {
     }
     attachments.clear();
     destroy_attachment(offscreen);
-    for (Buffer* b : {&readback, &static_vb, &static_ib, &dyn_vb, &dyn_ib}) destroy_buffer(*b);
+    for (Buffer* b : {&readback, &static_vb, &static_ib, &cloth_vb, &cloth_ib, &dyn_vb, &dyn_ib})
+      destroy_buffer(*b);
+    cloth_valid = false;
     for (auto& [k, p] : pipelines) vkDestroyPipeline(dev(), p, nullptr);
     pipelines.clear();
     for (auto& [k, p] : passes) vkDestroyRenderPass(dev(), p, nullptr);
@@ -360,9 +379,18 @@ struct Renderer::Impl {
     return rp;
   }
 
-  sim::Result<VkPipeline> pipeline_for(VkFormat fmt, VkRenderPass rp) {
-    const auto key = std::make_pair(fmt, samples);
+  // One pipeline per (format, samples, shading modes of the draw): the fragment shader is
+  // specialised to the modes present (scene.frag kModes).
+  sim::Result<VkPipeline> pipeline_for(VkFormat fmt, VkRenderPass rp, uint32_t modes) {
+    const auto key = std::make_tuple(fmt, samples, modes);
     if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
+    const auto spec_value = static_cast<int32_t>(modes);
+    const VkSpecializationMapEntry spec_entry{0, 0, sizeof(int32_t)};
+    VkSpecializationInfo spec{};
+    spec.mapEntryCount = 1;
+    spec.pMapEntries = &spec_entry;
+    spec.dataSize = sizeof(spec_value);
+    spec.pData = &spec_value;
     VkPipelineShaderStageCreateInfo stages[2]{};
     stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
     stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
@@ -371,6 +399,7 @@ struct Renderer::Impl {
     stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
     stages[1].module = fs;
     stages[1].pName = "main";
+    stages[1].pSpecializationInfo = &spec;
     VkVertexInputBindingDescription binding{0, sizeof(Vertex), VK_VERTEX_INPUT_RATE_VERTEX};
     VkVertexInputAttributeDescription attrs[5] = {
         {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, pos)},
@@ -504,121 +533,217 @@ struct Renderer::Impl {
 
   Status prepare_static(const sim::SceneSnapshot& snap, const DrawOptions& opt) {
     if (static_vb.buffer && cached_form == snap.form.get() && cached_floor == opt.floor_grid &&
-        cached_spacing == opt.form_section_spacing && cached_colour == opt.form_colour)
+        cached_spacing == opt.form_section_spacing && cached_angle_step == opt.form_angle_step &&
+        cached_colour == opt.form_colour)
       return {};
     mesh.clear();
     if (snap.form) append_form(*snap.form, opt.form_section_spacing, opt, mesh);
+    static_split = static_cast<uint32_t>(mesh.indices.size());
     if (opt.floor_grid) append_floor(mesh);
     if (Status s = upload(mesh, static_vb, static_ib); !s) return s;
     static_count = static_cast<uint32_t>(mesh.indices.size());
+    static_modes[0] = modes_of(mesh, 0, static_split);
+    static_modes[1] = modes_of(mesh, static_split, static_count);
     cached_form = snap.form.get();
     form_ref = snap.form;
     cached_floor = opt.floor_grid;
     cached_spacing = opt.form_section_spacing;
+    cached_angle_step = opt.form_angle_step;
     cached_colour = opt.form_colour;
     return {};
   }
 
-  // Records and submits one frame into `t`; when `copy_to` is set, also copies the result into
-  // the readback buffer. Waits for completion.
-  Status draw(const sim::SceneSnapshot& snap, const View& view, const ColorTarget& t,
-              const DrawOptions& opt, bool readback_copy) {
-    if (lost) return Status{"vulkan: the device was lost earlier; recreate the renderer"};
-    if (!t.image || t.width == 0 || t.height == 0)
-      return Status{"render: target image is null or has zero size"};
-    const double cpu0 = thread_cpu_ms();
-    auto t0 = Clock::now();
-    if (Status s = prepare_static(snap, opt); !s) return s;
+  // The shading modes (bit m = ShadeMode m) of the triangles indices[first, last) of m.
+  static uint32_t modes_of(const Mesh& m, size_t first, size_t last) {
+    uint32_t mask = 0;
+    for (size_t i = first; i < last; ++i) {
+      const int mode = static_cast<int>(m.vertices[m.indices[i]].aux[0] + 0.5f);
+      if (mode >= 0 && mode < 31) mask |= 1u << mode;
+    }
+    return mask;
+  }
+
+  template <class T>
+  static bool same(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+  }
+
+  // Rebuilds and uploads the cloth's vertices unless the inputs equal the cached ones.
+  // Returns whether it rebuilt; *upload_ms gets the copy time.
+  sim::Result<bool> prepare_cloth(const sim::SceneSnapshot& snap, const DrawOptions& opt,
+                                  double* upload_ms) {
+    ClothInputs& c = cloth_in;
+    const bool uses_strain = opt.colour_map == ColourMap::kStrain;
+    const sim::DressForm* form = opt.colour_map == ColourMap::kEase ? snap.form.get() : nullptr;
+    if (cloth_valid && cloth_vb.buffer && same(c.positions, snap.positions) &&
+        same(c.normals, snap.normals) && same(c.material, snap.material) &&
+        same(c.indices, snap.indices) && (!uses_strain || same(c.strain, snap.strain)) &&
+        c.form == form && c.colour_map == opt.colour_map && c.strain_range == opt.strain_range &&
+        c.ease_range == opt.ease_range && c.colour == opt.cloth_colour)
+      return false;
+    cloth_valid = false;
     mesh.clear();
     append_cloth(snap, opt, mesh);
+    const auto t0 = Clock::now();
+    if (Status s = upload(mesh, cloth_vb, cloth_ib); !s) return sim::Error{s.error};
+    *upload_ms += ms_since(t0);
+    cloth_count = static_cast<uint32_t>(mesh.indices.size());
+    cloth_modes = modes_of(mesh, 0, mesh.indices.size());
+    c.positions = snap.positions;
+    c.normals = snap.normals;
+    c.material = snap.material;
+    c.indices = snap.indices;
+    if (uses_strain)
+      c.strain = snap.strain;
+    else
+      c.strain.clear();
+    c.form = form;
+    c.colour_map = opt.colour_map;
+    c.strain_range = opt.strain_range;
+    c.ease_range = opt.ease_range;
+    c.colour = opt.cloth_colour;
+    cloth_valid = true;
+    return true;
+  }
+
+  // Records and submits one frame into every target of `views` (the geometry is built and
+  // uploaded once); with `readback_copy` (one view) also copies the result into the readback
+  // buffer. Waits for completion.
+  Status draw(const sim::SceneSnapshot& snap, const ViewTarget* views, int count,
+              const DrawOptions& opt, bool readback_copy) {
+    if (lost) return Status{"vulkan: the device was lost earlier; recreate the renderer"};
+    if (!views || count <= 0) return Status{"render: no view to draw"};
+    for (int i = 0; i < count; ++i) {
+      const ColorTarget& t = views[i].target;
+      if (!t.image || t.width == 0 || t.height == 0)
+        return Status{"render: target image is null or has zero size"};
+    }
+    const double cpu0 = thread_cpu_ms();
+    auto t0 = Clock::now();
+    stats = FrameStats{};
+    stats.views = count;
+    if (Status s = prepare_static(snap, opt); !s) return s;
+    auto rebuilt = prepare_cloth(snap, opt, &stats.upload_ms);
+    if (!rebuilt) return Status{rebuilt.error()};
+    stats.cloth_rebuilt = *rebuilt;
+    mesh.clear();
     append_decorations(snap, opt, mesh);
     append_hand_overlays(snap, opt, mesh);
     const auto dyn_count = static_cast<uint32_t>(mesh.indices.size());
-    stats.triangles = (static_count + dyn_count) / 3;
-    stats.build_ms = ms_since(t0);
-    t0 = Clock::now();
+    const uint32_t dyn_modes = modes_of(mesh, 0, mesh.indices.size());
+    // The draws, roughly near to far (hands and decorations, cloth, form, floor) so that
+    // lavapipe's early depth test skips the shading of hidden pixels; each with a pipeline
+    // specialised to its shading modes.
+    struct DrawRange {
+      const Buffer *vb, *ib;
+      uint32_t first, count, modes;
+    };
+    const DrawRange ranges[4] = {
+        {&dyn_vb, &dyn_ib, 0, dyn_count, dyn_modes},
+        {&cloth_vb, &cloth_ib, 0, cloth_count, cloth_modes},
+        {&static_vb, &static_ib, 0, static_split, static_modes[0]},
+        {&static_vb, &static_ib, static_split, static_count - static_split, static_modes[1]}};
+    stats.triangles = (static_count + cloth_count + dyn_count) / 3;
+    const auto t_up = Clock::now();
     if (Status s = upload(mesh, dyn_vb, dyn_ib); !s) return s;
-
-    auto rp = pass_for(t.format, t.final_layout);
-    if (!rp) return Status{rp.error()};
-    auto pipe = pipeline_for(t.format, *rp);
-    if (!pipe) return Status{pipe.error()};
-    auto fb = framebuffer_for(t, *rp);
-    if (!fb) return Status{fb.error()};
-
-    PushConstants pc{};
-    const Mat4f vp = view.view_proj();
-    std::memcpy(pc.view_proj, vp.data(), sizeof(pc.view_proj));
-    pc.eye[0] = view.eye.x();
-    pc.eye[1] = view.eye.y();
-    pc.eye[2] = view.eye.z();
-    pc.eye[3] = opt.grain_spacing;
-    if (snap.form) {
-      const auto& lm = snap.form->landmarks();
-      pc.heights[0] = static_cast<float>(lm.waist_y);
-      pc.heights[1] = static_cast<float>(lm.hip_y);
-      pc.heights[2] = static_cast<float>(lm.bust_y);
-      pc.angles[0] = static_cast<float>(lm.centre_front_theta);
-      pc.angles[1] = static_cast<float>(lm.centre_back_theta);
-      pc.angles[2] = static_cast<float>(lm.left_side_theta);
-      pc.angles[3] = static_cast<float>(lm.right_side_theta);
-    }
-    pc.heights[3] = opt.line_half_width;
-    pc.flags[0] = static_cast<int32_t>(opt.colour_map);
-    pc.flags[1] = needs_shader_encode(t.format) ? 1 : 0;
-    pc.flags[2] = opt.grain ? 1 : 0;
+    stats.upload_ms += ms_since(t_up);
+    stats.build_ms = ms_since(t0) - stats.upload_ms;
+    t0 = Clock::now();
 
     vkResetCommandBuffer(cmd, 0);
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     if (VkResult r = vkBeginCommandBuffer(cmd, &bi); r != VK_SUCCESS)
       return fail("vkBeginCommandBuffer", r);
-    VkClearValue clears[3]{};
-    for (int i = 0; i < 3; ++i)
-      clears[0].color.float32[i] = pc.flags[1] ? srgb_encode(opt.background[i]) : opt.background[i];
-    clears[0].color.float32[3] = 1.0f;
-    clears[1].depthStencil = {1.0f, 0};
-    clears[2] = clears[0];
-    VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-    rbi.renderPass = *rp;
-    rbi.framebuffer = *fb;
-    rbi.renderArea = {{0, 0}, {t.width, t.height}};
-    rbi.clearValueCount = samples > 1 ? 3 : 2;
-    rbi.pClearValues = clears;
-    vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, *pipe);
-    VkViewport viewport{0, 0, static_cast<float>(t.width), static_cast<float>(t.height), 0, 1};
-    VkRect2D scissor{{0, 0}, {t.width, t.height}};
-    vkCmdSetViewport(cmd, 0, 1, &viewport);
-    vkCmdSetScissor(cmd, 0, 1, &scissor);
-    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                       sizeof(pc), &pc);
-    const VkDeviceSize zero = 0;
-    if (static_count) {
-      vkCmdBindVertexBuffers(cmd, 0, 1, &static_vb.buffer, &zero);
-      vkCmdBindIndexBuffer(cmd, static_ib.buffer, 0, VK_INDEX_TYPE_UINT32);
-      vkCmdDrawIndexed(cmd, static_count, 1, 0, 0, 0);
-    }
-    if (dyn_count) {
-      vkCmdBindVertexBuffers(cmd, 0, 1, &dyn_vb.buffer, &zero);
-      vkCmdBindIndexBuffer(cmd, dyn_ib.buffer, 0, VK_INDEX_TYPE_UINT32);
-      vkCmdDrawIndexed(cmd, dyn_count, 1, 0, 0, 0);
-    }
-    vkCmdEndRenderPass(cmd);
-    if (readback_copy) {
-      VkBufferImageCopy region{};
-      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, t.array_layer, 1};
-      region.imageExtent = {t.width, t.height, 1};
-      vkCmdCopyImageToBuffer(cmd, t.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1,
-                             &region);
-      VkBufferMemoryBarrier bar{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-      bar.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-      bar.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-      bar.srcQueueFamilyIndex = bar.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-      bar.buffer = readback.buffer;
-      bar.size = VK_WHOLE_SIZE;
-      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
-                           nullptr, 1, &bar, 0, nullptr);
+    for (int i = 0; i < count; ++i) {
+      const View& view = views[i].view;
+      const ColorTarget& t = views[i].target;
+      auto rp = pass_for(t.format, t.final_layout);
+      if (!rp) return Status{rp.error()};
+      auto fb = framebuffer_for(t, *rp);
+      if (!fb) return Status{fb.error()};
+
+      PushConstants pc{};
+      const Mat4f vp = view.view_proj();
+      std::memcpy(pc.view_proj, vp.data(), sizeof(pc.view_proj));
+      pc.eye[0] = view.eye.x();
+      pc.eye[1] = view.eye.y();
+      pc.eye[2] = view.eye.z();
+      pc.eye[3] = opt.grain_spacing;
+      if (snap.form) {
+        const auto& lm = snap.form->landmarks();
+        pc.heights[0] = static_cast<float>(lm.waist_y);
+        pc.heights[1] = static_cast<float>(lm.hip_y);
+        pc.heights[2] = static_cast<float>(lm.bust_y);
+        pc.angles[0] = static_cast<float>(lm.centre_front_theta);
+        pc.angles[1] = static_cast<float>(lm.centre_back_theta);
+        pc.angles[2] = static_cast<float>(lm.left_side_theta);
+        pc.angles[3] = static_cast<float>(lm.right_side_theta);
+      }
+      pc.heights[3] = opt.line_half_width;
+      pc.flags[0] = static_cast<int32_t>(opt.colour_map);
+      pc.flags[1] = needs_shader_encode(t.format) ? 1 : 0;
+      pc.flags[2] = opt.grain ? 1 : 0;
+
+      VkClearValue clears[3]{};
+      for (int k = 0; k < 3; ++k)
+        clears[0].color.float32[k] =
+            pc.flags[1] ? srgb_encode(opt.background[k]) : opt.background[k];
+      clears[0].color.float32[3] = 1.0f;
+      clears[1].depthStencil = {1.0f, 0};
+      clears[2] = clears[0];
+      VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+      rbi.renderPass = *rp;
+      rbi.framebuffer = *fb;
+      rbi.renderArea = {{0, 0}, {t.width, t.height}};
+      rbi.clearValueCount = samples > 1 ? 3 : 2;
+      rbi.pClearValues = clears;
+      vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+      VkViewport viewport{0, 0, static_cast<float>(t.width), static_cast<float>(t.height), 0, 1};
+      VkRect2D scissor{{0, 0}, {t.width, t.height}};
+      vkCmdSetViewport(cmd, 0, 1, &viewport);
+      vkCmdSetScissor(cmd, 0, 1, &scissor);
+      vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                         sizeof(pc), &pc);  // same layout for every pipeline below
+      const VkDeviceSize zero = 0;
+      VkPipeline bound = VK_NULL_HANDLE;
+      const Buffer* bound_vb = nullptr;
+      for (const DrawRange& d : ranges) {
+        if (!d.count) continue;
+        auto pipe = pipeline_for(t.format, *rp, d.modes);
+        if (!pipe) {
+          vkCmdEndRenderPass(cmd);
+          vkEndCommandBuffer(cmd);
+          return Status{pipe.error()};
+        }
+        if (*pipe != bound) {
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, *pipe);
+          bound = *pipe;
+        }
+        if (d.vb != bound_vb) {
+          vkCmdBindVertexBuffers(cmd, 0, 1, &d.vb->buffer, &zero);
+          vkCmdBindIndexBuffer(cmd, d.ib->buffer, 0, VK_INDEX_TYPE_UINT32);
+          bound_vb = d.vb;
+        }
+        vkCmdDrawIndexed(cmd, d.count, 1, d.first, 0, 0);
+      }
+      vkCmdEndRenderPass(cmd);
+      if (readback_copy && i == 0) {
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, t.array_layer, 1};
+        region.imageExtent = {t.width, t.height, 1};
+        vkCmdCopyImageToBuffer(cmd, t.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer,
+                               1, &region);
+        VkBufferMemoryBarrier bar{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+        bar.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        bar.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+        bar.srcQueueFamilyIndex = bar.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        bar.buffer = readback.buffer;
+        bar.size = VK_WHOLE_SIZE;
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
+                             nullptr, 1, &bar, 0, nullptr);
+      }
     }
     if (VkResult r = vkEndCommandBuffer(cmd); r != VK_SUCCESS) return fail("vkEndCommandBuffer", r);
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
@@ -627,7 +752,7 @@ struct Renderer::Impl {
     vkResetFences(dev(), 1, &fence);
     if (VkResult r = vkQueueSubmit(ctx->queue, 1, &si, fence); r != VK_SUCCESS)
       return fail("vkQueueSubmit", r);
-    stats.submit_ms = ms_since(t0);
+    stats.submit_ms = ms_since(t0) + stats.upload_ms;
     t0 = Clock::now();
     constexpr uint64_t kTimeoutNs = 60ull * 1000 * 1000 * 1000;
     VkResult r = vkWaitForFences(dev(), 1, &fence, VK_TRUE, kTimeoutNs);
@@ -665,8 +790,9 @@ struct Renderer::Impl {
             ensure_buffer(readback, VkDeviceSize(uw) * uh * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
         !s)
       return sim::Error{s.error};
-    ColorTarget t{offscreen.image, kFormat, uw, uh, 0, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
-    if (Status s = draw(snap, view, t, opt, true); !s) return sim::Error{s.error};
+    const ViewTarget vt{view, ColorTarget{offscreen.image, kFormat, uw, uh, 0,
+                                          VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL}};
+    if (Status s = draw(snap, &vt, 1, opt, true); !s) return sim::Error{s.error};
     Image img;
     img.width = w;
     img.height = h;
@@ -700,7 +826,13 @@ sim::Result<std::unique_ptr<Renderer>> Renderer::create_on(const ExternalDevice&
 
 Status Renderer::render(const sim::SceneSnapshot& snap, const View& view, const ColorTarget& t,
                         const DrawOptions& opt) {
-  return impl_->draw(snap, view, t, opt, false);
+  const ViewTarget vt{view, t};
+  return impl_->draw(snap, &vt, 1, opt, false);
+}
+
+Status Renderer::render_views(const sim::SceneSnapshot& snap, const ViewTarget* views, int count,
+                              const DrawOptions& opt) {
+  return impl_->draw(snap, views, count, opt, false);
 }
 
 sim::Result<Image> Renderer::render_offscreen(const sim::SceneSnapshot& snap, const View& view,

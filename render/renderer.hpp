@@ -40,11 +40,20 @@ struct Image {
 };
 
 struct FrameStats {
-  double build_ms = 0;       // CPU geometry (cloth, decorations; the form is cached)
-  double submit_ms = 0;      // upload, command recording, submission
-  double wait_ms = 0;        // waiting for the device (lavapipe: the rasterisation itself)
-  double thread_cpu_ms = 0;  // CPU time of the calling thread for the whole frame
-  size_t triangles = 0;
+  double build_ms = 0;         // CPU geometry (cloth, decorations; the form is cached)
+  double upload_ms = 0;        // copying the geometry into the vertex/index buffers
+  double submit_ms = 0;        // upload, command recording, submission (upload_ms included)
+  double wait_ms = 0;          // waiting for the device (lavapipe: the rasterisation itself)
+  double thread_cpu_ms = 0;    // CPU time of the calling thread for the whole frame
+  size_t triangles = 0;        // per view
+  int views = 0;               // views drawn by the call
+  bool cloth_rebuilt = false;  // the cloth's vertices were rebuilt and uploaded (else cached)
+};
+
+// One view of a multi-view frame (e.g. an XR eye): where it looks from and what it draws into.
+struct ViewTarget {
+  View view;
+  ColorTarget target;
 };
 
 class Renderer {
@@ -63,6 +72,11 @@ class Renderer {
   // to the XR compositor or presented).
   Status render(const sim::SceneSnapshot& snap, const View& view, const ColorTarget& target,
                 const DrawOptions& opt = {});
+  // Draws the same snapshot into several views (both XR eyes) with one geometry build and
+  // upload, one command buffer, one submission and one wait. The cloth's vertices are re-built
+  // only when the snapshot's cloth (or the options that colour it) changed since the last call.
+  Status render_views(const sim::SceneSnapshot& snap, const ViewTarget* views, int count,
+                      const DrawOptions& opt = {});
   // Draws into the renderer's own target and reads it back.
   sim::Result<Image> render_offscreen(const sim::SceneSnapshot& snap, const View& view, int width,
                                       int height, const DrawOptions& opt = {});

@@ -15,9 +15,15 @@ namespace {
 using Mat32 = Eigen::Matrix<double, 3, 2>;
 
 Eigen::Matrix2d clamp_psd(const Eigen::Matrix2d& S) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(S);
-  Eigen::Vector2d ev = es.eigenvalues().cwiseMax(0.0);
-  return es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+  // Closed form for a symmetric 2x2: eigenvalues m +- r; with one positive eigenvalue l1 the
+  // positive part is l1 P1, P1 = (S - l2 I) / (l1 - l2) the projector onto its eigenvector.
+  const double m = 0.5 * (S(0, 0) + S(1, 1));
+  const double d = 0.5 * (S(0, 0) - S(1, 1));
+  const double r = std::sqrt(d * d + S(0, 1) * S(0, 1));
+  const double l1 = m + r, l2 = m - r;
+  if (l2 >= 0) return S;
+  if (l1 <= 0) return Eigen::Matrix2d::Zero();
+  return (l1 / (l1 - l2)) * (S - l2 * Eigen::Matrix2d::Identity());
 }
 
 }  // namespace
@@ -55,6 +61,12 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
   hinge_v_.clear();
   hinge_k_.clear();
   hinge_w_.clear();
+  hinge_t_.clear();
+  tri_nh_.clear();
+  tri_S_off_.clear();
+  bend_off_.clear();
+  bend_col_.clear();
+  bend_val_.clear();
   // Springs added by add_spring() before build are kept only for the springs model rebuild.
   spring_v_.clear();
   spring_rest_.clear();
@@ -119,11 +131,14 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
             hinge_v_.push_back({e0, e1, oa, o});
             hinge_k_.push_back(K);
             hinge_w_.push_back(B * len * len / area);
+            hinge_t_.push_back({t1, ti});
             it->second.first = -1;  // a third triangle on this edge makes no further hinge
           }
         }
       }
     }
+    if (opt_.bending && opt_.bending_model == EnergyOptions::Bending::kTensor)
+      build_tensor_bending(cloth);
   } else {
     // The study's 8-neighbour springs: structural springs along grid rows/columns and both
     // diagonals of every cell (grid panels), else along triangle edges.
@@ -172,6 +187,324 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
   contacts_.clear();
   contacts_.reserve(num_vertices_);
   build_vertex_lists();
+}
+
+namespace {
+
+// Minimal CSR matrix and Gustavson products for cooking P (Eigen's general sparse products
+// cost ~0.3 s at 128^2; these ~30 ms).
+struct Csr {
+  std::vector<int> off{0}, col;
+  std::vector<double> val;
+  void reset(int rows) {
+    off.assign(1, 0);
+    off.reserve(rows + 1);
+    col.clear();
+    val.clear();
+  }
+  void push(int c, double v) {
+    col.push_back(c);
+    val.push_back(v);
+  }
+  void end_row() { off.push_back(static_cast<int>(col.size())); }
+  int rows() const { return static_cast<int>(off.size()) - 1; }
+};
+
+// C = A diag(s) B (s optional, over A's columns = B's rows); B has `ncols` columns. Rows of C
+// sorted by column, exact zeros kept (the pattern is what VBD's colouring needs).
+void spgemm(const Csr& A, const Csr& B, int ncols, Csr& C, const std::vector<double>* s) {
+  std::vector<double> acc(ncols, 0.0);
+  std::vector<int> mark(ncols, -1), touched;
+  C.reset(A.rows());
+  for (int i = 0; i < A.rows(); ++i) {
+    touched.clear();
+    for (int ka = A.off[i]; ka < A.off[i + 1]; ++ka) {
+      const int r = A.col[ka];
+      const double a = A.val[ka] * (s ? (*s)[r] : 1.0);
+      for (int kb = B.off[r]; kb < B.off[r + 1]; ++kb) {
+        const int j = B.col[kb];
+        if (mark[j] != i) {
+          mark[j] = i;
+          acc[j] = 0.0;
+          touched.push_back(j);
+        }
+        acc[j] += a * B.val[kb];
+      }
+    }
+    std::sort(touched.begin(), touched.end());
+    for (int j : touched) C.push(j, acc[j]);
+    C.end_row();
+  }
+}
+
+// C = A + B (same row count).
+void spadd(const Csr& A, const Csr& B, int ncols, Csr& C) {
+  C.reset(A.rows());
+  std::vector<double> acc(ncols, 0.0);
+  std::vector<int> mark(ncols, -1), touched;
+  for (int i = 0; i < A.rows(); ++i) {
+    touched.clear();
+    for (const Csr* M : {&A, &B})
+      for (int k = M->off[i]; k < M->off[i + 1]; ++k) {
+        const int j = M->col[k];
+        if (mark[j] != i) {
+          mark[j] = i;
+          acc[j] = 0.0;
+          touched.push_back(j);
+        }
+        acc[j] += M->val[k];
+      }
+    std::sort(touched.begin(), touched.end());
+    for (int j : touched) C.push(j, acc[j]);
+    C.end_row();
+  }
+}
+
+void transpose(const Csr& A, int ncols, Csr& T) {
+  T.off.assign(ncols + 1, 0);
+  for (int c : A.col) ++T.off[c + 1];
+  for (int j = 0; j < ncols; ++j) T.off[j + 1] += T.off[j];
+  T.col.assign(A.col.size(), 0);
+  T.val.assign(A.col.size(), 0.0);
+  std::vector<int> fill(T.off.begin(), T.off.end() - 1);
+  for (int i = 0; i < A.rows(); ++i)
+    for (int k = A.off[i]; k < A.off[i + 1]; ++k) {
+      const int p = fill[A.col[k]]++;
+      T.col[p] = i;
+      T.val[p] = A.val[k];
+    }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Bending, kTensor (docs/solvers.md "Bending"): per triangle, the shape operator S = (S_uu,
+// S_vv, S_uv) in material coordinates is recovered from the (up to) three hinge angles of its
+// edges, theta_e = L_e . S, and E_t = 1/2 A_t S^T D S with D = diag(B_weft, B_warp, 2 B_twist).
+// With fewer than three hinges (free boundary) S is the least-energy one compatible with the
+// known angles; both cases are E_t = 1/2 theta^T C_t theta, C_t = A_t (L D^-1 L^T)^-1. The
+// angles are replaced by the linear hinge vectors s_e = sum_k K_ek x_k (|s_e| ~ theta_e), so
+// E = 1/2 sum_t sum_ij C_t,ij s_i . s_j = 1/2 x^T (P (x) I3) x, P = sum_t K_t^T C_t K_t.
+
+void ClothEnergy::build_tensor_bending(const Cloth& cloth) {
+  const auto& M = cloth.topo.material;
+  const FabricParams& fab = cloth.fabric;
+  const double bu = std::max(fab.bending_weft, 0.0), bv = std::max(fab.bending_warp, 0.0);
+  const double bt = opt_.bending_twist > 0 ? opt_.bending_twist : std::sqrt(bu * bv);
+  const double bmax = std::max({bu, bv, bt});
+  const int nt = num_triangles(), nh = num_hinges(), n = num_vertices_;
+  tri_nh_.assign(nt, 0);
+  bend_D_ = Eigen::Vector3d(bu, bv, 2 * bt);
+  if (!(bmax > 0) || nh == 0) return;
+  // D^-1 (a zero rigidity is floored at 1e-9 of the largest: that mode is then nearly free).
+  const Eigen::Vector3d dinv(1.0 / std::max(bu, 1e-9 * bmax), 1.0 / std::max(bv, 1e-9 * bmax),
+                             1.0 / (2.0 * std::max(bt, 1e-9 * bmax)));
+  std::vector<char> rigid(nt, 0);
+  for (int t = 0; t < nt; ++t) {
+    const auto& tv = tri_v_[t];
+    rigid[t] = opt_.rigid_boundary_hinges && !cloth.is_free(tv[0]) && !cloth.is_free(tv[1]) &&
+               !cloth.is_free(tv[2]);
+  }
+  // L_e = 1/2 sum_k K_ek q(p_k), q(p) = (u^2, v^2, 2uv), p relative to the edge's first vertex:
+  // theta_e for the height field z = 1/2 p^T S p (K annihilates affine fields, so the origin
+  // does not matter). Next to a rigid (clamped) triangle the rigid side does not curve: its
+  // opposite vertex takes the chord value along the edge (foot parameter s: s q(p_1)), so the
+  // hinge angle is that of the free side alone (theta = S_nn h_free / 2).
+  auto q = [](const Vec2& p) {
+    return Eigen::Vector3d(p.x() * p.x(), p.y() * p.y(), 2 * p.x() * p.y());
+  };
+  std::vector<Eigen::Vector3d> L(nh), Nn(nh);
+  std::vector<double> len(nh);
+  for (int h = 0; h < nh; ++h) {
+    const auto& v = hinge_v_[h];
+    const auto& K = hinge_k_[h];
+    const Vec2 o = M[v[0]];
+    const Vec2 e = M[v[1]] - o;
+    const bool r1 = rigid[hinge_t_[h][0]], r2 = rigid[hinge_t_[h][1]];
+    Eigen::Vector3d acc = K[1] * q(e);
+    for (int k = 2; k < 4; ++k) {
+      const Vec2 p = M[v[k]] - o;
+      const bool chord = (k == 2 ? r1 : r2) && !(r1 && r2);
+      acc += K[k] * (chord ? Eigen::Vector3d(p.dot(e) / e.squaredNorm() * q(e)) : q(p));
+    }
+    L[h] = 0.5 * acc;
+    len[h] = e.norm();
+    const double nu = -e.y() / len[h], nv = e.x() / len[h];
+    Nn[h] = Eigen::Vector3d(nu * nu, nv * nv, nu * nv);  // n n^T as (uu, vv, uv)
+  }
+  // Hinges and deformable edge-neighbours per triangle.
+  std::vector<std::array<int, 3>> th(nt, {-1, -1, -1}), tn(nt, {-1, -1, -1});
+  for (int h = 0; h < nh; ++h)
+    for (int side = 0; side < 2; ++side) {
+      const int t = hinge_t_[h][side], o = hinge_t_[h][1 - side];
+      if (rigid[t] || tri_nh_[t] >= 3) continue;
+      tn[t][tri_nh_[t]] = rigid[o] ? -1 : o;
+      th[t][tri_nh_[t]++] = h;
+    }
+  // Raw per-triangle estimates S_t = G_t theta (rows 3t..3t+2 over hinge columns).
+  // Local: S = D^-1 L^T (L D^-1 L^T)^-1 theta over the triangle's k hinges (= L^-1 theta with
+  // three hinges: exact for any constant S; with fewer, the least-energy S compatible with the
+  // known angles: a free edge resists no curvature on its own).
+  // Divergence form: S_t = 1/A_t sum_e beta_e |e| theta_e n_e n_e^T (the distributional Hessian
+  // of the piecewise-linear surface, beta = 1/2; 1 next to a rigid triangle).
+  Csr Gloc, Gdiv;  // rows 3t + c, columns hinges (the same pattern)
+  Gloc.reset(3 * nt);
+  Gdiv.reset(3 * nt);
+  for (int t = 0; t < nt; ++t) {
+    const int k = tri_nh_[t];
+    if (k > 0) {
+      Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
+      Eigen::Matrix3d Lt = Eigen::Matrix3d::Zero();
+      for (int a = 0; a < k; ++a) Lt.row(a) = L[th[t][a]].transpose();
+      for (int a = 0; a < k; ++a)
+        for (int b = 0; b < k; ++b) G(a, b) = L[th[t][a]].dot(dinv.cwiseProduct(L[th[t][b]]));
+      const double scale = std::max(G.trace() / k, 1e-300);
+      for (int a = k; a < 3; ++a) G(a, a) = scale;
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(G);
+      const Eigen::Vector3d ev = es.eigenvalues();
+      Eigen::Vector3d evi;
+      for (int c = 0; c < 3; ++c) evi[c] = ev[c] > 1e-12 * ev.cwiseAbs().maxCoeff() ? 1 / ev[c] : 0;
+      const Eigen::Matrix3d Gi =
+          es.eigenvectors() * evi.asDiagonal() * es.eigenvectors().transpose();
+      const Eigen::Matrix3d Mloc = dinv.asDiagonal() * Lt.transpose() * Gi;  // S = Mloc theta
+      for (int c = 0; c < 3; ++c) {
+        for (int a = 0; a < k; ++a) {
+          const int h = th[t][a];
+          const int other = hinge_t_[h][0] == t ? hinge_t_[h][1] : hinge_t_[h][0];
+          const double beta = rigid[other] ? 1.0 : 0.5;
+          Gloc.push(h, Mloc(c, a));
+          Gdiv.push(h, beta * len[h] / tri_area_[t] * Nn[h][c]);
+        }
+        Gloc.end_row();
+        Gdiv.end_row();
+      }
+    } else {
+      for (int c = 0; c < 3; ++c) Gloc.end_row(), Gdiv.end_row();
+    }
+  }
+  Csr Gs;
+  const auto est = opt_.curvature_estimator;
+  if (est == EnergyOptions::Curvature::kLocal) {
+    Gs = Gloc;
+  } else if (est == EnergyOptions::Curvature::kDivergence) {
+    Gs = Gdiv;
+  } else {
+    // kBlended: S = (I - W) S_loc + W S_div with the mass-conserving neighbour average
+    // (W X)_t = 1/A_t (Wb_tt A_t X_t + sum_{t' ~ t} 1/4 A_t' X_t'), Wb symmetric with unit row
+    // sums. sum_t A_t S_t = sum_t A_t S_div,t (the distributional Hessian: no zig-zag mode can
+    // bend the cloth for free), and S_t = S exactly for constant curvature wherever W removes
+    // the divergence form's element-to-element noise (the criss-cross grid: exact).
+    Csr W, Gdl = Gdiv;
+    for (size_t k = 0; k < Gdl.val.size(); ++k) Gdl.val[k] -= Gloc.val[k];
+    W.reset(3 * nt);
+    for (int t = 0; t < nt; ++t)
+      for (int c = 0; c < 3; ++c) {
+        if (tri_nh_[t] > 0) {
+          int nn = 0;
+          for (int a = 0; a < 3; ++a)
+            if (tn[t][a] >= 0 && tri_nh_[tn[t][a]] > 0) {
+              ++nn;
+              W.push(3 * tn[t][a] + c, 0.25 * tri_area_[tn[t][a]] / tri_area_[t]);
+            }
+          W.push(3 * t + c, 1.0 - 0.25 * nn);
+        }
+        W.end_row();
+      }
+    Csr WG;
+    spgemm(W, Gdl, nh, WG, nullptr);
+    for (int pass = 1; pass < opt_.curvature_smoothing; ++pass) {
+      Csr next;
+      spgemm(W, WG, nh, next, nullptr);
+      WG = std::move(next);
+    }
+    spadd(Gloc, WG, nh, Gs);
+  }
+  // S rows over vertices Gk = Gs Km (Km: hinge -> its 4 vertices with weights K), and
+  // P = Gk^T (A D) Gk.
+  Csr Km;
+  Km.reset(nh);
+  for (int h = 0; h < nh; ++h) {
+    for (int k = 0; k < 4; ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
+    Km.end_row();
+  }
+  Csr Gk, GkT, P;
+  spgemm(Gs, Km, n, Gk, nullptr);
+  transpose(Gk, n, GkT);
+  std::vector<double> ad(3 * nt);
+  for (int t = 0; t < nt; ++t)
+    for (int c = 0; c < 3; ++c) ad[3 * t + c] = tri_area_[t] * bend_D_[c];
+  spgemm(GkT, Gk, n, P, &ad);
+  // CSR with the diagonal always present.
+  bend_off_.assign(n + 1, 0);
+  bend_diag_.assign(n, 0.0);
+  bend_col_.clear();
+  bend_val_.clear();
+  for (int i = 0; i < n; ++i) {
+    bool diag = false;
+    for (int k = P.off[i]; k < P.off[i + 1]; ++k) {
+      if (!diag && P.col[k] > i) {
+        bend_col_.push_back(i);
+        bend_val_.push_back(0.0);
+        diag = true;
+      }
+      bend_col_.push_back(P.col[k]);
+      bend_val_.push_back(P.val[k]);
+      if (P.col[k] == i) {
+        bend_diag_[i] = P.val[k];
+        diag = true;
+      }
+    }
+    if (!diag) {
+      bend_col_.push_back(i);
+      bend_val_.push_back(0.0);
+    }
+    bend_off_[i + 1] = static_cast<int>(bend_col_.size());
+  }
+  tri_S_off_ = std::move(Gk.off);
+  tri_S_col_ = std::move(Gk.col);
+  tri_S_val_ = std::move(Gk.val);
+}
+
+double ClothEnergy::bending_triangle_energy(int t, const std::vector<Vec3>& x) const {
+  if (tri_S_off_.empty()) return 0.0;
+  double e = 0;
+  for (int c = 0; c < 3; ++c) {
+    Vec3 s = Vec3::Zero();
+    for (int k = tri_S_off_[3 * t + c]; k < tri_S_off_[3 * t + c + 1]; ++k)
+      s += tri_S_val_[k] * x[tri_S_col_[k]];
+    e += bend_D_[c] * s.squaredNorm();
+  }
+  return 0.5 * tri_area_[t] * e;
+}
+
+double ClothEnergy::bending_energy(const std::vector<Vec3>& x) const {
+  double e = 0;
+  if (tensor_bending()) {
+    for (int i = 0; i < num_vertices_; ++i) {
+      Vec3 g = Vec3::Zero();
+      for (int k = bend_off_[i]; k < bend_off_[i + 1]; ++k) g += bend_val_[k] * x[bend_col_[k]];
+      e += x[i].dot(g);
+    }
+    return 0.5 * e;
+  }
+  for (int h = 0; h < num_hinges(); ++h) e += hinge_energy(h, x);
+  return e;
+}
+
+void ClothEnergy::add_bending_gradient(const std::vector<Vec3>& x, std::vector<Vec3>& grad) const {
+  if (tensor_bending()) {
+    for (int i = 0; i < num_vertices_; ++i) {
+      Vec3 g = Vec3::Zero();
+      for (int k = bend_off_[i]; k < bend_off_[i + 1]; ++k) g += bend_val_[k] * x[bend_col_[k]];
+      grad[i] += g;
+    }
+    return;
+  }
+  Vec3 g[4];
+  for (int h = 0; h < num_hinges(); ++h) {
+    hinge_gradient(h, x, g);
+    for (int k = 0; k < 4; ++k) grad[hinge_v_[h][k]] += g[k];
+  }
 }
 
 void ClothEnergy::add_spring(int a, int b, double k, double rest) {
@@ -250,25 +583,59 @@ void ClothEnergy::tri_hessian(int t, const std::vector<Vec3>& x, Mat9& H, bool p
     }
 }
 
+namespace {
+
+// The VBD membrane block of vertex slot a of a triangle, in scalars (the hot path): adds the
+// gradient to g and the PSD 3x3 block to h (row-major, symmetric). fu, fv = columns of F.
+inline void membrane_block(const Vec3& x0, const Vec3& x1, const Vec3& x2,
+                           const Eigen::Matrix<double, 3, 2>& D, int a, double A, double ku,
+                           double kv, double kshear, Vec3& g, double h[9]) {
+  const Vec3 fu = x0 * D(0, 0) + x1 * D(1, 0) + x2 * D(2, 0);
+  const Vec3 fv = x0 * D(0, 1) + x1 * D(1, 1) + x2 * D(2, 1);
+  const double suu = ku * 0.5 * (fu.squaredNorm() - 1.0);
+  const double svv = kv * 0.5 * (fv.squaredNorm() - 1.0);
+  const double suv = kshear * fu.dot(fv);  // 2 G E_uv
+  const double du = D(a, 0), dv = D(a, 1);
+  g += A * ((suu * du + suv * dv) * fu + (suv * du + svv * dv) * fv);
+  // Positive part of S (closed form, see clamp_psd).
+  double puu = suu, pvv = svv, puv = suv;
+  const double m = 0.5 * (suu + svv), dd = 0.5 * (suu - svv);
+  const double r = std::sqrt(dd * dd + suv * suv);
+  const double l1 = m + r, l2 = m - r;
+  if (l2 < 0) {
+    if (l1 <= 0) {
+      puu = pvv = puv = 0;
+    } else {
+      const double c = l1 / (l1 - l2);
+      puu = c * (suu - l2);
+      pvv = c * (svv - l2);
+      puv = c * suv;
+    }
+  }
+  const double dSd = du * du * puu + 2 * du * dv * puv + dv * dv * pvv;
+  const Vec3 au = du * fu, av = dv * fv, as = 0.5 * (du * fv + dv * fu);
+  const double cu = A * ku, cv = A * kv, cs = 4.0 * A * kshear;
+  for (int r0 = 0; r0 < 3; ++r0)
+    for (int c0 = r0; c0 < 3; ++c0) {
+      const double v = cu * au[r0] * au[c0] + cv * av[r0] * av[c0] + cs * as[r0] * as[c0];
+      h[3 * r0 + c0] += v;
+    }
+  h[0] += A * dSd;
+  h[4] += A * dSd;
+  h[8] += A * dSd;
+}
+
+}  // namespace
+
 void ClothEnergy::tri_vertex_block(int t, int a, const std::vector<Vec3>& x, Vec3& g,
                                    Mat3& H) const {
-  Mat32 F;
-  Eigen::Matrix2d S;
-  stress(t, x, F, S);
-  const auto& D = tri_D_[t];
-  const double A = tri_area_[t];
-  const Eigen::Vector2d d = D.row(a).transpose();
-  g = A * F * (S * d);
-  // Closed form of the 3x3 block: A [ (d.Sp d) I + sum over strain components of C dE dE ].
-  // dF = e_c d^T, dE = 1/2 (d f_c^T + f_c d^T) with f_c = F^T e_c... computed column-wise.
-  const Eigen::Matrix2d Sp = (S.determinant() >= 0 && S.trace() >= 0) ? S : clamp_psd(S);
-  const double dSd = d.dot(Sp * d);
-  const Eigen::Vector3d fu = F.col(0), fv = F.col(1);
-  // dE_uu = d_u (fu . e_c), dE_vv = d_v (fv . e_c), dE_uv = 1/2 (d_u fv + d_v fu) . e_c
-  const Eigen::Vector3d au = d.x() * fu, av = d.y() * fv, as = 0.5 * (d.x() * fv + d.y() * fu);
-  // d(dP d)/..: H = A [ dSd I + ku au au^T + kv av av^T + 4 G as as^T ]
-  H = A * (dSd * Mat3::Identity() + ku_ * au * au.transpose() + kv_ * av * av.transpose() +
-           4.0 * kshear_ * as * as.transpose());
+  // H = A [ (d.S+ d) I + ku au au^T + kv av av^T + 4 G as as^T ], d = D.row(a), S+ = positive
+  // part of the second Piola stress, au = d_u f_u, av = d_v f_v, as = (d_u f_v + d_v f_u)/2.
+  const auto& v = tri_v_[t];
+  g.setZero();
+  double h[9] = {};
+  membrane_block(x[v[0]], x[v[1]], x[v[2]], tri_D_[t], a, tri_area_[t], ku_, kv_, kshear_, g, h);
+  H << h[0], h[1], h[2], h[1], h[4], h[5], h[2], h[5], h[8];
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -331,7 +698,7 @@ bool ClothEnergy::hinge_angle(int h, const std::vector<Vec3>& x, double& theta,
 
 double ClothEnergy::hinge_energy(int h, const std::vector<Vec3>& x) const {
   const auto& v = hinge_v_[h];
-  if (opt_.bending_model == EnergyOptions::Bending::kLinear) {
+  if (opt_.bending_model != EnergyOptions::Bending::kDihedral) {
     const auto& K = hinge_k_[h];
     const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
     return 0.5 * hinge_w_[h] * s.squaredNorm();
@@ -344,7 +711,7 @@ double ClothEnergy::hinge_energy(int h, const std::vector<Vec3>& x) const {
 
 void ClothEnergy::hinge_gradient(int h, const std::vector<Vec3>& x, Vec3 g[4]) const {
   const auto& v = hinge_v_[h];
-  if (opt_.bending_model == EnergyOptions::Bending::kLinear) {
+  if (opt_.bending_model != EnergyOptions::Bending::kDihedral) {
     const auto& K = hinge_k_[h];
     const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
     for (int k = 0; k < 4; ++k) g[k] = hinge_w_[h] * K[k] * s;
@@ -363,7 +730,7 @@ void ClothEnergy::hinge_hessian(int h, Mat12& H) const {
 }
 
 void ClothEnergy::hinge_hessian(int h, const std::vector<Vec3>& x, Mat12& H, bool project) const {
-  if (opt_.bending_model == EnergyOptions::Bending::kLinear) {
+  if (opt_.bending_model != EnergyOptions::Bending::kDihedral) {
     hinge_hessian(h, H);
     return;
   }
@@ -424,7 +791,7 @@ void ClothEnergy::hinge_vertex_block(int h, int a, const std::vector<Vec3>& x, V
                                      Mat3& H) const {
   const auto& v = hinge_v_[h];
   const double w = hinge_w_[h];
-  if (opt_.bending_model == EnergyOptions::Bending::kLinear) {
+  if (opt_.bending_model != EnergyOptions::Bending::kDihedral) {
     const auto& K = hinge_k_[h];
     const Vec3 s = K[0] * x[v[0]] + K[1] * x[v[1]] + K[2] * x[v[2]] + K[3] * x[v[3]];
     g = w * K[a] * s;
@@ -603,7 +970,7 @@ void ClothEnergy::project_contacts(std::vector<Vec3>& x) const {
 double ClothEnergy::energy(const std::vector<Vec3>& x, const std::vector<double>& mass) const {
   double e = 0;
   for (int t = 0; t < num_triangles(); ++t) e += tri_energy(t, x);
-  for (int h = 0; h < num_hinges(); ++h) e += hinge_energy(h, x);
+  e += bending_energy(x);
   for (int s = 0; s < num_springs(); ++s) e += spring_energy(s, x);
   for (int i = 0; i < num_vertices_; ++i) {
     if (opt_.gravity) e -= mass[i] * opt_.g.dot(x[i]);
@@ -631,10 +998,7 @@ void ClothEnergy::gradient(const std::vector<Vec3>& x, const std::vector<double>
     tri_gradient(t, x, g);
     for (int k = 0; k < 3; ++k) grad[tri_v_[t][k]] += g[k];
   }
-  for (int h = 0; h < num_hinges(); ++h) {
-    hinge_gradient(h, x, g);
-    for (int k = 0; k < 4; ++k) grad[hinge_v_[h][k]] += g[k];
-  }
+  add_bending_gradient(x, grad);
   for (int s = 0; s < num_springs(); ++s) {
     spring_gradient(s, x, g);
     grad[spring_v_[s][0]] += g[0];
@@ -649,21 +1013,32 @@ void ClothEnergy::gradient(const std::vector<Vec3>& x, const std::vector<double>
 void ClothEnergy::vertex_force_hessian(int i, const std::vector<Vec3>& x, double mass, Vec3& f,
                                        Mat3& H) const {
   f = external_force(i, x[i], mass);
-  H.setZero();
-  for (int e = vt_off_[i]; e < vt_off_[i + 1]; ++e) {
-    const int t = vt_[e] / 3, a = vt_[e] % 3;
-    Vec3 g;
-    Mat3 Hb;
-    tri_vertex_block(t, a, x, g, Hb);
+  {
+    Vec3 g = Vec3::Zero();
+    double h[9] = {};
+    for (int e = vt_off_[i]; e < vt_off_[i + 1]; ++e) {
+      const int t = vt_[e] / 3, a = vt_[e] % 3;
+      const auto& v = tri_v_[t];
+      membrane_block(x[v[0]], x[v[1]], x[v[2]], tri_D_[t], a, tri_area_[t], ku_, kv_, kshear_, g,
+                     h);
+    }
     f -= g;
-    H += Hb;
+    H << h[0], h[1], h[2], h[1], h[4], h[5], h[2], h[5], h[8];
   }
-  for (int e = vh_off_[i]; e < vh_off_[i + 1]; ++e) {
-    Vec3 g;
-    Mat3 Hb;
-    hinge_vertex_block(vh_[e] / 4, vh_[e] % 4, x, g, Hb);
+  if (tensor_bending()) {
+    // Constant P: g_i = sum_j P_ij x_j, H_ii = P_ii I (exact, PSD).
+    Vec3 g = Vec3::Zero();
+    for (int k = bend_off_[i]; k < bend_off_[i + 1]; ++k) g += bend_val_[k] * x[bend_col_[k]];
     f -= g;
-    H += Hb;
+    H.diagonal().array() += bend_diag_[i];
+  } else {
+    for (int e = vh_off_[i]; e < vh_off_[i + 1]; ++e) {
+      Vec3 g;
+      Mat3 Hb;
+      hinge_vertex_block(vh_[e] / 4, vh_[e] % 4, x, g, Hb);
+      f -= g;
+      H += Hb;
+    }
   }
   for (int e = vs_off_[i]; e < vs_off_[i + 1]; ++e) {
     const int s = vs_[e] / 2, a = vs_[e] % 2;
@@ -695,6 +1070,10 @@ void ClothEnergy::vertex_neighbours(std::vector<int>& offsets, std::vector<int>&
   for (const auto& t : tri_v_) link(t.data(), 3);
   for (const auto& h : hinge_v_) link(h.data(), 4);
   for (const auto& s : spring_v_) link(s.data(), 2);
+  // kTensor: P couples every pair of vertices of a triangle's three hinge stencils (2-ring).
+  for (int i = 0; i < static_cast<int>(bend_off_.size()) - 1; ++i)
+    for (int k = bend_off_[i]; k < bend_off_[i + 1]; ++k)
+      if (bend_col_[k] != i) adj[i].push_back(bend_col_[k]);
   offsets.assign(num_vertices_ + 1, 0);
   nbrs.clear();
   for (int i = 0; i < num_vertices_; ++i) {

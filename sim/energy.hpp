@@ -1,7 +1,8 @@
 // The cloth energy every solver minimises (docs/solvers.md):
 //   E(x) = membrane (anisotropic StVK on material coordinates: warp, weft, shear)
-//        + bending (discrete-shell dihedral-angle hinges, warp/weft rigidity; the former
-//          quadratic linear-operator hinge stays available as EnergyOptions::Bending::kLinear)
+//        + bending (default: a consistent anisotropic per-triangle shape-operator energy built
+//          from the hinge vectors, constant Hessian; the discrete-shell dihedral-angle hinges
+//          and the quadratic hinges stay available as EnergyOptions::Bending::kDihedral/kLinear)
 //        + gravity + optional weak pressure toward the form + contact penalty,
 // or, as a second model, the study's 8-neighbour springs (method eq. 3-1) + gravity + contact.
 // Everything is cooked once per topology_version into flat arrays (no allocation per step).
@@ -27,16 +28,47 @@ struct EnergyOptions {
   Vec3 g{0, -kGravity, 0};
   double pressure = 0.0;  // Pa: weak pressure pushing the cloth toward the form's axis
   bool bending = true;
-  // Bending hinge model. kDihedral (default): E = 1/2 w theta^2 with theta the dihedral angle
-  // between the two triangles' normals (discrete shells, Grinspun et al. 2003; rest angle 0:
-  // the material is flat). kLinear: E = 1/2 w |sum_k K_k x_k|^2 with the rest-state weights
-  // (Bergou et al. 2006 form; constant Hessian). Both use the same w and K.
-  enum class Bending { kDihedral, kLinear };
-  Bending bending_model = Bending::kDihedral;
+  // Bending model.
+  // kTensor (default): per triangle t the shape operator S = (S_uu, S_vv, S_uv) (material
+  //   coordinates) is recovered from the angles of its (up to three) hinges, theta_e = L_e . S
+  //   (exact for any constant curvature on any mesh), and E_t = 1/2 A_t (B_weft S_uu^2 +
+  //   B_warp S_vv^2 + 2 B_twist S_uv^2); a free edge (no hinge) leaves S to the least energy
+  //   (see curvature_estimator for how S_t is formed). theta_e is the linear hinge vector
+  //   s_e = sum_k K_k x_k, so E = 1/2 x^T (P (x) I3) x with a constant sparse PSD vertex matrix
+  //   P (the triangle, its neighbours and their flaps: ~32 entries per row): gradient P x,
+  //   Hessian P (x) I3.
+  // kDihedral: E = 1/2 w theta^2 per hinge with theta the dihedral angle between the two
+  //   triangles' normals (discrete shells, Grinspun et al. 2003; rest angle 0: flat material).
+  // kLinear: E = 1/2 w |sum_k K_k x_k|^2 per hinge (Bergou et al. 2006 form; constant Hessian).
+  // The hinge models use the same w and K. They are not consistent on the criss-cross grid
+  // (a warp bend can go through alternating diagonal folds: the Peirce strip is ~15-20 % too
+  // soft, docs/solvers.md "Cantilever").
+  enum class Bending { kTensor, kDihedral, kLinear };
+  Bending bending_model = Bending::kTensor;
+  // Twist rigidity B_twist (N m) of kTensor; <= 0: sqrt(bending_warp * bending_weft) (Huber's
+  // orthotropic-plate estimate with nu = 0; = B for an isotropic fabric: the nu = 0 plate).
+  double bending_twist = 0;
+  // kTensor's curvature estimate per triangle from the hinge angles (docs/solvers.md):
+  // kLocal: S_t = L_t^-1 theta_t (exact for constant curvature on any mesh, but its
+  //   element average is not the surface's: alternating diagonal folds bend a strip for
+  //   twist energy only; the Peirce strip comes out ~23 % soft);
+  // kDivergence: S_t = 1/A_t sum_e |e|/2 theta_e n_e n_e^T (the distributional Hessian; no
+  //   soft mode, but element-to-element noise: twist on the criss-cross grid 2x too stiff);
+  // kBlended (default): S = S_loc + W (S_div - S_loc), W a mass-conserving average over the
+  //   triangle and its edge neighbours: the average of kDivergence, the accuracy of kLocal
+  //   (exact on the criss-cross grid for any constant curvature).
+  enum class Curvature { kBlended, kLocal, kDivergence };
+  Curvature curvature_estimator = Curvature::kBlended;
+  // kBlended: number of W passes (W^k). 2 halves the error on irregular meshes (30 % jitter:
+  // <= 2.3 % instead of <= 6.6 %) at twice P's stencil (~59 entries per row, 27 VBD colours at
+  // 128^2 instead of 32 and 17); both are exact on the criss-cross grid.
+  int curvature_smoothing = 1;
   // A hinge between a deformable triangle and a rigid one (all three vertices pinned or
   // kinematic when the energy is built) takes only the deformable triangle's area as its dual
   // area: the clamped side does not bend, so the hinge's curvature theta/width lives on half
   // the usual strip. Without it a clamped edge is first-order wrong (docs/solvers.md).
+  // kTensor: rigid triangles store no bending energy, and such a hinge's L_e is that of the
+  // free side alone (the rigid opposite vertex is taken on the edge's chord).
   bool rigid_boundary_hinges = true;
   double contact_stiffness = 0;   // N/m per vertex; 0 = automatic (from mass and dt)
   double contact_margin = 0.005;  // m: contacts detected within offset + margin
@@ -77,10 +109,38 @@ class ClothEnergy {
   // The 3x3 block of vertex slot a (0..2) and that slot's gradient (for VBD).
   void tri_vertex_block(int t, int a, const std::vector<Vec3>& x, Vec3& g, Mat3& H) const;
 
+  // --- bending, whichever model --------------------------------------------------------------
+  double bending_energy(const std::vector<Vec3>& x) const;
+  void add_bending_gradient(const std::vector<Vec3>& x, std::vector<Vec3>& grad) const;
+  // kTensor: the constant vertex matrix P (E_bend = 1/2 sum_ij P_ij x_i . x_j), CSR with sorted
+  // columns, symmetric, diagonal always stored; empty for the hinge models.
+  bool tensor_bending() const { return !bend_col_.empty(); }
+  const std::vector<int>& bending_offsets() const { return bend_off_; }
+  const std::vector<int>& bending_columns() const { return bend_col_; }
+  const std::vector<double>& bending_values() const { return bend_val_; }
+  // kTensor: energy 1/2 A_t sum_c D_c |S_t,c|^2 of triangle t alone (S_t,c = its curvature
+  // rows below, vectors along the normal), and its number of own hinges (3: interior; 1-2:
+  // free boundary; 0: rigid or no hinge, no bending energy).
+  double bending_triangle_energy(int t, const std::vector<Vec3>& x) const;
+  int bending_triangle_hinges(int t) const { return tri_nh_.empty() ? 0 : tri_nh_[t]; }
+  // kTensor as linear vector constraints (for XPBD): row r = 3t + c (c = uu, vv, uv) is
+  // V_r = sum_k bending_row_values()[k] x[bending_row_columns()[k]] over
+  // k in [bending_row_offsets()[r], [r + 1]) (the curvature component c of triangle t, carried
+  // by the surface normal), and E_bend = 1/2 sum_r bending_row_stiffness(r) |V_r|^2.
+  int num_bending_rows() const {
+    return tri_S_off_.empty() ? 0 : static_cast<int>(tri_S_off_.size()) - 1;
+  }
+  const std::vector<int>& bending_row_offsets() const { return tri_S_off_; }
+  const std::vector<int>& bending_row_columns() const { return tri_S_col_; }
+  const std::vector<double>& bending_row_values() const { return tri_S_val_; }
+  double bending_row_stiffness(int r) const { return tri_area_[r / 3] * bend_D_[r % 3]; }
+
   // --- bending hinges ------------------------------------------------------------------------
   // Hinge h: edge (0, 1), opposite vertices 2 (first triangle) and 3 (second triangle).
   // kDihedral: E = 1/2 w theta^2, theta = signed dihedral angle (0 when flat, in (-pi, pi]);
   // kLinear:   E = 1/2 w |sum_k K_k x_k|^2.
+  // Under kTensor the per-hinge functions below evaluate the kLinear hinge (XPBD's bending
+  // constraint); the energy's bending term is then bending_energy(), not their sum.
   // w = B(n) |e|^2 / (A_1 + A_2) (rest areas; A of a rigid triangle left out, see
   // EnergyOptions::rigid_boundary_hinges), B(n) = bending_warp n_v^2 + bending_weft n_u^2 with
   // n the edge's in-plane normal in material space (the direction of curvature it resists).
@@ -161,6 +221,14 @@ class ClothEnergy {
   std::vector<std::array<int32_t, 4>> hinge_v_;  // edge (0,1), opposite (2,3)
   std::vector<std::array<double, 4>> hinge_k_;
   std::vector<double> hinge_w_;
+  std::vector<std::array<int32_t, 2>> hinge_t_;  // the triangles of slots 2 and 3
+  // kTensor: hinges per deformable triangle, its curvature rows S_t = sum_j G_tj x_j (CSR over
+  // rows 3t + c, c = uu, vv, uv), D = (B_weft, B_warp, 2 B_twist) and P in CSR.
+  std::vector<int> tri_nh_, tri_S_off_, tri_S_col_;
+  std::vector<double> tri_S_val_;
+  Eigen::Vector3d bend_D_ = Eigen::Vector3d::Zero();
+  std::vector<int> bend_off_, bend_col_;
+  std::vector<double> bend_val_, bend_diag_;
   // springs
   std::vector<std::array<int32_t, 2>> spring_v_;
   std::vector<double> spring_rest_, spring_k_;
@@ -176,6 +244,7 @@ class ClothEnergy {
   int culled_ = 0;
 
   void build_vertex_lists();
+  void build_tensor_bending(const Cloth& cloth);
   void stress(int t, const std::vector<Vec3>& x, Eigen::Matrix<double, 3, 2>& F,
               Eigen::Matrix2d& S) const;
 };

@@ -4,6 +4,20 @@
 
 namespace drape::sim {
 
+namespace {
+// Lists the items colour by colour (CSR: offsets per colour, items in index order).
+void bucket_by_colour(const std::vector<int>& colour, int colours, std::vector<int>& offsets,
+                      std::vector<int>& items) {
+  const int n = static_cast<int>(colour.size());
+  offsets.assign(colours + 1, 0);
+  for (int i = 0; i < n; ++i) ++offsets[colour[i] + 1];
+  for (int c = 0; c < colours; ++c) offsets[c + 1] += offsets[c];
+  items.assign(n, 0);
+  std::vector<int> fill(offsets.begin(), offsets.end() - 1);
+  for (int i = 0; i < n; ++i) items[fill[colour[i]]++] = i;
+}
+}  // namespace
+
 int greedy_colouring(const std::vector<int>& offsets, const std::vector<int>& nbrs,
                      std::vector<int>& colour_of, std::vector<int>& colour_offsets,
                      std::vector<int>& colour_items) {
@@ -28,12 +42,48 @@ int greedy_colouring(const std::vector<int>& offsets, const std::vector<int>& nb
     colour_of[i] = c;
     colours = std::max(colours, c + 1);
   }
-  colour_offsets.assign(colours + 1, 0);
-  for (int i = 0; i < n; ++i) ++colour_offsets[colour_of[i] + 1];
-  for (int c = 0; c < colours; ++c) colour_offsets[c + 1] += colour_offsets[c];
-  colour_items.assign(std::max(n, 0), 0);
-  std::vector<int> fill(colour_offsets.begin(), colour_offsets.end() - 1);
-  for (int i = 0; i < n; ++i) colour_items[fill[colour_of[i]]++] = i;
+  bucket_by_colour(colour_of, colours, colour_offsets, colour_items);
+  return colours;
+}
+
+int colour_elements(int num_vertices, const std::vector<int>& elem_offsets,
+                    const std::vector<int>& elem_verts, std::vector<int>& order,
+                    std::vector<int>& colour_offsets) {
+  const int m = static_cast<int>(elem_offsets.size()) - 1;
+  // Per vertex, the colours already used by its elements (64 per word, grown on demand).
+  std::vector<uint64_t> used(static_cast<size_t>(std::max(num_vertices, 0)), 0);
+  std::vector<std::vector<uint64_t>> more;  // words beyond the first, rarely needed
+  std::vector<int> colour(std::max(m, 0), 0);
+  int colours = 0;
+  for (int e = 0; e < m; ++e) {
+    int c = 0;
+    for (int word = 0;; ++word) {
+      uint64_t taken = 0;
+      for (int k = elem_offsets[e]; k < elem_offsets[e + 1]; ++k) {
+        const int v = elem_verts[k];
+        if (word == 0)
+          taken |= used[v];
+        else if (static_cast<int>(more.size()) >= word && !more[word - 1].empty())
+          taken |= more[word - 1][v];
+      }
+      if (taken != ~uint64_t{0}) {
+        c = 64 * word + __builtin_ctzll(~taken);
+        break;
+      }
+    }
+    const int word = c / 64;
+    if (word > 0) {
+      if (static_cast<int>(more.size()) < word) more.resize(word);
+      if (more[word - 1].empty()) more[word - 1].assign(used.size(), 0);
+    }
+    for (int k = elem_offsets[e]; k < elem_offsets[e + 1]; ++k) {
+      const int v = elem_verts[k];
+      (word == 0 ? used[v] : more[word - 1][v]) |= uint64_t{1} << (c % 64);
+    }
+    colour[e] = c;
+    colours = std::max(colours, c + 1);
+  }
+  bucket_by_colour(colour, colours, colour_offsets, order);
   return colours;
 }
 
@@ -48,21 +98,42 @@ ThreadPool::~ThreadPool() {
   for (auto& t : workers_) t.join();
 }
 
+// Chunks are claimed from one counter that also carries the generation (high 32 bits): the
+// caller claims chunks too, so when a worker is not scheduled (a loaded 2-core machine, the
+// renderer's threads) the caller simply runs every chunk itself and waits only for chunks a
+// worker has actually claimed and is running. A late worker cannot claim a chunk of a newer
+// generation with a stale task: its compare-exchange fails on the generation bits.
 void ThreadPool::run(int n, Thunk thunk, void* ctx) {
   thunk_ = thunk;
   ctx_ = ctx;
   n_ = n;
-  pending_.store(threads_ - 1, std::memory_order_relaxed);
-  generation_.fetch_add(1, std::memory_order_release);
+  const int chunks = std::min(n, threads_ * 4);
+  chunks_.store(chunks, std::memory_order_relaxed);
+  done_.store(0, std::memory_order_relaxed);
+  const uint64_t gen = generation_.load(std::memory_order_relaxed) + 1;
+  next_.store(gen << 32, std::memory_order_release);
+  generation_.store(gen, std::memory_order_release);
   generation_.notify_all();
-  const int chunk = (n + threads_ - 1) / threads_;
-  thunk(ctx, 0, std::min(n, chunk), 0);
-  // Wait for the workers: spin briefly, then block.
-  for (int spin = 0; pending_.load(std::memory_order_acquire) != 0; ++spin) {
-    if (spin > 2000) {
-      int p = pending_.load(std::memory_order_acquire);
-      if (p != 0) pending_.wait(p, std::memory_order_acquire);
-    }
+  work(gen, 0);
+  for (int spin = 0; done_.load(std::memory_order_acquire) != chunks; ++spin)
+    if (spin > 64) std::this_thread::yield();
+}
+
+void ThreadPool::work(uint64_t gen, int w) {
+  for (;;) {
+    uint64_t cur = next_.load(std::memory_order_acquire);
+    int k;
+    do {
+      if ((cur >> 32) != gen) return;
+      k = static_cast<int>(cur & 0xffffffffu);
+      if (k >= chunks_.load(std::memory_order_relaxed)) return;
+    } while (!next_.compare_exchange_weak(cur, cur + 1, std::memory_order_acq_rel));
+    // Claimed chunk k of this generation: the caller waits for it, so the task is valid.
+    const int64_t m = chunks_.load(std::memory_order_relaxed);
+    const int b = static_cast<int>(static_cast<int64_t>(n_) * k / m);
+    const int e = static_cast<int>(static_cast<int64_t>(n_) * (k + 1) / m);
+    if (b < e) thunk_(ctx_, b, e, w);
+    done_.fetch_add(1, std::memory_order_acq_rel);
   }
 }
 
@@ -76,10 +147,7 @@ void ThreadPool::worker_main(int w) {
     }
     seen = g;
     if (stop_.load()) return;
-    const int chunk = (n_ + threads_ - 1) / threads_;
-    const int b = std::min(n_, w * chunk), e = std::min(n_, (w + 1) * chunk);
-    if (b < e) thunk_(ctx_, b, e, w);
-    if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) pending_.notify_all();
+    work(g, w);
   }
 }
 

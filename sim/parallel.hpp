@@ -17,6 +17,14 @@ int greedy_colouring(const std::vector<int>& offsets, const std::vector<int>& nb
                      std::vector<int>& colour_of, std::vector<int>& colour_offsets,
                      std::vector<int>& colour_items);
 
+// Greedy colouring of elements (triangles, hinges, springs...) given their vertex lists in CSR
+// form (elem_offsets size m+1 over elem_verts): elements of one colour share no vertex, so a
+// colour can be projected in parallel. Returns the number of colours; `order` lists the
+// elements colour by colour and `colour_offsets` (size colours+1) delimits them.
+int colour_elements(int num_vertices, const std::vector<int>& elem_offsets,
+                    const std::vector<int>& elem_verts, std::vector<int>& order,
+                    std::vector<int>& colour_offsets);
+
 class ThreadPool {
  public:
   // threads = total workers including the caller (>= 1).
@@ -26,8 +34,10 @@ class ThreadPool {
   ThreadPool& operator=(const ThreadPool&) = delete;
   int size() const { return threads_; }
 
-  // Runs fn(begin, end, worker) over [0, n) split in size() contiguous chunks; returns when
-  // all are done. fn must be callable as void(int, int, int). No allocation.
+  // Runs fn(begin, end, worker) over [0, n) split in up to 4 size() contiguous chunks claimed
+  // by whichever thread is free (the caller included; fn may be called several times per
+  // thread, `worker` is the calling thread's index); returns when all are done. fn must be
+  // callable as void(int, int, int). No allocation.
   template <class Fn>
   void parallel_for(int n, Fn&& fn) {
     if (threads_ == 1 || n < min_parallel_) {
@@ -46,13 +56,16 @@ class ThreadPool {
     (*static_cast<Fn*>(f))(b, e, w);
   }
   void run(int n, Thunk thunk, void* ctx);
+  void work(uint64_t generation, int w);
   void worker_main(int w);
 
   int threads_;
   int min_parallel_ = 64;
   std::vector<std::thread> workers_;
   std::atomic<uint64_t> generation_{0};
-  std::atomic<int> pending_{0};
+  std::atomic<uint64_t> next_{0};  // generation << 32 | next chunk to claim
+  std::atomic<int> done_{0};       // chunks finished in this generation
+  std::atomic<int> chunks_{0};     // chunks of this generation
   std::atomic<bool> stop_{false};
   Thunk thunk_ = nullptr;
   void* ctx_ = nullptr;

@@ -10,6 +10,7 @@
 #include "sim/cloth.hpp"
 #include "sim/energy.hpp"
 #include "sim/scene.hpp"
+#include "sim/solver.hpp"
 
 namespace drape::sim {
 
@@ -19,6 +20,9 @@ struct StudyScene {
   SceneObjects objects;
   bool springs_model = false;  // the chain uses springs (no triangles)
   double duration = 2.0;       // simulated seconds before the error is measured
+  // Air drag (1/s) every solver of the study uses on this scene; < 0: the solvers' default
+  // (1/s). The form scene settles (its error is that of the settled drape, not of a swing).
+  double air_damping = -1;
 };
 
 // Muslin (or `fabric`) sheet of side 0.5 m with res x res vertices, hanging in the x-y plane
@@ -34,11 +38,16 @@ StudyScene make_cantilever(double overhang, double spacing, double width = 0.01,
 // A res x res muslin panel 0.5 x 0.5 m whose top edge is pinned across the upper chest of
 // the parametric 9AR form (form collision). fall = false (the app's default scenario): it
 // hangs straight down from the chest line, 1.5 s. fall = true (the study's "form" scene): it
-// starts horizontal, sticking forward, falls over the bust and drapes against it, 3 s.
+// starts horizontal, sticking forward, falls over the bust and drapes against it, 3 s, with
+// an air drag of 4/s so that it has settled when the error is measured.
 StudyScene make_form_drape(int res, const FabricParams& fabric = {}, bool fall = false);
 // A res x res panel 0.6 x 0.6 m dropped flat onto a sphere (r = 0.15 m) with its centre
 // vertex pinned on the sphere's top.
 StudyScene make_sphere_drape(int res, const FabricParams& fabric = {});
+// Drags the hanging sheet's top-right corner (its last vertex, pinned) along +x at 0.2 m/s for
+// `frames` frames of 1/90 s with `solver`; returns how far the bottom-left vertex moved (m).
+// Tests use it to check that a solver's resting (frozen) cloth wakes and follows.
+double drag_sheet_corner(StudyScene& sheet, Solver& solver, int frames);
 // By name: "sheet", "chain", "cantilever", "form", "sphere".
 StudyScene make_scene(const std::string& name, int res);
 

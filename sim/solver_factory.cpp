@@ -8,7 +8,8 @@
 
 namespace drape::sim {
 
-Result<std::unique_ptr<Solver>> make_solver(const std::string& name, const SolverConfig& cfg) {
+Result<std::unique_ptr<Solver>> make_solver(const std::string& name_in, const SolverConfig& cfg) {
+  const std::string name = name_in == "default" ? std::string(kDefaultSolver) : name_in;
   std::unique_ptr<Solver> s;
   EnergyOptions eo;
   if (cfg.springs_model) eo.model = EnergyOptions::Model::kSprings;
@@ -29,6 +30,8 @@ Result<std::unique_ptr<Solver>> make_solver(const std::string& name, const Solve
     if (cfg.substeps > 0) o.substeps = cfg.substeps;
     if (cfg.iterations > 0) o.iterations = cfg.iterations;
     if (cfg.air_damping >= 0) o.damping = cfg.air_damping;
+    o.threads = cfg.threads;
+    o.freeze = cfg.freeze;
     s = std::make_unique<XpbdSolver>(o);
   } else if (name == "newton") {
     NewtonOptions o;
@@ -36,14 +39,16 @@ Result<std::unique_ptr<Solver>> make_solver(const std::string& name, const Solve
     if (cfg.substeps > 0) o.substeps = cfg.substeps;
     if (cfg.iterations > 0) o.max_iterations = cfg.iterations;
     if (cfg.tolerance > 0) o.tolerance = cfg.tolerance;
+    if (cfg.air_damping >= 0) o.air_damping = cfg.air_damping;
     s = std::make_unique<NewtonSolver>(o);
   } else if (name == "verlet") {
     VerletParams p;
     if (cfg.substeps > 0) p.substeps = cfg.substeps;
+    if (cfg.air_damping >= 0) p.damping_rate = cfg.air_damping;
     s = std::make_unique<VerletSolver>(p);
   } else {
-    return make_error("make_solver",
-                      "unknown solver '" + name + "' (expected vbd, xpbd, newton or verlet)");
+    return make_error("make_solver", "unknown solver '" + name +
+                                         "' (expected default, vbd, xpbd, newton or verlet)");
   }
   if (cfg.watchdog) s = std::make_unique<WatchdogSolver>(std::move(s));
   return s;

@@ -107,12 +107,28 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) add_block(v[a], v[b], H9.block<3, 3>(3 * a, 3 * b));
     }
-    Mat12 H12;
-    for (int hh = 0; hh < energy_.num_hinges(); ++hh) {
-      energy_.hinge_hessian(hh, S.x, H12, true);
-      const auto& v = energy_.hinge(hh);
-      for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b) add_block(v[a], v[b], H12.block<3, 3>(3 * a, 3 * b));
+    if (energy_.tensor_bending()) {
+      // kTensor bending: the constant P (x) I3 (exact, PSD).
+      const auto& off = energy_.bending_offsets();
+      const auto& col = energy_.bending_columns();
+      const auto& val = energy_.bending_values();
+      for (int i = 0; i < n; ++i) {
+        const int di = dof_[i];
+        if (di < 0) continue;
+        for (int k = off[i]; k < off[i + 1]; ++k) {
+          const int dj = dof_[col[k]];
+          if (dj < 0) continue;
+          for (int r = 0; r < 3; ++r) trip_.emplace_back(3 * di + r, 3 * dj + r, val[k]);
+        }
+      }
+    } else {
+      Mat12 H12;
+      for (int hh = 0; hh < energy_.num_hinges(); ++hh) {
+        energy_.hinge_hessian(hh, S.x, H12, true);
+        const auto& v = energy_.hinge(hh);
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b) add_block(v[a], v[b], H12.block<3, 3>(3 * a, 3 * b));
+      }
     }
     Eigen::Matrix<double, 6, 6> H6;
     for (int s = 0; s < energy_.num_springs(); ++s) {
@@ -202,7 +218,7 @@ StepStats NewtonSolver::step(Cloth& cloth, const SceneObjects& scene, double dt)
     for (int i = 0; i < n; ++i) {
       xt_[i] = S.x[i];
       if (cloth.is_free(i)) {
-        y_[i] = S.x[i] + h * S.v[i];
+        y_[i] = S.x[i] + (h * std::exp(-opt_.air_damping * h)) * S.v[i];
         S.x[i] = y_[i] + h * h * g;
       } else {
         y_[i] = S.x[i];

@@ -20,6 +20,8 @@ struct NewtonOptions {
   bool line_search = true;  // backtracking (Armijo) on G
   EnergyOptions energy;
   double contact_stiffness = 0;  // 0: automatic
+  // Air drag (1/s) as in VBD: the inertia target is y = x + h v exp(-air_damping h).
+  double air_damping = 0;
 };
 
 class NewtonSolver : public Solver {

@@ -1,104 +1,490 @@
 #include "sim/solver_xpbd.hpp"
 
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
 namespace drape::sim {
 
+XpbdSolver::XpbdSolver(XpbdOptions opt)
+    : opt_(opt), pool_(std::make_unique<ThreadPool>(std::max(1, opt.threads))) {
+  pool_->set_min_parallel(256);
+}
+XpbdSolver::~XpbdSolver() = default;
+
+namespace {
+
+// Sorts elements by colour: returns the colour offsets and fills `order`.
+std::vector<int> colour_sorted(int n, int count, int k, const int32_t* verts, size_t stride,
+                               std::vector<int>& order) {
+  std::vector<int> off(count + 1), vs;
+  vs.reserve(static_cast<size_t>(count) * k);
+  for (int e = 0; e < count; ++e) {
+    const int32_t* v = reinterpret_cast<const int32_t*>(reinterpret_cast<const char*>(verts) +
+                                                        stride * static_cast<size_t>(e));
+    for (int a = 0; a < k; ++a) vs.push_back(v[a]);
+    off[e + 1] = static_cast<int>(vs.size());
+  }
+  std::vector<int> col;
+  colour_elements(n, off, vs, order, col);
+  return col;
+}
+
+template <class T>
+void apply_order(std::vector<T>& items, const std::vector<int>& order) {
+  std::vector<T> sorted;
+  sorted.reserve(items.size());
+  for (int e : order) sorted.push_back(items[e]);
+  items.swap(sorted);
+}
+
+}  // namespace
+
+void XpbdSolver::cook(const Cloth& cloth) {
+  energy_.build(cloth, opt_.energy);
+  const FabricParams& fab = cloth.fabric;
+  const double kc[3] = {fab.stretch_weft, fab.stretch_warp, 4.0 * fab.shear};
+  const int n = cloth.num_vertices();
+  std::vector<int> order;
+  tris_.clear();
+  for (int t = 0; t < energy_.num_triangles(); ++t) {
+    Tri T{};
+    const auto& D = energy_.tri_D(t);
+    for (int a = 0; a < 3; ++a) {
+      T.v[a] = energy_.tri(t)[a];
+      T.D[2 * a] = D(a, 0);
+      T.D[2 * a + 1] = D(a, 1);
+      const double kA = kc[a] * energy_.rest_area(t);
+      T.ia[a] = kA > 0 ? 1.0 / kA : 0.0;
+    }
+    tris_.push_back(T);
+  }
+  tri_col_ = colour_sorted(n, static_cast<int>(tris_.size()), 3,
+                           tris_.empty() ? nullptr : tris_[0].v, sizeof(Tri), order);
+  apply_order(tris_, order);
+  hinges_.clear();
+  // Bending: the energy's own rows when it has them (tensor bending), else its hinges. The
+  // three rows of a triangle (uu, vv, uv) share their stencil: they are one block, solved
+  // together (3x3 system) with one pass over the stencil.
+  const int nrows = energy_.num_bending_rows();
+  {
+    const auto& ro = energy_.bending_row_offsets();
+    const auto& rc = energy_.bending_row_columns();
+    const auto& rv = energy_.bending_row_values();
+    std::vector<int> boff(1, 0), bcol;
+    std::vector<double> bval, bik;
+    std::vector<std::array<double, 4>> ent;  // column, value uu, vv, uv
+    for (int r0 = 0; r0 < nrows; r0 += 3) {
+      ent.clear();
+      for (int a = 0; a < 3 && r0 + a < nrows; ++a)
+        for (int e = ro[r0 + a]; e < ro[r0 + a + 1]; ++e) {
+          std::array<double, 4> q{double(rc[e]), 0, 0, 0};
+          q[1 + a] = rv[e];
+          ent.push_back(q);
+        }
+      std::sort(ent.begin(), ent.end(), [](const auto& p, const auto& q) { return p[0] < q[0]; });
+      for (size_t i = 0; i < ent.size(); ++i) {
+        if (!bcol.empty() && static_cast<int>(boff.size()) - 1 >= 0 &&
+            static_cast<int>(bcol.size()) > boff.back() && bcol.back() == int(ent[i][0])) {
+          for (int a = 0; a < 3; ++a) bval[bval.size() - 3 + a] += ent[i][1 + a];
+          continue;
+        }
+        bcol.push_back(static_cast<int>(ent[i][0]));
+        for (int a = 0; a < 3; ++a) bval.push_back(ent[i][1 + a]);
+      }
+      boff.push_back(static_cast<int>(bcol.size()));
+      for (int a = 0; a < 3; ++a) {
+        const double k = r0 + a < nrows ? energy_.bending_row_stiffness(r0 + a) : 0.0;
+        bik.push_back(k > 0 ? 1.0 / k : 0.0);
+      }
+    }
+    std::vector<int> order_b, col;
+    colour_elements(n, boff, bcol, order_b, col);
+    row_cols_ = col.empty() ? std::vector<int>(1, 0) : col;
+    row_off_.assign(1, 0);
+    row_colv_.clear();
+    row_val_.clear();
+    row_ik_.clear();
+    for (int bk : order_b) {
+      for (int e = boff[bk]; e < boff[bk + 1]; ++e) {
+        row_colv_.push_back(bcol[e]);
+        for (int a = 0; a < 3; ++a) row_val_.push_back(bval[3 * e + a]);
+      }
+      row_off_.push_back(static_cast<int>(row_colv_.size()));
+      for (int a = 0; a < 3; ++a) row_ik_.push_back(bik[3 * bk + a]);
+    }
+    lambda_row_.assign(row_ik_.size(), Vec3::Zero());
+  }
+  for (int h = 0; h < (nrows > 0 ? 0 : energy_.num_hinges()); ++h) {
+    Hinge H{};
+    for (int a = 0; a < 4; ++a) {
+      H.v[a] = energy_.hinge(h)[a];
+      H.K[a] = energy_.hinge_K(h)[a];
+    }
+    H.iw = energy_.hinge_w(h) > 0 ? 1.0 / energy_.hinge_w(h) : 0.0;
+    if (energy_.hinge_w(h) > 0) hinges_.push_back(H);
+  }
+  hinge_col_ = colour_sorted(n, static_cast<int>(hinges_.size()), 4,
+                             hinges_.empty() ? nullptr : hinges_[0].v, sizeof(Hinge), order);
+  apply_order(hinges_, order);
+  springs_.clear();
+  for (int s = 0; s < energy_.num_springs(); ++s) {
+    Spring S{};
+    S.v[0] = energy_.spring(s)[0];
+    S.v[1] = energy_.spring(s)[1];
+    S.rest = energy_.spring_rest(s);
+    S.ik = energy_.spring_k(s) > 0 ? 1.0 / energy_.spring_k(s) : 0.0;
+    springs_.push_back(S);
+  }
+  spring_col_ = colour_sorted(n, static_cast<int>(springs_.size()), 2,
+                              springs_.empty() ? nullptr : springs_[0].v, sizeof(Spring), order);
+  apply_order(springs_, order);
+  lambda_tri_.assign(3 * tris_.size(), 0.0);
+  lambda_hinge_.assign(hinges_.size(), Vec3::Zero());
+  lambda_spring_.assign(springs_.size(), 0.0);
+  xt_.resize(n);
+  w_.resize(n);
+  // Connected pieces (union-find over the elements' vertices).
+  std::vector<int> parent(n);
+  for (int i = 0; i < n; ++i) parent[i] = i;
+  auto find = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  auto join = [&](int a, int b) { parent[find(a)] = find(b); };
+  for (const Tri& T : tris_) join(T.v[0], T.v[1]), join(T.v[1], T.v[2]);
+  for (const Hinge& H : hinges_) join(H.v[0], H.v[2]), join(H.v[0], H.v[3]);
+  for (const Spring& Sp : springs_) join(Sp.v[0], Sp.v[1]);
+  for (size_t r = 0; r + 1 < row_off_.size(); ++r)
+    for (int e = row_off_[r] + 1; e < row_off_[r + 1]; ++e)
+      join(row_colv_[row_off_[r]], row_colv_[e]);
+  piece_of_.assign(n, -1);
+  std::vector<int> id(n, -1);
+  num_pieces_ = 0;
+  for (int i = 0; i < n; ++i) {
+    const int r = find(i);
+    if (id[r] < 0) id[r] = num_pieces_++;
+    piece_of_[i] = id[r];
+  }
+  piece_rest_.assign(num_pieces_, 0);
+  piece_frozen_.assign(num_pieces_, 0);
+  piece_awake_.assign(num_pieces_, 0);
+}
+
+bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
+  auto& S = cloth.state;
+  const int n = cloth.num_vertices();
+  bool any_frozen = false;
+  for (int p = 0; p < num_pieces_; ++p) any_frozen = any_frozen || piece_frozen_[p];
+  if (!any_frozen) {  // also clears flags left by a cut (re-cook) or by another solver
+    for (int i = 0; i < n; ++i) S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
+    frozen_count_ = 0;
+    return false;
+  }
+  std::fill(piece_awake_.begin(), piece_awake_.end(), 0);
+  energy_.detect_contacts(cloth, scene);
+  for (int i = 0; i < n; ++i) {
+    const int p = piece_of_[i];
+    if (!piece_frozen_[p] || piece_awake_[p]) continue;
+    bool go;
+    if (!cloth.is_free(i))
+      go = (S.x[i] - S.x_prev[i]).squaredNorm() > 1e-18;  // a fixed vertex was moved
+    else if (!(S.flags[i] & kFlagFrozen))
+      go = true;  // released, or freed by a command
+    else {
+      const int ci = energy_.contact_of(i);
+      go = ci >= 0 && energy_.contacts()[ci].n.dot(S.x[i] - energy_.contacts()[ci].p) < 0;
+    }
+    if (go) piece_awake_[p] = 1;
+  }
+  bool all_frozen = true;
+  for (int p = 0; p < num_pieces_; ++p) {
+    if (piece_awake_[p]) {
+      piece_frozen_[p] = 0;
+      piece_rest_[p] = 0;
+    }
+    all_frozen = all_frozen && piece_frozen_[p];
+  }
+  frozen_count_ = 0;
+  for (int i = 0; i < n; ++i) {
+    if (!piece_frozen_[piece_of_[i]]) {
+      S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
+    } else if (S.flags[i] & kFlagFrozen) {
+      ++frozen_count_;
+      S.x_prev[i] = S.x[i];
+    }
+  }
+  return all_frozen;
+}
+
 StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   StepStats st;
-  if (!energy_.up_to_date(cloth)) energy_.build(cloth, opt_.energy);
+  if (!energy_.up_to_date(cloth)) cook(cloth);
   energy_.set_form(&scene);
   auto& S = cloth.state;
+  auto& x = S.x;
   const int n = cloth.num_vertices();
   const int ns = std::max(1, opt_.substeps);
   const double h = dt / ns;
-  const FabricParams& fab = cloth.fabric;
-  const double ku = fab.stretch_weft, kv = fab.stretch_warp, kg = fab.shear;
-  lambda_tri_.resize(3 * energy_.num_triangles());
-  lambda_hinge_.resize(energy_.num_hinges());
-  lambda_spring_.resize(energy_.num_springs());
-  xt_.resize(n);
-  for (int s = 0; s < ns; ++s) {
-    const auto t0 = std::chrono::steady_clock::now();
-    st.max_penetration = std::max(st.max_penetration, energy_.detect_contacts(cloth, scene));
-    st.collision_ms +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    for (int i = 0; i < n; ++i) {
-      xt_[i] = S.x[i];
-      if (S.inv_mass[i] > 0 && cloth.is_free(i))
-        S.x[i] += h * S.v[i] + h * h * energy_.external_force(i, S.x[i], S.mass[i]) / S.mass[i];
-    }
-    std::fill(lambda_tri_.begin(), lambda_tri_.end(), 0.0);
-    std::fill(lambda_hinge_.begin(), lambda_hinge_.end(), Vec3::Zero());
-    std::fill(lambda_spring_.begin(), lambda_spring_.end(), 0.0);
-    const double ih2 = 1.0 / (h * h);
-    auto w = [&](int i) { return cloth.is_free(i) ? S.inv_mass[i] : 0.0; };
-    for (int it = 0; it < opt_.iterations; ++it) {
-      // Membrane: three strain constraints per triangle.
-      for (int t = 0; t < energy_.num_triangles(); ++t) {
-        const auto& v = energy_.tri(t);
-        const auto& D = energy_.tri_D(t);
-        for (int c = 0; c < 3; ++c) {
-          const Vec3 fu = S.x[v[0]] * D(0, 0) + S.x[v[1]] * D(1, 0) + S.x[v[2]] * D(2, 0);
-          const Vec3 fv = S.x[v[0]] * D(0, 1) + S.x[v[1]] * D(1, 1) + S.x[v[2]] * D(2, 1);
-          Vec3 grads[3];
-          double C;
-          if (c == 0) {
-            C = 0.5 * (fu.squaredNorm() - 1);
-            for (int k = 0; k < 3; ++k) grads[k] = D(k, 0) * fu;
-          } else if (c == 1) {
-            C = 0.5 * (fv.squaredNorm() - 1);
-            for (int k = 0; k < 3; ++k) grads[k] = D(k, 1) * fv;
-          } else {
-            C = 0.5 * fu.dot(fv);
-            for (int k = 0; k < 3; ++k) grads[k] = 0.5 * (D(k, 0) * fv + D(k, 1) * fu);
-          }
-          const double A = energy_.rest_area(t);
-          const double k = c == 0 ? ku : (c == 1 ? kv : 4.0 * kg);
-          const double alpha = ih2 / (k * A);
-          double denom = alpha;
-          for (int q = 0; q < 3; ++q) denom += w(v[q]) * grads[q].squaredNorm();
-          if (denom < 1e-20) continue;
-          double& lam = lambda_tri_[3 * t + c];
-          const double dl = (-C - alpha * lam) / denom;
-          lam += dl;
-          for (int q = 0; q < 3; ++q) S.x[v[q]] += w(v[q]) * dl * grads[q];
+  const double ih2 = 1.0 / (h * h);
+  if (!opt_.freeze) {
+    for (int i = 0; i < n; ++i) S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
+    std::fill(piece_frozen_.begin(), piece_frozen_.end(), 0);
+    frozen_count_ = 0;
+  } else if (wake(cloth, scene)) {
+    // Every piece sleeps and nothing disturbed it: nothing to compute this frame.
+    for (int i = 0; i < n; ++i)
+      if (!cloth.is_free(i)) S.x_prev[i] = S.x[i];
+    S.time += dt;
+    return st;
+  }
+  auto set_w = [&] {
+    for (int i = 0; i < n; ++i)
+      w_[i] = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
+  };
+  const double* w = w_.data();
+  const bool warm = opt_.warm_start > 0;
+  const bool keep_lambda = opt_.iterations > 1 || warm;
+
+  auto project_tris = [&](int b, int e, int) {
+    for (int k = b; k < e; ++k) {
+      const Tri& T = tris_[k];
+      const double wq[3] = {w[T.v[0]], w[T.v[1]], w[T.v[2]]};
+      if (wq[0] + wq[1] + wq[2] == 0) continue;
+      Vec3 p[3] = {x[T.v[0]], x[T.v[1]], x[T.v[2]]};
+      const double* D = T.D;
+      for (int c = 0; c < 3; ++c) {
+        const Vec3 fu = p[0] * D[0] + p[1] * D[2] + p[2] * D[4];
+        const Vec3 fv = p[0] * D[1] + p[1] * D[3] + p[2] * D[5];
+        double C, denom = ih2 * T.ia[c];
+        Vec3 g[3];
+        if (c == 0) {
+          C = 0.5 * (fu.squaredNorm() - 1);
+          for (int q = 0; q < 3; ++q) g[q] = D[2 * q] * fu;
+        } else if (c == 1) {
+          C = 0.5 * (fv.squaredNorm() - 1);
+          for (int q = 0; q < 3; ++q) g[q] = D[2 * q + 1] * fv;
+        } else {
+          C = 0.5 * fu.dot(fv);
+          for (int q = 0; q < 3; ++q) g[q] = 0.5 * (D[2 * q] * fv + D[2 * q + 1] * fu);
         }
-      }
-      for (int hh = 0; hh < energy_.num_hinges(); ++hh) {
-        const auto& v = energy_.hinge(hh);
-        const auto& K = energy_.hinge_K(hh);
-        const Vec3 C = K[0] * S.x[v[0]] + K[1] * S.x[v[1]] + K[2] * S.x[v[2]] + K[3] * S.x[v[3]];
-        const double alpha = ih2 / energy_.hinge_w(hh);
-        double denom = alpha;
-        for (int q = 0; q < 4; ++q) denom += w(v[q]) * K[q] * K[q];
-        const Vec3 dl = (-C - alpha * lambda_hinge_[hh]) / denom;
-        lambda_hinge_[hh] += dl;
-        for (int q = 0; q < 4; ++q) S.x[v[q]] += w(v[q]) * K[q] * dl;
-      }
-      for (int sp = 0; sp < energy_.num_springs(); ++sp) {
-        const auto& v = energy_.spring(sp);
-        const Vec3 d = S.x[v[0]] - S.x[v[1]];
-        const double l = d.norm();
-        if (l < 1e-15) continue;
-        const Vec3 nn = d / l;
-        const double C = l - energy_.spring_rest(sp);
-        const double alpha = ih2 / energy_.spring_k(sp);
-        const double denom = w(v[0]) + w(v[1]) + alpha;
+        const double alpha = denom;
+        for (int q = 0; q < 3; ++q) denom += wq[q] * g[q].squaredNorm();
         if (denom < 1e-20) continue;
-        const double dl = (-C - alpha * lambda_spring_[sp]) / denom;
-        lambda_spring_[sp] += dl;
-        S.x[v[0]] += w(v[0]) * dl * nn;
-        S.x[v[1]] -= w(v[1]) * dl * nn;
+        double lam = keep_lambda ? lambda_tri_[3 * k + c] : 0.0;
+        const double dl = (-C - alpha * lam) / denom;
+        if (keep_lambda) lambda_tri_[3 * k + c] = lam + dl;
+        for (int q = 0; q < 3; ++q) p[q] += (wq[q] * dl) * g[q];
       }
-      energy_.project_contacts(S.x);
+      for (int q = 0; q < 3; ++q) x[T.v[q]] = p[q];
+    }
+  };
+  auto project_hinges = [&](int b, int e, int) {
+    for (int k = b; k < e; ++k) {
+      const Hinge& H = hinges_[k];
+      const double wq[4] = {w[H.v[0]], w[H.v[1]], w[H.v[2]], w[H.v[3]]};
+      double denom = ih2 * H.iw;
+      const double alpha = denom;
+      for (int q = 0; q < 4; ++q) denom += wq[q] * H.K[q] * H.K[q];
+      if (denom == alpha) continue;
+      const Vec3 C =
+          H.K[0] * x[H.v[0]] + H.K[1] * x[H.v[1]] + H.K[2] * x[H.v[2]] + H.K[3] * x[H.v[3]];
+      const Vec3 lam = keep_lambda ? lambda_hinge_[k] : Vec3::Zero();
+      const Vec3 dl = (-C - alpha * lam) / denom;
+      if (keep_lambda) lambda_hinge_[k] = lam + dl;
+      for (int q = 0; q < 4; ++q) x[H.v[q]] += (wq[q] * H.K[q]) * dl;
+    }
+  };
+  auto project_rows = [&](int b, int e, int) {
+    for (int r = b; r < e; ++r) {
+      // C_a = sum_j v_aj x_j; (sum_j w_j v_aj v_bj + alpha_a delta_ab) dl_b = -C_a - alpha_a l_a.
+      Vec3 C[3] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+      Mat3 A = Mat3::Zero();
+      for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
+        const int j = row_colv_[k];
+        const double* v = &row_val_[3 * k];
+        for (int a = 0; a < 3; ++a) C[a] += v[a] * x[j];
+        if (w[j] > 0)
+          for (int a = 0; a < 3; ++a)
+            for (int c = a; c < 3; ++c) A(a, c) += w[j] * v[a] * v[c];
+      }
+      if (A.trace() == 0) continue;
+      Vec3* lam = &lambda_row_[3 * r];
+      Eigen::Matrix3d R;  // rows a: right-hand side of component a (x, y, z)
+      for (int a = 0; a < 3; ++a) {
+        const double alpha = ih2 * row_ik_[3 * r + a];
+        A(a, a) += alpha;
+        R.row(a) = (keep_lambda ? Vec3(-C[a] - alpha * lam[a]) : Vec3(-C[a])).transpose();
+      }
+      // Closed-form inverse of the symmetric positive definite 3x3 A.
+      const double c00 = A(1, 1) * A(2, 2) - A(1, 2) * A(1, 2);
+      const double c01 = A(0, 2) * A(1, 2) - A(0, 1) * A(2, 2);
+      const double c02 = A(0, 1) * A(1, 2) - A(0, 2) * A(1, 1);
+      const double det = A(0, 0) * c00 + A(0, 1) * c01 + A(0, 2) * c02;
+      if (!(det > 0)) continue;
+      const double c11 = A(0, 0) * A(2, 2) - A(0, 2) * A(0, 2);
+      const double c12 = A(0, 2) * A(0, 1) - A(0, 0) * A(1, 2);
+      const double c22 = A(0, 0) * A(1, 1) - A(0, 1) * A(0, 1);
+      Eigen::Matrix3d Ai;
+      Ai << c00, c01, c02, c01, c11, c12, c02, c12, c22;
+      const Eigen::Matrix3d dl = (Ai * (1.0 / det)) * R;
+      if (keep_lambda)
+        for (int a = 0; a < 3; ++a) lam[a] += dl.row(a).transpose();
+      for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
+        const int j = row_colv_[k];
+        if (w[j] == 0) continue;
+        const double* v = &row_val_[3 * k];
+        x[j] += w[j] * (v[0] * dl.row(0) + v[1] * dl.row(1) + v[2] * dl.row(2)).transpose();
+      }
+    }
+  };
+  // Spring k's unit direction (v0 - v1) and length; false when degenerate.
+  auto spring_dir = [&](const Spring& Sp, Vec3& nn, double& l) {
+    const Vec3 d = x[Sp.v[0]] - x[Sp.v[1]];
+    l = d.norm();
+    if (l < 1e-15) return false;
+    nn = d / l;
+    return true;
+  };
+  // Moves spring k's ends by w dl along nn (the constraint's gradient).
+  auto spring_move = [&](const Spring& Sp, const Vec3& nn, double dl) {
+    x[Sp.v[0]] += (w[Sp.v[0]] * dl) * nn;
+    x[Sp.v[1]] -= (w[Sp.v[1]] * dl) * nn;
+  };
+  auto project_springs = [&](int b, int e, int) {
+    for (int k = b; k < e; ++k) {
+      const Spring& Sp = springs_[k];
+      Vec3 nn;
+      double l;
+      if (!spring_dir(Sp, nn, l)) continue;
+      const double C = l - Sp.rest;
+      const double alpha = ih2 * Sp.ik;
+      const double denom = w[Sp.v[0]] + w[Sp.v[1]] + alpha;
+      if (denom < 1e-20 || denom == alpha) continue;
+      const double lam = keep_lambda ? lambda_spring_[k] : 0.0;
+      const double dl = (-C - alpha * lam) / denom;
+      if (keep_lambda) lambda_spring_[k] = lam + dl;
+      spring_move(Sp, nn, dl);
+    }
+  };
+  auto by_colour = [&](const std::vector<int>& off, auto& fn) {
+    for (size_t c = 0; c + 1 < off.size(); ++c) {
+      const int b = off[c], cnt = off[c + 1] - off[c];
+      pool_->parallel_for(cnt, [&](int lo, int hi, int wk) { fn(b + lo, b + hi, wk); });
+    }
+  };
+
+  // Warm start: apply the (scaled) multipliers of the previous substep as displacements.
+  auto warm_tris = [&](int b, int e, int) {
+    for (int k = b; k < e; ++k) {
+      const Tri& T = tris_[k];
+      const double wq[3] = {w[T.v[0]], w[T.v[1]], w[T.v[2]]};
+      const double* L = &lambda_tri_[3 * k];
+      if (wq[0] + wq[1] + wq[2] == 0 || (L[0] == 0 && L[1] == 0 && L[2] == 0)) continue;
+      const double* D = T.D;
+      const Vec3 fu = x[T.v[0]] * D[0] + x[T.v[1]] * D[2] + x[T.v[2]] * D[4];
+      const Vec3 fv = x[T.v[0]] * D[1] + x[T.v[1]] * D[3] + x[T.v[2]] * D[5];
+      for (int q = 0; q < 3; ++q) {
+        const Vec3 g = L[0] * D[2 * q] * fu + L[1] * D[2 * q + 1] * fv +
+                       L[2] * 0.5 * (D[2 * q] * fv + D[2 * q + 1] * fu);
+        x[T.v[q]] += wq[q] * g;
+      }
+    }
+  };
+  auto warm_hinges = [&](int b, int e, int) {
+    for (int k = b; k < e; ++k) {
+      const Hinge& H = hinges_[k];
+      for (int q = 0; q < 4; ++q) x[H.v[q]] += (w[H.v[q]] * H.K[q]) * lambda_hinge_[k];
+    }
+  };
+  auto warm_rows = [&](int b, int e, int) {
+    for (int r = b; r < e; ++r) {
+      const Vec3* lam = &lambda_row_[3 * r];
+      for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
+        const int j = row_colv_[k];
+        const double* v = &row_val_[3 * k];
+        x[j] += w[j] * (v[0] * lam[0] + v[1] * lam[1] + v[2] * lam[2]);
+      }
+    }
+  };
+  auto warm_springs = [&](int b, int e, int) {
+    for (int k = b; k < e; ++k) {
+      Vec3 nn;
+      double l;
+      if (spring_dir(springs_[k], nn, l)) spring_move(springs_[k], nn, lambda_spring_[k]);
+    }
+  };
+
+  const double damp = std::exp(-opt_.damping * h);
+  for (int s = 0; s < ns; ++s) {
+    if (s % std::max(1, opt_.contact_every) == 0) {
+      const auto t0 = std::chrono::steady_clock::now();
+      st.max_penetration = std::max(st.max_penetration, energy_.detect_contacts(cloth, scene));
+      st.collision_ms +=
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    }
+    set_w();
+    pool_->parallel_for(n, [&](int b, int e, int) {
+      for (int i = b; i < e; ++i) {
+        xt_[i] = x[i];
+        if (w[i] > 0)
+          x[i] += h * S.v[i] + (h * h / S.mass[i]) * energy_.external_force(i, x[i], S.mass[i]);
+      }
+    });
+    if (warm) {
+      const double f = opt_.warm_start * (h_prev_ > 0 ? (h / h_prev_) * (h / h_prev_) : 0.0);
+      for (double& l : lambda_tri_) l *= f;
+      for (Vec3& l : lambda_hinge_) l *= f;
+      for (Vec3& l : lambda_row_) l *= f;
+      for (double& l : lambda_spring_) l *= f;
+      h_prev_ = h;
+      by_colour(tri_col_, warm_tris);
+      by_colour(hinge_col_, warm_hinges);
+      by_colour(row_cols_, warm_rows);
+      by_colour(spring_col_, warm_springs);
+    } else if (keep_lambda) {
+      std::fill(lambda_tri_.begin(), lambda_tri_.end(), 0.0);
+      std::fill(lambda_hinge_.begin(), lambda_hinge_.end(), Vec3::Zero());
+      std::fill(lambda_row_.begin(), lambda_row_.end(), Vec3::Zero());
+      std::fill(lambda_spring_.begin(), lambda_spring_.end(), 0.0);
+    }
+    for (int it = 0; it < opt_.iterations; ++it) {
+      by_colour(tri_col_, project_tris);
+      by_colour(hinge_col_, project_hinges);
+      by_colour(row_cols_, project_rows);
+      by_colour(spring_col_, project_springs);
+      energy_.project_contacts(x);
       ++st.iterations;
     }
-    const double damp = std::exp(-opt_.damping * h);
-    for (int i = 0; i < n; ++i) {
-      S.x_prev[i] = xt_[i];
-      if (cloth.is_free(i)) S.v[i] = damp * (S.x[i] - xt_[i]) / h;
+    pool_->parallel_for(n, [&](int b, int e, int) {
+      for (int i = b; i < e; ++i) {
+        S.x_prev[i] = xt_[i];
+        if (w[i] > 0)
+          S.v[i] = damp * (x[i] - xt_[i]) / h;
+        else if (S.flags[i] & kFlagFrozen)
+          S.v[i].setZero();
+      }
+    });
+    if (opt_.freeze) {
+      // A piece rests when all its free vertices are slow; after freeze_steps substeps it sleeps.
+      std::fill(piece_awake_.begin(), piece_awake_.end(), 0);  // reused: "moving" per piece
+      const double v2 = opt_.freeze_speed * opt_.freeze_speed;
+      for (int i = 0; i < n; ++i)
+        if (w[i] > 0 && S.v[i].squaredNorm() >= v2) piece_awake_[piece_of_[i]] = 1;
+      for (int p = 0; p < num_pieces_; ++p) {
+        if (piece_frozen_[p]) continue;
+        piece_rest_[p] = piece_awake_[p] ? 0 : piece_rest_[p] + 1;
+        if (piece_rest_[p] >= opt_.freeze_steps) piece_frozen_[p] = 1;
+      }
+      frozen_count_ = 0;
+      for (int i = 0; i < n; ++i)
+        if (piece_frozen_[piece_of_[i]] && cloth.is_free(i)) {
+          S.flags[i] |= kFlagFrozen;
+          S.v[i].setZero();
+          ++frozen_count_;
+        }
     }
     S.time += h;
     ++st.substeps;

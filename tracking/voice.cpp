@@ -290,61 +290,229 @@ VoiceRecognizer::VoiceRecognizer(VoiceConfig cfg) : cfg_(std::move(cfg)) {
   const std::string filler_grammar = gf.str();
   char wip[32];
   std::snprintf(wip, sizeof wip, "%g", cfg_.word_penalty);
-  cmd_ln_t* c = cmd_ln_init(nullptr, ps_args(), TRUE, "-hmm", cfg_.model_dir.c_str(), "-dict",
-                            cfg_.dict.c_str(), "-logfn", "/dev/null", "-remove_silence", "no",
-                            "-wip", wip, nullptr);
-  if (!c) {
-    error_ = "voice: pocketsphinx rejected the configuration";
+  // Front end: see VoiceConfig::remove_noise / comfort_noise. extra: "-name value ..." pairs
+  // (VoiceConfig::decoder_args / garbage_args).
+  auto make = [&](const std::string& extra) -> ps_decoder_t* {
+    std::vector<std::string> a = {"drape",
+                                  "-hmm",
+                                  cfg_.model_dir,
+                                  "-dict",
+                                  cfg_.dict,
+                                  "-logfn",
+                                  "/dev/null",
+                                  "-remove_silence",
+                                  "no",
+                                  "-remove_noise",
+                                  cfg_.remove_noise ? "yes" : "no",
+                                  "-wip",
+                                  wip,
+                                  "-allphone_ci",
+                                  "yes"};
+    std::istringstream in(extra);
+    for (std::string w; in >> w;) a.push_back(w);
+    std::vector<char*> argv;
+    for (auto& w : a) argv.push_back(w.data());
+    cmd_ln_t* c =
+        cmd_ln_parse_r(nullptr, ps_args(), static_cast<int32>(argv.size()), argv.data(), FALSE);
+    if (!c) return nullptr;
+    ps_decoder_t* d = ps_init(c);
+    cmd_ln_free_r(c);
+    return d;
+  };
+  const bool two_pass =
+      cfg_.rejection == Rejection::Garbage || cfg_.rejection == Rejection::Combined;
+  ps_decoder_t* ps = make(cfg_.decoder_args);
+  char glw[32];
+  std::snprintf(glw, sizeof glw, "%g", cfg_.garbage_lw);
+  ps_decoder_t* gs =
+      two_pass ? make(cfg_.decoder_args + " -lw " + glw + " " + cfg_.garbage_args) : nullptr;
+  auto fail = [&](const std::string& m) {
+    error_ = m;
+    if (ps) ps_free(ps);
+    if (gs) ps_free(gs);
+  };
+  if (!ps || (two_pass && !gs)) {
+    fail("voice: pocketsphinx failed to load " + cfg_.model_dir);
     return;
   }
-  ps_decoder_t* ps = ps_init(c);
-  cmd_ln_free_r(c);
-  if (!ps) {
-    error_ = "voice: pocketsphinx failed to load " + cfg_.model_dir;
+  const bool phones = cfg_.garbage == GarbageModel::Phones;
+  const std::string phone_lm = cfg_.model_dir + "/../en-us-phone.lm.bin";
+  if (two_pass && phones && !std::ifstream(phone_lm)) {
+    fail("voice: missing " + phone_lm);
     return;
   }
   if (ps_set_jsgf_string(ps, "drape", grammar_.c_str()) < 0 ||
-      ps_set_jsgf_string(ps, "filler", filler_grammar.c_str()) < 0) {
-    error_ = "voice: bad grammar from " + cfg_.phrases + " / " + cfg_.filler +
-             " (a word missing from " + cfg_.dict + "?)";
-    ps_free(ps);
+      (two_pass && (phones ? ps_set_allphone_file(gs, "garbage", phone_lm.c_str())
+                           : ps_set_jsgf_string(gs, "garbage", filler_grammar.c_str())) < 0)) {
+    fail("voice: bad grammar from " + cfg_.phrases + " / " + cfg_.filler +
+         " (a word missing from " + cfg_.dict + "?)");
     return;
   }
+  ps_set_search(ps, "drape");
+  if (gs) ps_set_search(gs, "garbage");
   ps_ = ps;
+  gs_ = gs;
 }
 
 VoiceRecognizer::~VoiceRecognizer() {
   if (ps_) ps_free(static_cast<ps_decoder_t*>(ps_));
+  if (gs_) ps_free(static_cast<ps_decoder_t*>(gs_));
+}
+
+void VoiceRecognizer::begin() {
+  if (!ps_) return;
+  if (in_utt_) finish(0);
+  if (cfg_.streaming) {
+    ps_start_utt(static_cast<ps_decoder_t*>(ps_));
+    if (gs_) ps_start_utt(static_cast<ps_decoder_t*>(gs_));
+  }
+  in_utt_ = true;
+  feed_ms_ = 0;
+  fed_ = 0;
+  utt_.clear();
+  noise_state_ = 12345u;  // the same comfort noise for the same audio: deterministic results
+}
+
+void VoiceRecognizer::feed(const int16_t* s, long n) {
+  if (!ps_ || !in_utt_ || n <= 0) return;
+  const double t0 = now_s();
+  // Comfort noise (uniform, fixed-seed LCG, +-comfort_noise LSB): a floor under digital silence
+  // for the noise subtraction (VoiceConfig::comfort_noise); a real microphone's floor is higher.
+  const size_t at = utt_.size();
+  utt_.resize(at + static_cast<size_t>(n));
+  const int amp = static_cast<int>(cfg_.comfort_noise);
+  for (long i = 0; i < n; ++i) {
+    int d = 0;
+    if (amp > 0) {
+      noise_state_ = noise_state_ * 1664525u + 1013904223u;
+      d = static_cast<int>((noise_state_ >> 16) % (2u * amp + 1u)) - amp;
+    }
+    utt_[at + i] = static_cast<int16_t>(std::clamp(int(s[i]) + d, -32768, 32767));
+  }
+  if (cfg_.streaming) {  // live CMN (see VoiceConfig::streaming)
+    ps_process_raw(static_cast<ps_decoder_t*>(ps_), utt_.data() + at, static_cast<size_t>(n), FALSE,
+                   FALSE);
+    if (gs_)
+      ps_process_raw(static_cast<ps_decoder_t*>(gs_), utt_.data() + at, static_cast<size_t>(n),
+                     FALSE, FALSE);
+  }
+  feed_ms_ += (now_s() - t0) * 1000.0;
+  fed_ += n;
 }
 
 VoiceResult VoiceRecognizer::decode(const int16_t* s, long n, double speech_s) {
+  // 50 ms blocks like VoiceSource (live cepstral mean normalisation updates per block and
+  // carries over between utterances: scores vary slightly, see the test).
+  begin();
+  for (long k = 0; k < n; k += kVoiceRate / 20) feed(s + k, std::min<long>(kVoiceRate / 20, n - k));
+  return finish(speech_s);
+}
+
+namespace {
+struct Seg {
+  std::string w;
+  int sf = 0, ef = 0;
+  int32 ascr = 0;
+};
+std::string finish_pass(ps_decoder_t* ps, int32& score, std::vector<Seg>& segs) {
+  ps_end_utt(ps);
+  score = 0;
+  const char* hyp = ps_get_hyp(ps, &score);
+  std::string h = hyp ? hyp : "";
+  segs.clear();
+  for (ps_seg_t* it = ps_seg_iter(ps); it; it = ps_seg_next(it)) {
+    Seg g;
+    g.w = ps_seg_word(it);
+    ps_seg_frames(it, &g.sf, &g.ef);
+    int32 lscr = 0, lback = 0;
+    ps_seg_prob(it, &g.ascr, &lscr, &lback);
+    segs.push_back(g);
+  }
+  return h;
+}
+}  // namespace
+
+VoiceResult VoiceRecognizer::finish(double speech_s) {
   VoiceResult r;
   r.speech_s = speech_s;
-  if (!ps_) {
-    r.reason = error_;
+  if (!ps_ || !in_utt_) {
+    r.reason = ps_ ? "no utterance" : error_;
     return r;
   }
+  in_utt_ = false;
   auto* ps = static_cast<ps_decoder_t*>(ps_);
+  auto* gs = static_cast<ps_decoder_t*>(gs_);
   const double t0 = now_s();
-  auto pass = [&](const char* search, int32& score) {
-    ps_set_search(ps, search);
-    ps_start_utt(ps);
-    ps_process_raw(ps, s, static_cast<size_t>(n), FALSE, TRUE);
-    ps_end_utt(ps);
-    score = 0;
-    const char* hyp = ps_get_hyp(ps, &score);
-    return std::string(hyp ? hyp : "");
-  };
+  if (!cfg_.streaming) {
+    // The whole utterance at once: batch cepstral mean normalisation over it (the model's
+    // feat.params says -cmn batch), both passes decoded now (their time is the latency part).
+    for (auto* d : {ps, gs}) {
+      if (!d) continue;
+      ps_start_utt(d);
+      ps_process_raw(d, utt_.data(), utt_.size(), FALSE, TRUE);
+    }
+  }
   int32 score = 0, fscore = 0;
-  r.hypothesis = pass("drape", score);
-  const bool garbage =
-      cfg_.rejection == Rejection::Garbage || cfg_.rejection == Rejection::Combined;
-  if (garbage && !r.hypothesis.empty()) {
+  std::vector<Seg> cs, gsegs;
+  r.hypothesis = finish_pass(ps, score, cs);
+  if (gs) {
+    r.filler_hypothesis = finish_pass(gs, fscore, gsegs);
     const int frames = std::max(1, ps_get_n_frames(ps));
-    r.filler_hypothesis = pass("filler", fscore);
     r.margin = double(score - fscore) / frames;
+    // Word level: each command word's acoustic score against the garbage path's acoustic score
+    // over the same frames (garbage segments counted pro rata); the weakest word decides.
+    auto garbage_ascr = [&](int sf, int ef) {
+      double a = 0;
+      for (const auto& g : gsegs) {
+        const int lo = std::max(sf, g.sf), hi = std::min(ef, g.ef);
+        if (hi >= lo) a += double(g.ascr) * (hi - lo + 1) / (g.ef - g.sf + 1);
+      }
+      return a;
+    };
+    r.word_margin = r.hypothesis.empty() ? -1e9 : 1e9;
+    for (const auto& c : cs) {
+      if (c.w.empty() || c.w[0] == '<' || c.w[0] == '[' || c.ef < c.sf) continue;
+      r.word_margin =
+          std::min(r.word_margin, (c.ascr - garbage_ascr(c.sf, c.ef)) / (c.ef - c.sf + 1));
+    }
+  }
+  // Speech the phrase does not explain: the FSG lets silence and noise fillers stand between and
+  // around the phrase words, so a sentence that contains a phrase word ("the cloth is too long
+  // here" -> "move cloth") aligns its other words to them. Count the voiced 10 ms frames (energy
+  // above the utterance's noise floor + outside_db) outside the phrase words.
+  {
+    constexpr size_t F = kVoiceRate / 100;
+    std::vector<double> db;
+    for (size_t k = 0; k + F <= utt_.size(); k += F) {
+      double e = 0;
+      for (size_t q = k; q < k + F; ++q) e += double(utt_[q]) * utt_[q];
+      db.push_back(10 * std::log10(e / F + 1.0));
+    }
+    std::vector<char> in_word(db.size(), 0);
+    int first = -1, last = -1, wframes = 0;
+    for (const auto& c : cs) {
+      if (c.w.empty() || c.w[0] == '<' || c.w[0] == '[' || c.w[0] == '+' || c.ef < c.sf) continue;
+      if (first < 0) first = c.sf;
+      last = c.ef;
+      wframes += c.ef - c.sf + 1;
+      for (int f = std::max(0, c.sf); f <= c.ef && f < static_cast<int>(db.size()); ++f)
+        in_word[f] = 1;
+    }
+    if (!db.empty()) {
+      std::vector<double> sorted = db;
+      std::sort(sorted.begin(), sorted.end());
+      const double floor_db = sorted[sorted.size() / 10];
+      int out = 0;
+      for (size_t f = 0; f < db.size(); ++f)
+        out += !in_word[f] && db[f] > floor_db + cfg_.outside_db;
+      r.outside_s = out / 100.0;
+    }
+    r.words_s = first >= 0 ? (last - first + 1) / 100.0 : 0;
+    if (gs && wframes > 0) r.word_span_margin = double(score - fscore) / wframes;
   }
   r.decode_ms = (now_s() - t0) * 1000.0;
+  r.feed_ms = feed_ms_;
+  r.audio_s = double(fed_) / kVoiceRate;
   const bool dur = cfg_.rejection == Rejection::Duration || cfg_.rejection == Rejection::Combined;
   if (dur && speech_s > cfg_.max_command_s) {
     r.reason = "too long for a command";
@@ -358,8 +526,16 @@ VoiceResult VoiceRecognizer::decode(const int16_t* s, long n, double speech_s) {
     r.reason = "nothing recognised";
     return r;
   }
-  if (garbage && r.margin < -cfg_.filler_margin) {
-    r.reason = "filler path wins (" + r.filler_hypothesis + ")";
+  if (gs && r.margin - cfg_.margin_per_s * speech_s < -cfg_.filler_margin) {
+    r.reason = "garbage path wins (" + r.filler_hypothesis + ")";
+    return r;
+  }
+  if (gs && r.outside_s > cfg_.max_outside_s) {
+    r.reason = "speech outside the phrase words (a sentence?)";
+    return r;
+  }
+  if (gs && r.word_margin < cfg_.min_word_margin) {
+    r.reason = "a command word fits no better than the filler path";
     return r;
   }
   for (const auto& p : phrases_)
@@ -369,6 +545,8 @@ VoiceResult VoiceRecognizer::decode(const int16_t* s, long n, double speech_s) {
 }
 
 // ---- energy VAD ----------------------------------------------------------------------
+constexpr double kMinFloorDb = 30.0;  // dB re 1 LSB^2
+
 void EnergyVad::feed(const int16_t* s, long n, std::vector<Segment>& out) {
   constexpr int F = kVoiceRate / 100;
   for (long i = 0; i < n; ++i) {
@@ -383,11 +561,18 @@ void EnergyVad::feed(const int16_t* s, long n, std::vector<Segment>& out) {
 void EnergyVad::frame(const int16_t* f, std::vector<Segment>& out) {
   constexpr int F = kVoiceRate / 100;
   double e = 0;
-  for (int i = 0; i < F; ++i) e += double(f[i]) * f[i];
+  for (int i = 0; i < F; ++i) {
+    const double x = c_.vad_preemphasis > 0 ? f[i] - c_.vad_preemphasis * prev_ : double(f[i]);
+    prev_ = f[i];
+    e += x * x;
+  }
   const double db = 10 * std::log10(e / F + 1.0);
   if (floor_db_ < 0) floor_db_ = db;
   // Noise floor: follows down fast, up slowly (only outside speech).
   if (!in_speech_) floor_db_ = db < floor_db_ ? 0.9 * floor_db_ + 0.1 * db : floor_db_ + 0.02;
+  // Never below -60 dBFS (RMS 33): a real microphone's floor is above it, and digital silence
+  // in a synthesised file (0 dB here) would make every quiet frame between words "speech".
+  floor_db_ = std::max(floor_db_, kMinFloorDb);
   const long preroll = static_cast<long>(c_.preroll_s * kVoiceRate);
   const long hang = static_cast<long>(c_.hangover_s * kVoiceRate);
   if (!in_speech_) {
@@ -467,7 +652,8 @@ void VoiceSource::run() {
   EnergyVad vad(cfg_);
   std::vector<int16_t> buf(kVoiceRate / 20);
   std::vector<EnergyVad::Segment> segs;
-  bool ended = false;
+  bool ended = false, streaming = false;
+  long stream_start = -1, fed = 0;
   while (!stop_ && !ended) {
     const long n = in_->read(buf.data(), static_cast<long>(buf.size()));
     if (n < 0) {
@@ -480,10 +666,18 @@ void VoiceSource::run() {
     } else {
       vad.feed(buf.data(), n, segs);
     }
+    // Completed utterances: the one being fed only needs its last audio; one that started and
+    // ended within this block is fed whole. finish() decodes it (VoiceConfig::streaming).
     for (auto& s : segs) {
       const double speech_s = double(s.speech_end - s.start) / kVoiceRate - cfg_.preroll_s;
+      if (!streaming || s.start != stream_start) {
+        rec.begin();
+        fed = 0;
+      }
+      rec.feed(s.audio.data() + fed, static_cast<long>(s.audio.size()) - fed);
+      streaming = false;
       VoiceEvent ev;
-      ev.result = rec.decode(s.audio.data(), static_cast<long>(s.audio.size()), speech_s);
+      ev.result = rec.finish(speech_s);
       ev.speech_end = s.speech_end;
       ev.decided = s.decided;
       ev.latency_ms = double(s.decided - s.speech_end) * 1000.0 / kVoiceRate + ev.result.decode_ms;
@@ -491,6 +685,18 @@ void VoiceSource::run() {
       if (!ev.result.command.empty())
         triggers_.push_back(Trigger{ev.result.command, "voice", now_s(), Hand::Right, true});
       events_.push_back(std::move(ev));
+    }
+    // An utterance in progress: feed its audio as it arrives.
+    if (vad.in_speech()) {
+      if (!streaming || vad.current_start() != stream_start) {
+        rec.begin();
+        streaming = true;
+        stream_start = vad.current_start();
+        fed = 0;
+      }
+      const auto& cur = vad.current();
+      rec.feed(cur.data() + fed, static_cast<long>(cur.size()) - fed);
+      fed = static_cast<long>(cur.size());
     }
     segs.clear();
   }

@@ -17,6 +17,12 @@ layout(push_constant) uniform PC {
 
 layout(location = 0) out vec4 out_color;
 
+// The shading modes a pipeline can meet (bit m = mode m), a specialisation constant: the renderer
+// makes one pipeline per set of modes a draw contains, so the code of the other modes is
+// removed at pipeline creation. On lavapipe (llvmpipe) divergent branches are not skipped: an
+// uber-shader runs every mode's code for every pixel.
+layout(constant_id = 0) const int kModes = 31;
+
 const float PI = 3.14159265358979;
 
 // Coverage of a line of half-width hw (in the units of d) with a one-pixel soft edge.
@@ -73,10 +79,10 @@ void main() {
   vec3 n = normalize(v_normal);
   vec3 c = v_color.rgb;
 
-  if (mode == 0) {
+  if (mode == 0 && (kModes & 1) != 0) {
     if (dot(n, v) < 0.0) n = -n;
     c = lit(c, n, v, 0.15);
-  } else if (mode == 1) {
+  } else if (mode == 1 && (kModes & 2) != 0) {
     if (dot(n, v) < 0.0) n = -n;
     vec2 rel = v_pos.xz - v_aux.yz;
     float r = length(rel);
@@ -93,7 +99,7 @@ void main() {
     c = mix(c, vec3(0.75, 0.05, 0.05), cf);
     c = mix(c, vec3(0.05, 0.20, 0.75), sides);
     c = mix(c, vec3(0.08, 0.08, 0.08), horiz);
-  } else if (mode == 2) {
+  } else if (mode == 2 && (kModes & 4) != 0) {
     bool back = dot(n, v) < 0.0;
     if (back) n = -n;
     vec3 base = c;
@@ -112,7 +118,7 @@ void main() {
       base = mix(base, vec3(0.05, 0.10, 0.45), grain * 0.8);
     }
     c = lit(base, n, v, 0.05);
-  } else if (mode == 4) {
+  } else if (mode == 4 && (kModes & 16) != 0) {
     float minor = max(grid_cov(v_pos.x, 0.1, 0.004), grid_cov(v_pos.z, 0.1, 0.004));
     float major = max(grid_cov(v_pos.x, 1.0, 0.008), grid_cov(v_pos.z, 1.0, 0.008));
     float dist = length(v_pos.xz);

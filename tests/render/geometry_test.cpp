@@ -146,5 +146,76 @@ TEST(Geometry, HandOverlaysDrawSkeletonPointerAndCandidateLine) {
   EXPECT_EQ(bad.indices.size(), 0u);
 }
 
+// The level of detail the XR app draws the form at: fewer angles and sections, the vertices still
+// on the form's surface, every triangle (grid and both caps) counter-clockwise seen from outside.
+TEST(Geometry, FormLevelOfDetailKeepsTheSurfaceAndTheWinding) {
+  auto form = test::analytic_form();
+  DrawOptions full_opt;
+  Mesh full, lod;
+  append_form(*form, 0.01f, full_opt, full);
+  DrawOptions lod_opt;
+  lod_opt.form_angle_step = 4;
+  append_form(*form, 0.025f, lod_opt, lod);
+  const size_t tri_full = full.indices.size() / 3, tri_lod = lod.indices.size() / 3;
+  std::printf("form triangles: full %zu, LOD (every 4th angle, 25 mm) %zu\n", tri_full, tri_lod);
+  EXPECT_LT(tri_lod * 8, tri_full);
+  float worst = 0;
+  int grid = 0, measured = 0;
+  for (const Vertex& v : lod.vertices) {
+    if (v.aux[0] != float(ShadeMode::kForm)) continue;
+    ++grid;
+    // (+inf just above the top section: float rounding of the top row's height)
+    const float d = form_distance(*form, {v.pos[0], v.pos[1], v.pos[2]});
+    if (!std::isfinite(d)) continue;
+    ++measured;
+    worst = std::max(worst, std::abs(d));
+  }
+  std::printf("%d grid vertices (%d angles), %d measured: worst distance from the surface %.2e m\n",
+              grid, sim::DressForm::kAngles / 4, measured, worst);
+  EXPECT_EQ(grid % (sim::DressForm::kAngles / 4), 0);
+  EXPECT_GE(measured, grid - sim::DressForm::kAngles / 4);
+  EXPECT_LT(worst, 1e-4f);
+  for (const Mesh* m : {&full, &lod}) {
+    int outward = 0, total = 0;
+    for (size_t t = 0; t + 2 < m->indices.size(); t += 3) {
+      const Vertex &a = m->vertices[m->indices[t]], &b = m->vertices[m->indices[t + 1]],
+                   &c = m->vertices[m->indices[t + 2]];
+      const Eigen::Vector3f pa(a.pos), pb(b.pos), pc(c.pos);
+      const Eigen::Vector3f face = (pb - pa).cross(pc - pa);
+      if (face.norm() < 1e-12f) continue;
+      Eigen::Vector3f out;
+      if (a.aux[0] == float(ShadeMode::kForm))  // the grid: away from the section centre
+        out = Eigen::Vector3f((pa + pb + pc).x() / 3 - a.aux[1], 0,
+                              (pa + pb + pc).z() / 3 - a.aux[2]);
+      else  // a cap: along its normal (down at the bottom, up at the top)
+        out = Eigen::Vector3f(a.normal);
+      ++total;
+      outward += face.dot(out) > 0;
+    }
+    std::printf("%d of %d triangles wound counter-clockwise seen from outside\n", outward, total);
+    EXPECT_EQ(outward, total);
+  }
+}
+
+TEST(Geometry, FormLevelOfDetailFollowsThePixelSize) {
+  const float quarter_turn = 1.5707963f;
+  const FormLod xr512 = form_lod_for_pixels(quarter_turn / 512, 8);
+  const FormLod xr4k = form_lod_for_pixels(quarter_turn / 4096, 8);
+  const FormLod xr64 = form_lod_for_pixels(quarter_turn / 64, 8);
+  std::printf("512 px: %.4f m, step %d; 4096 px: %.4f m, step %d; 64 px: %.4f m, step %d\n",
+              xr512.section_spacing, xr512.angle_step, xr4k.section_spacing, xr4k.angle_step,
+              xr64.section_spacing, xr64.angle_step);
+  // 8 px of 90/512 degrees at 1 m = 24.5 mm; 1.3 m / 64 angles = 20 mm fits, / 32 does not.
+  EXPECT_NEAR(xr512.section_spacing, 8 * quarter_turn / 512, 1e-5f);
+  EXPECT_EQ(xr512.angle_step, 4);
+  EXPECT_FLOAT_EQ(xr4k.section_spacing, 0.008f);  // never finer than the default
+  EXPECT_EQ(xr4k.angle_step, 1);
+  EXPECT_FLOAT_EQ(xr64.section_spacing, 0.03f);  // never coarser than 3 cm
+  EXPECT_EQ(xr64.angle_step, 4);
+  const FormLod bad = form_lod_for_pixels(-1, 8);  // nonsense in: the full-detail default
+  EXPECT_FLOAT_EQ(bad.section_spacing, 0.008f);
+  EXPECT_EQ(bad.angle_step, 1);
+}
+
 }  // namespace
 }  // namespace drape::render

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 
 #include "render/image_io.hpp"
 #include "test_scenes.hpp"
@@ -155,7 +156,8 @@ TEST(Renderer, ProjectionOfKnownPointsWithAsymmetricXrFov) {
 
 // Simulates the XR path: "the runtime" creates instance and device, the renderer adopts them and
 // draws two eyes into layers 0 and 1 of a caller-owned array image (like an XR swapchain image),
-// which the test copies out itself.
+// which the test copies out itself: once eye by eye (render), once both eyes in one submission
+// (render_views, as the XR app does); the two must be identical.
 TEST(Renderer, HandedOverDeviceAndArraySwapchainImage) {
   ContextOptions co;
   co.validation = true;
@@ -173,36 +175,47 @@ TEST(Renderer, HandedOverDeviceAndArraySwapchainImage) {
   ii.samples = VK_SAMPLE_COUNT_1_BIT;
   ii.tiling = VK_IMAGE_TILING_OPTIMAL;
   ii.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-  VkImage image = VK_NULL_HANDLE;
-  ASSERT_EQ(vkCreateImage(rt.device, &ii, nullptr, &image), VK_SUCCESS);
+  VkImage images[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+  VkDeviceMemory mems[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
   VkMemoryRequirements req;
-  vkGetImageMemoryRequirements(rt.device, image, &req);
-  uint32_t type = 0;
-  while (!(req.memoryTypeBits & (1u << type))) ++type;
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  ai.allocationSize = req.size;
-  ai.memoryTypeIndex = type;
-  VkDeviceMemory mem = VK_NULL_HANDLE;
-  ASSERT_EQ(vkAllocateMemory(rt.device, &ai, nullptr, &mem), VK_SUCCESS);
-  vkBindImageMemory(rt.device, image, mem, 0);
+  uint32_t type = 0;
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_EQ(vkCreateImage(rt.device, &ii, nullptr, &images[k]), VK_SUCCESS);
+    vkGetImageMemoryRequirements(rt.device, images[k], &req);
+    type = 0;
+    while (!(req.memoryTypeBits & (1u << type))) ++type;
+    ai.allocationSize = req.size;
+    ai.memoryTypeIndex = type;
+    ASSERT_EQ(vkAllocateMemory(rt.device, &ai, nullptr, &mems[k]), VK_SUCCESS);
+    vkBindImageMemory(rt.device, images[k], mems[k], 0);
+  }
   {
     auto r = Renderer::create_on({rt.instance, rt.physical, rt.device, rt.queue_family, 0});
     ASSERT_TRUE(r.ok()) << r.error();
-    sim::SceneSnapshot s;
-    s.form = test::analytic_form();
+    sim::SceneSnapshot s = test::decorated_scene();  // form, cloth, decorations: every draw
+    ViewTarget vt[2];
     for (uint32_t eye = 0; eye < 2; ++eye) {
       Pose p;
       p.position = Eigen::Vector3f(eye == 0 ? -0.032f : 0.032f, 1.1f, 1.0f);
-      const View v = make_view(p, Fov{-0.6f, 0.6f, 0.6f, -0.6f});
-      ColorTarget t{image, ii.format, w, h, eye, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
-      const Status st = (*r)->render(s, v, t);
+      vt[eye].view = make_view(p, Fov{-0.6f, 0.6f, 0.6f, -0.6f});
+      vt[eye].target =
+          ColorTarget{images[0], ii.format, w, h, eye, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+      const Status st = (*r)->render(s, vt[eye].view, vt[eye].target);
       ASSERT_TRUE(st.ok()) << st.error;
+      EXPECT_EQ((*r)->last_frame().views, 1);
     }
+    for (auto& v : vt) v.target.image = images[1];
+    const Status st = (*r)->render_views(s, vt, 2);
+    ASSERT_TRUE(st.ok()) << st.error;
+    EXPECT_EQ((*r)->last_frame().views, 2);
+    EXPECT_FALSE((*r)->last_frame().cloth_rebuilt);  // same snapshot: the cloth is cached
     (*r)->forget_targets();
   }  // the renderer is gone; the runtime's device must still work
-  // Copy both layers out with the "runtime's" own commands.
+  // Copy both layers of both images out with the "runtime's" own commands.
   VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  bi.size = VkDeviceSize(w) * h * 4 * 2;
+  const VkDeviceSize image_bytes = VkDeviceSize(w) * h * 4 * 2;
+  bi.size = 2 * image_bytes;
   bi.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   VkBuffer buf = VK_NULL_HANDLE;
   ASSERT_EQ(vkCreateBuffer(rt.device, &bi, nullptr, &buf), VK_SUCCESS);
@@ -227,10 +240,13 @@ TEST(Renderer, HandedOverDeviceAndArraySwapchainImage) {
   vkAllocateCommandBuffers(rt.device, &cai, &cmd);
   VkCommandBufferBeginInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   vkBeginCommandBuffer(cmd, &cbi);
-  VkBufferImageCopy region{};
-  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 2};
-  region.imageExtent = {w, h, 1};
-  vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buf, 1, &region);
+  for (int k = 0; k < 2; ++k) {
+    VkBufferImageCopy region{};
+    region.bufferOffset = k * image_bytes;
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 2};
+    region.imageExtent = {w, h, 1};
+    vkCmdCopyImageToBuffer(cmd, images[k], VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buf, 1, &region);
+  }
   VkBufferMemoryBarrier bar{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
   bar.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
   bar.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
@@ -257,20 +273,87 @@ TEST(Renderer, HandedOverDeviceAndArraySwapchainImage) {
     }
     differ += std::abs(int(px[i * 4]) - int(px[(w * h + i) * 4])) > 8;
   }
-  std::printf("form pixels: left %d right %d; pixels that differ: %d\n", form_px[0], form_px[1],
-              differ);
-  EXPECT_GT(form_px[0], 200);
-  EXPECT_GT(form_px[1], 200);
+  // render_views (both eyes, one submission) == render per eye, byte for byte.
+  int max_diff = 0;
+  for (VkDeviceSize i = 0; i < image_bytes; ++i)
+    max_diff = std::max(max_diff, std::abs(int(px[i]) - int(px[image_bytes + i])));
+  std::printf(
+      "form pixels: left %d right %d; pixels that differ: %d; render_views vs render: max "
+      "channel difference %d\n",
+      form_px[0], form_px[1], differ, max_diff);
+  EXPECT_GT(form_px[0], 100);  // (the cloth hides part of the form)
+  EXPECT_GT(form_px[1], 100);
   EXPECT_GT(differ, 20);
+  EXPECT_EQ(max_diff, 0);
   vkUnmapMemory(rt.device, bmem);
   vkDestroyCommandPool(rt.device, pool, nullptr);
   vkDestroyBuffer(rt.device, buf, nullptr);
   vkFreeMemory(rt.device, bmem, nullptr);
-  vkDestroyImage(rt.device, image, nullptr);
-  vkFreeMemory(rt.device, mem, nullptr);
+  for (int k = 0; k < 2; ++k) {
+    vkDestroyImage(rt.device, images[k], nullptr);
+    vkFreeMemory(rt.device, mems[k], nullptr);
+  }
   const ValidationCounts vc = rt.validation();
   EXPECT_EQ(vc.errors + vc.warnings, 0u);
   for (const auto& m : vc.messages) ADD_FAILURE() << "validation: " << m;
+}
+
+// The cloth's vertices are cached between frames: an unchanged snapshot is not rebuilt, a moved,
+// re-coloured or re-meshed cloth is, and the image always equals a fresh renderer's.
+TEST(Renderer, ClothCacheFollowsTheSnapshot) {
+  auto r = test::make_test_renderer();
+  auto fresh = test::make_test_renderer();
+  ASSERT_TRUE(r && fresh);
+  sim::SceneSnapshot s = test::decorated_scene();
+  vertex_normals(s.positions, s.indices, s.normals);  // as the sim publishes them
+  Pose p;
+  p.position = Eigen::Vector3f(0.1f, 1.1f, 1.2f);
+  const View v = make_view(p, Fov{-0.5f, 0.5f, 0.5f, -0.5f});
+  auto max_diff = [](const Image& a, const Image& b) {
+    int m = 0;
+    for (size_t i = 0; i < a.rgba.size(); ++i)
+      m = std::max(m, std::abs(int(a.rgba[i]) - int(b.rgba[i])));
+    return m;
+  };
+  auto first = r->render_offscreen(s, v, 96, 96);
+  ASSERT_TRUE(first.ok()) << first.error();
+  EXPECT_TRUE(r->last_frame().cloth_rebuilt);
+  auto again = r->render_offscreen(s, v, 96, 96);
+  ASSERT_TRUE(again.ok());
+  EXPECT_FALSE(r->last_frame().cloth_rebuilt);
+  EXPECT_EQ(max_diff(*first, *again), 0);
+  struct Change {
+    const char* what;
+    std::function<void(sim::SceneSnapshot&, DrawOptions&)> apply;
+  };
+  const Change changes[] = {
+      {"moved", [](sim::SceneSnapshot& x, DrawOptions&) { x.positions[5].z() += 0.05f; }},
+      {"normals", [](sim::SceneSnapshot& x, DrawOptions&) { x.normals[7] = -x.normals[7]; }},
+      {"re-meshed",
+       [](sim::SceneSnapshot& x, DrawOptions&) { x.indices.resize(x.indices.size() / 2); }},
+      {"colour",
+       [](sim::SceneSnapshot&, DrawOptions& o) {
+         o.cloth_colour = {0.2f, 0.3f, 0.9f};
+       }},
+      {"strain map",
+       [](sim::SceneSnapshot&, DrawOptions& o) { o.colour_map = ColourMap::kStrain; }},
+  };
+  DrawOptions opt;
+  for (const auto& c : changes) {
+    auto before = r->render_offscreen(s, v, 96, 96, opt);
+    ASSERT_TRUE(before.ok());
+    c.apply(s, opt);
+    auto cached = r->render_offscreen(s, v, 96, 96, opt);
+    ASSERT_TRUE(cached.ok());
+    EXPECT_TRUE(r->last_frame().cloth_rebuilt) << c.what;
+    auto ref = fresh->render_offscreen(s, v, 96, 96, opt);
+    ASSERT_TRUE(ref.ok());
+    std::printf("%s: image vs before %d, vs a fresh renderer %d (max channel difference)\n", c.what,
+                max_diff(*before, *cached), max_diff(*cached, *ref));
+    EXPECT_GT(max_diff(*before, *cached), 0) << c.what;
+    EXPECT_EQ(max_diff(*cached, *ref), 0) << c.what;
+  }
+  expect_no_validation_messages(*r);
 }
 
 TEST(Renderer, MsaaOffscreenMatchesSingleSampleBroadly) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -276,4 +277,220 @@ TEST(Energy, ElasticaReferenceMatchesSmallDeflectionLimit) {
   const Vec2 t2 = elastica_tip(0.04, 8e-8, 0.013, 2000);
   const double Bi = elastica_rigidity_for_drop(0.04, 0.013, t2.y());
   EXPECT_NEAR(Bi / 8e-8, 1.0, 1e-3);
+}
+
+// --- kTensor bending (the default) -------------------------------------------------------------
+
+namespace {
+
+// A 0.1 x 0.1 m panel, n x n grid; jitter > 0 moves every interior vertex's material
+// coordinates by up to jitter * spacing (an irregular mesh).
+Cloth tensor_panel(int n, double jitter, unsigned seed = 1) {
+  PanelSpec p;
+  p.width = p.height = 0.1;
+  p.nx = p.ny = n;
+  Cloth c = make_panel(p, FabricParams{});
+  const double h = 0.1 / (n - 1);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-jitter * h, jitter * h);
+  for (int j = 1; j + 1 < n; ++j)
+    for (int i = 1; i + 1 < n; ++i) c.topo.material[j * n + i] += Vec2(u(rng), u(rng));
+  c.relump_masses();
+  return c;
+}
+
+// Height field z = 1/2 p^T S p over the material coordinates (x = (u, v, z)).
+void set_height_field(Cloth& c, double suu, double svv, double suv) {
+  for (int i = 0; i < c.num_vertices(); ++i) {
+    const Vec2 m = c.topo.material[i];
+    c.state.x[i] =
+        Vec3(m.x(), m.y(), 0.5 * (suu * m.x() * m.x() + svv * m.y() * m.y()) + suv * m.x() * m.y());
+  }
+}
+
+}  // namespace
+
+TEST(Energy, TensorBendingEqualsAnalyticEnergyOfConstantCurvature) {
+  // E = 1/2 A (B_weft S_uu^2 + B_warp S_vv^2 + 2 B_twist S_uv^2), B_twist = sqrt(B_warp B_weft).
+  // Deep interior (triangles farther than 2.5 cells from the boundary): exact on the regular
+  // grid, tight on a jittered mesh; whole sheet: the free-boundary layer (one row of
+  // triangles resists no curvature normal to its free edge) is printed and bounded.
+  const FabricParams f;
+  const double bt = std::sqrt(f.bending_warp * f.bending_weft);
+  const struct {
+    const char* name;
+    double suu, svv, suv;
+  } fields[] = {{"warp bend", 0, 4, 0},
+                {"weft bend", 4, 0, 0},
+                {"twist", 0, 0, 4},
+                {"saddle", 3, -3, 0},
+                {"mixed", 1, -2.5, 1.5}};
+  for (double jitter : {0.0, 0.3})
+    for (int variant = 0; variant < 4; ++variant) {
+      const auto est = variant == 2   ? EnergyOptions::Curvature::kLocal
+                       : variant == 3 ? EnergyOptions::Curvature::kDivergence
+                                      : EnergyOptions::Curvature::kBlended;
+      const int n = 21;
+      Cloth c = tensor_panel(n, jitter);
+      EnergyOptions o;
+      o.gravity = false;
+      o.curvature_estimator = est;
+      o.curvature_smoothing = variant == 1 ? 2 : 1;
+      ClothEnergy e;
+      e.build(c, o);
+      ASSERT_TRUE(e.tensor_bending());
+      const double h = 0.1 / (n - 1), margin = 2.5 * h;
+      double worst_in = 0, worst_all = 0;
+      for (const auto& fd : fields) {
+        set_height_field(c, fd.suu, fd.svv, fd.suv);
+        const double dens = 0.5 * (f.bending_weft * fd.suu * fd.suu +
+                                   f.bending_warp * fd.svv * fd.svv + 2 * bt * fd.suv * fd.suv);
+        double ein = 0, ain = 0, atot = 0;
+        for (int t = 0; t < e.num_triangles(); ++t) {
+          atot += e.rest_area(t);
+          bool deep = true;
+          for (int k = 0; k < 3; ++k) {
+            const Vec2 m = c.topo.material[e.tri(t)[k]];
+            deep = deep && m.x() > margin && m.y() > margin && m.x() < 0.1 - margin &&
+                   m.y() < 0.1 - margin;
+          }
+          if (!deep) continue;
+          ein += e.bending_triangle_energy(t, c.state.x);
+          ain += e.rest_area(t);
+        }
+        const double etot = e.bending_energy(c.state.x);
+        const double err_in = ein / (dens * ain) - 1, err_all = etot / (dens * atot) - 1;
+        std::printf(
+            "estimator %d (W passes %d), jitter %.1f, %-9s: interior %.6e J vs %.6e J (%+.2e), "
+            "whole sheet %+.2f %%\n",
+            static_cast<int>(est), o.curvature_smoothing, jitter, fd.name, ein, dens * ain, err_in,
+            100 * err_all);
+        worst_in = std::max(worst_in, std::abs(err_in));
+        worst_all = std::max(worst_all, std::abs(err_all));
+      }
+      if (est == EnergyOptions::Curvature::kDivergence) continue;  // printed for comparison
+      if (jitter == 0.0 || est == EnergyOptions::Curvature::kLocal) {
+        EXPECT_LT(worst_in, 1e-9);
+      } else {
+        // GAP: the blended estimator is exact only where the neighbour average removes the
+        // divergence form's element noise (regular grids); on this 30 %-jittered mesh the
+        // interior is measured 3-7 % too stiff (kLocal is exact here but has the soft mode).
+        EXPECT_LT(worst_in, variant == 1 ? 0.03 : 0.09);
+      }
+      EXPECT_LT(worst_all, 0.12);  // boundary layer of a 20-cell sheet
+    }
+}
+
+TEST(Energy, TensorBendingRigidMotionsAndFlatStatesCostNothing) {
+  Cloth c = tensor_panel(9, 0.3, 4);
+  EnergyOptions o;
+  o.gravity = false;
+  ClothEnergy e;
+  e.build(c, o);
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(1.1, Vec3(-1, 2, 0.5).normalized()).toRotationMatrix();
+  // Flat, rotated and translated: zero; and a curved state moved rigidly keeps its energy.
+  std::vector<Vec3> x(c.num_vertices());
+  for (int i = 0; i < c.num_vertices(); ++i) {
+    const Vec2 m = c.topo.material[i];
+    x[i] = R * Vec3(m.x(), m.y(), 0) + Vec3(0.4, -1, 2);
+  }
+  const double e_flat = e.bending_energy(x);
+  set_height_field(c, 2, -1, 3);
+  perturb(c, 1e-3, 9);
+  const double e0 = e.bending_energy(c.state.x);
+  for (int i = 0; i < c.num_vertices(); ++i) x[i] = R * c.state.x[i] + Vec3(-3, 0.2, 1);
+  const double e1 = e.bending_energy(x);
+  // The constraint rows (XPBD's view) carry the same energy.
+  double er = 0;
+  for (int r = 0; r < e.num_bending_rows(); ++r) {
+    Vec3 v = Vec3::Zero();
+    for (int k = e.bending_row_offsets()[r]; k < e.bending_row_offsets()[r + 1]; ++k)
+      v += e.bending_row_values()[k] * c.state.x[e.bending_row_columns()[k]];
+    er += 0.5 * e.bending_row_stiffness(r) * v.squaredNorm();
+  }
+  EXPECT_NEAR(er, e0, 1e-9 * e0);
+  std::printf("flat rotated sheet %.3e J; curved %.9e J, moved %.9e J, by rows %.9e J\n", e_flat,
+              e0, e1, er);
+  EXPECT_LT(std::abs(e_flat), 1e-9 * e0);  // round-off of P x at |x| ~ 2 m
+  EXPECT_GT(e0, 0);
+  EXPECT_NEAR(e1, e0, 1e-8 * e0);
+}
+
+TEST(Energy, TensorBendingGradientHessianAndVertexBlocks) {
+  // E_b = 1/2 x^T (P (x) I3) x: gradient against finite differences of the energy, P symmetric
+  // and PSD, P annihilates affine maps, the VBD vertex block is (P x)_i and P_ii I.
+  Cloth c = tensor_panel(6, 0.3, 2);
+  set_height_field(c, 3, 1, -2);
+  perturb(c, 2e-3, 5);
+  EnergyOptions o;
+  o.gravity = false;
+  o.model = EnergyOptions::Model::kFem;
+  ClothEnergy e;
+  e.build(c, o);
+  const int n = c.num_vertices();
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, n);
+  const auto& off = e.bending_offsets();
+  for (int i = 0; i < n; ++i)
+    for (int k = off[i]; k < off[i + 1]; ++k) P(i, e.bending_columns()[k]) = e.bending_values()[k];
+  EXPECT_LT((P - P.transpose()).norm(), 1e-12 * P.norm());
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(P);
+  std::printf("P: %d x %d, eigenvalues %.3e .. %.3e\n", n, n, es.eigenvalues().minCoeff(),
+              es.eigenvalues().maxCoeff());
+  EXPECT_GT(es.eigenvalues().minCoeff(), -1e-10 * es.eigenvalues().maxCoeff());
+  Eigen::VectorXd one = Eigen::VectorXd::Ones(n), pu(n), pv(n);
+  for (int i = 0; i < n; ++i) {
+    pu[i] = c.topo.material[i].x();
+    pv[i] = c.topo.material[i].y();
+  }
+  const double pn = P.norm();
+  EXPECT_LT((P * one).norm(), 1e-10 * pn);
+  EXPECT_LT((P * pu).norm(), 1e-10 * pn * 0.1);
+  EXPECT_LT((P * pv).norm(), 1e-10 * pn * 0.1);
+  // Bending gradient against central differences of the bending energy (exact for a quadratic).
+  std::vector<Vec3> g(n, Vec3::Zero());
+  e.add_bending_gradient(c.state.x, g);
+  double gerr = 0, gscale = 0;
+  const double eps = 1e-6;
+  for (int i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d) {
+      auto xp = c.state.x, xm = c.state.x;
+      xp[i][d] += eps;
+      xm[i][d] -= eps;
+      const double fd = (e.bending_energy(xp) - e.bending_energy(xm)) / (2 * eps);
+      gerr = std::max(gerr, std::abs(fd - g[i][d]));
+      gscale = std::max(gscale, std::abs(g[i][d]));
+      // Hessian column (i, d) against differences of the gradient: P_ji delta_dd'.
+      std::vector<Vec3> gp(n, Vec3::Zero()), gm(n, Vec3::Zero());
+      e.add_bending_gradient(xp, gp);
+      e.add_bending_gradient(xm, gm);
+      for (int j = 0; j < n; ++j) {
+        const Vec3 col = (gp[j] - gm[j]) / (2 * eps);
+        EXPECT_NEAR(col[d], P(j, i), 1e-6 * pn);
+      }
+    }
+  std::printf("tensor bending gradient error %.3e (scale %.3e)\n", gerr, gscale);
+  EXPECT_LT(gerr, 1e-6 * gscale);
+  // Vertex blocks: f_i = -(membrane + bending) gradient, H contains P_ii I.
+  EnergyOptions nb = o;
+  nb.bending = false;
+  ClothEnergy em;
+  em.build(c, nb);
+  for (int i = 0; i < n; ++i) {
+    Vec3 f, fm;
+    Mat3 H, Hm;
+    e.vertex_force_hessian(i, c.state.x, c.state.mass[i], f, H);
+    em.vertex_force_hessian(i, c.state.x, c.state.mass[i], fm, Hm);
+    EXPECT_LT((fm - f - g[i]).norm(), 1e-9 * (g[i].norm() + 1e-12));
+    EXPECT_LT((H - Hm - P(i, i) * Mat3::Identity()).norm(), 1e-9 * pn);
+  }
+  // The neighbour lists contain P's pattern (VBD colours stay independent).
+  std::vector<int> no, nbr;
+  e.vertex_neighbours(no, nbr);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      if (i != j && P(i, j) != 0.0) {
+        EXPECT_TRUE(std::find(nbr.begin() + no[i], nbr.begin() + no[i + 1], j) !=
+                    nbr.begin() + no[i + 1]);
+      }
 }

@@ -89,13 +89,9 @@ TEST(Vbd, FreezingSkipsRestingVerticesAndWakes) {
   std::printf("frozen after rest: %d of %d\n", s.frozen_count(), sc.cloth.num_vertices());
   EXPECT_GT(s.frozen_count(), sc.cloth.num_vertices() / 2);
   // Move a pinned corner: neighbours wake and the cloth follows.
-  const Vec3 before = sc.cloth.state.x[0];
-  for (int k = 0; k < 45; ++k) {
-    sc.cloth.state.x[99] += Vec3(0.2 / 90, 0, 0);
-    s.step(sc.cloth, sc.objects, 1.0 / 90);
-  }
-  std::printf("bottom-left moved %.2f mm after the corner moved, frozen %d\n",
-              (sc.cloth.state.x[0] - before).norm() * 1e3, s.frozen_count());
+  const double moved = drag_sheet_corner(sc, s, 45);
+  std::printf("bottom-left moved %.2f mm after the corner moved, frozen %d\n", moved * 1e3,
+              s.frozen_count());
   EXPECT_LT(s.frozen_count(), sc.cloth.num_vertices() / 2);
 }
 

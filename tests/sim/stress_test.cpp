@@ -1,4 +1,5 @@
-// Short versions of the stress cases: 0 failures for the default solver (VBD + watchdog).
+// Short versions of the stress cases: 0 failures for the default solver (XPBD + watchdog) and
+// for VBD.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -9,14 +10,15 @@
 
 using namespace drape::sim;
 
-TEST(Stress, DefaultSolverHasNoFailures) {
-  for (const auto& name : stress_case_names()) {
-    StressResult r = run_stress_case(name, "vbd", 1);
-    std::printf("%-16s steps %4d failures %d rollbacks %d vertices %d %s\n", name.c_str(), r.steps,
-                r.failures, r.rollbacks, r.vertices, r.note.c_str());
-    EXPECT_GT(r.steps, 0) << name;
-    EXPECT_EQ(r.failures, 0) << name;
-  }
+TEST(Stress, DefaultSolverAndVbdHaveNoFailures) {
+  for (const char* solver : {"default", "vbd"})
+    for (const auto& name : stress_case_names()) {
+      StressResult r = run_stress_case(name, solver, 1);
+      std::printf("%-8s %-16s steps %4d failures %d rollbacks %d vertices %d %s\n", solver,
+                  name.c_str(), r.steps, r.failures, r.rollbacks, r.vertices, r.note.c_str());
+      EXPECT_GT(r.steps, 0) << solver << " " << name;
+      EXPECT_EQ(r.failures, 0) << solver << " " << name;
+    }
 }
 
 TEST(Stress, WatchdogRollsBackANonFiniteStep) {

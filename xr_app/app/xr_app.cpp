@@ -1,6 +1,8 @@
 // The drape OpenXR application (see xr_app.hpp).
 #include "xr_app/app/xr_app.hpp"
 
+#include <malloc.h>
+#include <time.h>
 #include <unistd.h>
 #include <vulkan/vulkan.h>
 // (Vulkan first: openxr_platform.h uses its types)
@@ -8,6 +10,7 @@
 #include <openxr/openxr.h>
 #include <openxr/openxr_platform.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +20,8 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <set>
+#include <sstream>
 #include <thread>
 
 #ifdef DRAPE_XR_WITH_RENDER
@@ -89,6 +94,47 @@ std::string select_runtime() {
 }
 
 namespace {
+
+double cpu_ms(clockid_t clock) {
+  timespec ts{};
+  clock_gettime(clock, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+double thread_cpu_ms() {
+  return cpu_ms(CLOCK_THREAD_CPUTIME_ID);
+}
+double process_cpu_ms() {  // all threads: the app, lavapipe's, the sim's
+  return cpu_ms(CLOCK_PROCESS_CPUTIME_ID);
+}
+
+using Clock = std::chrono::steady_clock;
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// CPU seconds (user + system) of each live thread of this process: tid -> (name, seconds).
+[[maybe_unused]] std::map<int, std::pair<std::string, double>> thread_cpu_seconds() {
+  std::map<int, std::pair<std::string, double>> out;
+  const double tick = static_cast<double>(sysconf(_SC_CLK_TCK));
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator("/proc/self/task", ec)) {
+    std::ifstream f(e.path() / "stat");
+    std::string line;
+    if (!std::getline(f, line)) continue;
+    const size_t open = line.find('('), close = line.rfind(')');
+    if (open == std::string::npos || close == std::string::npos) continue;
+    std::istringstream rest(line.substr(close + 2));
+    std::string tok;
+    double ut = 0, st = 0;
+    for (int field = 3; rest >> tok && field <= 15; ++field) {  // utime 14, stime 15
+      if (field == 14) ut = std::atof(tok.c_str());
+      if (field == 15) st = std::atof(tok.c_str());
+    }
+    out[std::atoi(e.path().filename().c_str())] = {line.substr(open + 1, close - open - 1),
+                                                   (ut + st) / tick};
+  }
+  return out;
+}
 
 const char* const kProfiles[] = {
     "/interaction_profiles/khr/simple_controller", "/interaction_profiles/oculus/touch_controller",
@@ -209,10 +255,26 @@ class App {
   std::vector<render::HandOverlay> overlays_;  // this frame's hands, drawn from its own pose
   bool ops_busy_[2] = {false, false}, cutting_[2] = {false, false};
   int pinned_at_start_ = 0;
-  std::vector<std::pair<int64_t, sim::Vec3>> posted_;  // right-hand pose posted per frame
+  struct Posted {
+    int64_t frame;
+    sim::Vec3 position;
+    Clock::time_point when;
+  };
+  std::vector<Posted> posted_;  // right-hand pose posted per frame
   std::mutex tick_mu_;
   std::vector<std::chrono::steady_clock::time_point> tick_starts_;
+  // Sim tick cost (profile): written on the thread that runs the ticks, read at the end.
+  Clock::time_point step_t0_{}, step_end_{};
+  double step_cpu0_ = 0;
+  bool step_done_ = false;
+  std::atomic<int> sim_tid_{0};  // the thread running the ticks
+  std::set<int> pre_sim_tids_;   // threads alive before the sim and its solver were made
+  std::map<int, std::pair<std::string, double>> cpu_at_first_frame_;      // start-up excluded
+  std::vector<double> sim_step_wall_, sim_step_cpu_, sim_snapshot_wall_;  // guarded by tick_mu_
 #endif
+  void prof(const char* stage, double ms) {
+    r_.profile_ms[stage].push_back(ms);
+  }
   int64_t session_frame_ = 0;  // xrWaitFrame calls in this session (the scenario's frame index)
 };
 
@@ -251,15 +313,44 @@ void App::start_sim() {
     note("command map: " + r_.commands_file + " (" + std::to_string(commands_.bindings().size()) +
          " bindings)");
   }
-  if (!opt_.sim_lock_step) {
-    // Tick start times, for the jitter of the free-running sim clock under rendering load.
+  {
+    // Tick start times (free-running sim: the jitter of its clock under rendering load) and the
+    // tick's cost: the solver step (wall and CPU of the thread running it) and fill_snapshot.
     auto inner = w.before_step;
-    w.before_step = [this, inner](sim::World& world, double dt) {
-      {
+    const bool free = !opt_.sim_lock_step;
+    w.before_step = [this, inner, free](sim::World& world, double dt) {
+      if (free) {
         std::lock_guard<std::mutex> lk(tick_mu_);
-        if (tick_starts_.size() < 100000) tick_starts_.push_back(std::chrono::steady_clock::now());
+        if (tick_starts_.size() < 100000) tick_starts_.push_back(Clock::now());
       }
       if (inner) inner(world, dt);
+      sim_tid_.store(static_cast<int>(gettid()), std::memory_order_relaxed);
+      step_cpu0_ = thread_cpu_ms();
+      step_t0_ = Clock::now();
+    };
+    auto inner_after = w.after_step;
+    w.after_step = [this, inner_after](sim::World& world, double dt) {
+      const auto t1 = Clock::now();
+      const double cpu = thread_cpu_ms() - step_cpu0_;
+      {
+        std::lock_guard<std::mutex> lk(tick_mu_);
+        if (sim_step_wall_.size() < 100000) {
+          sim_step_wall_.push_back(ms_between(step_t0_, t1));
+          sim_step_cpu_.push_back(cpu);
+        }
+      }
+      if (inner_after) inner_after(world, dt);
+      step_end_ = Clock::now();
+      step_done_ = true;
+    };
+    auto inner_decorate = w.decorate_snapshot;
+    w.decorate_snapshot = [this, inner_decorate](const sim::World& world, sim::SceneSnapshot& s) {
+      if (inner_decorate) inner_decorate(world, s);
+      if (!step_done_) return;  // make_reader() before the first tick
+      step_done_ = false;
+      std::lock_guard<std::mutex> lk(tick_mu_);
+      if (sim_snapshot_wall_.size() < 100000)
+        sim_snapshot_wall_.push_back(ms_between(step_end_, Clock::now()));
     };
   }
   // Lock step: the ticks run on this thread inside advance() (no hand-off per frame).
@@ -460,7 +551,7 @@ void App::interact(const XrFrameState& fs,
     use.push_back(op);
   }
   if (hands[1].tracked) {
-    posted_.emplace_back(frame_idx, hands[1].position);
+    posted_.push_back({frame_idx, hands[1].position, Clock::now()});
     if (posted_.size() > 256) posted_.erase(posted_.begin());
   }
   bool cut_trigger = false;
@@ -501,6 +592,23 @@ void App::interact(const XrFrameState& fs,
 
 void App::finish_sim() {
   if (!sim_) return;
+  // Who used the CPU (before the sim's threads end): the frame loop, the sim thread, the
+  // solver's workers (threads created with the sim), lavapipe's rasterisers (llvmpipe-N), the
+  // rest (lavapipe's queue thread, the loader, ...).
+  for (const auto& [tid, t] : thread_cpu_seconds()) {
+    const auto base = cpu_at_first_frame_.find(tid);
+    const double sec = t.second - (base != cpu_at_first_frame_.end() ? base->second.second : 0.0);
+    std::string group = "other (lavapipe queue, loader)";
+    if (tid == getpid())
+      group = "app frame loop (main)";
+    else if (tid == sim_tid_.load())
+      group = "sim thread";
+    else if (t.first.rfind("llvmpipe", 0) == 0)
+      group = "lavapipe rasterisers (" + t.first.substr(0, 8) + "-*)";
+    else if (!pre_sim_tids_.count(tid))
+      group = "solver workers";
+    r_.thread_cpu_s[group] += sec;
+  }
   sim_->stop();
   sim::World& w = sim_->world();
   r_.pinned_added = count_pinned(w.cloth) - pinned_at_start_;
@@ -517,7 +625,11 @@ void App::finish_sim() {
       mean /= static_cast<double>(d.size());
       for (double x : d) var += (x - mean) * (x - mean);
       r_.sim_tick_jitter_ms = std::sqrt(var / static_cast<double>(d.size()));
+      r_.profile_ms["sim.tick_interval"] = d;
     }
+    r_.profile_ms["sim.step_wall"] = sim_step_wall_;
+    r_.profile_ms["sim.step_cpu"] = sim_step_cpu_;
+    r_.profile_ms["sim.snapshot_wall"] = sim_snapshot_wall_;
   }
   if (ops_ && !opt_.out_dir.empty()) {
     std::error_code ec;
@@ -714,8 +826,11 @@ bool App::create_vulkan() {
       return false;
     }
     renderer_ = std::move(rr.value());
+    for (const auto& [tid, t] : thread_cpu_seconds()) pre_sim_tids_.insert(tid);
     auto scene = sim::make_form_drape(opt_.cloth_res);
-    auto solver = sim::make_solver("vbd");
+    sim::SolverConfig solver_cfg;
+    solver_cfg.freeze = true;  // pieces at rest sleep until a hand, pin or cut disturbs them
+    auto solver = sim::make_solver("default", solver_cfg);
     if (!solver) {
       r_.error = "solver: " + solver.error();
       return false;
@@ -993,14 +1108,29 @@ bool App::handle_events() {
 
 bool App::frame() {
   XrFrameState fs{XR_TYPE_FRAME_STATE};
+  const auto tw = Clock::now();
   XrResult x = xrWaitFrame(session_, nullptr, &fs);
   if (x == XR_ERROR_SESSION_LOST) return true;  // LOSS_PENDING arrives through the event queue
   if (!ok(x, "xrWaitFrame")) return false;
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
+  const double cpu0 = thread_cpu_ms(), pcpu0 = process_cpu_ms();
+  // Stage laps of this frame (the profile): wall ms since the previous lap.
+  std::vector<std::pair<const char*, double>> laps;
+  laps.emplace_back("xr.wait_frame", ms_between(tw, t0));
+  auto lap_t = t0;
+  auto lap = [&](const char* stage) {
+    const auto now = Clock::now();
+    laps.emplace_back(stage, ms_between(lap_t, now));
+    lap_t = now;
+  };
   const int64_t this_frame = session_frame_++;
+#ifdef DRAPE_XR_WITH_RENDER
+  if (r_.frames == 0 && cpu_at_first_frame_.empty()) cpu_at_first_frame_ = thread_cpu_seconds();
+#endif
   x = xrBeginFrame(session_, nullptr);
   if (x == XR_ERROR_SESSION_LOST) return true;
   if (!ok(x, "xrBeginFrame")) return false;
+  lap("xr.begin_frame");
 
   // Input: actions and hands.
   XrActiveActionSet active{action_set_, XR_NULL_PATH};
@@ -1029,9 +1159,11 @@ bool App::frame() {
     li.time = fs.predictedDisplayTime;
     joints_active[h] = XR_SUCCEEDED(locate_joints_(trackers_[h], &li, &loc)) && loc.isActive;
   }
+  lap("input");
 #ifdef DRAPE_XR_WITH_RENDER
   if (running_) interact(fs, joints, joints_active);
 #endif
+  lap("interact");
   {
     const XrHandJointLocationEXT* j = joints[1];
     if (joints_active[1]) {
@@ -1050,6 +1182,8 @@ bool App::frame() {
   const XrCompositionLayerBaseHeader* layers[1] = {
       reinterpret_cast<XrCompositionLayerBaseHeader*>(&layer)};
   uint32_t layer_count = 0;
+  bool cloth_matched = false;           // the drawn snapshot holds a posted right-hand pose ...
+  Clock::time_point cloth_posted_at{};  // ... posted then
   if (fs.shouldRender) {
     XrView views[2] = {{XR_TYPE_VIEW}, {XR_TYPE_VIEW}};
     XrViewState vs{XR_TYPE_VIEW_STATE};
@@ -1059,6 +1193,7 @@ bool App::frame() {
     vl.space = space_;
     uint32_t nv = 0;
     x = xrLocateViews(session_, &vl, &vs, 2, &nv, views);
+    lap("xr.locate_views");
     bool located = XR_SUCCEEDED(x) && (vs.viewStateFlags & XR_VIEW_STATE_ORIENTATION_VALID_BIT) &&
                    (vs.viewStateFlags & XR_VIEW_STATE_POSITION_VALID_BIT);
     if (located) {
@@ -1066,14 +1201,16 @@ bool App::frame() {
       const sim::SceneSnapshot* snap = renderer_ ? &reader_.latest() : nullptr;
       // Free-running sim: wait a bounded time for the tick that consumed this frame's hand pose
       // (posted in interact()), so the cloth drawn now reacts to the hand drawn now.
+      // Only when the sim's ticks are short enough for that tick to finish within the wait
+      // (a 128^2 VBD tick takes ~240 ms of CPU: waiting would only add to every frame).
       if (snap && ops_ && !opt_.sim_lock_step && opt_.pose_wait_ms > 0 && !posted_.empty() &&
-          posted_.back().first == this_frame) {
+          posted_.back().frame == this_frame && sim_->timing().step_ms_p50 < opt_.pose_wait_ms) {
         const auto deadline =
             std::chrono::steady_clock::now() +
             std::chrono::microseconds(static_cast<int64_t>(opt_.pose_wait_ms * 1e3));
         auto holds_pose = [&](const sim::SceneSnapshot& s) {
           for (const auto& hp : s.hands)
-            if (hp.id == 1 && hp.tracked && hp.position == posted_.back().second) return true;
+            if (hp.id == 1 && hp.tracked && hp.position == posted_.back().position) return true;
           return false;
         };
         while (!holds_pose(*snap) && std::chrono::steady_clock::now() < deadline) {
@@ -1081,35 +1218,45 @@ bool App::frame() {
           snap = &reader_.latest();
         }
       }
+      lap("pose_wait");
       // Pose-to-photon probes. Cloth (sim) latency: which frame's right-hand pose is in the
       // snapshot drawn now. Hand latency: which frame's pose the drawn hand has.
       if (snap && ops_) {
-        auto frames_back = [&](const sim::Vec3& pos) {
-          for (auto it = posted_.rbegin(); it != posted_.rend(); ++it)
-            if (it->second == pos) return static_cast<int>(this_frame - it->first);
-          return -1;
-        };
         for (const auto& hp : snap->hands)
           if (hp.id == 1 && hp.tracked)
-            if (int k = frames_back(hp.position); k >= 0) r_.cloth_latency_frames.push_back(k);
+            for (auto it = posted_.rbegin(); it != posted_.rend(); ++it)
+              if (it->position == hp.position) {
+                r_.cloth_latency_frames.push_back(static_cast<int>(this_frame - it->frame));
+                cloth_posted_at = it->when;
+                cloth_matched = true;
+                break;
+              }
         for (const auto& ov : overlays_)
           if (ov.id == 1)
             for (auto it = posted_.rbegin(); it != posted_.rend(); ++it)
-              if (it->second.cast<float>() == ov.pointer) {
-                r_.latency_frames.push_back(static_cast<int>(this_frame - it->first));
+              if (it->position.cast<float>() == ov.pointer) {
+                r_.latency_frames.push_back(static_cast<int>(this_frame - it->frame));
                 break;
               }
       }
 #endif
+      lap("probes");
+      // Both eyes: acquire and wait both swapchain images, draw them with one geometry build and
+      // one submission (render::Renderer::render_views), release both.
+      uint32_t idx[2] = {0, 0};
       for (int e = 0; e < 2; ++e) {
-        uint32_t idx = 0;
-        if (!ok(xrAcquireSwapchainImage(eyes_[e].chain, nullptr, &idx), "xrAcquireSwapchainImage"))
+        if (!ok(xrAcquireSwapchainImage(eyes_[e].chain, nullptr, &idx[e]),
+                "xrAcquireSwapchainImage"))
           return false;
         XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
         wi.timeout = XR_INFINITE_DURATION;
         if (!ok(xrWaitSwapchainImage(eyes_[e].chain, &wi), "xrWaitSwapchainImage")) return false;
+      }
+      lap("xr.acquire");
 #ifdef DRAPE_XR_WITH_RENDER
-        if (renderer_ && snap) {
+      if (renderer_ && snap) {
+        render::ViewTarget vt[2];
+        for (int e = 0; e < 2; ++e) {
           render::Pose pose;
           const XrPosef& p = views[e].pose;
           pose.orientation = Eigen::Quaternionf(p.orientation.w, p.orientation.x, p.orientation.y,
@@ -1117,34 +1264,50 @@ bool App::frame() {
           pose.position = {p.position.x, p.position.y, p.position.z};
           render::Fov fov{views[e].fov.angleLeft, views[e].fov.angleRight, views[e].fov.angleUp,
                           views[e].fov.angleDown};
-          render::ColorTarget t;
-          t.image = eyes_[e].images[idx].image;
-          t.format = static_cast<VkFormat>(format_);
-          t.width = eyes_[e].width;
-          t.height = eyes_[e].height;
-          render::DrawOptions dopt;
-          dopt.hands = overlays_;
-          const render::View view = render::make_view(pose, fov);
-          if (e == 0 && opt_.pointer_probe && ops_) {
-            // Left eye: where the right-hand pointer of this and the 3 previous frames projects.
-            XrAppResult::PointerProbe pr;
-            pr.frame = this_frame;
-            int n = 0;
-            for (auto it = posted_.rbegin(); it != posted_.rend() && n < 4; ++it, ++n) {
-              auto px =
-                  render::project_to_pixel(view, it->second.cast<float>(),
-                                           static_cast<int>(t.width), static_cast<int>(t.height));
-              pr.frames_back[n] = static_cast<int>(this_frame - it->first);
-              pr.px[n] =
-                  px ? std::array<float, 2>{px->x(), px->y()} : std::array<float, 2>{-1e9f, -1e9f};
-            }
-            pr.count = n;
-            r_.pointer_probe.push_back(pr);
-          }
-          auto st = renderer_->render(*snap, view, t, dopt);
-          if (!st) note("render: " + st.error);
+          vt[e].view = render::make_view(pose, fov);
+          vt[e].target.image = eyes_[e].images[idx[e]].image;
+          vt[e].target.format = static_cast<VkFormat>(format_);
+          vt[e].target.width = eyes_[e].width;
+          vt[e].target.height = eyes_[e].height;
         }
+        render::DrawOptions dopt;
+        dopt.hands = overlays_;
+        // The form's level of detail from the eyes' pixel size (lavapipe is vertex-bound).
+        const float rad_per_px =
+            (views[0].fov.angleRight - views[0].fov.angleLeft) / static_cast<float>(eyes_[0].width);
+        const render::FormLod lod = render::form_lod_for_pixels(rad_per_px);
+        if (opt_.form_lod) {
+          dopt.form_section_spacing = lod.section_spacing;
+          dopt.form_angle_step = lod.angle_step;
+        }
+        if (opt_.pointer_probe && ops_) {
+          // Left eye: where the right-hand pointer of this and the 3 previous frames projects.
+          XrAppResult::PointerProbe pr;
+          pr.frame = this_frame;
+          int n = 0;
+          for (auto it = posted_.rbegin(); it != posted_.rend() && n < 4; ++it, ++n) {
+            auto px = render::project_to_pixel(vt[0].view, it->position.cast<float>(),
+                                               static_cast<int>(vt[0].target.width),
+                                               static_cast<int>(vt[0].target.height));
+            pr.frames_back[n] = static_cast<int>(this_frame - it->frame);
+            pr.px[n] =
+                px ? std::array<float, 2>{px->x(), px->y()} : std::array<float, 2>{-1e9f, -1e9f};
+          }
+          pr.count = n;
+          r_.pointer_probe.push_back(pr);
+        }
+        auto st = renderer_->render_views(*snap, vt, 2, dopt);
+        if (!st) note("render: " + st.error);
+        lap("render");
+        const render::FrameStats& rs = renderer_->last_frame();
+        laps.emplace_back("render.build", rs.build_ms);
+        laps.emplace_back("render.upload", rs.upload_ms);
+        laps.emplace_back("render.record_submit", rs.submit_ms - rs.upload_ms);
+        laps.emplace_back("render.gpu_wait", rs.wait_ms);
+        laps.emplace_back("render.cloth_rebuilt", rs.cloth_rebuilt ? 1.0 : 0.0);
+      }
 #endif
+      for (int e = 0; e < 2; ++e) {
         if (!ok(xrReleaseSwapchainImage(eyes_[e].chain, nullptr), "xrReleaseSwapchainImage"))
           return false;
         pv[e].pose = views[e].pose;
@@ -1153,6 +1316,7 @@ bool App::frame() {
         pv[e].subImage.imageRect = {
             {0, 0}, {static_cast<int32_t>(eyes_[e].width), static_cast<int32_t>(eyes_[e].height)}};
       }
+      lap("xr.release");
       layer.space = space_;
       layer.viewCount = 2;
       layer.views = pv;
@@ -1167,8 +1331,13 @@ bool App::frame() {
   x = xrEndFrame(session_, &ei);
   if (x == XR_ERROR_SESSION_LOST) return true;
   if (!ok(x, "xrEndFrame")) return false;
-  r_.frame_ms.push_back(
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  lap("xr.end_frame");
+  const auto t_end = Clock::now();
+  r_.frame_ms.push_back(ms_between(t0, t_end));
+  if (cloth_matched) r_.cloth_latency_ms.push_back(ms_between(cloth_posted_at, t_end));
+  for (const auto& [stage, ms] : laps) prof(stage, ms);
+  prof("frame.cpu", thread_cpu_ms() - cpu0);
+  prof("frame.process_cpu", process_cpu_ms() - pcpu0);
   ++r_.frames;
   if (layer_count) ++r_.frames_rendered;
   if (opt_.max_frames > 0 && r_.frames >= opt_.max_frames && !exit_requested_) {
@@ -1206,6 +1375,17 @@ void App::run() {
 
 XrAppResult run_xr_app(const XrAppOptions& opt) {
   XrAppResult res;
+#ifdef M_TRIM_THRESHOLD
+  if (opt.tune_malloc) {
+    // lavapipe (llvmpipe's draw module) mallocs and frees tens of MB of vertex data per draw on
+    // its queue thread; glibc returns the freed top of that thread's arena to the kernel
+    // (madvise) every time and the next frame faults every page back in: 660k page faults and
+    // ~30 ms of system time per frame at 2 x 512^2 (docs/xr.md, "Profile"). Keep freed memory in
+    // the process instead (as GLIBC_TUNABLES=glibc.malloc.trim_threshold=... would).
+    mallopt(M_TRIM_THRESHOLD, 512 << 20);
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  }
+#endif
   {
     App app(opt, &res);
     app.run();

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,12 @@ struct XrAppOptions {
   // before drawing (0 = never wait: draw the newest snapshot at once).
   double pose_wait_ms = 6.0;
   bool pointer_probe = false;  // record XrAppResult::pointer_probe (tests)
+  // Keep freed heap memory in the process (glibc mallopt) instead of trimming it back to the
+  // kernel after every frame: lavapipe's per-draw allocations otherwise page-fault every frame.
+  bool tune_malloc = true;
+  // Draw the dress form at a level of detail chosen from the eyes' pixel size
+  // (render::form_lod_for_pixels); false: the renderer's full-detail default.
+  bool form_lod = true;
 };
 
 struct XrAppResult {
@@ -72,7 +79,19 @@ struct XrAppResult {
   std::vector<std::string> sim_messages;            // World::messages at the end
   std::vector<std::string> written;                 // files written to out_dir
   std::vector<double> frame_ms;                     // wall time per frame (wait → end)
-  double sim_tick_jitter_ms = -1;                   // free-running sim: stddev of tick period
+  // Per-stage profile, one sample per frame (or per sim tick for "sim.*"): wall ms of each stage
+  // of the frame loop ("xr.wait_frame", "input", "interact", "pose_wait", "render.build",
+  // "render.upload", "render.record_submit", "render.gpu_wait", "xr.end_frame", ...), the frame
+  // loop thread's CPU ms ("frame.cpu"), the whole process's CPU ms from xrWaitFrame's return to
+  // xrEndFrame's return ("frame.process_cpu": lavapipe's threads, the sim thread, the loop),
+  // and the sim's tick cost: "sim.step_wall",
+  // "sim.step_cpu" (solver step on the sim thread), "sim.snapshot_wall" (fill_snapshot).
+  std::map<std::string, std::vector<double>> profile_ms;
+  // CPU seconds (user + system) per group of threads from the first frame to the end of the run
+  // (start-up excluded): the frame loop, the sim
+  // thread, the solver's workers, lavapipe's rasterisers, the rest.
+  std::map<std::string, double> thread_cpu_s;
+  double sim_tick_jitter_ms = -1;  // free-running sim: stddev of tick period
   // Pose-to-photon, per rendered frame (only where a unique pose was matched): frames between
   // the frame whose right-hand pose the drawn hand has and the frame drawing it (the hand is
   // drawn from the frame's own located pose) ...
@@ -80,6 +99,9 @@ struct XrAppResult {
   // ... and frames between the frame whose right-hand pose the drawn snapshot (the cloth's
   // response) holds and the frame drawing it.
   std::vector<int> cloth_latency_frames;
+  // ... and the same in time: from posting that pose to the sim to the end of the frame drawing
+  // the snapshot that holds it (ms).
+  std::vector<double> cloth_latency_ms;
   // Per rendered frame (XrAppOptions::pointer_probe): left-eye pixel positions of the right-hand
   // pointer as located in this frame (frames_back 0) and the previous ones, for a pixel check of
   // the pose-to-photon latency against the runtime's screenshots.
