@@ -24,9 +24,6 @@ struct XpbdOptions {
   EnergyOptions energy;
   double damping = 1.0;  // velocity damping rate (1/s), air drag as in Verlet and VBD
   int threads = 2;       // colours projected in parallel (results do not depend on it)
-  // Contacts are detected every `contact_every` substeps (1: every substep, the most accurate;
-  // the half-spaces found are re-projected every substep in between).
-  int contact_every = 1;
   // Warm start (0..1): each substep starts from the previous substep's multipliers scaled by
   // this factor (and by (h / h_prev)^2), applying their displacement w grad C lambda with the
   // prediction. 0 (default) is classic XPBD: multipliers reset every substep, whose fixed point
