@@ -155,7 +155,7 @@ void write_svg(const std::vector<Row>& rows, const std::string& scene, int res,
   double tmin = 1e9, tmax = 0, emin = 1e9, emax = 0;
   std::map<std::string, std::vector<const Row*>> by;
   for (const auto& r : rows) {
-    if (r.scene != scene || r.resolution != res || !r.stable) continue;
+    if (r.scene != scene || r.resolution != res || !r.stable || !(r.rms_mm >= 0)) continue;
     by[r.solver].push_back(&r);
     tmin = std::min(tmin, r.ms_per_frame);
     tmax = std::max(tmax, r.ms_per_frame);
@@ -424,9 +424,9 @@ int main(int argc, char** argv) {
     if (settled[1] > 0)
       std::printf("    settled cost without / with freezing = %.1fx\n", settled[0] / settled[1]);
   }
-  int top = 0;
+  int top = 0;  // the chart: the finest form resolution that is scored (not time only)
   for (const auto& j : jobs)
-    if (j.scene == "form") top = std::max(top, j.res);
+    if (j.scene == "form" && j.error) top = std::max(top, j.res);
   write_svg(rows, "form", top, "out/bench/solvers.svg");
   write_svg(rows, "sheet", quick ? 16 : 32, "out/bench/solvers_sheet.svg");
   // Summary: time at equal error. For each scene, the fastest stable configuration of every
