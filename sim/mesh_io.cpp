@@ -1,6 +1,8 @@
 // Triangle meshes in and out through assimp.
 #include "sim/mesh_io.hpp"
 
+#include <assimp/BaseImporter.h>
+#include <assimp/importerdesc.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -8,10 +10,15 @@
 #include <algorithm>
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <sstream>
+#include <string_view>
 
 #include "sim/cloth.hpp"
 
@@ -24,6 +31,48 @@ namespace {
 // fuzz_mesh), and in one ReadFile call the validation does not run before it.
 constexpr unsigned kImportFlags =
     aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType;
+
+// assimp 5.2's PLY reader loops forever on a header without an "end_header" line (found by
+// fuzz_mesh: a 510-byte file hung the loader for > 30 s). Data that assimp would read as PLY
+// (it starts with "ply") must close its header within the first MiB, use only the header
+// keywords and declare no element count above the file's size; false with `error` set.
+bool ply_header_closed(const char* p, size_t n, std::string& error) {
+  size_t i = 0;
+  while (i < n && std::isspace(static_cast<unsigned char>(p[i]))) ++i;
+  if (n - i < 3 || std::string_view(p + i, 3) != "ply") return true;
+  const size_t limit = std::min(n, size_t{1} << 20);
+  size_t line = i;
+  for (size_t k = i; k <= limit; ++k) {
+    if (k < limit && p[k] != '\n') continue;
+    std::string_view l(p + line, k - line);
+    while (!l.empty() && std::isspace(static_cast<unsigned char>(l.back()))) l.remove_suffix(1);
+    if (l == "end_header") return true;
+    // Every header line is one of the format's keywords (assimp hangs on some it does not
+    // know, e.g. a mangled "property" line: fuzz_mesh).
+    const std::string_view kw = l.substr(0, l.find(' '));
+    if (line > i && !l.empty() && kw != "format" && kw != "comment" && kw != "obj_info" &&
+        kw != "element" && kw != "property") {
+      error = "PLY header: unknown line \"" + std::string(l.substr(0, 40)) + "\"";
+      return false;
+    }
+    // "element NAME COUNT": every entry takes at least one byte of the file, so a count above
+    // the file's size is a lie (assimp would allocate it: fuzz_mesh found a 57 GB request).
+    if (l.substr(0, 8) == "element ") {
+      const size_t sp = l.rfind(' ');
+      const std::string count(l.substr(sp + 1));
+      char* end = nullptr;
+      const unsigned long long c = std::strtoull(count.c_str(), &end, 10);
+      if (end && *end == '\0' && c > n) {
+        error =
+            "PLY header: \"" + std::string(l) + "\" declares more entries than the file has bytes";
+        return false;
+      }
+    }
+    line = k + 1;
+  }
+  error = "PLY header has no end_header line";
+  return false;
+}
 
 // Validates the raw scene (assimp's own checks, then face sizes and indices) before any step
 // that assumes a valid scene; returns the post-processed scene or nullptr with `error` set.
@@ -61,6 +110,21 @@ const aiScene* postprocess(Assimp::Importer& imp, const aiScene* scene, std::str
 void configure(Assimp::Importer& imp) {
   // Drop point and line primitives (SortByPType): a form is made of faces.
   imp.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  // Only the formats the product reads (docs/dress-form.md): every other assimp 5.2 importer is
+  // unregistered, so a stray file cannot reach their parsers (fuzz_mesh found a heap overflow
+  // in one of them on an 18-byte input).
+  static const char* const kKeep[] = {"obj", "ply", "stl", "gltf", "glb", "fbx", "dae"};
+  std::vector<Assimp::BaseImporter*> drop;
+  for (size_t i = 0; i < imp.GetImporterCount(); ++i) {
+    const aiImporterDesc* d = imp.GetImporterInfo(i);
+    bool keep = false;
+    for (const char* ext : kKeep)
+      if (d && d->mFileExtensions &&
+          std::string_view(d->mFileExtensions).find(ext) != std::string_view::npos)
+        keep = true;
+    if (!keep) drop.push_back(imp.GetImporter(i));
+  }
+  for (Assimp::BaseImporter* b : drop) imp.UnregisterLoader(b);
 }
 
 void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, TriMesh& out,
@@ -143,6 +207,14 @@ Result<TriMesh> load_mesh(const std::string& path) {
   const auto size = fs::file_size(path, ec);
   if (ec) return make_error(path, "cannot read file size: " + ec.message());
   if (size == 0) return make_error(path, "empty file");
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::string head(static_cast<size_t>(std::min<std::uintmax_t>(size, 1u << 20)), '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    std::string error;
+    if (!ply_header_closed(head.data(), static_cast<size_t>(in.gcount()), error))
+      return make_error(path, error);
+  }
   Assimp::Importer imp;
   configure(imp);
   const aiScene* scene = nullptr;
@@ -159,6 +231,11 @@ Result<TriMesh> load_mesh(const std::string& path) {
 Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char* hint,
                                       const std::string& name) {
   if (!data || size == 0) return make_error(name, "empty file");
+  {
+    std::string error;
+    if (!ply_header_closed(static_cast<const char*>(data), size, error))
+      return make_error(name, error);
+  }
   Assimp::Importer imp;
   configure(imp);
   const aiScene* scene = nullptr;
