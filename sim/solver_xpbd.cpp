@@ -184,7 +184,8 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
     return false;
   }
   std::fill(piece_awake_.begin(), piece_awake_.end(), 0);
-  energy_.detect_contacts(cloth, scene);
+  fresh_penetration_ = energy_.detect_contacts(cloth, scene);
+  contacts_fresh_ = true;  // the first substep reuses them (same positions)
   for (int i = 0; i < n; ++i) {
     const int p = piece_of_[i];
     if (!piece_frozen_[p] || piece_awake_[p]) continue;
@@ -229,6 +230,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   const int ns = std::max(1, opt_.substeps);
   const double h = dt / ns;
   const double ih2 = 1.0 / (h * h);
+  contacts_fresh_ = false;
   if (!opt_.freeze) {
     for (int i = 0; i < n; ++i) S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
     std::fill(piece_frozen_.begin(), piece_frozen_.end(), 0);
@@ -419,12 +421,14 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
 
   const double damp = std::exp(-opt_.damping * h);
   for (int s = 0; s < ns; ++s) {
-    {  // contacts every substep
+    if (s == 0 && contacts_fresh_) st.max_penetration = fresh_penetration_;
+    if (s > 0 || !contacts_fresh_) {  // contacts every substep (the wake check's are current)
       const auto t0 = std::chrono::steady_clock::now();
       st.max_penetration = std::max(st.max_penetration, energy_.detect_contacts(cloth, scene));
       st.collision_ms +=
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     }
+    contacts_fresh_ = false;
     set_w();
     pool_->parallel_for(n, [&](int b, int e, int) {
       for (int i = b; i < e; ++i) {

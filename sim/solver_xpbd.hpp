@@ -95,6 +95,8 @@ class XpbdSolver : public Solver {
   std::vector<int> piece_of_, piece_rest_;  // connected piece per vertex; rest substeps
   std::vector<uint8_t> piece_frozen_, piece_awake_;
   int num_pieces_ = 0, frozen_count_ = 0;
+  bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
+  double fresh_penetration_ = 0;
   // Wakes frozen pieces that something disturbs; true when every piece is (still) frozen.
   bool wake(Cloth& cloth, const SceneObjects& scene);
 };
