@@ -22,6 +22,8 @@
 # filler-word garbage model, VOICE_SINGLE=1 the single-pass grammar, VOICE_FRONT="--remove-noise 0
 # --comfort-noise 0" the bare pocketsphinx front end; VOICE_TUNE_ONLY=1 only synthesises the
 # tuning/test/held-out sets (no FINAL set, no decoding).
+# The set arrays are passed to gen_set by name (namerefs), which shellcheck does not follow.
+# shellcheck disable=SC2034
 set -euo pipefail
 ROOT="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
 cd "$ROOT"
@@ -75,48 +77,56 @@ gen() { # list out text voice speed expect noise_offset_s [pitch [pad_after [noi
   printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$out" "$exp" "$text" "$e" "$v" "$s" >> "$list"
 }
 name() { echo "$1" | tr ' +' '__'; }
+# One set: every voice x speed x command phrase -> <prefix>_<voice>_<speed>_<phrase>.wav, then
+# every sentence x sentence voice -> <sent_prefix>_<voice>_<sentence>.wav at the fixed speed, or,
+# where sent_speed names a function (it sets S for k), <sent_prefix>_<voice>_<S>_<sentence>.wav.
+# Each file advances the global counter k; the carrier function sets CAR (noise offset [pitch
+# [pad_after [noise]]], gen's optional tail) for k. Array arguments are passed by name.
+gen_set() { # list prefix sent_prefix carrier voices speeds sentences sent_voices sent_speed
+  local list="$1" prefix="$2" sprefix="$3" carrier="$4" sent_speed="$9"
+  local -n voices_="$5" speeds_="$6" sents_="$7" svoices_="$8"
+  local v s i t out
+  for v in "${voices_[@]}"; do
+    for s in "${speeds_[@]}"; do
+      for i in "${!PHR[@]}"; do
+        k=$((k + 1))
+        "$carrier"
+        gen "$list" "$SET/${prefix}_$(name "$v")_${s}_$(name "${PHR[$i]}").wav" "${PHR[$i]}" "$v" \
+          "$s" "${CMD[$i]}" "${CAR[@]}"
+      done
+    done
+  done
+  for t in "${sents_[@]}"; do
+    for v in "${svoices_[@]}"; do
+      k=$((k + 1))
+      "$carrier"
+      if [[ $sent_speed =~ ^[0-9]+$ ]]; then
+        s=$sent_speed out="$SET/${sprefix}_$(name "$v")_$(name "$t").wav"
+      else
+        "$sent_speed"
+        s=$S out="$SET/${sprefix}_$(name "$v")_${S}_$(name "$t").wav"
+      fi
+      gen "$list" "$out" "$t" "$v" "$s" - "${CAR[@]}"
+    done
+  done
+}
+NONE=()
 echo "synthesising tuning and test sets into $SET ($NOISE, 10 dB SNR) ..."
 TUNE="$SET/tune.tsv" TEST="$SET/test.tsv"
 : > "$TUNE"
 : > "$TEST"
+car_tune() { CAR=($((k % 190))); }
 k=0
-for v in "${TUNE_VOICES[@]}"; do
-  for s in "${TUNE_SPEEDS[@]}"; do
-    for i in "${!PHR[@]}"; do
-      k=$((k + 1))
-      gen "$TUNE" "$SET/tune_$(name "$v")_${s}_$(name "${PHR[$i]}").wav" "${PHR[$i]}" "$v" "$s" \
-        "${CMD[$i]}" $((k % 190))
-    done
-  done
-done
-for t in "${TUNE_SENT[@]}"; do
-  for v in en-us en-us+f3 en-gb-x-rp; do
-    k=$((k + 1))
-    gen "$TUNE" "$SET/tune_sent_$(name "$v")_$(name "$t").wav" "$t" "$v" 150 - $((k % 190))
-  done
-done
+TUNE_SENT_VOICES=(en-us en-us+f3 en-gb-x-rp)
+gen_set "$TUNE" tune tune_sent car_tune TUNE_VOICES TUNE_SPEEDS TUNE_SENT TUNE_SENT_VOICES 150
 # Slow speech (added by the session-2 attempt): espeak-ng pauses longer between words below ~130 wpm, which
 # the VAD hangover must bridge; its own noise offsets, so the sets above are unchanged.
-for v in "${TUNE_VOICES[@]}"; do
-  for i in "${!PHR[@]}"; do
-    k=$((k + 1))
-    gen "$TUNE" "$SET/tune_$(name "$v")_${TUNE_SLOW}_$(name "${PHR[$i]}").wav" "${PHR[$i]}" "$v" \
-      "$TUNE_SLOW" "${CMD[$i]}" $((k % 190))
-  done
-done
+TUNE_SLOW_SPEEDS=("$TUNE_SLOW")
+gen_set "$TUNE" tune - car_tune TUNE_VOICES TUNE_SLOW_SPEEDS NONE NONE 150
 # More accents in the tuning set (session-2 attempt; none of them is a test voice).
-for v in "${TUNE_ACCENTS[@]}"; do
-  for s in "${TUNE_SPEEDS[@]}"; do
-    for i in "${!PHR[@]}"; do
-      k=$((k + 1))
-      gen "$TUNE" "$SET/tune_$(name "$v")_${s}_$(name "${PHR[$i]}").wav" "${PHR[$i]}" "$v" "$s" \
-        "${CMD[$i]}" $((k % 190))
-    done
-  done
-  for t in "${TUNE_SENT[@]}"; do
-    k=$((k + 1))
-    gen "$TUNE" "$SET/tune_sent_$(name "$v")_$(name "$t").wav" "$t" "$v" 150 - $((k % 190))
-  done
+for accent in "${TUNE_ACCENTS[@]}"; do
+  ACCENT=("$accent")
+  gen_set "$TUNE" tune tune_sent car_tune ACCENT TUNE_SPEEDS TUNE_SENT ACCENT 150
 done
 # More non-command sentences (session 3): 16 sentences gave too few false-trigger candidates to
 # place the thresholds (the chosen margin let 5 % of the test sentences through). None of them is
@@ -129,31 +139,13 @@ TUNE_SENT2=("could you pass the pins please" "the hem is uneven on the left"
   "the mannequin is too tall" "we ran out of blue thread" "redo the buttonhole later"
   "hold it right there" "the zip is stuck again" "it is getting late" "put the kettle on please"
   "I measured it twice" "the bobbin is empty" "thank you very much")
-k2=0
-for t in "${TUNE_SENT2[@]}"; do
-  for v in en-us en-us+f3 en-us+m3 en-gb-x-rp; do
-    k=$((k + 1))
-    k2=$((k2 + 1))
-    s=$((k2 % 2 ? 130 : 170))
-    gen "$TUNE" "$SET/tune_sent2_$(name "$v")_${s}_$(name "$t").wav" "$t" "$v" "$s" - $((k % 190))
-  done
-done
+TUNE_SENT2_VOICES=(en-us en-us+f3 en-us+m3 en-gb-x-rp)
+K2_BASE=$k # the n-th of these files (from 1) is spoken at 130 wpm if n is odd, else 170
+speed_sent2() { S=$(((k - K2_BASE) % 2 ? 130 : 170)); }
+gen_set "$TUNE" tune tune_sent2 car_tune NONE NONE TUNE_SENT2 TUNE_SENT2_VOICES speed_sent2
+car_test() { CAR=($((200 + k % 190))); }
 k=120 # the test set's noise offsets as in session 2
-for v in "${TEST_VOICES[@]}"; do
-  for s in "${TEST_SPEEDS[@]}"; do
-    for i in "${!PHR[@]}"; do
-      k=$((k + 1))
-      gen "$TEST" "$SET/test_$(name "$v")_${s}_$(name "${PHR[$i]}").wav" "${PHR[$i]}" "$v" "$s" \
-        "${CMD[$i]}" $((200 + k % 190))
-    done
-  done
-done
-for t in "${TEST_SENT[@]}"; do
-  for v in "${TEST_VOICES[@]}"; do
-    k=$((k + 1))
-    gen "$TEST" "$SET/test_sent_$(name "$v")_$(name "$t").wav" "$t" "$v" 150 - $((200 + k % 190))
-  done
-done
+gen_set "$TEST" test test_sent car_test TEST_VOICES TEST_SPEEDS TEST_SENT TEST_VOICES 150
 # HOLDOUT set (session 3): made after the phrases were changed, never used for any decision:
 # 9 phrases x 4 voices used nowhere else (en-us+m2, en-us+f4, en-gb-x-gbclan, en-gb+m4) x speeds
 # 140/165 + 20 more sentences x 4 voices; noise from the test half at other offsets.
@@ -168,22 +160,9 @@ HOLD_SENT=("the fitting is at three" "could you check the waistline" "my coffee 
   "that is a lovely colour" "a pinch more ease at the hip")
 HOLD="$SET/holdout.tsv"
 : > "$HOLD"
+car_hold() { CAR=($((205 + (k * 7) % 185))); }
 k=0
-for v in "${HOLD_VOICES[@]}"; do
-  for s in "${HOLD_SPEEDS[@]}"; do
-    for i in "${!PHR[@]}"; do
-      k=$((k + 1))
-      gen "$HOLD" "$SET/hold_$(name "$v")_${s}_$(name "${PHR[$i]}").wav" "${PHR[$i]}" "$v" "$s" \
-        "${CMD[$i]}" $((205 + (k * 7) % 185))
-    done
-  done
-done
-for t in "${HOLD_SENT[@]}"; do
-  for v in "${HOLD_VOICES[@]}"; do
-    k=$((k + 1))
-    gen "$HOLD" "$SET/hold_sent_$(name "$v")_$(name "$t").wav" "$t" "$v" 155 - $((205 + (k * 7) % 185))
-  done
-done
+gen_set "$HOLD" hold hold_sent car_hold HOLD_VOICES HOLD_SPEEDS HOLD_SENT HOLD_VOICES 155
 # TUNING extension (session 4): the remaining errors were accented and slow voices, so the tuning
 # set gets 4 more voices (variants of the Caribbean, New York and British accents; none is a test,
 # held-out or FINAL voice) x speeds 115/145/175 x the phrases with espeak pitch 40/50/60, and 24
@@ -199,24 +178,10 @@ TUNE3_SENT=("the tailor is coming at noon" "could you fetch the measuring tape"
   "my hands are cold today" "show me the back view" "the wool came from scotland"
   "add two centimetres at the waist" "the needle is blunt" "her apron has deep pockets"
   "check the grain line first")
+car_tune3() { CAR=($((3 + (k * 11) % 187)) $((40 + 10 * (k % 3)))); }
+speed_tune3() { S=${TUNE3_SPEEDS[$((k % 3))]}; }
 k=0
-for v in "${TUNE3_VOICES[@]}"; do
-  for s in "${TUNE3_SPEEDS[@]}"; do
-    for i in "${!PHR[@]}"; do
-      k=$((k + 1))
-      gen "$TUNE" "$SET/tune3_$(name "$v")_${s}_$(name "${PHR[$i]}").wav" "${PHR[$i]}" "$v" "$s" \
-        "${CMD[$i]}" $((3 + (k * 11) % 187)) $((40 + 10 * (k % 3)))
-    done
-  done
-done
-for t in "${TUNE3_SENT[@]}"; do
-  for v in "${TUNE3_VOICES[@]}"; do
-    k=$((k + 1))
-    s=${TUNE3_SPEEDS[$((k % 3))]}
-    gen "$TUNE" "$SET/tune3_sent_$(name "$v")_${s}_$(name "$t").wav" "$t" "$v" "$s" - \
-      $((3 + (k * 11) % 187)) $((40 + 10 * (k % 3)))
-  done
-done
+gen_set "$TUNE" tune3 tune3_sent car_tune3 TUNE3_VOICES TUNE3_SPEEDS TUNE3_SENT TUNE3_VOICES speed_tune3
 [ -z "${VOICE_TUNE_ONLY:-}" ] || exit 0
 # FINAL set (session 4): generated after every decision, evaluated once, the headline of
 # out/bench/voice.json. The test set's voice/speed mix (5 voices x 120/150/180 x the phrases + 20
@@ -235,23 +200,12 @@ FINAL_SENT=("the bride wants a longer train" "please sweep the floor later" "is 
   "the map pins are red" "we release the collection in spring")
 FINAL="$SET/final.tsv"
 : > "$FINAL"
+car_final() {
+  CAR=($((1 + (k * 17) % 390)) $((35 + 15 * (k % 3))) "$(awk -v x=$((5 + k % 7)) 'BEGIN{print x / 10}')"
+    "$FNOISE")
+}
 k=0
-for v in "${TEST_VOICES[@]}"; do
-  for s in "${TEST_SPEEDS[@]}"; do
-    for i in "${!PHR[@]}"; do
-      k=$((k + 1))
-      gen "$FINAL" "$SET/final_$(name "$v")_${s}_$(name "${PHR[$i]}").wav" "${PHR[$i]}" "$v" "$s" \
-        "${CMD[$i]}" $((1 + (k * 17) % 390)) $((35 + 15 * (k % 3))) "$(awk -v x=$((5 + k % 7)) 'BEGIN{print x / 10}')" "$FNOISE"
-    done
-  done
-done
-for t in "${FINAL_SENT[@]}"; do
-  for v in "${TEST_VOICES[@]}"; do
-    k=$((k + 1))
-    gen "$FINAL" "$SET/final_sent_$(name "$v")_$(name "$t").wav" "$t" "$v" 150 - \
-      $((1 + (k * 17) % 390)) $((35 + 15 * (k % 3))) "$(awk -v x=$((5 + k % 7)) 'BEGIN{print x / 10}')" "$FNOISE"
-  done
-done
+gen_set "$FINAL" final final_sent car_final TEST_VOICES TEST_SPEEDS FINAL_SENT TEST_VOICES 150
 # Garbage path: the phone loop (default since the session-2 attempt) or the filler words (VOICE_FILLERS=1).
 GARBAGE=--phones
 [ -z "${VOICE_FILLERS:-}" ] || GARBAGE=--fillers

@@ -18,15 +18,32 @@ int grid_count(double len, double spacing) {
   return std::max(2, static_cast<int>(std::lround(len / spacing)) + 1);
 }
 
-// Barycentric coordinates of material point m in triangle ti (negative outside).
-Vec3 material_barycentric(const ClothTopology& t, int ti, const Vec2& m) {
-  const auto& tri = t.triangles[ti];
-  const Vec2 a = t.material[tri[0]], b = t.material[tri[1]], c = t.material[tri[2]];
-  const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-  const Vec2 q = m - a;
-  const double l1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
-  const double l2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
-  return Vec3(1 - l1 - l2, l1, l2);
+// Of the candidate triangles offered, the one whose barycentric coordinates of m have the
+// largest minimum (>= 0: m inside it); the first such candidate wins ties.
+struct BestTriangle {
+  const Panel& panel;
+  Vec2 m;
+  int tri = -1;
+  double min_coeff = -1e300;
+  Vec3 bary{1.0 / 3, 1.0 / 3, 1.0 / 3};
+
+  void offer(int ti) {
+    const Vec3 bc = panel.barycentric(ti, m);
+    if (bc.minCoeff() > min_coeff) {
+      min_coeff = bc.minCoeff();
+      tri = ti;
+      bary = bc;
+    }
+  }
+  int result(Vec3* out) const {
+    if (out) *out = bary;
+    return tri;
+  }
+};
+
+// The grid cell index (clamped to the grid's count - 1 cells) of a material coordinate.
+int cell_index(double coord, double spacing, int count) {
+  return std::clamp(static_cast<int>(std::floor(coord / spacing)), 0, count - 2);
 }
 
 }  // namespace
@@ -196,48 +213,35 @@ Result<Panel> build_panel(const PanelDesign& d, const FabricParams& fabric,
   return p;
 }
 
-int Panel::locate(const Vec2& m, Vec3* bary) const {
+Vec3 Panel::barycentric(int ti, const Vec2& m) const {
   const auto& t = cloth.topo;
-  const int ci = std::clamp(static_cast<int>(std::floor(m.x() / dx)), 0, nx - 2);
-  const int cj = std::clamp(static_cast<int>(std::floor(m.y() / dy)), 0, ny - 2);
-  int best = -1;
-  double best_min = -1e300;
-  Vec3 best_b(1.0 / 3, 1.0 / 3, 1.0 / 3);
-  for (int k = 0; k < 2; ++k) {
-    const int ti = cell_triangle(ci, cj, k);
-    const Vec3 bc = material_barycentric(t, ti, m);
-    if (bc.minCoeff() > best_min) {
-      best_min = bc.minCoeff();
-      best = ti;
-      best_b = bc;
-    }
-  }
-  if (bary) *bary = best_b;
-  return best;
+  const auto& tri = t.triangles[ti];
+  const Vec2 a = t.material[tri[0]], b = t.material[tri[1]], c = t.material[tri[2]];
+  const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  const Vec2 q = m - a;
+  const double l1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
+  const double l2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
+  return Vec3(1 - l1 - l2, l1, l2);
+}
+
+int Panel::locate(const Vec2& m, Vec3* bary) const {
+  const int ci = cell_index(m.x(), dx, nx), cj = cell_index(m.y(), dy, ny);
+  BestTriangle best{*this, m};
+  for (int k = 0; k < 2; ++k) best.offer(cell_triangle(ci, cj, k));
+  return best.result(bary);
 }
 
 int Panel::locate_in_zone(const Vec2& m, int zone, Vec3* bary) const {
-  const auto& t = cloth.topo;
-  const int ci0 = std::clamp(static_cast<int>(std::floor(m.x() / dx)), 0, nx - 2);
-  const int cj0 = std::clamp(static_cast<int>(std::floor(m.y() / dy)), 0, ny - 2);
-  int best = -1;
-  double best_min = -1e300;
-  Vec3 best_b(1.0 / 3, 1.0 / 3, 1.0 / 3);
+  const int ci0 = cell_index(m.x(), dx, nx), cj0 = cell_index(m.y(), dy, ny);
+  BestTriangle best{*this, m};
   for (int ci = std::max(0, ci0 - 1); ci <= std::min(nx - 2, ci0 + 1); ++ci)
     for (int cj = std::max(0, cj0 - 1); cj <= std::min(ny - 2, cj0 + 1); ++cj)
       for (int k = 0; k < 2; ++k) {
         const int ti = cell_triangle(ci, cj, k);
-        if (t.triangle_zone[ti] != zone) continue;
-        const Vec3 bc = material_barycentric(t, ti, m);
-        if (bc.minCoeff() > best_min) {
-          best_min = bc.minCoeff();
-          best = ti;
-          best_b = bc;
-        }
+        if (cloth.topo.triangle_zone[ti] == zone) best.offer(ti);
       }
-  if (best < 0 || best_min < -0.5) return locate(m, bary);
-  if (bary) *bary = best_b;
-  return best;
+  if (best.tri < 0 || best.min_coeff < -0.5) return locate(m, bary);
+  return best.result(bary);
 }
 
 }  // namespace drape::sim

@@ -54,6 +54,8 @@ struct Panel {
   double u_of_distance(double l) const { return design.centre_edge_left ? l : design.width - l; }
   // The (up to) two triangles of grid cell (i, j): index 2 * (j * (nx - 1) + i) + k.
   int cell_triangle(int i, int j, int k) const { return 2 * (j * (nx - 1) + i) + k; }
+  // Barycentric coordinates of material point m in triangle tri (negative outside).
+  Vec3 barycentric(int tri, const Vec2& m) const;
   // Triangle of the flat panel containing material point m (or -1), with barycentrics.
   int locate(const Vec2& m, Vec3* bary) const;
   // Same, among the triangles of one zone only (a point on a slit lies on both of its sides;

@@ -97,7 +97,7 @@ class CurvedCloth {
     double best_min = -1e300;
     for (int k = 0; k < 2; ++k) {
       const int t = panel_.cell_triangle(ci, cj, k);
-      const Vec3 b = bary(t, m);
+      const Vec3 b = panel_.barycentric(t, m);
       if (b.minCoeff() > best_min) {
         best_min = b.minCoeff();
         best = t;
@@ -105,16 +105,6 @@ class CurvedCloth {
       }
     }
     return at(best, bb, m);
-  }
-  Vec3 bary(int tri, const Vec2& m) const {
-    const auto& mat = panel_.cloth.topo.material;
-    const auto& t = panel_.cloth.topo.triangles[tri];
-    const Vec2 a = mat[t[0]], b = mat[t[1]], c = mat[t[2]];
-    const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-    const Vec2 q = m - a;
-    const double l1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
-    const double l2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
-    return Vec3(1 - l1 - l2, l1, l2);
   }
   Vec3 at(int tri, const Vec3& b, const Vec2& m) const {
     const auto& topo = panel_.cloth.topo;
@@ -143,15 +133,6 @@ class CurvedCloth {
   std::vector<ArcTable> rows_;
   mutable std::map<double, ArcTable> cache_;
 };
-
-Vec3 bary_of(const std::vector<Vec2>& mat, const std::array<int32_t, 3>& tri, const Vec2& m) {
-  const Vec2 a = mat[tri[0]], b = mat[tri[1]], c = mat[tri[2]];
-  const double det = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-  const Vec2 q = m - a;
-  const double l1 = (q.x() * (c - a).y() - q.y() * (c - a).x()) / det;
-  const double l2 = ((b - a).x() * q.y() - (b - a).y() * q.x()) / det;
-  return Vec3(1 - l1 - l2, l1, l2);
-}
 
 struct Hit {
   bool ok = false;
@@ -219,7 +200,7 @@ Hit cast(const Panel& panel, const MappingSurface& surf, const RayGrid& grid,
     A = E * M.inverse();
   }
   Vec2 m = best.flat;
-  Vec3 X = curved.at(best.tri, bary_of(mat, tri, m), m);
+  Vec3 X = curved.at(best.tri, panel.barycentric(best.tri, m), m);
   for (int it = 0; it < 8; ++it) {
     const Vec2 c = surf.centre(X.y());
     const double dx = X.x() - c.x(), dz = X.z() - c.y(), rho2 = dx * dx + dz * dz;
@@ -231,13 +212,13 @@ Hit cast(const Panel& panel, const MappingSurface& surf, const RayGrid& grid,
     if (std::abs(J.determinant()) < 1e-14) break;
     const Eigen::Vector2d dm = J.inverse() * r;
     m -= Vec2(dm.x(), dm.y());
-    X = curved.at(best.tri, bary_of(mat, tri, m), m);
+    X = curved.at(best.tri, panel.barycentric(best.tri, m), m);
     if (dm.norm() < 1e-11) break;
   }
   if ((m - best.flat).norm() < 0.5 * (mat[tri[1]] - mat[tri[0]]).norm()) {
     best.flat = m;
     best.world = X;
-    best.bary = bary_of(mat, tri, m);
+    best.bary = panel.barycentric(best.tri, m);
   }
   return best;
 }

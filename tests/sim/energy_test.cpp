@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -33,14 +34,52 @@ void perturb(Cloth& c, double amp, unsigned seed) {
   for (auto& x : c.state.x) x += Vec3(u(rng), u(rng), u(rng));
 }
 
+// The cloth energy of c without gravity (the elastic terms), `o` giving the other options.
+ClothEnergy elastic_energy(const Cloth& c, EnergyOptions o = {}) {
+  o.gravity = false;
+  ClothEnergy e;
+  e.build(c, o);
+  return e;
+}
+
+// Central difference (step eps) of the scalar f(x) along coordinate d of vertex i.
+template <class F>
+double central_difference(const std::vector<Vec3>& x, int i, int d, double eps, F f) {
+  auto xp = x, xm = x;
+  xp[i][d] += eps;
+  xm[i][d] -= eps;
+  return (f(xp) - f(xm)) / (2 * eps);
+}
+
+// An element's Hessian H (3N x 3N, vertices v) at x against central differences (step eps) of
+// its gradient grad(x, g[N]): the worst |FD - H's 3x1 block| / (|H| + floor) over every vertex
+// coordinate and gradient block.
+template <class Mat, std::size_t N, class Grad>
+double hessian_fd_error(const std::vector<Vec3>& x, const std::array<int32_t, N>& v, const Mat& H,
+                        double eps, double floor, Grad grad) {
+  double worst = 0;
+  for (std::size_t k = 0; k < N; ++k)
+    for (int d = 0; d < 3; ++d) {
+      auto xp = x, xm = x;
+      xp[v[k]][d] += eps;
+      xm[v[k]][d] -= eps;
+      Vec3 gp[N], gm[N];
+      grad(xp, gp);
+      grad(xm, gm);
+      for (std::size_t l = 0; l < N; ++l) {
+        const Vec3 fd = (gp[l] - gm[l]) / (2 * eps);
+        const double err = (fd - H.template block<3, 1>(3 * l, 3 * k + d)).norm();
+        worst = std::max(worst, err / (H.norm() + floor));
+      }
+    }
+  return worst;
+}
+
 }  // namespace
 
 TEST(Energy, RestEnergyIsZeroAndGradientVanishes) {
   Cloth c = small_panel();
-  EnergyOptions o;
-  o.gravity = false;
-  ClothEnergy e;
-  e.build(c, o);
+  ClothEnergy e = elastic_energy(c);
   EXPECT_GT(e.num_hinges(), 0);
   const double E = e.energy(c.state.x, c.state.mass);
   std::vector<Vec3> g;
@@ -66,10 +105,8 @@ TEST(Energy, GradientMatchesFiniteDifferences) {
     const double eps = 1e-7;
     for (int i = 0; i < c.num_vertices(); ++i)
       for (int d = 0; d < 3; ++d) {
-        auto xp = c.state.x, xm = c.state.x;
-        xp[i][d] += eps;
-        xm[i][d] -= eps;
-        const double fd = (e.energy(xp, c.state.mass) - e.energy(xm, c.state.mass)) / (2 * eps);
+        const double fd = central_difference(
+            c.state.x, i, d, eps, [&](const auto& x) { return e.energy(x, c.state.mass); });
         maxerr = std::max(maxerr, std::abs(fd - g[i][d]));
         scale = std::max(scale, std::abs(g[i][d]));
       }
@@ -89,21 +126,9 @@ TEST(Energy, ElementHessiansMatchFiniteDifferences) {
   for (int t = 0; t < e.num_triangles(); ++t) {
     Mat9 H;
     e.tri_hessian(t, c.state.x, H, false);
-    const auto& v = e.tri(t);
-    for (int k = 0; k < 3; ++k)
-      for (int d = 0; d < 3; ++d) {
-        auto xp = c.state.x, xm = c.state.x;
-        xp[v[k]][d] += eps;
-        xm[v[k]][d] -= eps;
-        Vec3 gp[3], gm[3];
-        e.tri_gradient(t, xp, gp);
-        e.tri_gradient(t, xm, gm);
-        for (int l = 0; l < 3; ++l) {
-          const Vec3 fd = (gp[l] - gm[l]) / (2 * eps);
-          const double err = (fd - H.block<3, 1>(3 * l, 3 * k + d)).norm();
-          worst = std::max(worst, err / (H.norm() + 1e-12));
-        }
-      }
+    worst =
+        std::max(worst, hessian_fd_error(c.state.x, e.tri(t), H, eps, 1e-12,
+                                         [&](const auto& x, Vec3* g) { e.tri_gradient(t, x, g); }));
     // The vertex blocks used by VBD equal the diagonal blocks of the projected Hessian.
     Mat9 Hp;
     e.tri_hessian(t, c.state.x, Hp, true);
@@ -129,20 +154,9 @@ TEST(Energy, ElementHessiansMatchFiniteDifferences) {
     for (int h = 0; h < eb.num_hinges(); ++h) {
       Mat12 H;
       eb.hinge_hessian(h, c.state.x, H, false);
-      const auto& v = eb.hinge(h);
-      for (int k = 0; k < 4; ++k)
-        for (int d = 0; d < 3; ++d) {
-          auto xp = c.state.x, xm = c.state.x;
-          xp[v[k]][d] += eps;
-          xm[v[k]][d] -= eps;
-          Vec3 gp[4], gm[4];
-          eb.hinge_gradient(h, xp, gp);
-          eb.hinge_gradient(h, xm, gm);
-          for (int l = 0; l < 4; ++l)
-            hworst = std::max(
-                hworst, ((gp[l] - gm[l]) / (2 * eps) - H.block<3, 1>(3 * l, 3 * k + d)).norm() /
-                            (H.norm() + 1e-12));
-        }
+      hworst = std::max(
+          hworst, hessian_fd_error(c.state.x, eb.hinge(h), H, eps, 1e-12,
+                                   [&](const auto& x, Vec3* g) { eb.hinge_gradient(h, x, g); }));
       Mat12 Hp;
       eb.hinge_hessian(h, c.state.x, Hp, true);
       Eigen::SelfAdjointEigenSolver<Mat12> es(Hp);
@@ -170,10 +184,7 @@ TEST(Energy, DihedralAngleAndGradientAtLargeFolds) {
   p.width = p.height = 0.01;
   p.nx = p.ny = 2;
   Cloth c = make_panel(p, FabricParams{});
-  EnergyOptions o;
-  o.gravity = false;
-  ClothEnergy e;
-  e.build(c, o);
+  ClothEnergy e = elastic_energy(c);
   ASSERT_EQ(e.num_hinges(), 1);
   const auto& v = e.hinge(0);
   double gworst = 0, hworst = 0, tworst = 0;
@@ -197,19 +208,13 @@ TEST(Energy, DihedralAngleAndGradientAtLargeFolds) {
     e.hinge_hessian(0, x, H, false);
     for (int k = 0; k < 4; ++k)
       for (int dd = 0; dd < 3; ++dd) {
-        auto xp = x, xm = x;
-        xp[v[k]][dd] += eps;
-        xm[v[k]][dd] -= eps;
-        const double fd = (e.hinge_energy(0, xp) - e.hinge_energy(0, xm)) / (2 * eps);
+        const double fd = central_difference(x, v[k], dd, eps,
+                                             [&](const auto& y) { return e.hinge_energy(0, y); });
         gworst = std::max(gworst, std::abs(fd - g[k][dd]) / (std::abs(g[k][dd]) + 1e-9));
-        Vec3 gp[4], gm[4];
-        e.hinge_gradient(0, xp, gp);
-        e.hinge_gradient(0, xm, gm);
-        for (int l = 0; l < 4; ++l)
-          hworst = std::max(
-              hworst,
-              ((gp[l] - gm[l]) / (2 * eps) - H.block<3, 1>(3 * l, 3 * k + dd)).norm() / H.norm());
       }
+    hworst = std::max(hworst, hessian_fd_error(x, v, H, eps, 0.0, [&](const auto& y, Vec3* gy) {
+                        e.hinge_gradient(0, y, gy);
+                      }));
   }
   std::printf("large folds: |theta| error %.2e rad, gradient rel. error %.2e, Hessian %.2e\n",
               tworst, gworst, hworst);
@@ -221,10 +226,7 @@ TEST(Energy, DihedralAngleAndGradientAtLargeFolds) {
 TEST(Energy, RigidMotionInvariance) {
   Cloth c = small_panel();
   perturb(c, 0.003, 11);
-  EnergyOptions o;
-  o.gravity = false;
-  ClothEnergy e;
-  e.build(c, o);
+  ClothEnergy e = elastic_energy(c);
   const double E0 = e.energy(c.state.x, c.state.mass);
   const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
   auto x = c.state.x;
@@ -250,10 +252,7 @@ TEST(Energy, CylinderBendingMatchesWarpAndWeftRigidity) {
       const double a = axis == 0 ? m.x() : m.y();
       c.state.x[i] = Vec3(a, R * std::sin(s / R), R * (1 - std::cos(s / R)));
     }
-    EnergyOptions o;
-    o.gravity = false;
-    ClothEnergy e;
-    e.build(c, o);
+    ClothEnergy e = elastic_energy(c);
     double Eb = 0, Em = 0;
     for (int h = 0; h < e.num_hinges(); ++h) Eb += e.hinge_energy(h, c.state.x);
     for (int t = 0; t < e.num_triangles(); ++t) Em += e.tri_energy(t, c.state.x);
@@ -333,11 +332,9 @@ TEST(Energy, TensorBendingEqualsAnalyticEnergyOfConstantCurvature) {
       const int n = 21;
       Cloth c = tensor_panel(n, jitter);
       EnergyOptions o;
-      o.gravity = false;
       o.curvature_estimator = est;
       o.curvature_smoothing = variant == 1 ? 2 : 1;
-      ClothEnergy e;
-      e.build(c, o);
+      ClothEnergy e = elastic_energy(c, o);
       ASSERT_TRUE(e.tensor_bending());
       const double h = 0.1 / (n - 1), margin = 2.5 * h;
       double worst_in = 0, worst_all = 0;
@@ -383,10 +380,7 @@ TEST(Energy, TensorBendingEqualsAnalyticEnergyOfConstantCurvature) {
 
 TEST(Energy, TensorBendingRigidMotionsAndFlatStatesCostNothing) {
   Cloth c = tensor_panel(9, 0.3, 4);
-  EnergyOptions o;
-  o.gravity = false;
-  ClothEnergy e;
-  e.build(c, o);
+  ClothEnergy e = elastic_energy(c);
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(1.1, Vec3(-1, 2, 0.5).normalized()).toRotationMatrix();
   // Flat, rotated and translated: zero; and a curved state moved rigidly keeps its energy.
@@ -424,10 +418,9 @@ TEST(Energy, TensorBendingGradientHessianAndVertexBlocks) {
   set_height_field(c, 3, 1, -2);
   perturb(c, 2e-3, 5);
   EnergyOptions o;
-  o.gravity = false;
+  o.gravity = false;  // also for the membrane-only energy below (a copy of o)
   o.model = EnergyOptions::Model::kFem;
-  ClothEnergy e;
-  e.build(c, o);
+  ClothEnergy e = elastic_energy(c, o);
   const int n = c.num_vertices();
   Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, n);
   const auto& off = e.bending_offsets();

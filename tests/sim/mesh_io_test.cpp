@@ -106,6 +106,25 @@ void expect_load_error(const std::string& path, const char* what) {
   EXPECT_NE(m.error().find(path), std::string::npos) << m.error();
 }
 
+// Loading `ply` from memory as the file `name` must fail: returns the error (printed with
+// `print`); a test failure and "" if it loads.
+std::string ply_load_error(const std::string& ply, const std::string& name, bool print = false) {
+  auto m = load_mesh_from_memory(ply.data(), ply.size(), "ply", name);
+  if (m.ok()) {
+    ADD_FAILURE() << name << " loaded";
+    return "";
+  }
+  if (print) std::printf("error: %s\n", m.error().c_str());
+  return m.error();
+}
+
+// Loading `ply` from memory as the file `name` must give `triangles` triangles.
+void expect_ply_loads(const std::string& ply, const std::string& name, std::size_t triangles) {
+  auto g = load_mesh_from_memory(ply.data(), ply.size(), "ply", name);
+  ASSERT_TRUE(g.ok()) << g.error();
+  EXPECT_EQ(g->triangles.size(), triangles);
+}
+
 TEST(MeshIo, BadFiles) {
   expect_load_error((tmp_dir() / "does_not_exist.obj").string(), "missing");
   expect_load_error(write_text("empty.obj", ""), "empty");
@@ -141,17 +160,11 @@ TEST(MeshIo, PlyFaceWithoutIndicesIsAnErrorNotAnAbort) {
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
       "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
       "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0\n";
-  auto m = drape::sim::load_mesh_from_memory(ply.data(), ply.size(), "ply", "empty_face.ply");
-  ASSERT_FALSE(m.ok());
-  std::printf("error: %s\n", m.error().c_str());
-  EXPECT_NE(m.error().find("empty_face.ply"), std::string::npos);
+  EXPECT_NE(ply_load_error(ply, "empty_face.ply", true).find("empty_face.ply"), std::string::npos);
   // A valid PLY still loads.
   const std::string good = ply.substr(0, ply.find("element face 2")) + "element face 1" +
                            ply.substr(ply.find("\nproperty list"), std::string::npos);
-  const std::string good_body = good.substr(0, good.rfind("0\n"));
-  auto g = drape::sim::load_mesh_from_memory(good_body.data(), good_body.size(), "ply", "ok.ply");
-  ASSERT_TRUE(g.ok()) << g.error();
-  EXPECT_EQ(g->triangles.size(), 1u);
+  expect_ply_loads(good.substr(0, good.rfind("0\n")), "ok.ply", 1);
 }
 
 TEST(MeshIo, ClothToMesh) {
@@ -182,11 +195,9 @@ TEST(MeshIo, PlyHeaderWithoutEndHeaderIsAnErrorNotAHang) {
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
       "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
       "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
-  auto m = drape::sim::load_mesh_from_memory(ply.data(), ply.size(), "ply", "open_header.ply");
-  ASSERT_FALSE(m.ok());
-  std::printf("error: %s\n", m.error().c_str());
-  EXPECT_NE(m.error().find("open_header.ply"), std::string::npos);
-  EXPECT_NE(m.error().find("PLY header"), std::string::npos);  // the data reads as header lines
+  const std::string err = drape::sim::ply_load_error(ply, "open_header.ply", true);
+  EXPECT_NE(err.find("open_header.ply"), std::string::npos);
+  EXPECT_NE(err.find("PLY header"), std::string::npos);  // the data reads as header lines
   const std::string path = std::string(DRAPE_BINARY_DIR) + "/open_header.ply";
   {
     std::ofstream f(path, std::ios::binary);
@@ -197,15 +208,12 @@ TEST(MeshIo, PlyHeaderWithoutEndHeaderIsAnErrorNotAHang) {
   EXPECT_NE(fm.error().find("PLY header"), std::string::npos);
   // Without data lines the header simply never ends.
   const std::string open_only = ply.substr(0, ply.find("0 0 0\n"));
-  auto o = drape::sim::load_mesh_from_memory(open_only.data(), open_only.size(), "ply", "o.ply");
-  ASSERT_FALSE(o.ok());
-  EXPECT_NE(o.error().find("no end_header"), std::string::npos);
+  EXPECT_NE(drape::sim::ply_load_error(open_only, "o.ply").find("no end_header"),
+            std::string::npos);
   // The same file with its header closed loads.
   const std::string closed =
       ply.substr(0, ply.find("0 0 0\n")) + "end_header\n" + ply.substr(ply.find("0 0 0\n"));
-  auto g = drape::sim::load_mesh_from_memory(closed.data(), closed.size(), "ply", "closed.ply");
-  ASSERT_TRUE(g.ok()) << g.error();
-  EXPECT_EQ(g->triangles.size(), 1u);
+  drape::sim::expect_ply_loads(closed, "closed.ply", 1);
 }
 
 // A PLY element count larger than the file (fuzz_mesh: assimp tried to allocate 57 GB, seed
@@ -214,16 +222,12 @@ TEST(MeshIo, PlyElementCountBeyondTheFileIsAnError) {
   const std::string ply =
       "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
       "property float z\nend_header\n0 0 0\n";
-  auto m = drape::sim::load_mesh_from_memory(ply.data(), ply.size(), "ply", "huge.ply");
-  ASSERT_FALSE(m.ok());
-  std::printf("error: %s\n", m.error().c_str());
-  EXPECT_NE(m.error().find("huge.ply"), std::string::npos);
-  EXPECT_NE(m.error().find("element vertex 4000000000"), std::string::npos);
+  const std::string err = drape::sim::ply_load_error(ply, "huge.ply", true);
+  EXPECT_NE(err.find("huge.ply"), std::string::npos);
+  EXPECT_NE(err.find("element vertex 4000000000"), std::string::npos);
   // An unknown header keyword (fuzz_mesh: assimp looped on "prloat z") is an error too.
   const std::string mangled =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nprloat z\n"
       "end_header\n0 0 0\n1 0 0\n0 1 0\n";
-  auto k = drape::sim::load_mesh_from_memory(mangled.data(), mangled.size(), "ply", "kw.ply");
-  ASSERT_FALSE(k.ok());
-  EXPECT_NE(k.error().find("prloat"), std::string::npos);
+  EXPECT_NE(drape::sim::ply_load_error(mangled, "kw.ply").find("prloat"), std::string::npos);
 }

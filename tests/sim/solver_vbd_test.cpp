@@ -11,8 +11,20 @@
 #include "sim/parallel.hpp"
 #include "sim/scenes.hpp"
 #include "sim/solver_newton.hpp"
+#include "solver_checks.hpp"
 
 using namespace drape::sim;
+using namespace drape::sim::test;
+
+namespace {
+// VBD options with `substeps` substeps of at most `iterations` iterations; the rest default.
+VbdOptions vbd_options(int substeps, int iterations) {
+  VbdOptions o;
+  o.substeps = substeps;
+  o.iterations = iterations;
+  return o;
+}
+}  // namespace
 
 TEST(Vbd, ColouringSeparatesNeighbours) {
   StudyScene sc = make_hanging_sheet(12);
@@ -28,38 +40,20 @@ TEST(Vbd, ColouringSeparatesNeighbours) {
 }
 
 TEST(Vbd, ChainSupportForceEqualsTotalWeight) {
-  StudyScene sc = make_chain(20, 1.0, 1e5);
-  VbdOptions o;
+  VbdOptions o = vbd_options(4, 50);
   o.energy.model = EnergyOptions::Model::kSprings;
-  o.substeps = 4;
-  o.iterations = 50;
   o.tolerance = 1e-9;
   o.damping = 0.001;
   VbdSolver s(o);
-  for (int k = 0; k < 900; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
-  const auto& x = sc.cloth.state.x;
-  const double support = 1e5 * ((x[0] - x[1]).norm() - 0.1) + kGravity;
-  std::printf("VBD chain: support %.4f N vs weight %.4f N (%.3f %%)\n", support, 20 * kGravity,
-              100 * (support / (20 * kGravity) - 1));
-  EXPECT_NEAR(support / (20 * kGravity), 1.0, 0.01);
+  expect_chain_carries_its_weight(s, 900, "VBD", 0.01);
 }
 
 TEST(Vbd, HangingSheetConvergesToNewtonReference) {
-  StudyScene ref = make_hanging_sheet(12);
-  StaticOptions so;
-  so.tolerance = 1e-9;
-  relax_static(ref.cloth, ref.objects, so);
-  StudyScene sc = make_hanging_sheet(12);
-  VbdOptions o;
-  o.substeps = 2;
-  o.iterations = 20;
+  VbdOptions o = vbd_options(2, 20);
   o.damping = 0.01;
   VbdSolver s(o);
-  for (int k = 0; k < 450; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
   double rms, mx;
-  position_error(sc.cloth.state.x, ref.cloth.state.x, rms, mx);
-  std::printf("VBD sheet after 5 s vs static Newton: rms %.3f mm, max %.3f mm\n", rms * 1e3,
-              mx * 1e3);
+  sheet_error_vs_newton(s, 12, 450, "VBD sheet after 5 s vs static Newton", rms, mx);
   EXPECT_LT(rms, 2e-3);  // stated tolerance: 2 mm RMS on a 0.5 m sheet
   EXPECT_LT(mx, 5e-3);
 }
@@ -85,36 +79,27 @@ TEST(Vbd, FreezingSkipsRestingVerticesAndWakes) {
   o.freeze = true;
   o.damping = 0.02;
   VbdSolver s(o);
-  for (int k = 0; k < 600; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  run_frames(s, sc, 600);
   std::printf("frozen after rest: %d of %d\n", s.frozen_count(), sc.cloth.num_vertices());
-  EXPECT_GT(s.frozen_count(), sc.cloth.num_vertices() / 2);
   // Move a pinned corner: neighbours wake and the cloth follows.
-  const double moved = drag_sheet_corner(sc, s, 45);
-  std::printf("bottom-left moved %.2f mm after the corner moved, frozen %d\n", moved * 1e3,
-              s.frozen_count());
-  EXPECT_LT(s.frozen_count(), sc.cloth.num_vertices() / 2);
+  expect_frozen_then_woken_by_a_drag(sc, s);
 }
 
 // The adaptive initial guess (Chen et al. 2024, sec. 3.6) makes a cloth at rest a fixed point
 // of an under-converged VBD step; the full-gravity guess drags it down by the solver's lag.
 TEST(Vbd, AdaptiveInitialGuessKeepsAClothAtRest) {
-  StudyScene ref = make_hanging_sheet(12);
-  StaticOptions so;
-  so.tolerance = 1e-9;
-  relax_static(ref.cloth, ref.objects, so);
+  const StudyScene ref = newton_hanging_sheet(12);
   double drift[2];
   const VbdOptions::Init inits[2] = {VbdOptions::Init::kAdaptive,
                                      VbdOptions::Init::kInertiaGravity};
   for (int k = 0; k < 2; ++k) {
     StudyScene sc = make_hanging_sheet(12);
     sc.cloth.state.x = ref.cloth.state.x;  // start at the static minimum, at rest
-    VbdOptions o;
-    o.substeps = 1;
-    o.iterations = 5;
+    VbdOptions o = vbd_options(1, 5);
     o.init = inits[k];
     o.threads = 1;
     VbdSolver s(o);
-    for (int f = 0; f < 90; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+    run_frames(s, sc, 90);
     double rms, mx;
     position_error(sc.cloth.state.x, ref.cloth.state.x, rms, mx);
     drift[k] = rms;
@@ -131,9 +116,7 @@ TEST(Vbd, AdaptiveInitialGuessKeepsAClothAtRest) {
 // iteration because every Gauss-Seidel step is tiny (the old displacement-only test did).
 TEST(Vbd, EarlyStopUsesTheForceResidual) {
   StudyScene sc = make_hanging_sheet(12);
-  VbdOptions o;
-  o.substeps = 1;
-  o.iterations = 30;
+  VbdOptions o = vbd_options(1, 30);
   o.threads = 1;
   VbdSolver s(o);
   StepStats st = s.step(sc.cloth, sc.objects, 1.0 / 90);

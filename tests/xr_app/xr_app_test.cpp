@@ -20,6 +20,8 @@
 
 namespace {
 
+namespace fs = std::filesystem;
+
 const std::string kManifest = std::string(DRAPE_BINARY_DIR) + "/bin/drape_mock_runtime.json";
 
 void base_env() {
@@ -44,6 +46,34 @@ void print(const drape::app::XrAppResult& r) {
               static_cast<long long>(r.frames_rendered), r.sessions, r.sessions_lost,
               r.validation_messages);
   if (!r.error.empty()) std::printf("error: %s\n", r.error.c_str());
+}
+
+// A fresh xr_test_out/<name> holding an empty frames/ for the runtime's screenshots.
+fs::path fresh_out_dir(const char* name) {
+  const fs::path dir = fs::path(DRAPE_BINARY_DIR) / "xr_test_out" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir / "frames");
+  return dir;
+}
+
+// Runs the app while the runtime writes screenshots (left eye) to dir/frames, every `every`-th
+// frame if given; prints the result.
+drape::app::XrAppResult run_with_screenshots(const drape::app::XrAppOptions& o, const fs::path& dir,
+                                             const char* every = nullptr) {
+  setenv("DRAPE_MOCK_WRITE_FRAMES", (dir / "frames").c_str(), 1);
+  if (every) setenv("DRAPE_MOCK_WRITE_EVERY", every, 1);
+  auto r = drape::app::run_xr_app(o);
+  unsetenv("DRAPE_MOCK_WRITE_FRAMES");
+  unsetenv("DRAPE_MOCK_WRITE_EVERY");
+  print(r);
+  return r;
+}
+
+// The file name of the runtime's screenshot of frame f (in <dir>/frames).
+std::string frame_png(long long f) {
+  char name[64];
+  std::snprintf(name, sizeof name, "frame_%06lld.png", f);
+  return name;
 }
 
 TEST(XrApp, RunsToExitingWhenTheRuntimeEndsTheSession) {
@@ -126,10 +156,7 @@ void check_golden(const std::string& shot, const std::string& name) {
 // the key frames match golden images.
 TEST(XrApp, DefaultScenarioPinchesPinsAndCutsTheCloth) {
   base_env();
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::path(DRAPE_BINARY_DIR) / "xr_test_out" / "app_default";
-  fs::remove_all(dir);
-  fs::create_directories(dir / "frames");
+  const fs::path dir = fresh_out_dir("app_default");
   const std::string raw = (dir / "pin_22k.wav").string(), wav = (dir / "pin.wav").string();
   const std::string cmd = "espeak-ng -s 140 -w '" + raw + "' 'pin here' && sox '" + raw +
                           "' -r 16000 -c 1 -b 16 '" + wav + "' pad 0.3 0.5";
@@ -144,16 +171,11 @@ TEST(XrApp, DefaultScenarioPinchesPinsAndCutsTheCloth) {
   const std::string sc = (dir / "scenario.json").string();
   std::ofstream(sc) << text;
   setenv("DRAPE_MOCK_SCENARIO", sc.c_str(), 1);
-  setenv("DRAPE_MOCK_WRITE_FRAMES", (dir / "frames").c_str(), 1);
-  setenv("DRAPE_MOCK_WRITE_EVERY", "30", 1);
   auto o = small();
   o.eye_size = 128;
   o.cloth_res = 12;
   o.out_dir = dir.string();
-  auto r = drape::app::run_xr_app(o);
-  unsetenv("DRAPE_MOCK_WRITE_FRAMES");
-  unsetenv("DRAPE_MOCK_WRITE_EVERY");
-  print(r);
+  auto r = run_with_screenshots(o, dir, "30");
   for (const auto& t : r.triggers) std::printf("trigger %s\n", t.c_str());
   for (const auto& l : r.log)
     if (l.rfind("voice", 0) == 0 || l.rfind("cut", 0) == 0 || l.rfind("command", 0) == 0)
@@ -166,11 +188,8 @@ TEST(XrApp, DefaultScenarioPinchesPinsAndCutsTheCloth) {
 #ifdef DRAPE_XR_TEST_WITH_RENDER
   // Key frames: the start, the pinch taking the cloth (90) and pulling it out (120). (Frames
   // after the voice cue at 140 also depend on the recogniser's result; see docs/xr.md.)
-  for (int f : {0, 90, 120}) {
-    char name[64];
-    std::snprintf(name, sizeof name, "frame_%06d.png", f);
-    check_golden((dir / "frames" / name).string(), std::string("default_") + name);
-  }
+  for (int f : {0, 90, 120})
+    check_golden((dir / "frames" / frame_png(f)).string(), "default_" + frame_png(f));
 #endif
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_EQ(r.frames, 300);
@@ -212,10 +231,7 @@ TEST(XrApp, DefaultScenarioPinchesPinsAndCutsTheCloth) {
 // projects, not where an earlier frame's pose does (k = 0 frames).
 TEST(XrApp, HandMarkerIsDrawnAtTheFramesOwnPose) {
   base_env();
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::path(DRAPE_BINARY_DIR) / "xr_test_out" / "app_pointer";
-  fs::remove_all(dir);
-  fs::create_directories(dir / "frames");
+  const fs::path dir = fresh_out_dir("app_pointer");
   const std::string sc = (dir / "scenario.json").string();
   std::ofstream(sc) << R"({"name": "pointer", "end_after_frames": 30, "fast": true,
     "head": [{"frame": 0, "position": [0.0, 1.3, 1.2]}],
@@ -223,15 +239,12 @@ TEST(XrApp, HandMarkerIsDrawnAtTheFramesOwnPose) {
       {"frame": 0, "palm": {"position": [-0.45, 1.1, 0.75]}, "pinch": 0.0},
       {"frame": 30, "palm": {"position": [0.45, 1.3, 0.75]}, "pinch": 0.0}]}})";
   setenv("DRAPE_MOCK_SCENARIO", sc.c_str(), 1);
-  setenv("DRAPE_MOCK_WRITE_FRAMES", (dir / "frames").c_str(), 1);
   auto o = small();
   o.eye_size = 256;
   o.cloth_res = 8;
   o.voice = false;
   o.pointer_probe = true;
-  auto r = drape::app::run_xr_app(o);
-  unsetenv("DRAPE_MOCK_WRITE_FRAMES");
-  print(r);
+  auto r = run_with_screenshots(o, dir);
   ASSERT_EQ(r.exit_code, 0);
   ASSERT_GE(r.pointer_probe.size(), 25u);
   int checked = 0, at_k0 = 0;
@@ -239,9 +252,7 @@ TEST(XrApp, HandMarkerIsDrawnAtTheFramesOwnPose) {
   std::vector<double> offsets;
   for (const auto& pr : r.pointer_probe) {
     if (pr.frame < 4 || pr.count < 4) continue;
-    char name[64];
-    std::snprintf(name, sizeof name, "frame_%06lld.png", static_cast<long long>(pr.frame));
-    auto img = drape::render::read_png((dir / "frames" / name).string());
+    auto img = drape::render::read_png((dir / "frames" / frame_png(pr.frame)).string());
     ASSERT_TRUE(img.ok()) << img.error();
     // Marker pixels near the candidate projections (a window over all of them, so no k is
     // favoured); the median is robust to the odd highlight of the same colour elsewhere.
