@@ -206,7 +206,9 @@ void write_svg(const std::vector<Row>& rows, const std::string& scene, int res,
 
 // --probe SCENE RES SOLVER SUBSTEPS ITERATIONS: one configuration with every VBD option from
 // the environment (VBD_INIT 0/1/2, VBD_RHO, VBD_DAMP, VBD_FREEZE, VBD_TOL, VBD_THREADS,
-// PROBE_FRAMES, REF_ITERS), printing wall and CPU time per frame and the error per 0.1 s.
+// PROBE_FRAMES, REF_ITERS, PROBE_POLISH=0 skips the final scoring; XPBD: XPBD_WARM,
+// XPBD_REUSE 0/1, XPBD_BEND_EVERY, XPBD_WARM_FRAME + XPBD_WARM_LATE: warm start from a frame on),
+// printing wall and CPU time per frame and the error per 0.1 s.
 int probe(int argc, char** argv) {
   if (argc < 7) {
     std::fprintf(stderr, "usage: solvers_bench --probe SCENE RES SOLVER SUBSTEPS ITERATIONS\n");
@@ -255,12 +257,26 @@ int probe(int argc, char** argv) {
     cfg.air_damping = sc.air_damping;
     auto made = make_solver(solver, cfg);
     s = std::move(made.value());
+    Solver* inner = s.get();
+    if (auto* wd = dynamic_cast<WatchdogSolver*>(inner)) inner = &wd->inner();
+    if (auto* xp = dynamic_cast<XpbdSolver*>(inner)) {  // XPBD_WARM, XPBD_REUSE
+      xp->options().warm_start = env_num("XPBD_WARM", xp->options().warm_start);
+      xp->options().reuse_contacts = env_num("XPBD_REUSE", 1) > 0;
+      xp->options().bending_every = static_cast<int>(env_num("XPBD_BEND_EVERY", 1));
+    }
   }
   const double frame = 1.0 / 90;
   const int frames = static_cast<int>(env_num("PROBE_FRAMES", std::lround(sc.duration / frame)));
   double wall = 0, cpu = 0;
   long iters = 0;
+  const int warm_frame = static_cast<int>(env_num("XPBD_WARM_FRAME", -1));
   for (int f = 0; f < frames; ++f) {
+    if (f == warm_frame) {
+      Solver* inner = s.get();
+      if (auto* wd = dynamic_cast<WatchdogSolver*>(inner)) inner = &wd->inner();
+      if (auto* xp = dynamic_cast<XpbdSolver*>(inner))
+        xp->options().warm_start = env_num("XPBD_WARM_LATE", 1.0);
+    }
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = cpu_ms();
     StepStats st = s->step(sc.cloth, sc.objects, frame);
@@ -290,7 +306,12 @@ int probe(int argc, char** argv) {
   }
   std::printf("%s %d %s %dx%d: wall %.3f ms/frame, cpu %.3f ms/frame\n", scene.c_str(), res,
               solver.c_str(), ns, it, wall / frames, cpu / frames);
-  if (path_dependent(scene)) {
+  Solver* inner = s.get();
+  if (auto* wd = dynamic_cast<WatchdogSolver*>(inner)) inner = &wd->inner();
+  if (auto* xp = dynamic_cast<XpbdSolver*>(inner))
+    std::printf("xpbd: %.2f contact detections per frame\n",
+                double(xp->contact_detections()) / frames);
+  if (path_dependent(scene) && env_num("PROBE_POLISH", 1) > 0) {
     double res_polish = 0, rms = 0, mx = 0;
     position_error(sc.cloth.state.x, polished(sc, res_polish), rms, mx);
     std::printf(
@@ -423,6 +444,73 @@ int main(int argc, char** argv) {
     }
     if (settled[1] > 0)
       std::printf("    settled cost without / with freezing = %.1fx\n", settled[0] / settled[1]);
+  }
+  // Switches of "skip what a scene doesn't need", on and off: XPBD 10x1 on the form scene with
+  // contact reuse (detection only after half the margin of motion) on/off, and self-collision
+  // (spatial hash) off/on; CPU ms per frame, detections per frame, self pairs at the end.
+  {
+    const int kres = quick ? 32 : 64;
+    std::ofstream kc("out/bench/solvers_skip.csv");
+    kc << "scene,solver,resolution,switch,on,ms_per_frame,detections_per_frame,self_pairs\n";
+    struct Sw {
+      const char* name;
+      bool on, reuse, self;
+    };
+    for (const Sw& sw :
+         {Sw{"contact_reuse", true, true, false}, Sw{"contact_reuse", false, false, false},
+          Sw{"self_collision", false, true, false}, Sw{"self_collision", true, true, true}}) {
+      StudyScene sc = make_scene("form", kres);
+      sc.objects.self_collision = sw.self;
+      XpbdOptions o;
+      o.substeps = 10;
+      o.threads = 1;
+      o.damping = sc.air_damping;
+      o.reuse_contacts = sw.reuse;
+      XpbdSolver s(o);
+      const int frames = static_cast<int>(std::lround(sc.duration * 90));
+      const double c0 = cpu_ms();
+      for (int f = 0; f < frames; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+      const double ms = (cpu_ms() - c0) / frames;
+      const double det = double(s.contact_detections()) / frames;
+      const int pairs = static_cast<int>(s.self_collision().contacts().size());
+      std::printf(
+          "skip     %4d xpbd 10x1 %-14s %-3s: %8.3f ms/frame, %.2f detections/frame, %d "
+          "self pairs\n",
+          kres, sw.name, sw.on ? "on" : "off", ms, det, pairs);
+      kc << "form,xpbd," << kres << "," << sw.name << "," << (sw.on ? 1 : 0) << "," << ms << ","
+         << det << "," << pairs << std::endl;
+    }
+  }
+  // Both cores: the default solver 10x1 on the form scene with 1 and 2 threads (colour-parallel,
+  // same result), wall and CPU ms per frame at 128^2 and 256^2. The rows above are CPU time of
+  // one thread (the machine is shared); this is what one frame takes on this 2-core machine.
+  if (!quick && max_res >= 128) {
+    std::ofstream tc("out/bench/solvers_threads.csv");
+    tc << "scene,solver,resolution,substeps,threads,wall_ms_per_frame,cpu_ms_per_frame\n";
+    for (int res : {128, 256}) {
+      if (res > max_res) continue;
+      for (int threads : {1, 2}) {
+        StudyScene sc = make_scene("form", res);
+        SolverConfig cfg;
+        cfg.substeps = 10;
+        cfg.threads = threads;
+        cfg.air_damping = sc.air_damping;
+        auto s = make_solver("default", cfg);
+        const int frames = static_cast<int>(std::lround(sc.duration * 90));
+        const double c0 = cpu_ms();
+        const auto w0 = std::chrono::steady_clock::now();
+        for (int f = 0; f < frames; ++f) (*s)->step(sc.cloth, sc.objects, 1.0 / 90);
+        const double wall =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0)
+                .count() /
+            frames;
+        const double cpu = (cpu_ms() - c0) / frames;
+        std::printf("threads  %4d %s 10x1, %d thread%s: %8.3f ms/frame wall, %8.3f ms CPU\n", res,
+                    kDefaultSolver, threads, threads > 1 ? "s" : "", wall, cpu);
+        tc << "form," << kDefaultSolver << "," << res << ",10," << threads << "," << wall << ","
+           << cpu << std::endl;
+      }
+    }
   }
   int top = 0;  // the chart: the finest form resolution that is scored (not time only)
   for (const auto& j : jobs)

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace drape::sim {
@@ -44,7 +45,7 @@ class ThreadPool {
       fn(0, n, 0);
       return;
     }
-    run(n, &invoke<Fn>, &fn);
+    run(n, &invoke<std::remove_reference_t<Fn>>, &fn);
   }
   // Below this many items the caller runs the range alone (sync costs more than it saves).
   void set_min_parallel(int n) { min_parallel_ = n; }

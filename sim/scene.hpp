@@ -51,6 +51,11 @@ struct SceneObjects {
   std::vector<HandProxy> hands;
   bool floor = true;      // the stage floor y = 0
   double offset = 0.002;  // cloth thickness / collision offset (m): kept-out distance
+  // The cloth against itself (vertex-triangle pairs found through a spatial hash, kept
+  // `offset` apart; sim/self_collision.hpp). Off unless the scene asks: it costs a hash build
+  // per contact detection and a pass per substep. Solved by XPBD (the default solver); the
+  // other solvers ignore it (docs/solvers.md).
+  bool self_collision = false;
 };
 
 }  // namespace drape::sim

@@ -116,6 +116,8 @@ void XpbdSolver::cook(const Cloth& cloth) {
       for (int a = 0; a < 3; ++a) row_ik_.push_back(bik[3 * bk + a]);
     }
     lambda_row_.assign(row_ik_.size(), Vec3::Zero());
+    row_ai_.assign(2 * row_ik_.size(), 0.0);
+    row_ai_h_ = -1;
   }
   for (int h = 0; h < (nrows > 0 ? 0 : energy_.num_hinges()); ++h) {
     Hinge H{};
@@ -145,7 +147,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
   lambda_hinge_.assign(hinges_.size(), Vec3::Zero());
   lambda_spring_.assign(springs_.size(), 0.0);
   xt_.resize(n);
-  w_.resize(n);
+  w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
   // Connected pieces (union-find over the elements' vertices).
   std::vector<int> parent(n);
   for (int i = 0; i < n; ++i) parent[i] = i;
@@ -185,6 +187,10 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
   }
   std::fill(piece_awake_.begin(), piece_awake_.end(), 0);
   fresh_penetration_ = energy_.detect_contacts(cloth, scene);
+  if (scene.self_collision)
+    self_.detect(cloth, S.x, scene.offset, energy_.options().contact_margin);
+  x_det_ = S.x;
+  ++detections_;
   contacts_fresh_ = true;  // the first substep reuses them (same positions)
   for (int i = 0; i < n; ++i) {
     const int p = piece_of_[i];
@@ -230,6 +236,10 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   const int ns = std::max(1, opt_.substeps);
   const double h = dt / ns;
   const double ih2 = 1.0 / (h * h);
+  // Bending blocks projected every be-th substep with compliance alpha / (be h^2): the same
+  // impulse per be substeps (multi-rate splitting; be = 1 is plain XPBD).
+  const int be = std::max(1, opt_.bending_every);
+  const double ihb = ih2 / be;
   contacts_fresh_ = false;
   if (!opt_.freeze) {
     for (int i = 0; i < n; ++i) S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
@@ -243,44 +253,117 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     return st;
   }
   auto set_w = [&] {
-    for (int i = 0; i < n; ++i)
-      w_[i] = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double wi = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
+      if (wi != w_[i]) w_changed_ = true;
+      w_[i] = wi;
+    }
+  };
+  // The bending blocks' inverse system matrices (see row_ai_), for the current w and h.
+  auto build_row_inverses = [&](int b, int e, int) {
+    for (int r = b; r < e; ++r) {
+      double A[6] = {0, 0, 0, 0, 0, 0};  // 00 01 02 11 12 22
+      for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
+        const double wj = w_[row_colv_[k]];
+        if (wj == 0) continue;
+        const double* v = &row_val_[3 * k];
+        A[0] += wj * v[0] * v[0];
+        A[1] += wj * v[0] * v[1];
+        A[2] += wj * v[0] * v[2];
+        A[3] += wj * v[1] * v[1];
+        A[4] += wj * v[1] * v[2];
+        A[5] += wj * v[2] * v[2];
+      }
+      double* ai = &row_ai_[6 * r];
+      std::fill(ai, ai + 6, 0.0);
+      if (A[0] + A[3] + A[5] == 0) continue;  // every vertex of the block fixed
+      A[0] += ihb * row_ik_[3 * r];
+      A[3] += ihb * row_ik_[3 * r + 1];
+      A[5] += ihb * row_ik_[3 * r + 2];
+      // Closed-form inverse of the symmetric positive definite 3x3 A.
+      const double c00 = A[3] * A[5] - A[4] * A[4];
+      const double c01 = A[2] * A[4] - A[1] * A[5];
+      const double c02 = A[1] * A[4] - A[2] * A[3];
+      const double det = A[0] * c00 + A[1] * c01 + A[2] * c02;
+      if (!(det > 0)) continue;
+      const double id = 1.0 / det;
+      ai[0] = c00 * id;
+      ai[1] = c01 * id;
+      ai[2] = c02 * id;
+      ai[3] = (A[0] * A[5] - A[2] * A[2]) * id;
+      ai[4] = (A[2] * A[1] - A[0] * A[4]) * id;
+      ai[5] = (A[0] * A[3] - A[1] * A[1]) * id;
+    }
   };
   const double* w = w_.data();
   const bool warm = opt_.warm_start > 0;
   const bool keep_lambda = opt_.iterations > 1 || warm;
 
   auto project_tris = [&](int b, int e, int) {
+    // The three strain constraints of a triangle (E_uu, E_vv, E_uv) are projected one after
+    // the other as in classic XPBD, but in the space of F = (fu, fv): every gradient is
+    // w_q (D_uq a + D_vq b) for vectors a, b, so each projection changes F by a closed form
+    // (S_uu, S_vv, S_uv below) and the vertices are moved once, by the sum.
     for (int k = b; k < e; ++k) {
       const Tri& T = tris_[k];
       const double wq[3] = {w[T.v[0]], w[T.v[1]], w[T.v[2]]};
       if (wq[0] + wq[1] + wq[2] == 0) continue;
-      Vec3 p[3] = {x[T.v[0]], x[T.v[1]], x[T.v[2]]};
+      const Vec3& p0 = x[T.v[0]];
+      const Vec3& p1 = x[T.v[1]];
+      const Vec3& p2 = x[T.v[2]];
       const double* D = T.D;
-      for (int c = 0; c < 3; ++c) {
-        const Vec3 fu = p[0] * D[0] + p[1] * D[2] + p[2] * D[4];
-        const Vec3 fv = p[0] * D[1] + p[1] * D[3] + p[2] * D[5];
-        double C, denom = ih2 * T.ia[c];
-        Vec3 g[3];
-        if (c == 0) {
-          C = 0.5 * (fu.squaredNorm() - 1);
-          for (int q = 0; q < 3; ++q) g[q] = D[2 * q] * fu;
-        } else if (c == 1) {
-          C = 0.5 * (fv.squaredNorm() - 1);
-          for (int q = 0; q < 3; ++q) g[q] = D[2 * q + 1] * fv;
-        } else {
-          C = 0.5 * fu.dot(fv);
-          for (int q = 0; q < 3; ++q) g[q] = 0.5 * (D[2 * q] * fv + D[2 * q + 1] * fu);
-        }
-        const double alpha = denom;
-        for (int q = 0; q < 3; ++q) denom += wq[q] * g[q].squaredNorm();
-        if (denom < 1e-20) continue;
-        double lam = keep_lambda ? lambda_tri_[3 * k + c] : 0.0;
-        const double dl = (-C - alpha * lam) / denom;
-        if (keep_lambda) lambda_tri_[3 * k + c] = lam + dl;
-        for (int q = 0; q < 3; ++q) p[q] += (wq[q] * dl) * g[q];
+      Vec3 fu = p0 * D[0] + p1 * D[2] + p2 * D[4];
+      Vec3 fv = p0 * D[1] + p1 * D[3] + p2 * D[5];
+      double Suu = 0, Svv = 0, Suv = 0;
+      for (int q = 0; q < 3; ++q) {
+        Suu += wq[q] * D[2 * q] * D[2 * q];
+        Svv += wq[q] * D[2 * q + 1] * D[2 * q + 1];
+        Suv += wq[q] * D[2 * q] * D[2 * q + 1];
       }
-      for (int q = 0; q < 3; ++q) x[T.v[q]] = p[q];
+      Vec3 a = Vec3::Zero(), bb = Vec3::Zero();
+      double* L = &lambda_tri_[3 * k];
+      // E_uu = (|fu|^2 - 1) / 2, gradient D_uq fu.
+      {
+        const double alpha = ih2 * T.ia[0];
+        const double denom = alpha + Suu * fu.squaredNorm();
+        if (denom >= 1e-20) {
+          const double lam = keep_lambda ? L[0] : 0.0;
+          const double dl = (-0.5 * (fu.squaredNorm() - 1) - alpha * lam) / denom;
+          if (keep_lambda) L[0] = lam + dl;
+          a += dl * fu;
+          fv += (dl * Suv) * fu;
+          fu *= 1 + dl * Suu;
+        }
+      }
+      // E_vv = (|fv|^2 - 1) / 2, gradient D_vq fv.
+      {
+        const double alpha = ih2 * T.ia[1];
+        const double denom = alpha + Svv * fv.squaredNorm();
+        if (denom >= 1e-20) {
+          const double lam = keep_lambda ? L[1] : 0.0;
+          const double dl = (-0.5 * (fv.squaredNorm() - 1) - alpha * lam) / denom;
+          if (keep_lambda) L[1] = lam + dl;
+          bb += dl * fv;
+          fu += (dl * Suv) * fv;
+          fv *= 1 + dl * Svv;
+        }
+      }
+      // E_uv = fu . fv / 2, gradient (D_uq fv + D_vq fu) / 2.
+      {
+        const double alpha = ih2 * T.ia[2];
+        const double uv = fu.dot(fv);
+        const double denom =
+            alpha + 0.25 * (Suu * fv.squaredNorm() + 2 * Suv * uv + Svv * fu.squaredNorm());
+        if (denom >= 1e-20) {
+          const double lam = keep_lambda ? L[2] : 0.0;
+          const double dl = (-0.5 * uv - alpha * lam) / denom;
+          if (keep_lambda) L[2] = lam + dl;
+          a += (0.5 * dl) * fv;
+          bb += (0.5 * dl) * fu;
+        }
+      }
+      for (int q = 0; q < 3; ++q)
+        if (wq[q] > 0) x[T.v[q]] += wq[q] * (D[2 * q] * a + D[2 * q + 1] * bb);
     }
   };
   auto project_hinges = [&](int b, int e, int) {
@@ -301,44 +384,35 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   };
   auto project_rows = [&](int b, int e, int) {
     for (int r = b; r < e; ++r) {
-      // C_a = sum_j v_aj x_j; (sum_j w_j v_aj v_bj + alpha_a delta_ab) dl_b = -C_a - alpha_a l_a.
+      // C_a = sum_j v_aj x_j; A dl = -C - alpha l with A^-1 cached (row_ai_).
+      const double* ai = &row_ai_[6 * r];
+      if (ai[0] == 0) continue;  // every vertex fixed (or A singular)
       Vec3 C[3] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
-      Mat3 A = Mat3::Zero();
       for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
-        const int j = row_colv_[k];
+        const Vec3& xj = x[row_colv_[k]];
         const double* v = &row_val_[3 * k];
-        for (int a = 0; a < 3; ++a) C[a] += v[a] * x[j];
-        if (w[j] > 0)
-          for (int a = 0; a < 3; ++a)
-            for (int c = a; c < 3; ++c) A(a, c) += w[j] * v[a] * v[c];
+        C[0] += v[0] * xj;
+        C[1] += v[1] * xj;
+        C[2] += v[2] * xj;
       }
-      if (A.trace() == 0) continue;
       Vec3* lam = &lambda_row_[3 * r];
-      Eigen::Matrix3d R;  // rows a: right-hand side of component a (x, y, z)
-      for (int a = 0; a < 3; ++a) {
-        const double alpha = ih2 * row_ik_[3 * r + a];
-        A(a, a) += alpha;
-        R.row(a) = (keep_lambda ? Vec3(-C[a] - alpha * lam[a]) : Vec3(-C[a])).transpose();
-      }
-      // Closed-form inverse of the symmetric positive definite 3x3 A.
-      const double c00 = A(1, 1) * A(2, 2) - A(1, 2) * A(1, 2);
-      const double c01 = A(0, 2) * A(1, 2) - A(0, 1) * A(2, 2);
-      const double c02 = A(0, 1) * A(1, 2) - A(0, 2) * A(1, 1);
-      const double det = A(0, 0) * c00 + A(0, 1) * c01 + A(0, 2) * c02;
-      if (!(det > 0)) continue;
-      const double c11 = A(0, 0) * A(2, 2) - A(0, 2) * A(0, 2);
-      const double c12 = A(0, 2) * A(0, 1) - A(0, 0) * A(1, 2);
-      const double c22 = A(0, 0) * A(1, 1) - A(0, 1) * A(0, 1);
-      Eigen::Matrix3d Ai;
-      Ai << c00, c01, c02, c01, c11, c12, c02, c12, c22;
-      const Eigen::Matrix3d dl = (Ai * (1.0 / det)) * R;
       if (keep_lambda)
-        for (int a = 0; a < 3; ++a) lam[a] += dl.row(a).transpose();
+        for (int a = 0; a < 3; ++a) C[a] += (ihb * row_ik_[3 * r + a]) * lam[a];
+      // dl_a = -sum_b Ai_ab (C_b + alpha_b l_b): one vector per row a.
+      const Vec3 d0 = -(ai[0] * C[0] + ai[1] * C[1] + ai[2] * C[2]);
+      const Vec3 d1 = -(ai[1] * C[0] + ai[3] * C[1] + ai[4] * C[2]);
+      const Vec3 d2 = -(ai[2] * C[0] + ai[4] * C[1] + ai[5] * C[2]);
+      if (keep_lambda) {
+        lam[0] += d0;
+        lam[1] += d1;
+        lam[2] += d2;
+      }
       for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
         const int j = row_colv_[k];
-        if (w[j] == 0) continue;
+        const double wj = w[j];
+        if (wj == 0) continue;
         const double* v = &row_val_[3 * k];
-        x[j] += w[j] * (v[0] * dl.row(0) + v[1] * dl.row(1) + v[2] * dl.row(2)).transpose();
+        x[j] += wj * (v[0] * d0 + v[1] * d1 + v[2] * d2);
       }
     }
   };
@@ -420,16 +494,31 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   };
 
   const double damp = std::exp(-opt_.damping * h);
+  const double margin = energy_.options().contact_margin;
   for (int s = 0; s < ns; ++s) {
     if (s == 0 && contacts_fresh_) st.max_penetration = fresh_penetration_;
-    if (s > 0 || !contacts_fresh_) {  // contacts every substep (the wake check's are current)
+    bool detect = s == 0 ? !contacts_fresh_ : true;
+    if (s > 0 && opt_.reuse_contacts) {
+      const double lim = 0.25 * margin * margin;
+      detect = false;
+      for (int i = 0; i < n && !detect; ++i) detect = (x[i] - x_det_[i]).squaredNorm() > lim;
+    }
+    if (detect) {
       const auto t0 = std::chrono::steady_clock::now();
       st.max_penetration = std::max(st.max_penetration, energy_.detect_contacts(cloth, scene));
+      if (scene.self_collision) self_.detect(cloth, x, scene.offset, margin);
+      x_det_ = x;
+      ++detections_;
       st.collision_ms +=
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     }
     contacts_fresh_ = false;
     set_w();
+    if (!row_ai_.empty() && (w_changed_ || ihb != row_ai_h_)) {
+      pool_->parallel_for(static_cast<int>(row_ai_.size() / 6), build_row_inverses);
+      row_ai_h_ = ihb;
+      w_changed_ = false;
+    }
     pool_->parallel_for(n, [&](int b, int e, int) {
       for (int i = b; i < e; ++i) {
         xt_[i] = x[i];
@@ -457,9 +546,10 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     for (int it = 0; it < opt_.iterations; ++it) {
       by_colour(tri_col_, project_tris);
       by_colour(hinge_col_, project_hinges);
-      by_colour(row_cols_, project_rows);
+      if (s % be == be - 1 || s == ns - 1) by_colour(row_cols_, project_rows);
       by_colour(spring_col_, project_springs);
       energy_.project_contacts(x);
+      if (scene.self_collision) self_.project(cloth, x, w, scene.offset);
       ++st.iterations;
     }
     pool_->parallel_for(n, [&](int b, int e, int) {

@@ -5,43 +5,32 @@
 
 #include <cstdio>
 
+#include "sim/dress_form.hpp"
 #include "sim/scenes.hpp"
 #include "sim/solver_newton.hpp"
+#include "solver_checks.hpp"
 
 using namespace drape::sim;
+using namespace drape::sim::test;
 
 TEST(Xpbd, ChainSupportForceEqualsTotalWeight) {
-  StudyScene sc = make_chain(20, 1.0, 1e5);
   XpbdOptions o;
   o.energy.model = EnergyOptions::Model::kSprings;
   o.substeps = 20;
   o.iterations = 20;
   o.damping = 2.0;
   XpbdSolver s(o);
-  for (int k = 0; k < 400; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
-  const auto& x = sc.cloth.state.x;
-  const double support = 1e5 * ((x[0] - x[1]).norm() - 0.1) + kGravity;
-  std::printf("XPBD chain: support %.4f N vs %.4f N (%.3f %%)\n", support, 20 * kGravity,
-              100 * (support / (20 * kGravity) - 1));
-  EXPECT_NEAR(support / (20 * kGravity), 1.0, 0.02);
+  expect_chain_carries_its_weight(s, 400, "XPBD", 0.02);
 }
 
 TEST(Xpbd, HangingSheetNearNewtonReference) {
-  StudyScene ref = make_hanging_sheet(10);
-  StaticOptions so;
-  so.tolerance = 1e-9;
-  relax_static(ref.cloth, ref.objects, so);
-  StudyScene sc = make_hanging_sheet(10);
   XpbdOptions o;
   o.substeps = 20;
   o.iterations = 2;
   o.damping = 2.0;
   XpbdSolver s(o);
-  for (int k = 0; k < 360; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
   double rms, mx;
-  position_error(sc.cloth.state.x, ref.cloth.state.x, rms, mx);
-  std::printf("XPBD sheet after 4 s vs static Newton: rms %.3f mm, max %.3f mm\n", rms * 1e3,
-              mx * 1e3);
+  sheet_error_vs_newton(s, 10, 360, "XPBD sheet after 4 s vs static Newton", rms, mx);
   EXPECT_LT(rms, 5e-3);  // stated: 5 mm RMS (XPBD leaves stiffness under-resolved)
 }
 
@@ -80,14 +69,9 @@ TEST(Xpbd, FreezingSkipsRestingVerticesWakesAndKeepsTheRestState) {
   position_error(sc.cloth.state.x, free_run.cloth.state.x, rms, mx);
   std::printf("frozen after rest: %d of %d; rest state vs no freezing: rms %.3f mm, max %.3f mm\n",
               s.frozen_count(), sc.cloth.num_vertices(), rms * 1e3, mx * 1e3);
-  EXPECT_GT(s.frozen_count(), sc.cloth.num_vertices() / 2);
   EXPECT_LT(mx, 1e-3);
   // Move a pinned corner: neighbours wake and the cloth follows.
-  const double moved = drag_sheet_corner(sc, s, 45);
-  std::printf("bottom-left moved %.2f mm after the corner moved, frozen %d\n", moved * 1e3,
-              s.frozen_count());
-  EXPECT_LT(s.frozen_count(), sc.cloth.num_vertices() / 2);
-  EXPECT_GT(moved, 5e-3);
+  EXPECT_GT(expect_frozen_then_woken_by_a_drag(sc, s), 5e-3);
 }
 
 // Warm-started multipliers shrink XPBD's under-converged sag of a hanging sheet (measured:
@@ -111,4 +95,66 @@ TEST(Xpbd, WarmStartHalvesTheSagBiasOfAHangingSheet) {
   std::printf("16^2 sheet, 10 substeps, after 4 s: rms %.3f mm (classic), %.3f mm (warm 0.5)\n",
               err[0] * 1e3, err[1] * 1e3);
   EXPECT_LT(err[1], 0.7 * err[0]);
+}
+
+// The study's 3 s form drape at 16^2 with options o: contact detections, the closest vertex's
+// distance to the form, and the RMS distance of the end state to its nearest equilibrium.
+struct DrapeEnd {
+  int detections = 0;
+  double min_sd = 1, err = 0, offset = 0;
+};
+DrapeEnd form_drape_end(XpbdOptions o, const char* label) {
+  StudyScene sc = make_scene("form", 16);
+  o.damping = sc.air_damping;
+  o.threads = 1;
+  XpbdSolver s(o);
+  for (int f = 0; f < 270; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  DrapeEnd d;
+  d.offset = sc.objects.offset;
+  d.detections = s.contact_detections();
+  for (const Vec3& p : sc.cloth.state.x)
+    d.min_sd = std::min(d.min_sd, sc.objects.form->signed_distance(p));
+  const std::vector<Vec3> end = sc.cloth.state.x;
+  StaticOptions so;
+  so.tolerance = 1e-8;
+  const StaticResult r = relax_static(sc.cloth, sc.objects, so);
+  double mx = 0;
+  position_error(end, sc.cloth.state.x, d.err, mx);
+  std::printf(
+      "%s: %d contact detections in 270 frames, closest vertex %.2f mm from the form "
+      "(offset %.1f mm), %.3f mm RMS from the nearest equilibrium (residual %.0e)\n",
+      label, d.detections, d.min_sd * 1e3, d.offset * 1e3, d.err * 1e3, r.residual);
+  return d;
+}
+
+// Contacts detected once per frame and again only after a vertex moved half the contact margin:
+// far fewer detections, no vertex inside the form's shell, and the end state as close to an
+// equilibrium as with detection every substep. (The two end states themselves differ by ~1.7 mm
+// RMS: the drape's folds amplify a 0.01 mm difference at first contact ~150x, a path-dependent
+// scene; docs/solvers.md.)
+TEST(Xpbd, ContactReuseKeepsTheDrapeAndSkipsDetections) {
+  XpbdOptions o;
+  o.substeps = 10;
+  o.reuse_contacts = false;
+  const DrapeEnd every = form_drape_end(o, "detection every substep");
+  o.reuse_contacts = true;
+  const DrapeEnd reused = form_drape_end(o, "detection reused");
+  EXPECT_EQ(every.detections, 270 * 10);
+  EXPECT_LT(reused.detections, 270 * 10 / 2);
+  EXPECT_GT(reused.min_sd, reused.offset - 5e-4);
+  EXPECT_LT(reused.err, 1.25 * every.err + 5e-4);
+}
+
+// Bending projected every second substep (an option): stable, and within 1.5 mm of the error
+// of bending every substep (measured 2.1 vs 1.3 mm at 16^2, 20 substeps: coarse meshes lose the
+// most; at 32^2 the two are equal, docs/solvers.md).
+TEST(Xpbd, BendingEverySecondSubstepKeepsTheDrape) {
+  XpbdOptions o;
+  o.substeps = 20;
+  o.bending_every = 1;
+  const DrapeEnd one = form_drape_end(o, "bending every substep");
+  o.bending_every = 2;
+  const DrapeEnd two = form_drape_end(o, "bending every 2nd substep");
+  EXPECT_GT(two.min_sd, two.offset - 5e-4);
+  EXPECT_LT(two.err, one.err + 1.5e-3);
 }
