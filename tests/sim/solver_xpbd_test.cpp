@@ -158,3 +158,32 @@ TEST(Xpbd, BendingEverySecondSubstepKeepsTheDrape) {
   EXPECT_GT(two.min_sd, two.offset - 5e-4);
   EXPECT_LT(two.err, one.err + 1.5e-3);
 }
+
+// The study's form drape at 32^2 settles (its last wrinkles stop at ~7 s) and then sleeps for
+// good: a vertex resting on its contact plane must not read as an object entering the shell
+// (before the 0.1 mm wake depth it fell asleep at 7.4 s and woke in the next frame).
+TEST(Xpbd, FormDrapeFallsAsleepAndStaysAsleep) {
+  StudyScene sc = make_scene("form", 32);
+  XpbdOptions o;
+  o.substeps = 10;
+  o.damping = sc.air_damping;
+  o.threads = 1;
+  o.freeze = true;
+  XpbdSolver s(o);
+  int free = 0;
+  for (int i = 0; i < sc.cloth.num_vertices(); ++i) free += sc.cloth.is_free(i) ? 1 : 0;
+  int first = -1, woke = 0;
+  for (int f = 0; f < 810; ++f) {
+    s.step(sc.cloth, sc.objects, 1.0 / 90);
+    const bool all = s.frozen_count() == free;
+    if (all && first < 0) first = f;
+    if (first >= 0 && !all) ++woke;
+  }
+  std::printf(
+      "32^2 form drape: all %d free vertices asleep from %.2f s, awake again in %d of the "
+      "following frames (to 9 s)\n",
+      free, first / 90.0, woke);
+  ASSERT_GE(first, 0);
+  EXPECT_LT(first, 8 * 90);
+  EXPECT_EQ(woke, 0);
+}
