@@ -1,11 +1,98 @@
 #include "sim/solver_newton.hpp"
 
+#include <Eigen/CholmodSupport>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 
 namespace drape::sim {
+
+namespace {
+using SpMat = Eigen::SparseMatrix<double>;
+constexpr double kStickyReach = 1e-3;  // m, see minimise()
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+// The Newton matrix (lower triangle only: both factorisations read nothing else) with a pattern
+// fixed while the free set and the topology stay the same: the first assembly records the
+// (row, col) of every contribution, later ones add each value straight into its slot of the
+// compressed storage (no triplet sort per iteration). The symbolic analysis (ordering,
+// elimination tree, supernodes) is done once per pattern as well.
+struct NewtonSolver::Linear {
+  SpMat H;
+  std::vector<std::pair<int, int>> entries;  // record pass: (row, col), row >= col
+  std::vector<int> slot;                     // value index of every contribution, in order
+  size_t next = 0;
+  LinearSolver kind = LinearSolver::kCholmod;
+  std::unique_ptr<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>> chol;
+  std::unique_ptr<Eigen::SimplicialLDLT<SpMat, Eigen::Lower>> ldlt;
+
+  void add(int r, int c, double v, bool record) {
+    if (r < c) return;
+    if (record) {
+      entries.emplace_back(r, c);
+    } else {
+      H.valuePtr()[slot[next++]] += v;
+    }
+  }
+  // Builds the pattern from the recorded entries and the slot of each.
+  void build_pattern(int n) {
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(entries.size());
+    for (const auto& [r, c] : entries) t.emplace_back(r, c, 0.0);
+    H.resize(n, n);
+    H.setFromTriplets(t.begin(), t.end());
+    H.makeCompressed();
+    slot.resize(entries.size());
+    const int* outer = H.outerIndexPtr();
+    const int* inner = H.innerIndexPtr();
+    for (size_t k = 0; k < entries.size(); ++k) {
+      const auto [r, c] = entries[k];
+      slot[k] =
+          static_cast<int>(std::lower_bound(inner + outer[c], inner + outer[c + 1], r) - inner);
+    }
+    entries.clear();
+    entries.shrink_to_fit();
+  }
+  void analyse() {
+    if (kind == LinearSolver::kCholmod) {
+      chol = std::make_unique<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>>();
+      chol->cholmod().print = 0;  // "not positive definite" is expected (exact H): no message
+      chol->analyzePattern(H);
+    } else {
+      ldlt = std::make_unique<Eigen::SimplicialLDLT<SpMat, Eigen::Lower>>();
+      ldlt->analyzePattern(H);
+    }
+  }
+  // Numeric factorisation. Returns false when it failed; `positive` tells whether the matrix
+  // was positive definite (LL^T succeeded; LDL^T: every pivot > 0).
+  bool factorize(bool& positive) {
+    if (kind == LinearSolver::kCholmod) {
+      chol->factorize(H);
+      positive = chol->info() == Eigen::Success;
+      return positive;
+    }
+    ldlt->factorize(H);
+    if (ldlt->info() != Eigen::Success) {
+      positive = false;
+      return false;
+    }
+    positive = ldlt->vectorD().minCoeff() > 0;
+    return true;
+  }
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+    if (kind == LinearSolver::kCholmod)
+      x = chol->solve(b);
+    else
+      x = ldlt->solve(b);
+  }
+};
 
 NewtonSolver::NewtonSolver(NewtonOptions opt) : opt_(opt) {}
 NewtonSolver::~NewtonSolver() = default;
@@ -25,11 +112,79 @@ double NewtonSolver::objective(const Cloth& cloth, const std::vector<Vec3>& x, d
   return e;
 }
 
+// H = M/h^2 + sum element Hessians (PSD-projected unless `exact`) + mu M / (1e-2 s)^2 + contact
+// blocks. `record`: only the pattern (every block is emitted whatever its value, so that the
+// scatter order of later calls is the same).
+void NewtonSolver::assemble(const Cloth& cloth, double inv_h2, double mu, bool exact, bool record) {
+  const auto& S = cloth.state;
+  const int n = cloth.num_vertices();
+  Linear& L = *lin_;
+  if (!record) {
+    std::fill(L.H.valuePtr(), L.H.valuePtr() + L.H.nonZeros(), 0.0);
+    L.next = 0;
+  }
+  auto add_block = [&](int a, int b, const auto& B) {
+    const int da = dof_[a], db = dof_[b];
+    if (da < 0 || db < 0) return;
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r) L.add(3 * da + r, 3 * db + c, B(r, c), record);
+  };
+  for (int i = 0; i < n; ++i) {
+    if (dof_[i] < 0) continue;
+    const double d = inv_h2 * S.mass[i] + mu * S.mass[i] / 1e-4;
+    Mat3 B = d * Mat3::Identity();
+    const int ci = energy_.contact_of(i);
+    if (ci >= 0 && contact_active_[ci]) {
+      const Contact& c = energy_.contacts()[ci];
+      B += energy_.contact_stiffness() * c.n * c.n.transpose();
+    }
+    add_block(i, i, B);
+  }
+  Mat9 H9;
+  for (int t = 0; t < energy_.num_triangles(); ++t) {
+    energy_.tri_hessian(t, S.x, H9, !exact);
+    const auto& v = energy_.tri(t);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) add_block(v[a], v[b], H9.block<3, 3>(3 * a, 3 * b));
+  }
+  if (energy_.tensor_bending()) {
+    // kTensor bending: the constant P (x) I3 (exact, PSD).
+    const auto& off = energy_.bending_offsets();
+    const auto& col = energy_.bending_columns();
+    const auto& val = energy_.bending_values();
+    for (int i = 0; i < n; ++i) {
+      const int di = dof_[i];
+      if (di < 0) continue;
+      for (int k = off[i]; k < off[i + 1]; ++k) {
+        const int dj = dof_[col[k]];
+        if (dj < 0) continue;
+        for (int r = 0; r < 3; ++r) L.add(3 * di + r, 3 * dj + r, val[k], record);
+      }
+    }
+  } else {
+    Mat12 H12;
+    for (int hh = 0; hh < energy_.num_hinges(); ++hh) {
+      energy_.hinge_hessian(hh, S.x, H12, !exact);
+      const auto& v = energy_.hinge(hh);
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) add_block(v[a], v[b], H12.block<3, 3>(3 * a, 3 * b));
+    }
+  }
+  Eigen::Matrix<double, 6, 6> H6;
+  for (int s = 0; s < energy_.num_springs(); ++s) {
+    energy_.spring_hessian(s, S.x, H6, !exact);
+    const auto& v = energy_.spring(s);
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) add_block(v[a], v[b], H6.block<3, 3>(3 * a, 3 * b));
+  }
+}
+
 int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
                            const std::vector<Vec3>* y, double tolerance, int max_iterations,
                            double& residual) {
   if (!energy_.up_to_date(cloth)) cook(cloth);
   energy_.set_form(&scene);
+  counters_ = Counters{};
   auto& S = cloth.state;
   const int n = cloth.num_vertices();
   // Free DOFs (re-analyse the pattern when the free set changed).
@@ -41,7 +196,20 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
     if (dof_[i] != d) changed = true;
     dof_[i] = d;
   }
+  // The energy may also have been rebuilt from outside (energy().build()): compare its element
+  // counts with the ones the assembly pattern was recorded for.
+  const std::array<size_t, 5> sig = {
+      static_cast<size_t>(energy_.num_triangles()), static_cast<size_t>(energy_.num_hinges()),
+      static_cast<size_t>(energy_.num_springs()), energy_.bending_columns().size(),
+      energy_.tensor_bending() ? 1u : 0u};
+  if (sig != pattern_sig_) changed = true;
+  pattern_sig_ = sig;
   if (changed || nd != ndof_) analysed_ = false;
+  if (!lin_ || lin_->kind != opt_.linear_solver) {
+    lin_ = std::make_unique<Linear>();
+    lin_->kind = opt_.linear_solver;
+    analysed_ = false;
+  }
   ndof_ = nd;
   const double inv_h2 = (h > 0 && std::isfinite(h)) ? 1.0 / (h * h) : 0.0;
   double wscale = 1e-12;
@@ -50,14 +218,26 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
     residual = 0;
     return 0;
   }
+  sticky_.assign(n, 0);
   rhs_.resize(3 * nd);
   dx_.resize(3 * nd);
   xtrial_.resize(n);
+  // Exact Hessian (static mode): tried at every iteration unless it was not positive definite
+  // recently (then `exact_hold` iterations with the projected one, doubling on each failure).
+  const bool allow_exact = opt_.exact_hessian && inv_h2 == 0;
+  int exact_hold = 0, exact_wait = 1;
   double mu = 0;  // Levenberg-Marquardt shift (static mode only)
   double best_res = std::numeric_limits<double>::infinity();
   int best_it = 0;
+  double prev_step = 0;
   int it = 0;
   for (; it < max_iterations; ++it) {
+    // Static mode: contact planes re-linearised at every iterate (Newton on the penalty of the
+    // distance itself; the planes of a fixed point are those of its own positions).
+    // Once the steps are below 0.1 um the planes stay (their change is second order in the
+    // tangential slide, < 1e-10 m) and the last iterations converge quadratically.
+    if (redetect_ && inv_h2 == 0 && it > 0 && prev_step > 1e-7)
+      energy_.detect_contacts(cloth, scene);
     energy_.gradient(S.x, S.mass, grad_);
     double gmax = 0;
     for (int i = 0; i < n; ++i) {
@@ -81,81 +261,136 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
     } else if (residual < 1e-5 && it - best_it >= 10) {
       break;
     }
-    // Assemble H = M/h^2 + sum PSD element Hessians (+ mu M).
-    trip_.clear();
-    auto add_block = [&](int a, int b, const Mat3& B) {
-      const int da = dof_[a], db = dof_[b];
-      if (da < 0 || db < 0) return;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) trip_.emplace_back(3 * da + r, 3 * db + c, B(r, c));
+    // The contact penalty's active set of the Newton model: the penetrating vertices. With
+    // prediction (below) it starts from the previous iteration's final set instead (a vertex
+    // the last model held on its plane stays held while within kStickyReach of it): the set
+    // then changes little from one iteration to the next and few re-solves are needed.
+    const auto& contacts = energy_.contacts();
+    contact_active_.resize(contacts.size());
+    const bool predict = opt_.contact_prediction && inv_h2 == 0;
+    for (size_t k = 0; k < contacts.size(); ++k) {
+      const double d = contacts[k].n.dot(S.x[contacts[k].vertex] - contacts[k].p);
+      contact_active_[k] = d < 0 || (predict && sticky_[contacts[k].vertex] && d < kStickyReach);
+    }
+    // rhs of the model with the current active set: -(E's gradient) with the plane term
+    // k d n of every held vertex above its plane added (and removed for a released one below).
+    auto model_rhs = [&]() {
+      model_rhs_ = rhs_;
+      for (size_t k = 0; k < contacts.size(); ++k) {
+        const Contact& c = contacts[k];
+        const int dv = dof_[c.vertex];
+        if (dv < 0) continue;
+        const double d0 = c.n.dot(S.x[c.vertex] - c.p);
+        if (contact_active_[k] && d0 >= 0)
+          model_rhs_.segment<3>(3 * dv) -= energy_.contact_stiffness() * d0 * c.n;
+        if (!contact_active_[k] && d0 < 0)
+          model_rhs_.segment<3>(3 * dv) += energy_.contact_stiffness() * d0 * c.n;
+      }
     };
-    for (int i = 0; i < n; ++i) {
-      if (dof_[i] < 0) continue;
-      double d = inv_h2 * S.mass[i] + mu * S.mass[i] / 1e-4;
-      Mat3 B = d * Mat3::Identity();
-      const int ci = energy_.contact_of(i);
-      if (ci >= 0) {
-        const Contact& c = energy_.contacts()[ci];
-        if (c.n.dot(S.x[i] - c.p) < 0) B += energy_.contact_stiffness() * c.n * c.n.transpose();
-      }
-      add_block(i, i, B);
-    }
-    Mat9 H9;
-    for (int t = 0; t < energy_.num_triangles(); ++t) {
-      energy_.tri_hessian(t, S.x, H9, true);
-      const auto& v = energy_.tri(t);
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) add_block(v[a], v[b], H9.block<3, 3>(3 * a, 3 * b));
-    }
-    if (energy_.tensor_bending()) {
-      // kTensor bending: the constant P (x) I3 (exact, PSD).
-      const auto& off = energy_.bending_offsets();
-      const auto& col = energy_.bending_columns();
-      const auto& val = energy_.bending_values();
-      for (int i = 0; i < n; ++i) {
-        const int di = dof_[i];
-        if (di < 0) continue;
-        for (int k = off[i]; k < off[i + 1]; ++k) {
-          const int dj = dof_[col[k]];
-          if (dj < 0) continue;
-          for (int r = 0; r < 3; ++r) trip_.emplace_back(3 * di + r, 3 * dj + r, val[k]);
-        }
-      }
-    } else {
-      Mat12 H12;
-      for (int hh = 0; hh < energy_.num_hinges(); ++hh) {
-        energy_.hinge_hessian(hh, S.x, H12, true);
-        const auto& v = energy_.hinge(hh);
-        for (int a = 0; a < 4; ++a)
-          for (int b = 0; b < 4; ++b) add_block(v[a], v[b], H12.block<3, 3>(3 * a, 3 * b));
-      }
-    }
-    Eigen::Matrix<double, 6, 6> H6;
-    for (int s = 0; s < energy_.num_springs(); ++s) {
-      energy_.spring_hessian(s, S.x, H6, true);
-      const auto& v = energy_.spring(s);
-      for (int a = 0; a < 2; ++a)
-        for (int b = 0; b < 2; ++b) add_block(v[a], v[b], H6.block<3, 3>(3 * a, 3 * b));
-    }
-    H_.resize(3 * nd, 3 * nd);
-    H_.setFromTriplets(trip_.begin(), trip_.end());
-    if (!ldlt_) ldlt_ = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>>();
+    const auto ta = std::chrono::steady_clock::now();
     if (!analysed_) {
-      ldlt_->analyzePattern(H_);
+      lin_->entries.clear();
+      assemble(cloth, inv_h2, mu, false, true);
+      lin_->build_pattern(3 * nd);
+      lin_->analyse();
       analysed_ = true;
     }
-    ldlt_->factorize(H_);
-    if (ldlt_->info() != Eigen::Success) {
+    bool exact = allow_exact && exact_hold == 0;
+    assemble(cloth, inv_h2, mu, exact, false);
+    counters_.assemble_ms += ms_since(ta);
+    auto tf = std::chrono::steady_clock::now();
+    bool positive = false;
+    bool factored = lin_->factorize(positive);
+    ++counters_.factorisations;
+    if (exact && !positive) {
+      // Not positive definite (wrinkles still moving, or a saddle): projected Hessian for a
+      // while; retry the exact one later.
+      ++counters_.not_positive;
+      exact = false;
+      exact_hold = exact_wait;
+      exact_wait = std::min(2 * exact_wait, 16);
+      counters_.factor_ms += ms_since(tf);
+      const auto ta2 = std::chrono::steady_clock::now();
+      assemble(cloth, inv_h2, mu, false, false);
+      counters_.assemble_ms += ms_since(ta2);
+      tf = std::chrono::steady_clock::now();
+      factored = lin_->factorize(positive);
+      ++counters_.factorisations;
+    } else if (exact_hold > 0) {
+      --exact_hold;
+    }
+    counters_.factor_ms += ms_since(tf);
+    if (!factored) {
       mu = mu > 0 ? mu * 10 : 1e-6;
       continue;
     }
-    dx_ = ldlt_->solve(rhs_);
+    if (!predict) {
+      lin_->solve(rhs_, dx_);
+    } else {
+      model_rhs();
+      lin_->solve(model_rhs_, dx_);
+      // The model's contact term is the penalty itself, 1/2 k min(0, d + n.dx)^2 (same value
+      // and gradient as E at dx = 0, convex): minimise it by updating the active set to the
+      // contacts the step ends up penetrating (a step through a contact the model thought
+      // inactive is what stalls the line search after each re-detection). Its minimiser is a
+      // descent direction of E. A few passes; the last system that factorised is kept.
+      for (int pass = 0; pass < 3; ++pass) {
+        bool change = false;
+        for (size_t k = 0; k < contacts.size(); ++k) {
+          const Contact& c = contacts[k];
+          const int dv = dof_[c.vertex];
+          if (dv < 0) continue;
+          const double d0 = c.n.dot(S.x[c.vertex] - c.p);
+          const bool want = d0 + c.n.dot(dx_.segment<3>(3 * dv)) < 0;
+          if (want != static_cast<bool>(contact_active_[k])) change = true;
+          contact_active_[k] = want;
+        }
+        if (!change) break;
+        model_rhs();
+        const auto ta2 = std::chrono::steady_clock::now();
+        assemble(cloth, inv_h2, mu, exact, false);
+        counters_.assemble_ms += ms_since(ta2);
+        const auto tf2 = std::chrono::steady_clock::now();
+        bool pos2 = false;
+        const bool ok2 = lin_->factorize(pos2);
+        ++counters_.factorisations;
+        ++counters_.contact_passes;
+        counters_.factor_ms += ms_since(tf2);
+        if (!ok2 || (exact && !pos2)) break;
+        lin_->solve(model_rhs_, dx_);
+      }
+      std::fill(sticky_.begin(), sticky_.end(), 0);
+      for (size_t k = 0; k < contacts.size(); ++k) sticky_[contacts[k].vertex] = contact_active_[k];
+    }
     // Backtracking line search on G.
     const double g0 = objective(cloth, S.x, inv_h2, y);
     const double slope = -rhs_.dot(dx_);
     double alpha = 1.0;
     bool accepted = false;
-    for (int ls = 0; ls < (opt_.line_search ? 20 : 1); ++ls) {
+    // Static mode, predicted decrease below 1e-13 of G: the Armijo test is decided by
+    // round-off in G (it then accepts or rejects tiny steps at random and the quadratic
+    // convergence is lost). Decide on the gradient instead: the full step (or half of it)
+    // when it lowers |grad|_inf; a step of < 1e-10 m that does not is the round-off floor;
+    // otherwise fall back to the Armijo test.
+    const bool roundoff =
+        opt_.line_search && inv_h2 == 0 && std::abs(slope) < 1e-13 * std::max(std::abs(g0), 1e-30);
+    if (roundoff) {
+      for (int ls = 0; ls < 2 && !accepted; ++ls, alpha *= 0.5) {
+        for (int i = 0; i < n; ++i)
+          xtrial_[i] = dof_[i] >= 0 ? Vec3(S.x[i] + alpha * dx_.segment<3>(3 * dof_[i])) : S.x[i];
+        energy_.gradient(xtrial_, S.mass, grad_);
+        double gtrial = 0;
+        for (int i = 0; i < n; ++i)
+          if (dof_[i] >= 0) gtrial = std::max(gtrial, grad_[i].cwiseAbs().maxCoeff());
+        if (std::isfinite(gtrial) && gtrial < gmax) {
+          accepted = true;
+          break;
+        }
+      }
+      if (!accepted && dx_.cwiseAbs().maxCoeff() < 1e-10) break;
+      alpha = 1.0;
+    }
+    for (int ls = 0; !accepted && ls < (opt_.line_search ? 20 : 1); ++ls) {
       for (int i = 0; i < n; ++i)
         xtrial_[i] = dof_[i] >= 0 ? Vec3(S.x[i] + alpha * dx_.segment<3>(3 * dof_[i])) : S.x[i];
       const double g1 = objective(cloth, xtrial_, inv_h2, y);
@@ -165,9 +400,10 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
       }
       alpha *= 0.5;
     }
-    if (!accepted && std::abs(slope) < 1e-12 * std::max(std::abs(g0), 1e-30)) {
+    if (!accepted && !roundoff && std::abs(slope) < 1e-12 * std::max(std::abs(g0), 1e-30)) {
       // The predicted decrease is below the round-off of G itself: the Armijo test cannot
       // decide. Take the full step when it lowers the gradient residual.
+      alpha = 1.0;
       for (int i = 0; i < n; ++i)
         xtrial_[i] = dof_[i] >= 0 ? Vec3(S.x[i] + dx_.segment<3>(3 * dof_[i])) : S.x[i];
       energy_.gradient(xtrial_, S.mass, grad_);
@@ -189,8 +425,22 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
       break;
     }
     std::swap(S.x, xtrial_);
+    if (exact)
+      ++counters_.exact_steps;
+    else
+      ++counters_.projected_steps;
+    const double step = alpha * dx_.cwiseAbs().maxCoeff();
+    counters_.last_step = step;
     if (mu > 0) mu = std::max(mu * 0.3, 1e-9);
     if (mu < 1e-8) mu = 0;
+    // Position rule: a full step below the tolerance whose length contracts (ratio r < 0.5
+    // on the previous step: the travel left, <= step r / (1 - r), is below it as well).
+    if (step_tolerance_ > 0 && alpha == 1.0 && step < step_tolerance_ && prev_step > 0 &&
+        step < 0.5 * prev_step) {
+      ++it;
+      break;
+    }
+    prev_step = step;
   }
   return it;
 }
@@ -243,7 +493,12 @@ StaticResult relax_static(Cloth& cloth, const SceneObjects& scene, const StaticO
   NewtonOptions no;
   no.energy = opt.energy;
   no.contact_stiffness = opt.contact_stiffness;
+  no.linear_solver = opt.linear_solver;
+  no.exact_hessian = opt.exact_hessian;
+  no.contact_prediction = opt.contact_prediction;
   NewtonSolver solver(no);
+  solver.set_step_tolerance(opt.step_tolerance);
+  solver.set_contact_redetection(opt.contacts && opt.redetect_every_iteration);
   auto& S = cloth.state;
   if (S.mass.size() != static_cast<size_t>(cloth.num_vertices())) lump_masses(cloth);
   double mmax = 0;
@@ -253,23 +508,32 @@ StaticResult relax_static(Cloth& cloth, const SceneObjects& scene, const StaticO
   // Contacts are linearised: redetect a few times as the cloth moves.
   int total = 0;
   double res = 0, prev_res = std::numeric_limits<double>::infinity();
+  bool step_converged = false;
   for (int round = 0; round < 8; ++round) {
     if (opt.contacts) solver.energy().detect_contacts(cloth, scene);
     const int it =
         solver.minimise(cloth, scene, 0.0, nullptr, opt.tolerance, opt.max_iterations - total, res);
     total += it;
-    if (!opt.contacts || total >= opt.max_iterations) break;
+    ++r.rounds;
+    const auto& c = solver.counters();
+    r.exact_steps += c.exact_steps;
+    r.factor_ms += c.factor_ms;
+    r.last_step = c.last_step;
+    step_converged = opt.step_tolerance > 0 && c.last_step > 0 && c.last_step < opt.step_tolerance;
+    if (!opt.contacts || total >= opt.max_iterations || (round > 0 && it == 0)) break;
     // A round that stalled (round-off floor of the line search) without any contact to
-    // re-linearise: another round cannot do better.
+    // re-linearise, or that ended on the round-off floor of the Newton step itself (steps of
+    // 1e-12 m: the residual cannot go lower in double precision, the tolerance was below
+    // it): another round cannot do better.
     if (res >= opt.tolerance && solver.energy().contacts().empty() && res > 0.99 * prev_res) break;
+    if (res >= opt.tolerance && c.last_step < 1e-12 && res < 1e-6) break;
     prev_res = res;
     // Done when no vertex violates a freshly detected contact by more than 0.1 mm.
-    std::vector<Vec3> before = S.x;
     solver.energy().detect_contacts(cloth, scene);
     bool violated = false;
-    for (const auto& c : solver.energy().contacts())
-      if (c.n.dot(S.x[c.vertex] - c.p) < -1e-4) violated = true;
-    if (!violated && res < opt.tolerance) break;
+    for (const auto& c2 : solver.energy().contacts())
+      if (c2.n.dot(S.x[c2.vertex] - c2.p) < -1e-4) violated = true;
+    if (!violated && (res < opt.tolerance || step_converged)) break;
   }
   for (int i = 0; i < cloth.num_vertices(); ++i) {
     S.v[i].setZero();
@@ -277,7 +541,7 @@ StaticResult relax_static(Cloth& cloth, const SceneObjects& scene, const StaticO
   }
   r.iterations = total;
   r.residual = res;
-  r.converged = res < opt.tolerance;
+  r.converged = res < opt.tolerance || step_converged;
   r.energy = solver.energy().energy(S.x, S.mass);
   r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return r;

@@ -1,10 +1,11 @@
-// Implicit Euler with Newton's method and a sparse direct solve (Eigen SimplicialLDLT): the
-// accuracy reference of the study, and the static solver (energy minimisation with pinned
-// vertices) that geometric draping calls through relax_static().
+// Implicit Euler with Newton's method and a sparse direct solve (CHOLMOD supernodal Cholesky by
+// default, Eigen's SimplicialLDLT as the fallback): the accuracy reference of the study, and the
+// static solver (energy minimisation with pinned vertices) that geometric draping calls through
+// relax_static().
 #pragma once
 
-#include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
+#include <Eigen/Core>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -12,6 +13,12 @@
 #include "sim/solver.hpp"
 
 namespace drape::sim {
+
+// The sparse factorisation of the Newton systems. kCholmod: CHOLMOD's supernodal LL^T (dense
+// BLAS kernels on the supernodes; several times faster than kSimplicial on the draped panels,
+// docs/solvers.md "Static solver speed (session 4)"). kSimplicial: Eigen's SimplicialLDLT
+// (the earlier path, kept as the cross-check).
+enum class LinearSolver { kCholmod, kSimplicial };
 
 struct NewtonOptions {
   int substeps = 1;
@@ -22,6 +29,17 @@ struct NewtonOptions {
   double contact_stiffness = 0;  // 0: automatic
   // Air drag (1/s) as in VBD: the inertia target is y = x + h v exp(-air_damping h).
   double air_damping = 0;
+  LinearSolver linear_solver = LinearSolver::kCholmod;
+  // Static mode (h <= 0) only: use the exact Hessian (no PSD projection of the membrane
+  // stress / hinge curvature) whenever it factorises as positive definite, falling back to the
+  // projected one when it does not. The projected Hessian drops the compressive geometric
+  // stiffness of wrinkled triangles: Newton then converges only linearly (rate ~0.9 on the
+  // draped form); with the exact Hessian near the minimum it converges quadratically.
+  bool exact_hessian = false;
+  // Static mode: update the Newton model's contact active set to the contacts the step
+  // penetrates (re-solving, up to 3 passes): the model is then the exact piecewise-quadratic
+  // penalty, not its linearisation at the current point.
+  bool contact_prediction = false;
 };
 
 class NewtonSolver : public Solver {
@@ -38,8 +56,27 @@ class NewtonSolver : public Solver {
   // sets the final |grad|_inf relative to the weight scale in `residual`.
   int minimise(Cloth& cloth, const SceneObjects& scene, double h, const std::vector<Vec3>* y,
                double tolerance, int max_iterations, double& residual);
+  // Optional position stopping rule for minimise(): also stop when a full accepted step moved
+  // no free vertex by more than `step_tolerance` (m) and was less than half the previous one
+  // (contracting by r < 1/2: the travel left, <= |dx| r / (1 - r), is below it too). 0: off.
+  void set_step_tolerance(double t) { step_tolerance_ = t; }
+  // Static mode: re-detect the contacts (re-linearise their planes) at every iteration.
+  void set_contact_redetection(bool on) { redetect_ = on; }
+  // Counters of the last minimise() call (diagnostics, tests).
+  struct Counters {
+    int factorisations = 0;
+    int exact_steps = 0;      // steps taken with the exact Hessian
+    int projected_steps = 0;  // steps taken with the PSD-projected Hessian
+    int not_positive = 0;     // exact Hessians that were not positive definite
+    int contact_passes = 0;   // extra factorisations for the contact active set
+    double factor_ms = 0, assemble_ms = 0;
+    double last_step = 0;  // |dx|_inf of the last accepted step (m)
+  };
+  const Counters& counters() const { return counters_; }
 
  private:
+  struct Linear;  // the sparse matrix, its fixed assembly pattern and the factorisation
+  void assemble(const Cloth& cloth, double inv_h2, double mu, bool exact, bool record);
   void cook(const Cloth& cloth);
   double objective(const Cloth& cloth, const std::vector<Vec3>& x, double inv_h2,
                    const std::vector<Vec3>* y) const;
@@ -48,17 +85,29 @@ class NewtonSolver : public Solver {
   ClothEnergy energy_;
   std::vector<int> dof_;  // free-vertex index or -1
   int ndof_ = 0;
-  std::vector<Eigen::Triplet<double>> trip_;
-  Eigen::SparseMatrix<double> H_;
-  std::unique_ptr<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> ldlt_;
+  std::unique_ptr<Linear> lin_;
+  std::array<size_t, 5> pattern_sig_{};  // element counts the pattern was recorded for
   bool analysed_ = false;
+  double step_tolerance_ = 0;
+  bool redetect_ = false;
+  Counters counters_;
   std::vector<Vec3> grad_, xtrial_, y_, xt_;
-  Eigen::VectorXd rhs_, dx_;
+  std::vector<char> contact_active_;  // per contact: in the Newton model's active set
+  std::vector<char> sticky_;          // per vertex: held by the previous iteration's model
+  Eigen::VectorXd rhs_, dx_, model_rhs_;
 };
 
 struct StaticOptions {
   double tolerance = 1e-6;  // |grad E|_inf relative to the largest vertex weight (m g)
   int max_iterations = 100;
+  // Also converged when the last Newton step moved no vertex by more than this (m) and the
+  // steps contract (see NewtonSolver::set_step_tolerance); 0: the residual rule alone.
+  double step_tolerance = 0;
+  LinearSolver linear_solver = LinearSolver::kCholmod;
+  bool exact_hessian = true;       // see NewtonOptions::exact_hessian
+  bool contact_prediction = true;  // see NewtonOptions::contact_prediction
+  // Re-linearise the contact planes at every Newton iterate (true) or only between rounds.
+  bool redetect_every_iteration = true;
   EnergyOptions energy;  // e.g. pressure toward the form (method 2.1), gravity off/on
   bool contacts = true;  // penalty contact against the scene's objects (redetected)
   double contact_stiffness = 0;
@@ -70,6 +119,10 @@ struct StaticResult {
   double residual = 0;  // final |grad E|_inf / (max m g)
   double energy = 0;    // J at the end
   double ms = 0;
+  int rounds = 0;        // contact re-detection rounds
+  int exact_steps = 0;   // Newton steps with the exact Hessian (the rest: projected)
+  double factor_ms = 0;  // time in the sparse factorisations
+  double last_step = 0;  // |dx|_inf of the last accepted Newton step (m)
 };
 
 // Static draping: minimises E with pinned/pinched/kinematic vertices fixed (Newton with
