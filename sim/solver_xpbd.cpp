@@ -326,32 +326,21 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       }
       Vec3 a = Vec3::Zero(), bb = Vec3::Zero();
       double* L = &lambda_tri_[3 * k];
-      // E_uu = (|fu|^2 - 1) / 2, gradient D_uq fu.
-      {
-        const double alpha = ih2 * T.ia[0];
-        const double denom = alpha + Suu * fu.squaredNorm();
-        if (denom >= 1e-20) {
-          const double lam = keep_lambda ? L[0] : 0.0;
-          const double dl = (-0.5 * (fu.squaredNorm() - 1) - alpha * lam) / denom;
-          if (keep_lambda) L[0] = lam + dl;
-          a += dl * fu;
-          fv += (dl * Suv) * fu;
-          fu *= 1 + dl * Suu;
-        }
-      }
-      // E_vv = (|fv|^2 - 1) / 2, gradient D_vq fv.
-      {
-        const double alpha = ih2 * T.ia[1];
-        const double denom = alpha + Svv * fv.squaredNorm();
-        if (denom >= 1e-20) {
-          const double lam = keep_lambda ? L[1] : 0.0;
-          const double dl = (-0.5 * (fv.squaredNorm() - 1) - alpha * lam) / denom;
-          if (keep_lambda) L[1] = lam + dl;
-          bb += dl * fv;
-          fu += (dl * Suv) * fv;
-          fv *= 1 + dl * Svv;
-        }
-      }
+      // E_uu = (|fu|^2 - 1) / 2 with gradient D_uq fu (c = 0; f = fu, g = fv, acc = a) and
+      // E_vv = (|fv|^2 - 1) / 2 with gradient D_vq fv (c = 1; f = fv, g = fu, acc = bb).
+      auto stretch = [&](int c, Vec3& f, Vec3& g, double Sff, Vec3& acc) {
+        const double alpha = ih2 * T.ia[c];
+        const double denom = alpha + Sff * f.squaredNorm();
+        if (denom < 1e-20) return;
+        const double lam = keep_lambda ? L[c] : 0.0;
+        const double dl = (-0.5 * (f.squaredNorm() - 1) - alpha * lam) / denom;
+        if (keep_lambda) L[c] = lam + dl;
+        acc += dl * f;
+        g += (dl * Suv) * f;
+        f *= 1 + dl * Sff;
+      };
+      stretch(0, fu, fv, Suu, a);
+      stretch(1, fv, fu, Svv, bb);
       // E_uv = fu . fv / 2, gradient (D_uq fv + D_vq fu) / 2.
       {
         const double alpha = ih2 * T.ia[2];

@@ -14,15 +14,20 @@ using namespace drape::sim;
 
 namespace {
 
-// A 0.4 x 0.2 m panel (21 x 11 vertices, 2 cm edges) folded in two about u = 0.2: the half
-// u <= 0.2 lies at height y0, the other half mirrored over it at y0 + gap.
-Cloth folded_panel(double y0, double gap) {
+// The test panel: 0.4 x 0.2 m, 21 x 11 vertices (2 cm edges), flat.
+Cloth test_panel() {
   PanelSpec p;
   p.width = 0.4;
   p.height = 0.2;
   p.nx = 21;
   p.ny = 11;
-  Cloth c = make_panel(p, FabricParams{});
+  return make_panel(p, FabricParams{});
+}
+
+// The test panel folded in two about u = 0.2: the half u <= 0.2 lies at height y0, the other
+// half mirrored over it at y0 + gap.
+Cloth folded_panel(double y0, double gap) {
+  Cloth c = test_panel();
   for (int i = 0; i < c.num_vertices(); ++i) {
     const Vec2 m = c.topo.material[i];
     const double u = m.x() - c.topo.material[0].x(), v = m.y() - c.topo.material[0].y();
@@ -51,12 +56,7 @@ TEST(SelfCollision, FindsPairsAcrossLayersOnly) {
   const double thick = 0.002, margin = 0.005;
   SelfCollision sc;
   // One flat layer: neighbours are in its plane but never over a triangle they are not in.
-  PanelSpec p;
-  p.width = 0.4;
-  p.height = 0.2;
-  p.nx = 21;
-  p.ny = 11;
-  Cloth single = make_panel(p, FabricParams{});
+  Cloth single = test_panel();
   EXPECT_EQ(sc.detect(single, single.state.x, thick, margin), 0);
   // Two layers 4 mm apart: each vertex of either layer strictly inside the other's area is
   // within reach (7 mm) of a triangle below/above it, and every pair links the two layers.

@@ -192,51 +192,58 @@ TEST(Newton, UnknownSceneFallsBackAndBadStateIsNotHidden) {
 // Session 4: the CHOLMOD supernodal factorisation and Eigen's SimplicialLDLT solve the same
 // Newton systems: the static sheet ends at the same positions (to round-off of the
 // factorisations) in the same number of iterations.
-TEST(Newton, CholmodAndSimplicialGiveTheSameStaticSheet) {
+// The 12x12 hanging sheet relaxed twice with options set by `configure(so, k)` (k = 0, 1):
+// positions, iterations and results of both.
+struct SheetPair {
   std::vector<Vec3> x[2];
-  int iters[2];
+  StaticResult r[2];
+  double max_diff = 0;
+};
+template <class Configure>
+SheetPair relax_sheet_twice(Configure configure) {
+  SheetPair p;
   for (int k = 0; k < 2; ++k) {
     StudyScene sc = make_hanging_sheet(12);
     StaticOptions so;
     so.tolerance = 1e-9;
-    so.linear_solver = k == 0 ? LinearSolver::kCholmod : LinearSolver::kSimplicial;
-    StaticResult r = relax_static(sc.cloth, sc.objects, so);
-    EXPECT_TRUE(r.converged) << "linear solver " << k << " residual " << r.residual;
-    x[k] = sc.cloth.state.x;
-    iters[k] = r.iterations;
+    configure(so, k);
+    p.r[k] = relax_static(sc.cloth, sc.objects, so);
+    p.x[k] = sc.cloth.state.x;
   }
-  double rms = 0, mx = 0;
-  position_error(x[0], x[1], rms, mx);
+  double rms = 0;
+  position_error(p.x[0], p.x[1], rms, p.max_diff);
+  return p;
+}
+
+TEST(Newton, CholmodAndSimplicialGiveTheSameStaticSheet) {
+  const SheetPair p = relax_sheet_twice([](StaticOptions& so, int k) {
+    so.linear_solver = k == 0 ? LinearSolver::kCholmod : LinearSolver::kSimplicial;
+  });
+  for (int k = 0; k < 2; ++k)
+    EXPECT_TRUE(p.r[k].converged) << "linear solver " << k << " residual " << p.r[k].residual;
   std::printf("sheet 12x12: cholmod %d iterations, simplicial %d, max difference %.2e m\n",
-              iters[0], iters[1], mx);
-  EXPECT_LT(mx, 1e-9);
-  EXPECT_NEAR(iters[0], iters[1], 1);
+              p.r[0].iterations, p.r[1].iterations, p.max_diff);
+  EXPECT_LT(p.max_diff, 1e-9);
+  EXPECT_NEAR(p.r[0].iterations, p.r[1].iterations, 1);
 }
 
 // The exact Hessian (used where positive definite) and the PSD-projected one reach the same
 // equilibrium of the sheet, the exact one in no more iterations (the sheet is hardly
 // compressed: the gain is on wrinkled drapes, docs/solvers.md "Static solver speed").
 TEST(Newton, ExactHessianReachesTheSameEquilibrium) {
-  std::vector<Vec3> x[2];
-  int iters[2];
-  for (int k = 0; k < 2; ++k) {
-    StudyScene sc = make_hanging_sheet(12);
-    StaticOptions so;
-    so.tolerance = 1e-9;
+  const SheetPair p = relax_sheet_twice([](StaticOptions& so, int k) {
     so.max_iterations = 400;
     so.exact_hessian = k == 0;
-    StaticResult r = relax_static(sc.cloth, sc.objects, so);
+  });
+  for (int k = 0; k < 2; ++k) {
     std::printf("sheet 12x12, %s Hessian: %d iterations (%d exact), residual %.2e\n",
-                k == 0 ? "exact" : "projected", r.iterations, r.exact_steps, r.residual);
-    EXPECT_TRUE(r.converged);
-    x[k] = sc.cloth.state.x;
-    iters[k] = r.iterations;
+                k == 0 ? "exact" : "projected", p.r[k].iterations, p.r[k].exact_steps,
+                p.r[k].residual);
+    EXPECT_TRUE(p.r[k].converged);
   }
-  double rms = 0, mx = 0;
-  position_error(x[0], x[1], rms, mx);
-  std::printf("exact vs projected: max difference %.2e m\n", mx);
-  EXPECT_LT(mx, 1e-7);
-  EXPECT_LE(iters[0], iters[1]);
+  std::printf("exact vs projected: max difference %.2e m\n", p.max_diff);
+  EXPECT_LT(p.max_diff, 1e-7);
+  EXPECT_LE(p.r[0].iterations, p.r[1].iterations);
 }
 
 // Contacts: the polished state is a fixed point of contact re-detection + minimisation (the
