@@ -206,6 +206,12 @@ void write_svg(const std::vector<Row>& rows, const std::string& scene, int res,
   o << "</svg>\n";
 }
 
+// The XPBD solver inside s (make_solver wraps it in the watchdog), or null.
+XpbdSolver* xpbd_of(Solver* s) {
+  if (auto* wd = dynamic_cast<WatchdogSolver*>(s)) s = &wd->inner();
+  return dynamic_cast<XpbdSolver*>(s);
+}
+
 // --probe SCENE RES SOLVER SUBSTEPS ITERATIONS: one configuration with every VBD option from
 // the environment (VBD_INIT 0/1/2, VBD_RHO, VBD_DAMP, VBD_FREEZE, VBD_TOL, VBD_THREADS,
 // PROBE_FRAMES, REF_ITERS, PROBE_POLISH=0 skips the final scoring; XPBD: XPBD_WARM,
@@ -259,9 +265,7 @@ int probe(int argc, char** argv) {
     cfg.air_damping = sc.air_damping;
     auto made = make_solver(solver, cfg);
     s = std::move(made.value());
-    Solver* inner = s.get();
-    if (auto* wd = dynamic_cast<WatchdogSolver*>(inner)) inner = &wd->inner();
-    if (auto* xp = dynamic_cast<XpbdSolver*>(inner)) {  // XPBD_WARM, XPBD_REUSE
+    if (auto* xp = xpbd_of(s.get())) {  // XPBD_WARM, XPBD_REUSE
       xp->options().warm_start = env_num("XPBD_WARM", xp->options().warm_start);
       xp->options().reuse_contacts = env_num("XPBD_REUSE", 1) > 0;
       xp->options().bending_every = static_cast<int>(env_num("XPBD_BEND_EVERY", 1));
@@ -274,10 +278,7 @@ int probe(int argc, char** argv) {
   const int warm_frame = static_cast<int>(env_num("XPBD_WARM_FRAME", -1));
   for (int f = 0; f < frames; ++f) {
     if (f == warm_frame) {
-      Solver* inner = s.get();
-      if (auto* wd = dynamic_cast<WatchdogSolver*>(inner)) inner = &wd->inner();
-      if (auto* xp = dynamic_cast<XpbdSolver*>(inner))
-        xp->options().warm_start = env_num("XPBD_WARM_LATE", 1.0);
+      if (auto* xp = xpbd_of(s.get())) xp->options().warm_start = env_num("XPBD_WARM_LATE", 1.0);
     }
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = cpu_ms();
@@ -308,9 +309,7 @@ int probe(int argc, char** argv) {
   }
   std::printf("%s %d %s %dx%d: wall %.3f ms/frame, cpu %.3f ms/frame\n", scene.c_str(), res,
               solver.c_str(), ns, it, wall / frames, cpu / frames);
-  Solver* inner = s.get();
-  if (auto* wd = dynamic_cast<WatchdogSolver*>(inner)) inner = &wd->inner();
-  if (auto* xp = dynamic_cast<XpbdSolver*>(inner))
+  if (auto* xp = xpbd_of(s.get()))
     std::printf("xpbd: %.2f contact detections per frame\n",
                 double(xp->contact_detections()) / frames);
   if (path_dependent(scene) && env_num("PROBE_POLISH", 1) > 0) {

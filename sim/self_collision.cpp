@@ -63,48 +63,30 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
   while (size < 2u * static_cast<uint32_t>(nt)) size <<= 1;
   const uint32_t mask = size - 1;
   table_start_.assign(size + 1, 0);
-  cell_lo_.resize(nt);
-  cell_hi_.resize(nt);
-  // Pass 1: each triangle's cell range (box grown by the reach), counts per bucket.
-  for (int t = 0; t < nt; ++t) {
+  // Calls fn(cell key) for each cell triangle t's bounding box, grown by the reach, overlaps
+  // (at most 3 per axis when the cell is >= the mean edge plus twice the reach; a triangle
+  // stretched beyond 8 cells per axis is entered in the first 8 only, a listed limit).
+  auto for_cells = [&](int t, auto&& fn) {
     const Vec3& a = x[tris[t][0]];
     const Vec3& b = x[tris[t][1]];
     const Vec3& c = x[tris[t][2]];
     const Vec3 lo = a.cwiseMin(b).cwiseMin(c).array() - reach;
     const Vec3 hi = a.cwiseMax(b).cwiseMax(c).array() + reach;
     const int x0 = coord(lo.x()), y0 = coord(lo.y()), z0 = coord(lo.z());
-    const int x1 = coord(hi.x()), y1 = coord(hi.y()), z1 = coord(hi.z());
-    cell_lo_[t] = pack(x0, y0, z0);
-    // Extents (at most 3 cells per axis when the cell is >= the mean edge; longer triangles
-    // are clamped to 8 per axis, which only costs them pairs beyond that, reported as a limit).
-    cell_hi_[t] = pack(std::min(x1 - x0, 7), std::min(y1 - y0, 7), std::min(z1 - z0, 7));
-    for (int i = 0; i <= std::min(x1 - x0, 7); ++i)
-      for (int j = 0; j <= std::min(y1 - y0, 7); ++j)
-        for (int k = 0; k <= std::min(z1 - z0, 7); ++k)
-          ++table_start_[bucket(pack(x0 + i, y0 + j, z0 + k), mask) + 1];
-  }
+    const int ex = std::min(coord(hi.x()) - x0, 7), ey = std::min(coord(hi.y()) - y0, 7),
+              ez = std::min(coord(hi.z()) - z0, 7);
+    for (int i = 0; i <= ex; ++i)
+      for (int j = 0; j <= ey; ++j)
+        for (int k = 0; k <= ez; ++k) fn(pack(x0 + i, y0 + j, z0 + k));
+  };
+  // Counting sort of (bucket, triangle): counts, prefix sums, fill.
+  for (int t = 0; t < nt; ++t)
+    for_cells(t, [&](uint32_t cell) { ++table_start_[bucket(cell, mask) + 1]; });
   for (uint32_t b = 0; b < size; ++b) table_start_[b + 1] += table_start_[b];
   entries_.resize(table_start_[size]);
   fill_.assign(table_start_.begin(), table_start_.end() - 1);
-  const uint32_t m10 = (1u << kCellBits) - 1;
-  auto unpack = [&](uint32_t v, int& i, int& j, int& k) {
-    // Sign-extend the 10-bit fields (coordinates may be negative).
-    auto sx = [](uint32_t f) { return static_cast<int>(f & 0x200u ? f | ~0x3FFu : f); };
-    i = sx(v & m10);
-    j = sx(v >> kCellBits & m10);
-    k = sx(v >> 2 * kCellBits & m10);
-  };
-  for (int t = 0; t < nt; ++t) {
-    int x0, y0, z0, ex, ey, ez;
-    unpack(cell_lo_[t], x0, y0, z0);
-    ex = static_cast<int>(cell_hi_[t] & m10);
-    ey = static_cast<int>(cell_hi_[t] >> kCellBits & m10);
-    ez = static_cast<int>(cell_hi_[t] >> 2 * kCellBits & m10);
-    for (int i = 0; i <= ex; ++i)
-      for (int j = 0; j <= ey; ++j)
-        for (int k = 0; k <= ez; ++k)
-          entries_[fill_[bucket(pack(x0 + i, y0 + j, z0 + k), mask)]++] = t;
-  }
+  for (int t = 0; t < nt; ++t)
+    for_cells(t, [&](uint32_t cell) { entries_[fill_[bucket(cell, mask)]++] = t; });
   // Per triangle its first corner a, unit normal n and the vectors g1, g2 with barycentric
   // coordinates b1 = g1 . (p - a), b2 = g2 . (p - a) of p's projection (g = 0: degenerate):
   // each candidate then costs three dot products.

@@ -15,7 +15,8 @@
 // the correction), inverse-mass weighted, one Gauss-Seidel pass.
 // Limits (docs/solvers.md): vertex-face pairs only (no edge-edge test: two layers can still
 // cross where edges pass each other between vertices, on meshes much coarser than the
-// thickness); the side is not repaired once a layer has passed through.
+// thickness); the side is not repaired once a layer has passed through; a triangle stretched over
+// more than 8 hash cells per axis is entered in the first 8 only.
 #pragma once
 
 #include <cstdint>
@@ -48,7 +49,6 @@ class SelfCollision {
   std::vector<SelfContact> pairs_;
   // The hash: table_start_[b] .. table_start_[b + 1] index entries_ (triangle ids).
   std::vector<int32_t> table_start_, entries_, fill_;
-  std::vector<uint32_t> cell_lo_, cell_hi_;  // per triangle: its cell range (3 x 10 bits)
   struct TriFrame {
     Vec3 a, n, g1, g2;  // corner, unit normal, barycentric gradients (detect())
   };

@@ -140,12 +140,15 @@ void NewtonSolver::assemble(const Cloth& cloth, double inv_h2, double mu, bool e
     }
     add_block(i, i, B);
   }
+  // An element's (3k x 3k) Hessian H over its k vertices v, block by block.
+  auto add_element = [&](const auto& v, int k, const auto& H) {
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b) add_block(v[a], v[b], H.template block<3, 3>(3 * a, 3 * b));
+  };
   Mat9 H9;
   for (int t = 0; t < energy_.num_triangles(); ++t) {
     energy_.tri_hessian(t, S.x, H9, !exact);
-    const auto& v = energy_.tri(t);
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) add_block(v[a], v[b], H9.block<3, 3>(3 * a, 3 * b));
+    add_element(energy_.tri(t), 3, H9);
   }
   if (energy_.tensor_bending()) {
     // kTensor bending: the constant P (x) I3 (exact, PSD).
@@ -165,17 +168,13 @@ void NewtonSolver::assemble(const Cloth& cloth, double inv_h2, double mu, bool e
     Mat12 H12;
     for (int hh = 0; hh < energy_.num_hinges(); ++hh) {
       energy_.hinge_hessian(hh, S.x, H12, !exact);
-      const auto& v = energy_.hinge(hh);
-      for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b) add_block(v[a], v[b], H12.block<3, 3>(3 * a, 3 * b));
+      add_element(energy_.hinge(hh), 4, H12);
     }
   }
   Eigen::Matrix<double, 6, 6> H6;
   for (int s = 0; s < energy_.num_springs(); ++s) {
     energy_.spring_hessian(s, S.x, H6, !exact);
-    const auto& v = energy_.spring(s);
-    for (int a = 0; a < 2; ++a)
-      for (int b = 0; b < 2; ++b) add_block(v[a], v[b], H6.block<3, 3>(3 * a, 3 * b));
+    add_element(energy_.spring(s), 2, H6);
   }
 }
 
