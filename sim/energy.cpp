@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <stdexcept>
 
 #include "sim/dress_form.hpp"
 
@@ -67,6 +68,7 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
   bend_off_.clear();
   bend_col_.clear();
   bend_val_.clear();
+  tensor_ = false;
   // Springs added by add_spring() before build are kept only for the springs model rebuild.
   spring_v_.clear();
   spring_rest_.clear();
@@ -216,6 +218,12 @@ void spgemm(const Csr& A, const Csr& B, int ncols, Csr& C, const std::vector<dou
   std::vector<double> acc(ncols, 0.0);
   std::vector<int> mark(ncols, -1), touched;
   C.reset(A.rows());
+  // Reserve the product's upper bound (sum of the B rows each A entry selects): the output is
+  // ~1M entries at 128^2, and growing it by push_back copied it ~20 times.
+  size_t bound = 0;
+  for (int r : A.col) bound += static_cast<size_t>(B.off[r + 1] - B.off[r]);
+  C.col.reserve(bound);
+  C.val.reserve(bound);
   for (int i = 0; i < A.rows(); ++i) {
     touched.clear();
     for (int ka = A.off[i]; ka < A.off[i + 1]; ++ka) {
@@ -240,6 +248,8 @@ void spgemm(const Csr& A, const Csr& B, int ncols, Csr& C, const std::vector<dou
 // C = A + B (same row count).
 void spadd(const Csr& A, const Csr& B, int ncols, Csr& C) {
   C.reset(A.rows());
+  C.col.reserve(A.col.size() + B.col.size());
+  C.val.reserve(A.col.size() + B.col.size());
   std::vector<double> acc(ncols, 0.0);
   std::vector<int> mark(ncols, -1), touched;
   for (int i = 0; i < A.rows(); ++i) {
@@ -429,6 +439,13 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth) {
   }
   Csr Gk, GkT, P;
   spgemm(Gs, Km, n, Gk, nullptr);
+  tensor_ = true;
+  if (!opt_.bending_matrix) {
+    tri_S_off_ = std::move(Gk.off);
+    tri_S_col_ = std::move(Gk.col);
+    tri_S_val_ = std::move(Gk.val);
+    return;
+  }
   transpose(Gk, n, GkT);
   std::vector<double> ad(3 * nt);
   for (int t = 0; t < nt; ++t)
@@ -479,6 +496,10 @@ double ClothEnergy::bending_triangle_energy(int t, const std::vector<Vec3>& x) c
 
 double ClothEnergy::bending_energy(const std::vector<Vec3>& x) const {
   double e = 0;
+  if (tensor_ && !has_bending_matrix()) {
+    for (int t = 0; t < num_triangles(); ++t) e += bending_triangle_energy(t, x);
+    return e;
+  }
   if (tensor_bending()) {
     for (int i = 0; i < num_vertices_; ++i) {
       Vec3 g = Vec3::Zero();
@@ -492,6 +513,17 @@ double ClothEnergy::bending_energy(const std::vector<Vec3>& x) const {
 }
 
 void ClothEnergy::add_bending_gradient(const std::vector<Vec3>& x, std::vector<Vec3>& grad) const {
+  if (tensor_ && !has_bending_matrix()) {
+    // Row by row: grad += A_t D_c V_r^T (V_r x), the same sum P x is assembled from.
+    for (int r = 0; r < num_bending_rows(); ++r) {
+      Vec3 s = Vec3::Zero();
+      for (int k = tri_S_off_[r]; k < tri_S_off_[r + 1]; ++k) s += tri_S_val_[k] * x[tri_S_col_[k]];
+      s *= tri_area_[r / 3] * bend_D_[r % 3];
+      for (int k = tri_S_off_[r]; k < tri_S_off_[r + 1]; ++k)
+        grad[tri_S_col_[k]] += tri_S_val_[k] * s;
+    }
+    return;
+  }
   if (tensor_bending()) {
     for (int i = 0; i < num_vertices_; ++i) {
       Vec3 g = Vec3::Zero();
@@ -1026,6 +1058,9 @@ void ClothEnergy::vertex_force_hessian(int i, const std::vector<Vec3>& x, double
     H << h[0], h[1], h[2], h[1], h[4], h[5], h[2], h[5], h[8];
   }
   if (tensor_bending()) {
+    if (!has_bending_matrix())
+      throw std::logic_error(
+          "ClothEnergy::vertex_force_hessian: built with bending_matrix = false");
     // Constant P: g_i = sum_j P_ij x_j, H_ii = P_ii I (exact, PSD).
     Vec3 g = Vec3::Zero();
     for (int k = bend_off_[i]; k < bend_off_[i + 1]; ++k) g += bend_val_[k] * x[bend_col_[k]];
@@ -1061,6 +1096,8 @@ void ClothEnergy::vertex_force_hessian(int i, const std::vector<Vec3>& x, double
 }
 
 void ClothEnergy::vertex_neighbours(std::vector<int>& offsets, std::vector<int>& nbrs) const {
+  if (tensor_ && !has_bending_matrix())
+    throw std::logic_error("ClothEnergy::vertex_neighbours: built with bending_matrix = false");
   std::vector<std::vector<int>> adj(num_vertices_);
   auto link = [&](const int* v, int k) {
     for (int a = 0; a < k; ++a)

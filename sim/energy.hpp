@@ -72,7 +72,13 @@ struct EnergyOptions {
   bool rigid_boundary_hinges = true;
   double contact_stiffness = 0;   // N/m per vertex; 0 = automatic (from mass and dt)
   double contact_margin = 0.005;  // m: contacts detected within offset + margin
-  bool cull_by_bounds = true;     // test only objects whose bounds touch the cloth's bounds
+  // kTensor: assemble the vertex matrix P (bending_offsets() ...). The energy, its gradient and
+  // the per-vertex blocks (Verlet, VBD, Newton, relax) read P; XPBD projects the curvature rows
+  // only and switches it off: P is the largest part of a rebuild (40 ms of ~120 ms at 128^2,
+  // after every cut). Without P the energy and gradient are summed over the rows (same values);
+  // vertex_force_hessian() and vertex_neighbours() then throw std::logic_error.
+  bool bending_matrix = true;
+  bool cull_by_bounds = true;  // test only objects whose bounds touch the cloth's bounds
   // Springs model only: structural and diagonal stiffness (N/m); 0 = derived from the fabric.
   double spring_k_struct = 0, spring_k_diag = 0;
 };
@@ -114,7 +120,8 @@ class ClothEnergy {
   void add_bending_gradient(const std::vector<Vec3>& x, std::vector<Vec3>& grad) const;
   // kTensor: the constant vertex matrix P (E_bend = 1/2 sum_ij P_ij x_i . x_j), CSR with sorted
   // columns, symmetric, diagonal always stored; empty for the hinge models.
-  bool tensor_bending() const { return !bend_col_.empty(); }
+  bool tensor_bending() const { return tensor_; }
+  bool has_bending_matrix() const { return !bend_col_.empty(); }
   const std::vector<int>& bending_offsets() const { return bend_off_; }
   const std::vector<int>& bending_columns() const { return bend_col_; }
   const std::vector<double>& bending_values() const { return bend_val_; }
@@ -229,6 +236,7 @@ class ClothEnergy {
   Eigen::Vector3d bend_D_ = Eigen::Vector3d::Zero();
   std::vector<int> bend_off_, bend_col_;
   std::vector<double> bend_val_, bend_diag_;
+  bool tensor_ = false;  // kTensor with nonzero rigidity: rows (and P unless switched off)
   // springs
   std::vector<std::array<int32_t, 2>> spring_v_;
   std::vector<double> spring_rest_, spring_k_;

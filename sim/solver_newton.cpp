@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace drape::sim {
 
@@ -152,6 +153,8 @@ void NewtonSolver::assemble(const Cloth& cloth, double inv_h2, double mu, bool e
   }
   if (energy_.tensor_bending()) {
     // kTensor bending: the constant P (x) I3 (exact, PSD).
+    if (!energy_.has_bending_matrix())
+      throw std::logic_error("NewtonSolver: the energy was built with bending_matrix = false");
     const auto& off = energy_.bending_offsets();
     const auto& col = energy_.bending_columns();
     const auto& val = energy_.bending_values();

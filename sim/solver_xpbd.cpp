@@ -43,7 +43,10 @@ void apply_order(std::vector<T>& items, const std::vector<int>& order) {
 }  // namespace
 
 void XpbdSolver::cook(const Cloth& cloth) {
-  energy_.build(cloth, opt_.energy);
+  // XPBD projects the bending rows and never evaluates P (EnergyOptions::bending_matrix).
+  EnergyOptions eo = opt_.energy;
+  eo.bending_matrix = false;
+  energy_.build(cloth, eo);
   const FabricParams& fab = cloth.fabric;
   const double kc[3] = {fab.stretch_weft, fab.stretch_warp, 4.0 * fab.shear};
   const int n = cloth.num_vertices();
@@ -76,6 +79,12 @@ void XpbdSolver::cook(const Cloth& cloth) {
     std::vector<int> boff(1, 0), bcol;
     std::vector<double> bval, bik;
     std::vector<std::array<double, 4>> ent;  // column, value uu, vv, uv
+    // Upper bounds (a block's three rows share most columns): ~1M entries at 128^2, which
+    // growing by push_back copied many times over (a re-cook after every cut).
+    bcol.reserve(rc.size());
+    bval.reserve(3 * rc.size());
+    boff.reserve(nrows / 3 + 2);
+    bik.reserve(nrows + 3);
     for (int r0 = 0; r0 < nrows; r0 += 3) {
       ent.clear();
       for (int a = 0; a < 3 && r0 + a < nrows; ++a)
@@ -107,6 +116,10 @@ void XpbdSolver::cook(const Cloth& cloth) {
     row_colv_.clear();
     row_val_.clear();
     row_ik_.clear();
+    row_colv_.reserve(bcol.size());
+    row_val_.reserve(bval.size());
+    row_ik_.reserve(bik.size());
+    row_off_.reserve(boff.size());
     for (int bk : order_b) {
       for (int e = boff[bk]; e < boff[bk + 1]; ++e) {
         row_colv_.push_back(bcol[e]);
