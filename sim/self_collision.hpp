@@ -41,6 +41,9 @@ class SelfCollision {
   // mass per vertex (0 = fixed). Returns the largest correction applied (m).
   double project(const Cloth& cloth, std::vector<Vec3>& x, const double* w, double thickness) const;
   const std::vector<SelfContact>& contacts() const { return pairs_; }
+  // The per-entry bounding-sphere rejection (on by default; off only to measure it: the same
+  // pairs are found either way).
+  void set_sphere_test(bool on) { sphere_test_ = on; }
   // Smallest side-signed distance minus thickness over the pairs at x (< 0: a pair too close
   // or crossed); +infinity when there are no pairs.
   double min_clearance(const Cloth& cloth, const std::vector<Vec3>& x, double thickness) const;
@@ -49,6 +52,11 @@ class SelfCollision {
   std::vector<SelfContact> pairs_;
   // The hash: table_start_[b] .. table_start_[b + 1] index entries_ (triangle ids).
   std::vector<int32_t> table_start_, entries_, fill_;
+  struct Sphere {
+    float x, y, z, r;  // an entry's triangle: bounding sphere centre, radius + reach (padded)
+  };
+  std::vector<Sphere> spheres_;  // parallel to entries_
+  bool sphere_test_ = true;
   struct TriFrame {
     Vec3 a, n, g1, g2;  // corner, unit normal, barycentric gradients (detect())
   };
