@@ -89,7 +89,9 @@ Row run(const std::string& scene, int res, const Config& c, const std::vector<Ve
   cfg.springs_model = sc.springs_model;
   cfg.threads = static_cast<int>(env_num("SOLVERS_THREADS", 1));
   cfg.air_damping = sc.air_damping;
-  auto s = make_solver(c.solver, cfg);
+  // "xpbd-nosettle": XPBD without settling pieces at rest (XpbdOptions::settle, on in "xpbd").
+  cfg.settle = c.solver != "xpbd-nosettle";
+  auto s = make_solver(c.solver == "xpbd-nosettle" ? "xpbd" : c.solver, cfg);
   const double frame = 1.0 / 90;
   const int frames = static_cast<int>(std::lround(sc.duration / frame));
   bool stable = true;
@@ -269,6 +271,12 @@ int probe(int argc, char** argv) {
       xp->options().warm_start = env_num("XPBD_WARM", xp->options().warm_start);
       xp->options().reuse_contacts = env_num("XPBD_REUSE", 1) > 0;
       xp->options().bending_every = static_cast<int>(env_num("XPBD_BEND_EVERY", 1));
+      xp->options().settle = env_num("XPBD_SETTLE", 1) > 0;
+      xp->options().freeze = env_num("XPBD_FREEZE", 0) > 0;
+      xp->options().settle_mass_scale = env_num("XPBD_SETTLE_SCALE", 64);
+      xp->options().settle_damping = env_num("XPBD_SETTLE_DAMP", 5);
+      xp->options().settle_speed = env_num("XPBD_SETTLE_SPEED", xp->options().settle_speed);
+      xp->options().settle_growth = env_num("XPBD_SETTLE_GROWTH", xp->options().settle_growth);
     }
   }
   const double frame = 1.0 / 90;
@@ -300,11 +308,11 @@ int probe(int argc, char** argv) {
           sd = std::min(sd, sc.objects.form->signed_distance(sc.cloth.state.x[i]));
       }
       std::printf(
-          "t %.2f s: rms %.3f mm max %.3f mm  iters/frame %.1f frozen %d  KE %.2e J  min sd %.1f "
-          "mm  box (%.3f %.3f %.3f)-(%.3f %.3f %.3f)\n",
+          "t %.2f s: rms %.3f mm max %.3f mm  iters/frame %.1f frozen %d settle x%.0f  KE %.2e J  "
+          "min sd %.1f mm  box (%.3f %.3f %.3f)-(%.3f %.3f %.3f)\n",
           (f + 1) * frame, rms * 1e3, mx * 1e3, double(iters) / (f + 1),
-          vbd ? vbd->frozen_count() : 0, ke, sd * 1e3, lo.x(), lo.y(), lo.z(), hi.x(), hi.y(),
-          hi.z());
+          vbd ? vbd->frozen_count() : 0, xpbd_of(s.get()) ? xpbd_of(s.get())->settle_scale() : 1.0,
+          ke, sd * 1e3, lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
     }
   }
   std::printf("%s %d %s %dx%d: wall %.3f ms/frame, cpu %.3f ms/frame\n", scene.c_str(), res,
@@ -341,9 +349,22 @@ int main(int argc, char** argv) {
     std::vector<Config> configs;
     bool error = true;  // false: time only (256^2)
   };
-  std::vector<Config> full{{"vbd", 1, 5},   {"vbd", 1, 10},  {"vbd", 2, 10},  {"vbd", 2, 20},
-                           {"vbd", 4, 20},  {"xpbd", 5, 1},  {"xpbd", 10, 1}, {"xpbd", 20, 1},
-                           {"xpbd", 40, 1}, {"verlet", 0, 1}};
+  // "xpbd" settles pieces at rest (the default since session 5); "xpbd-nosettle" is the same
+  // solver without it, side by side.
+  std::vector<Config> full{{"vbd", 1, 5},
+                           {"vbd", 1, 10},
+                           {"vbd", 2, 10},
+                           {"vbd", 2, 20},
+                           {"vbd", 4, 20},
+                           {"xpbd", 5, 1},
+                           {"xpbd", 10, 1},
+                           {"xpbd", 20, 1},
+                           {"xpbd", 40, 1},
+                           {"xpbd-nosettle", 5, 1},
+                           {"xpbd-nosettle", 10, 1},
+                           {"xpbd-nosettle", 20, 1},
+                           {"xpbd-nosettle", 40, 1},
+                           {"verlet", 0, 1}};
   // Quick mode (the default of ./drape bench solvers): a few minutes. VBD's iteration count
   // is a maximum (early stop on the residual).
   std::vector<Config> quick_cfg{{"vbd", 1, 5},     {"vbd", 1, 10},  {"vbd", 2, 20},
@@ -362,6 +383,8 @@ int main(int argc, char** argv) {
     // solvers.md "Static solver speed"), with the explicit baseline (~50 s of stepping).
     const std::vector<Config> big{{"vbd", 1, 5}, {"xpbd", 10, 1}, {"xpbd", 20, 1}};
     std::vector<Config> b64 = big;
+    b64.push_back({"xpbd", 5, 1});
+    b64.push_back({"xpbd-nosettle", 10, 1});
     b64.push_back({"xpbd", 40, 1});
     b64.push_back({"verlet", 0, 1});
     if (max_res >= 64) jobs.push_back({"form", 64, b64, true});
@@ -571,7 +594,7 @@ int main(int argc, char** argv) {
     for (double e : targets) {
       std::printf("%-7s %4d at <= %.3g mm:", j.scene.c_str(), j.res, e);
       const Row* d = best(j, default_solver, e);
-      for (const char* name : {"vbd", "xpbd", "newton", "verlet", "bullet"}) {
+      for (const char* name : {"vbd", "xpbd", "xpbd-nosettle", "newton", "verlet", "bullet"}) {
         const Row* r = best(j, name, e);
         if (r)
           std::printf("  %s %.3g ms", name, r->ms_per_frame);
@@ -579,7 +602,7 @@ int main(int argc, char** argv) {
           std::printf("  %s -", name);
       }
       std::printf("\n");
-      for (const char* peer : {"verlet", "bullet", "xpbd"}) {
+      for (const char* peer : {"verlet", "bullet", "xpbd-nosettle"}) {
         const Row* p = best(j, peer, e);
         if (d && p)
           std::printf("    ratio %s / %s (default) = %.2fx\n", peer, default_solver.c_str(),

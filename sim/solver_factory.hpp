@@ -16,6 +16,7 @@ struct SolverConfig {
   double tolerance = 0;  // 0: default
   bool watchdog = true;
   bool freeze = false;         // VBD: freeze regions at rest
+  bool settle = true;          // XPBD: settle pieces at rest (XpbdOptions::settle)
   bool chebyshev = false;      // VBD
   bool springs_model = false;  // the study's 8-spring energy instead of FEM + bending
   int threads = 2;

@@ -184,8 +184,11 @@ void XpbdSolver::cook(const Cloth& cloth) {
     piece_of_[i] = id[r];
   }
   piece_rest_.assign(num_pieces_, 0);
+  piece_scale_.assign(num_pieces_, 1.0);
+  piece_slow_.assign(num_pieces_, 0);
   piece_frozen_.assign(num_pieces_, 0);
   piece_awake_.assign(num_pieces_, 0);
+  speed2_.assign(num_pieces_, 0.0);
 }
 
 bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
@@ -228,6 +231,7 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
     if (piece_awake_[p]) {
       piece_frozen_[p] = 0;
       piece_rest_[p] = 0;
+      unsettle(p);
     }
     all_frozen = all_frozen && piece_frozen_[p];
   }
@@ -241,6 +245,17 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
     }
   }
   return all_frozen;
+}
+
+void XpbdSolver::unsettle(int piece) {
+  piece_scale_[piece] = 1.0;
+  piece_slow_[piece] = 0;
+}
+
+double XpbdSolver::settle_scale() const {
+  double m = 1.0;
+  for (double s : piece_scale_) m = std::max(m, s);
+  return m;
 }
 
 StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
@@ -269,9 +284,21 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     S.time += dt;
     return st;
   }
+  if (opt_.settle) {
+    // A fixed vertex that moved since the last frame (pinched, dragged) ends its piece's
+    // settling.
+    for (int i = 0; i < n; ++i)
+      if (!cloth.is_free(i) && piece_scale_[piece_of_[i]] > 1.0 &&
+          (S.x[i] - S.x_prev[i]).squaredNorm() > 1e-18)
+        unsettle(piece_of_[i]);
+  } else {
+    std::fill(piece_scale_.begin(), piece_scale_.end(), 1.0);
+  }
   auto set_w = [&] {
     for (int i = 0; i < n; ++i) {
-      const double wi = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
+      const double wi = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen)
+                            ? S.inv_mass[i] / piece_scale_[piece_of_[i]]
+                            : 0.0;
       if (wi != w_[i]) w_changed_ = true;
       w_[i] = wi;
     }
@@ -500,6 +527,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   };
 
   const double damp = std::exp(-opt_.damping * h);
+  const double damp_settle = std::exp(-opt_.settle_damping * h);
   const double margin = energy_.options().contact_margin;
   for (int s = 0; s < ns; ++s) {
     if (s == 0 && contacts_fresh_) st.max_penetration = fresh_penetration_;
@@ -513,6 +541,16 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       const auto t0 = std::chrono::steady_clock::now();
       st.max_penetration = std::max(st.max_penetration, energy_.detect_contacts(cloth, scene));
       if (scene.self_collision) self_.detect(cloth, x, scene.offset, margin);
+      if (opt_.settle && settle_scale() > 1.0) {
+        // Something entered a settling piece's contact shell (a hand, a moved form): deeper
+        // than 0.1 mm inside a fresh plane, as for waking a sleeping piece.
+        for (int i = 0; i < n; ++i) {
+          const int ci = energy_.contact_of(i);
+          if (ci >= 0 && piece_scale_[piece_of_[i]] > 1.0 &&
+              energy_.contacts()[ci].n.dot(x[i] - energy_.contacts()[ci].p) < -1e-4)
+            unsettle(piece_of_[i]);
+        }
+      }
       x_det_ = x;
       ++detections_;
       st.collision_ms +=
@@ -529,7 +567,8 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       for (int i = b; i < e; ++i) {
         xt_[i] = x[i];
         if (w[i] > 0)
-          x[i] += h * S.v[i] + (h * h / S.mass[i]) * energy_.external_force(i, x[i], S.mass[i]);
+          x[i] += h * S.v[i] + (h * h / (piece_scale_[piece_of_[i]] * S.mass[i])) *
+                                   energy_.external_force(i, x[i], S.mass[i]);
       }
     });
     if (warm) {
@@ -562,11 +601,35 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       for (int i = b; i < e; ++i) {
         S.x_prev[i] = xt_[i];
         if (w[i] > 0)
-          S.v[i] = damp * (x[i] - xt_[i]) / h;
+          S.v[i] = (piece_scale_[piece_of_[i]] > 1.0 ? damp_settle : damp) * (x[i] - xt_[i]) / h;
         else if (S.flags[i] & kFlagFrozen)
           S.v[i].setZero();
       }
     });
+    if (opt_.settle) {
+      // Per piece the largest free-vertex speed: slow pieces settle, fast ones stop settling.
+      std::fill(speed2_.begin(), speed2_.end(), 0.0);
+      for (int i = 0; i < n; ++i)
+        if (w[i] > 0) speed2_[piece_of_[i]] = std::max(speed2_[piece_of_[i]], S.v[i].squaredNorm());
+      const double slow2 = opt_.settle_speed * opt_.settle_speed;
+      const double exit2 = opt_.settle_exit_speed * opt_.settle_exit_speed;
+      for (int p = 0; p < num_pieces_; ++p) {
+        if (piece_frozen_[p]) continue;
+        if (piece_scale_[p] > 1.0 || piece_slow_[p] >= opt_.settle_steps) {
+          if (speed2_[p] > exit2) {
+            unsettle(p);
+          } else if (piece_scale_[p] == 1.0 || (piece_scale_[p] < opt_.settle_mass_scale &&
+                                                ++piece_slow_[p] >= opt_.settle_grow_steps)) {
+            // Start or grow; w changes, the bending inverses are rebuilt once for it.
+            piece_scale_[p] = std::min(std::max(opt_.settle_growth, 1.0 + 1e-9) * piece_scale_[p],
+                                       opt_.settle_mass_scale);
+            piece_slow_[p] = 0;
+          }
+        } else {
+          piece_slow_[p] = speed2_[p] < slow2 ? piece_slow_[p] + 1 : 0;
+        }
+      }
+    }
     if (opt_.freeze) {
       // A piece rests when all its free vertices are slow; after freeze_steps substeps it sleeps.
       std::fill(piece_awake_.begin(), piece_awake_.end(), 0);  // reused: "moving" per piece

@@ -56,6 +56,28 @@ struct XpbdOptions {
   bool freeze = false;
   double freeze_speed = 1e-3;  // m/s
   int freeze_steps = 30;
+  // Settling (quasi-static refinement of a piece at rest; docs/solvers.md "Settling"). With
+  // multipliers reset every substep, XPBD's fixed point at rest is not the energy's
+  // equilibrium: each substep rebuilds a constraint's whole load lambda ~ h^2 x (its tension)
+  // from a violation of about w lambda, so the cloth is too stretchy by ~ w h^2 x load, which
+  // grows with the hanging length (7 mm at 32^2, 22 mm at 64^2 on the form, 10 substeps). A
+  // piece whose free vertices have all been slower than settle_speed for settle_steps substeps
+  // settles: its inertia grows by settle_growth every settle_grow_steps substeps (gently: a
+  // sudden step releases the stretch as a jolt) up to settle_mass_scale
+  // (w and the prediction's acceleration divided by the scale: the forces, and so the
+  // equilibrium, are unchanged, the bias shrinks by the scale) and its air drag is
+  // settle_damping. It returns to its own mass at once when a free vertex moves faster than
+  // settle_exit_speed, one of its fixed vertices moves (pinch, drag), it is woken from sleep
+  // or the topology changes. A settling piece answers a push like a heavier cloth until the
+  // push speeds it past settle_exit_speed.
+  bool settle = true;
+  double settle_speed = 0.05;      // m/s
+  double settle_exit_speed = 0.2;  // m/s
+  int settle_steps = 30;
+  double settle_growth = 1.05;
+  int settle_grow_steps = 10;
+  double settle_mass_scale = 64;
+  double settle_damping = 5.0;  // 1/s
 };
 
 class XpbdSolver : public Solver {
@@ -67,6 +89,8 @@ class XpbdSolver : public Solver {
   XpbdOptions& options() { return opt_; }
   int frozen_count() const { return frozen_count_; }
   int contact_detections() const { return detections_; }
+  // Largest inertia scale of any piece (1: nothing settling; XpbdOptions::settle).
+  double settle_scale() const;
   // Self-collision pairs found at the last detection (scenes with self_collision on).
   const SelfCollision& self_collision() const { return self_; }
   int num_colours() const {
@@ -117,6 +141,10 @@ class XpbdSolver : public Solver {
   std::vector<double> w_;  // inverse mass of each vertex, 0 when not free or frozen
   std::vector<int> piece_of_, piece_rest_;  // connected piece per vertex; rest substeps
   std::vector<uint8_t> piece_frozen_, piece_awake_;
+  std::vector<double> piece_scale_;  // settling: inertia scale per piece (1: own mass)
+  std::vector<int> piece_slow_;      // settling: slow substeps, then substeps since growing
+  std::vector<double> speed2_;       // settling: largest squared speed per piece (scratch)
+  void unsettle(int piece);
   int num_pieces_ = 0, frozen_count_ = 0;
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
   std::vector<Vec3> x_det_;      // positions at the last contact detection
