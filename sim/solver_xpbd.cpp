@@ -189,6 +189,11 @@ void XpbdSolver::cook(const Cloth& cloth) {
   piece_frozen_.assign(num_pieces_, 0);
   piece_awake_.assign(num_pieces_, 0);
   speed2_.assign(num_pieces_, 0.0);
+  fixed_prev_.assign(n, 0);
+  mv2_.assign(num_pieces_, 0.0);
+  mv2c_.assign(num_pieces_, 0.0);
+  piece_full_.assign(num_pieces_, 0);
+  msum_.assign(num_pieces_, 0.0);
 }
 
 bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
@@ -249,6 +254,7 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
 
 void XpbdSolver::unsettle(int piece) {
   piece_scale_[piece] = 1.0;
+  piece_full_[piece] = 0;
   piece_slow_[piece] = 0;
 }
 
@@ -285,12 +291,16 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     return st;
   }
   if (opt_.settle) {
-    // A fixed vertex that moved since the last frame (pinched, dragged) ends its piece's
-    // settling.
-    for (int i = 0; i < n; ++i)
-      if (!cloth.is_free(i) && piece_scale_[piece_of_[i]] > 1.0 &&
-          (S.x[i] - S.x_prev[i]).squaredNorm() > 1e-18)
+    // A fixed vertex that moved since the last frame (pinched, dragged) or was let go ends its
+    // piece's settling.
+    fixed_prev_.resize(n, 0);
+    for (int i = 0; i < n; ++i) {
+      const bool fixed = !cloth.is_free(i);
+      if (piece_scale_[piece_of_[i]] > 1.0 &&
+          ((fixed && (S.x[i] - S.x_prev[i]).squaredNorm() > 1e-18) || (fixed_prev_[i] && !fixed)))
         unsettle(piece_of_[i]);
+      fixed_prev_[i] = fixed ? 1 : 0;
+    }
   } else {
     std::fill(piece_scale_.begin(), piece_scale_.end(), 1.0);
   }
@@ -542,12 +552,15 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       st.max_penetration = std::max(st.max_penetration, energy_.detect_contacts(cloth, scene));
       if (scene.self_collision) self_.detect(cloth, x, scene.offset, margin);
       if (opt_.settle && settle_scale() > 1.0) {
-        // Something entered a settling piece's contact shell (a hand, a moved form): deeper
-        // than 0.1 mm inside a fresh plane, as for waking a sleeping piece.
+        // Something pushed into a settling piece (a hand, a moved form): a vertex deeper than
+        // 1 mm inside a fresh contact plane. (Not 0.1 mm as for waking a sleeping piece: a
+        // settling piece still slides, and a plane re-found on a curved form after half a
+        // margin of sliding can sit ~0.1 mm off; measured at 128^2, it ended settling over and
+        // over and the drape never came to rest.)
         for (int i = 0; i < n; ++i) {
           const int ci = energy_.contact_of(i);
           if (ci >= 0 && piece_scale_[piece_of_[i]] > 1.0 &&
-              energy_.contacts()[ci].n.dot(x[i] - energy_.contacts()[ci].p) < -1e-4)
+              energy_.contacts()[ci].n.dot(x[i] - energy_.contacts()[ci].p) < -1e-3)
             unsettle(piece_of_[i]);
         }
       }
@@ -607,16 +620,32 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       }
     });
     if (opt_.settle) {
-      // Per piece the largest free-vertex speed: slow pieces settle, fast ones stop settling.
+      // Per piece the largest free-vertex speed (all slower than settle_speed: the piece may
+      // settle) and the mass-weighted RMS speed (faster than settle_exit_speed: it stops
+      // settling). Not the largest speed for the exit: a contact re-projection moves a single
+      // sliding vertex by ~0.2 mm in one substep, 0.2 m/s (measured at 64^2: it ended
+      // settling at rest, and the drape sagged back by its bias). The exit speed is well above
+      // the drape's own motion while its bias is released (~0.1-0.2 m/s RMS at 128^2, where
+      // the drape rises by up to ~80 mm in about a second).
       std::fill(speed2_.begin(), speed2_.end(), 0.0);
-      for (int i = 0; i < n; ++i)
-        if (w[i] > 0) speed2_[piece_of_[i]] = std::max(speed2_[piece_of_[i]], S.v[i].squaredNorm());
+      std::fill(mv2_.begin(), mv2_.end(), 0.0);
+      std::fill(msum_.begin(), msum_.end(), 0.0);
+      std::fill(mv2c_.begin(), mv2c_.end(), 0.0);
       const double slow2 = opt_.settle_speed * opt_.settle_speed;
+      for (int i = 0; i < n; ++i)
+        if (w[i] > 0) {
+          const int p = piece_of_[i];
+          const double v2 = S.v[i].squaredNorm();
+          speed2_[p] = std::max(speed2_[p], v2);
+          mv2_[p] += S.mass[i] * v2;
+          mv2c_[p] += S.mass[i] * std::min(v2, slow2);
+          msum_[p] += S.mass[i];
+        }
       const double exit2 = opt_.settle_exit_speed * opt_.settle_exit_speed;
       for (int p = 0; p < num_pieces_; ++p) {
         if (piece_frozen_[p]) continue;
         if (piece_scale_[p] > 1.0 || piece_slow_[p] >= opt_.settle_steps) {
-          if (speed2_[p] > exit2) {
+          if (msum_[p] > 0 && mv2_[p] > exit2 * msum_[p]) {
             unsettle(p);
           } else if (piece_scale_[p] == 1.0 || (piece_scale_[p] < opt_.settle_mass_scale &&
                                                 ++piece_slow_[p] >= opt_.settle_grow_steps)) {
@@ -638,8 +667,19 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         if (w[i] > 0 && S.v[i].squaredNorm() >= v2) piece_awake_[piece_of_[i]] = 1;
       for (int p = 0; p < num_pieces_; ++p) {
         if (piece_frozen_[p]) continue;
+        // A fully settled piece rests on its RMS speed, each vertex's speed capped at
+        // settle_speed (single sliding vertices re-projected onto the form jump ~0.2 m/s for one
+        // substep), and sleeps anyway after settle_sleep_steps substeps at the full scale: a
+        // settled 128^2 drape kept creeping along the frictionless form at ~2 mm/s RMS for
+        // good (it settled only after every vertex had been slower than settle_speed, so no
+        // flap is still swinging).
+        bool settled_long = false;
+        if (opt_.settle && piece_scale_[p] >= opt_.settle_mass_scale) {
+          settled_long = ++piece_full_[p] >= opt_.settle_sleep_steps;
+          if (piece_awake_[p] && msum_[p] > 0 && mv2c_[p] < v2 * msum_[p]) piece_awake_[p] = 0;
+        }
         piece_rest_[p] = piece_awake_[p] ? 0 : piece_rest_[p] + 1;
-        if (piece_rest_[p] >= opt_.freeze_steps) piece_frozen_[p] = 1;
+        if (piece_rest_[p] >= opt_.freeze_steps || settled_long) piece_frozen_[p] = 1;
       }
       frozen_count_ = 0;
       for (int i = 0; i < n; ++i)

@@ -66,18 +66,22 @@ struct XpbdOptions {
   // sudden step releases the stretch as a jolt) up to settle_mass_scale
   // (w and the prediction's acceleration divided by the scale: the forces, and so the
   // equilibrium, are unchanged, the bias shrinks by the scale) and its air drag is
-  // settle_damping. It returns to its own mass at once when a free vertex moves faster than
-  // settle_exit_speed, one of its fixed vertices moves (pinch, drag), it is woken from sleep
-  // or the topology changes. A settling piece answers a push like a heavier cloth until the
-  // push speeds it past settle_exit_speed.
+  // settle_damping. It returns to its own mass at once when its RMS speed exceeds
+  // settle_exit_speed, one of its fixed vertices moves or is let go (pinch, drag, release),
+  // something pushes 1 mm
+  // into its contact shell, it is woken from sleep or the topology changes. A settling piece
+  // answers a push like a heavier cloth until the push speeds it past settle_exit_speed.
   bool settle = true;
   double settle_speed = 0.05;      // m/s
-  double settle_exit_speed = 0.2;  // m/s
+  double settle_exit_speed = 0.5;  // m/s, RMS over the piece
   int settle_steps = 30;
   double settle_growth = 1.05;
   int settle_grow_steps = 10;
   double settle_mass_scale = 64;
   double settle_damping = 5.0;  // 1/s
+  // With freeze: a piece at the full scale for this many substeps sleeps even if it still
+  // creeps (a drape sliding along the frictionless form at mm/s).
+  int settle_sleep_steps = 900;
 };
 
 class XpbdSolver : public Solver {
@@ -144,6 +148,10 @@ class XpbdSolver : public Solver {
   std::vector<double> piece_scale_;  // settling: inertia scale per piece (1: own mass)
   std::vector<int> piece_slow_;      // settling: slow substeps, then substeps since growing
   std::vector<double> speed2_;       // settling: largest squared speed per piece (scratch)
+  std::vector<double> mv2_, msum_;   // settling: sum of m v^2 and of m per piece (scratch)
+  std::vector<double> mv2c_;         // settling: sum of m min(v^2, settle_speed^2) (scratch)
+  std::vector<int> piece_full_;      // settling: substeps at the full scale
+  std::vector<uint8_t> fixed_prev_;  // settling: vertex was fixed at the last step
   void unsettle(int piece);
   int num_pieces_ = 0, frozen_count_ = 0;
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
