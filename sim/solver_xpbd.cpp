@@ -188,12 +188,9 @@ void XpbdSolver::cook(const Cloth& cloth) {
   piece_slow_.assign(num_pieces_, 0);
   piece_frozen_.assign(num_pieces_, 0);
   piece_awake_.assign(num_pieces_, 0);
-  speed2_.assign(num_pieces_, 0.0);
+  motion_.assign(num_pieces_, PieceMotion{});
   fixed_prev_.assign(n, 0);
-  mv2_.assign(num_pieces_, 0.0);
-  mv2c_.assign(num_pieces_, 0.0);
   piece_full_.assign(num_pieces_, 0);
-  msum_.assign(num_pieces_, 0.0);
 }
 
 bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
@@ -293,7 +290,6 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   if (opt_.settle) {
     // A fixed vertex that moved since the last frame (pinched, dragged) or was let go ends its
     // piece's settling.
-    fixed_prev_.resize(n, 0);
     for (int i = 0; i < n; ++i) {
       const bool fixed = !cloth.is_free(i);
       if (piece_scale_[piece_of_[i]] > 1.0 &&
@@ -619,33 +615,35 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
           S.v[i].setZero();
       }
     });
-    if (opt_.settle) {
-      // Per piece the largest free-vertex speed (all slower than settle_speed: the piece may
-      // settle) and the mass-weighted RMS speed (faster than settle_exit_speed: it stops
-      // settling). Not the largest speed for the exit: a contact re-projection moves a single
-      // sliding vertex by ~0.2 mm in one substep, 0.2 m/s (measured at 64^2: it ended
-      // settling at rest, and the drape sagged back by its bias). The exit speed is well above
-      // the drape's own motion while its bias is released (~0.1-0.2 m/s RMS at 128^2, where
-      // the drape rises by up to ~80 mm in about a second).
-      std::fill(speed2_.begin(), speed2_.end(), 0.0);
-      std::fill(mv2_.begin(), mv2_.end(), 0.0);
-      std::fill(msum_.begin(), msum_.end(), 0.0);
-      std::fill(mv2c_.begin(), mv2c_.end(), 0.0);
+    if (opt_.settle || opt_.freeze) {
+      // Per piece, once per substep: the largest free-vertex speed (settling may start when
+      // all are below settle_speed; a piece is awake while one is above freeze_speed) and the
+      // mass-weighted RMS speed, plain (faster than settle_exit_speed: settling ends) and with
+      // each vertex capped at settle_speed (a settled piece's rest test). Not the largest speed
+      // for the exit: a contact re-projection moves a single sliding vertex by ~0.2 mm in one
+      // substep, 0.2 m/s (measured at 64^2: it ended settling at rest, and the drape sagged
+      // back by its bias). The exit speed is well above the drape's own motion while its bias
+      // is released (~0.1-0.2 m/s RMS at 128^2, where the drape rises by up to ~80 mm in about
+      // a second).
+      std::fill(motion_.begin(), motion_.end(), PieceMotion{});
       const double slow2 = opt_.settle_speed * opt_.settle_speed;
       for (int i = 0; i < n; ++i)
         if (w[i] > 0) {
-          const int p = piece_of_[i];
+          PieceMotion& pm = motion_[piece_of_[i]];
           const double v2 = S.v[i].squaredNorm();
-          speed2_[p] = std::max(speed2_[p], v2);
-          mv2_[p] += S.mass[i] * v2;
-          mv2c_[p] += S.mass[i] * std::min(v2, slow2);
-          msum_[p] += S.mass[i];
+          pm.max_v2 = std::max(pm.max_v2, v2);
+          pm.mv2 += S.mass[i] * v2;
+          pm.mv2_capped += S.mass[i] * std::min(v2, slow2);
+          pm.m += S.mass[i];
         }
+    }
+    if (opt_.settle) {
       const double exit2 = opt_.settle_exit_speed * opt_.settle_exit_speed;
       for (int p = 0; p < num_pieces_; ++p) {
         if (piece_frozen_[p]) continue;
+        const PieceMotion& pm = motion_[p];
         if (piece_scale_[p] > 1.0 || piece_slow_[p] >= opt_.settle_steps) {
-          if (msum_[p] > 0 && mv2_[p] > exit2 * msum_[p]) {
+          if (pm.m > 0 && pm.mv2 > exit2 * pm.m) {
             unsettle(p);
           } else if (piece_scale_[p] == 1.0 || (piece_scale_[p] < opt_.settle_mass_scale &&
                                                 ++piece_slow_[p] >= opt_.settle_grow_steps)) {
@@ -655,18 +653,18 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
             piece_slow_[p] = 0;
           }
         } else {
-          piece_slow_[p] = speed2_[p] < slow2 ? piece_slow_[p] + 1 : 0;
+          piece_slow_[p] =
+              pm.max_v2 < opt_.settle_speed * opt_.settle_speed ? piece_slow_[p] + 1 : 0;
         }
       }
     }
     if (opt_.freeze) {
       // A piece rests when all its free vertices are slow; after freeze_steps substeps it sleeps.
-      std::fill(piece_awake_.begin(), piece_awake_.end(), 0);  // reused: "moving" per piece
       const double v2 = opt_.freeze_speed * opt_.freeze_speed;
-      for (int i = 0; i < n; ++i)
-        if (w[i] > 0 && S.v[i].squaredNorm() >= v2) piece_awake_[piece_of_[i]] = 1;
       for (int p = 0; p < num_pieces_; ++p) {
         if (piece_frozen_[p]) continue;
+        const PieceMotion& pm = motion_[p];
+        bool moving = pm.max_v2 >= v2;
         // A fully settled piece rests on its RMS speed, each vertex's speed capped at
         // settle_speed (single sliding vertices re-projected onto the form jump ~0.2 m/s for one
         // substep), and sleeps anyway after settle_sleep_steps substeps at the full scale: a
@@ -676,9 +674,9 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         bool settled_long = false;
         if (opt_.settle && piece_scale_[p] >= opt_.settle_mass_scale) {
           settled_long = ++piece_full_[p] >= opt_.settle_sleep_steps;
-          if (piece_awake_[p] && msum_[p] > 0 && mv2c_[p] < v2 * msum_[p]) piece_awake_[p] = 0;
+          if (moving && pm.m > 0 && pm.mv2_capped < v2 * pm.m) moving = false;
         }
-        piece_rest_[p] = piece_awake_[p] ? 0 : piece_rest_[p] + 1;
+        piece_rest_[p] = moving ? 0 : piece_rest_[p] + 1;
         if (piece_rest_[p] >= opt_.freeze_steps || settled_long) piece_frozen_[p] = 1;
       }
       frozen_count_ = 0;

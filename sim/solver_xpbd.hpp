@@ -68,8 +68,8 @@ struct XpbdOptions {
   // equilibrium, are unchanged, the bias shrinks by the scale) and its air drag is
   // settle_damping. It returns to its own mass at once when its RMS speed exceeds
   // settle_exit_speed, one of its fixed vertices moves or is let go (pinch, drag, release),
-  // something pushes 1 mm
-  // into its contact shell, it is woken from sleep or the topology changes. A settling piece
+  // something pushes 1 mm into its contact shell, it is woken from sleep or the topology
+  // changes. A settling piece
   // answers a push like a heavier cloth until the push speeds it past settle_exit_speed.
   bool settle = true;
   double settle_speed = 0.05;      // m/s
@@ -147,9 +147,12 @@ class XpbdSolver : public Solver {
   std::vector<uint8_t> piece_frozen_, piece_awake_;
   std::vector<double> piece_scale_;  // settling: inertia scale per piece (1: own mass)
   std::vector<int> piece_slow_;      // settling: slow substeps, then substeps since growing
-  std::vector<double> speed2_;       // settling: largest squared speed per piece (scratch)
-  std::vector<double> mv2_, msum_;   // settling: sum of m v^2 and of m per piece (scratch)
-  std::vector<double> mv2c_;         // settling: sum of m min(v^2, settle_speed^2) (scratch)
+  // Per piece, each substep (settling and sleeping): the largest squared free-vertex speed,
+  // sum of m v^2, the same with v^2 capped at settle_speed^2, and the mass.
+  struct PieceMotion {
+    double max_v2 = 0, mv2 = 0, mv2_capped = 0, m = 0;
+  };
+  std::vector<PieceMotion> motion_;
   std::vector<int> piece_full_;      // settling: substeps at the full scale
   std::vector<uint8_t> fixed_prev_;  // settling: vertex was fixed at the last step
   void unsettle(int piece);

@@ -77,21 +77,15 @@ TEST(Xpbd, FreezingSkipsRestingVerticesWakesAndKeepsTheRestState) {
 // Warm-started multipliers shrink XPBD's under-converged sag of a hanging sheet (measured:
 // 12.1 -> 6.5 mm at 24^2 with 0.5); the option stays off by default (>= 0.7 diverges).
 TEST(Xpbd, WarmStartHalvesTheSagBiasOfAHangingSheet) {
-  StudyScene ref = make_hanging_sheet(16);
-  StaticOptions so;
-  so.tolerance = 1e-9;
-  relax_static(ref.cloth, ref.objects, so);
   double err[2];
   for (int k = 0; k < 2; ++k) {
-    StudyScene sc = make_hanging_sheet(16);
     XpbdOptions o;
     o.damping = 2.0;
     o.settle = false;  // the warm start alone
     o.warm_start = 0.5 * k;
     XpbdSolver s(o);
-    for (int f = 0; f < 360; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
     double mx;
-    position_error(sc.cloth.state.x, ref.cloth.state.x, err[k], mx);
+    sheet_error_vs_newton(s, 16, 360, k ? "warm 0.5" : "classic", err[k], mx);
   }
   std::printf("16^2 sheet, 10 substeps, after 4 s: rms %.3f mm (classic), %.3f mm (warm 0.5)\n",
               err[0] * 1e3, err[1] * 1e3);
@@ -193,20 +187,14 @@ TEST(Xpbd, FormDrapeFallsAsleepAndStaysAsleep) {
 // XPBD's rest bias (multipliers rebuilt from ~w lambda of violation every substep) without
 // moving the equilibrium: the 16^2 sheet ends far closer to the Newton static minimum.
 TEST(Xpbd, SettlingRemovesTheRestBiasOfAHangingSheet) {
-  StudyScene ref = make_hanging_sheet(16);
-  StaticOptions so;
-  so.tolerance = 1e-9;
-  relax_static(ref.cloth, ref.objects, so);
   double err[2], scale[2];
   for (int k = 0; k < 2; ++k) {
-    StudyScene sc = make_hanging_sheet(16);
     XpbdOptions o;
     o.damping = 2.0;
     o.settle = k == 1;
     XpbdSolver s(o);
-    for (int f = 0; f < 360; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
     double mx;
-    position_error(sc.cloth.state.x, ref.cloth.state.x, err[k], mx);
+    sheet_error_vs_newton(s, 16, 360, k ? "settling" : "without settling", err[k], mx);
     scale[k] = s.settle_scale();
   }
   std::printf(
@@ -229,7 +217,7 @@ TEST(Xpbd, SettlingEndsWhenAPinnedCornerMoves) {
     o.damping = 3.0;
     o.settle = k == 1;
     XpbdSolver s(o);
-    for (int f = 0; f < 600; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+    run_frames(s, sc, 600);
     if (k == 1) {
       EXPECT_GT(s.settle_scale(), 1.0);
       drag_sheet_corner(sc, s, 1);
