@@ -64,7 +64,7 @@ class ThreadPool {
   int min_parallel_ = 64;
   std::vector<std::thread> workers_;
   std::atomic<uint64_t> generation_{0};
-  std::atomic<uint64_t> next_{0};  // generation << 32 | next chunk to claim
+  std::atomic<uint64_t> next_{0};  // generation << 32 | back << 16 | front (see run())
   std::atomic<int> done_{0};       // chunks finished in this generation
   std::atomic<int> chunks_{0};     // chunks of this generation
   std::atomic<bool> stop_{false};

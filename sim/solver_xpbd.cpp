@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace drape::sim {
 
@@ -67,6 +68,9 @@ void XpbdSolver::cook(const Cloth& cloth) {
   tri_col_ = colour_sorted(n, static_cast<int>(tris_.size()), 3,
                            tris_.empty() ? nullptr : tris_[0].v, sizeof(Tri), order);
   apply_order(tris_, order);
+  pool_->set_min_parallel(static_cast<int>(tris_.size()) < opt_.min_parallel_triangles
+                              ? std::numeric_limits<int>::max()
+                              : 256);
   hinges_.clear();
   // Bending: the energy's own rows when it has them (tensor bending), else its hinges. The
   // three rows of a triangle (uu, vv, uv) share their stencil: they are one block, solved
@@ -160,6 +164,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
   lambda_hinge_.assign(hinges_.size(), Vec3::Zero());
   lambda_spring_.assign(springs_.size(), 0.0);
   xt_.resize(n);
+  xp_.resize(n);
   w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
   // Connected pieces (union-find over the elements' vertices).
   std::vector<int> parent(n);
@@ -353,62 +358,14 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   const bool warm = opt_.warm_start > 0;
   const bool keep_lambda = opt_.iterations > 1 || warm;
 
-  auto project_tris = [&](int b, int e, int) {
-    // The three strain constraints of a triangle (E_uu, E_vv, E_uv) are projected one after
-    // the other as in classic XPBD, but in the space of F = (fu, fv): every gradient is
-    // w_q (D_uq a + D_vq b) for vectors a, b, so each projection changes F by a closed form
-    // (S_uu, S_vv, S_uv below) and the vertices are moved once, by the sum.
-    for (int k = b; k < e; ++k) {
-      const Tri& T = tris_[k];
-      const double wq[3] = {w[T.v[0]], w[T.v[1]], w[T.v[2]]};
-      if (wq[0] + wq[1] + wq[2] == 0) continue;
-      const Vec3& p0 = x[T.v[0]];
-      const Vec3& p1 = x[T.v[1]];
-      const Vec3& p2 = x[T.v[2]];
-      const double* D = T.D;
-      Vec3 fu = p0 * D[0] + p1 * D[2] + p2 * D[4];
-      Vec3 fv = p0 * D[1] + p1 * D[3] + p2 * D[5];
-      double Suu = 0, Svv = 0, Suv = 0;
-      for (int q = 0; q < 3; ++q) {
-        Suu += wq[q] * D[2 * q] * D[2 * q];
-        Svv += wq[q] * D[2 * q + 1] * D[2 * q + 1];
-        Suv += wq[q] * D[2 * q] * D[2 * q + 1];
-      }
-      Vec3 a = Vec3::Zero(), bb = Vec3::Zero();
-      double* L = &lambda_tri_[3 * k];
-      // E_uu = (|fu|^2 - 1) / 2 with gradient D_uq fu (c = 0; f = fu, g = fv, acc = a) and
-      // E_vv = (|fv|^2 - 1) / 2 with gradient D_vq fv (c = 1; f = fv, g = fu, acc = bb).
-      auto stretch = [&](int c, Vec3& f, Vec3& g, double Sff, Vec3& acc) {
-        const double alpha = ih2 * T.ia[c];
-        const double denom = alpha + Sff * f.squaredNorm();
-        if (denom < 1e-20) return;
-        const double lam = keep_lambda ? L[c] : 0.0;
-        const double dl = (-0.5 * (f.squaredNorm() - 1) - alpha * lam) / denom;
-        if (keep_lambda) L[c] = lam + dl;
-        acc += dl * f;
-        g += (dl * Suv) * f;
-        f *= 1 + dl * Sff;
-      };
-      stretch(0, fu, fv, Suu, a);
-      stretch(1, fv, fu, Svv, bb);
-      // E_uv = fu . fv / 2, gradient (D_uq fv + D_vq fu) / 2.
-      {
-        const double alpha = ih2 * T.ia[2];
-        const double uv = fu.dot(fv);
-        const double denom =
-            alpha + 0.25 * (Suu * fv.squaredNorm() + 2 * Suv * uv + Svv * fu.squaredNorm());
-        if (denom >= 1e-20) {
-          const double lam = keep_lambda ? L[2] : 0.0;
-          const double dl = (-0.5 * uv - alpha * lam) / denom;
-          if (keep_lambda) L[2] = lam + dl;
-          a += (0.5 * dl) * fv;
-          bb += (0.5 * dl) * fu;
-        }
-      }
-      for (int q = 0; q < 3; ++q)
-        if (wq[q] > 0) x[T.v[q]] += wq[q] * (D[2 * q] * a + D[2 * q + 1] * bb);
-    }
-  };
+  // Triangles and bending blocks: the kernels of sim/xpbd_kernels.hpp on the padded copy xp_.
+  xpbd::P4* xp = xp_.data();
+  const xpbd::Kernels& K = *kern_;
+  double* lam_tri = keep_lambda ? lambda_tri_.data() : nullptr;
+  double* lam_row = keep_lambda && !lambda_row_.empty() ? lambda_row_[0].data() : nullptr;
+  const xpbd::RowBlocks rb{row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
+                           row_ai_.data()};
+  auto project_tris = [&](int b, int e, int) { K.tris(tris_.data(), b, e, w, xp, ih2, lam_tri); };
   auto project_hinges = [&](int b, int e, int) {
     for (int k = b; k < e; ++k) {
       const Hinge& H = hinges_[k];
@@ -425,40 +382,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       for (int q = 0; q < 4; ++q) x[H.v[q]] += (wq[q] * H.K[q]) * dl;
     }
   };
-  auto project_rows = [&](int b, int e, int) {
-    for (int r = b; r < e; ++r) {
-      // C_a = sum_j v_aj x_j; A dl = -C - alpha l with A^-1 cached (row_ai_).
-      const double* ai = &row_ai_[6 * r];
-      if (ai[0] == 0) continue;  // every vertex fixed (or A singular)
-      Vec3 C[3] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
-      for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
-        const Vec3& xj = x[row_colv_[k]];
-        const double* v = &row_val_[3 * k];
-        C[0] += v[0] * xj;
-        C[1] += v[1] * xj;
-        C[2] += v[2] * xj;
-      }
-      Vec3* lam = &lambda_row_[3 * r];
-      if (keep_lambda)
-        for (int a = 0; a < 3; ++a) C[a] += (ihb * row_ik_[3 * r + a]) * lam[a];
-      // dl_a = -sum_b Ai_ab (C_b + alpha_b l_b): one vector per row a.
-      const Vec3 d0 = -(ai[0] * C[0] + ai[1] * C[1] + ai[2] * C[2]);
-      const Vec3 d1 = -(ai[1] * C[0] + ai[3] * C[1] + ai[4] * C[2]);
-      const Vec3 d2 = -(ai[2] * C[0] + ai[4] * C[1] + ai[5] * C[2]);
-      if (keep_lambda) {
-        lam[0] += d0;
-        lam[1] += d1;
-        lam[2] += d2;
-      }
-      for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
-        const int j = row_colv_[k];
-        const double wj = w[j];
-        if (wj == 0) continue;
-        const double* v = &row_val_[3 * k];
-        x[j] += wj * (v[0] * d0 + v[1] * d1 + v[2] * d2);
-      }
-    }
-  };
+  auto project_rows = [&](int b, int e, int) { K.rows(rb, b, e, w, xp, ihb, lam_row); };
   // Spring k's unit direction (v0 - v1) and length; false when degenerate.
   auto spring_dir = [&](const Spring& Sp, Vec3& nn, double& l) {
     const Vec3 d = x[Sp.v[0]] - x[Sp.v[1]];
@@ -602,9 +526,15 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       std::fill(lambda_spring_.begin(), lambda_spring_.end(), 0.0);
     }
     for (int it = 0; it < opt_.iterations; ++it) {
+      pool_->parallel_for(n, [&](int b, int e, int) {
+        K.pack(reinterpret_cast<const double*>(x.data()), xp, b, e);
+      });
       by_colour(tri_col_, project_tris);
-      by_colour(hinge_col_, project_hinges);
       if (s % be == be - 1 || s == ns - 1) by_colour(row_cols_, project_rows);
+      pool_->parallel_for(
+          n, [&](int b, int e, int) { K.unpack(xp, reinterpret_cast<double*>(x.data()), b, e); });
+      // (Hinges exist only without bending rows: the order of the two does not matter.)
+      by_colour(hinge_col_, project_hinges);
       by_colour(spring_col_, project_springs);
       energy_.project_contacts(x);
       if (scene.self_collision) self_.project(cloth, x, w, scene.offset);

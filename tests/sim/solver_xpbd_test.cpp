@@ -42,6 +42,7 @@ TEST(Xpbd, ParallelColoursGiveTheSameResultAsOneThread) {
     StudyScene sc = make_hanging_sheet(24);
     XpbdOptions o;
     o.threads = t + 1;
+    o.min_parallel_triangles = 0;  // a 24^2 sheet would otherwise run on one thread
     XpbdSolver s(o);
     for (int k = 0; k < 30; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
     out[t] = sc.cloth.state.x;

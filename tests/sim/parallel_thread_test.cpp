@@ -1,0 +1,98 @@
+// sim/parallel.hpp: the thread pool runs every index exactly once, keeps each thread on its own
+// end of the range, and element colouring gives colours whose elements share no vertex. The
+// file name contains "thread": it also runs in the TSan build.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <memory>
+#include <set>
+#include <vector>
+
+#include "sim/parallel.hpp"
+
+namespace drape::sim {
+namespace {
+
+TEST(ThreadPool, RunsEveryIndexExactlyOnce) {
+  for (int threads : {1, 2, 3}) {
+    ThreadPool pool(threads);
+    pool.set_min_parallel(0);
+    for (int n : {0, 1, 5, 255, 256, 10007}) {
+      for (int rep = 0; rep < 20; ++rep) {
+        std::vector<std::atomic<int>> hits(n);
+        for (auto& h : hits) h.store(0);
+        pool.parallel_for(n, [&](int b, int e, int w) {
+          EXPECT_GE(w, 0);
+          EXPECT_LT(w, threads);
+          for (int i = b; i < e; ++i) hits[i].fetch_add(1);
+        });
+        for (int i = 0; i < n; ++i) ASSERT_EQ(hits[i].load(), 1) << threads << " " << n << " " << i;
+      }
+    }
+  }
+}
+
+// With two threads the caller claims chunks from the front and the worker from the back, so
+// whatever the timing, every index the caller ran comes before every index the worker ran: each
+// thread keeps to one part of the range (of the mesh) from call to call.
+TEST(ThreadPool, TwoThreadsKeepToTheirOwnEndOfTheRange) {
+  ThreadPool pool(2);
+  pool.set_min_parallel(0);
+  int both = 0;
+  for (int rep = 0; rep < 500; ++rep) {
+    std::atomic<int> max0{-1}, min1{1 << 30};
+    pool.parallel_for(4096, [&](int b, int e, int w) {
+      volatile double sink = 0;  // some work, so that the worker gets a chance to join
+      for (int i = b; i < e; ++i) sink = sink + i * 1e-3;
+      if (w == 0) {
+        int m = max0.load();
+        while (e - 1 > m && !max0.compare_exchange_weak(m, e - 1)) {
+        }
+      } else {
+        int m = min1.load();
+        while (b < m && !min1.compare_exchange_weak(m, b)) {
+        }
+      }
+    });
+    if (max0.load() >= 0 && min1.load() < (1 << 30)) {
+      ++both;
+      ASSERT_LT(max0.load(), min1.load()) << "call " << rep;
+    }
+  }
+  std::printf("calls in which both threads ran chunks: %d of 500\n", both);
+}
+
+TEST(Colouring, ElementsOfOneColourShareNoVertex) {
+  // Triangles of a 20 x 20 grid (two per cell).
+  const int g = 20, n = (g + 1) * (g + 1);
+  std::vector<int> off{0}, verts;
+  for (int j = 0; j < g; ++j)
+    for (int i = 0; i < g; ++i) {
+      const int a = j * (g + 1) + i, b = a + 1, c = a + g + 1, d = c + 1;
+      for (int t : {a, b, d}) verts.push_back(t);
+      off.push_back(static_cast<int>(verts.size()));
+      for (int t : {a, d, c}) verts.push_back(t);
+      off.push_back(static_cast<int>(verts.size()));
+    }
+  std::vector<int> order, col;
+  const int colours = colour_elements(n, off, verts, order, col);
+  ASSERT_EQ(static_cast<int>(col.size()), colours + 1);
+  EXPECT_LE(colours, 13);  // a vertex is in at most 6 triangles: greedy needs at most 13
+  std::vector<int> seen(order.size(), 0);
+  for (int c = 0; c < colours; ++c) {
+    std::set<int> used;
+    for (int k = col[c]; k < col[c + 1]; ++k) {
+      const int e = order[k];
+      ++seen[e];
+      for (int q = off[e]; q < off[e + 1]; ++q)
+        EXPECT_TRUE(used.insert(verts[q]).second) << "colour " << c << " vertex " << verts[q];
+    }
+  }
+  EXPECT_EQ(static_cast<int>(order.size()), 2 * g * g);
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int s) { return s == 1; }));
+}
+
+}  // namespace
+}  // namespace drape::sim
