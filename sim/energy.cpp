@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "sim/dress_form.hpp"
+#include "sim/parallel.hpp"
 
 namespace drape::sim {
 
@@ -889,7 +890,8 @@ void ClothEnergy::clear_contacts() {
   contacts_.clear();
 }
 
-double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scene) {
+double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scene,
+                                    ThreadPool* pool) {
   clear_contacts();
   const auto& x = cloth.state.x;
   const int n = cloth.num_vertices();
@@ -910,20 +912,15 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
     return t;
   };
   culled_ = 0;
-  double deepest = 0;
-  // Keep, per vertex, the deepest candidate.
-  auto consider = [&](int i, double dist, const Vec3& nrm, const Vec3& surf) {
+  // Per vertex, the deepest candidate (into candidate_[i]; vertex -1: none yet).
+  candidate_.resize(n);
+  auto consider = [&](int i, double dist, const Vec3& nrm, const Vec3& surf, double& deepest) {
     if (dist >= reach) return;
     const double pen = off - dist;
     deepest = std::max(deepest, pen);
     const Vec3 p = surf + off * nrm;
-    int ci = contact_index_[i];
-    if (ci < 0) {
-      contact_index_[i] = static_cast<int>(contacts_.size());
-      contacts_.push_back({i, nrm, p});
-    } else if (nrm.dot(x[i] - p) < contacts_[ci].n.dot(x[i] - contacts_[ci].p)) {
-      contacts_[ci] = {i, nrm, p};
-    }
+    Contact& c = candidate_[i];
+    if (c.vertex < 0 || nrm.dot(x[i] - p) < c.n.dot(x[i] - c.p)) c = {i, nrm, p};
   };
   const bool floor = scene.floor && touches(Vec3(-1e9, -1, -1e9), Vec3(1e9, 0, 1e9));
   bool form_on = false;
@@ -931,62 +928,77 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
     const DressForm& f = *scene.form;
     form_on = touches(Vec3(-1, f.min_y(), -1), Vec3(1, f.max_y(), 1));
   }
-  // Flags per object kind for culling (vectors are small; bool arrays on the stack).
-  for (int i = 0; i < n; ++i) {
-    const uint8_t fl = cloth.state.flags[i];
-    if (fl & (kFlagKinematic | kFlagNoCollide | kFlagPinned | kFlagPinched)) continue;
-    const Vec3& p = x[i];
-    if (floor) consider(i, p.y(), Vec3(0, 1, 0), Vec3(p.x(), 0, p.z()));
-    for (const auto& s : scene.spheres) {
-      const Vec3 d = p - s.centre;
-      const double dn = d.norm();
-      if (dn - s.radius >= reach || dn < 1e-12) continue;
-      const Vec3 nrm = d / dn;
-      consider(i, dn - s.radius, nrm, s.centre + s.radius * nrm);
+  auto test = [&](int b, int e, double& deepest) {
+    for (int i = b; i < e; ++i) {
+      candidate_[i].vertex = -1;
+      const uint8_t fl = cloth.state.flags[i];
+      if (fl & (kFlagKinematic | kFlagNoCollide | kFlagPinned | kFlagPinched)) continue;
+      const Vec3& p = x[i];
+      if (floor) consider(i, p.y(), Vec3(0, 1, 0), Vec3(p.x(), 0, p.z()), deepest);
+      for (const auto& s : scene.spheres) {
+        const Vec3 d = p - s.centre;
+        const double dn = d.norm();
+        if (dn - s.radius >= reach || dn < 1e-12) continue;
+        const Vec3 nrm = d / dn;
+        consider(i, dn - s.radius, nrm, s.centre + s.radius * nrm, deepest);
+      }
+      for (const auto& h : scene.hands) {
+        if (!h.tracked || !h.collides) continue;
+        const Vec3 ab = h.tip - h.position;
+        const double L2 = ab.squaredNorm();
+        const double t = L2 > 0 ? std::clamp((p - h.position).dot(ab) / L2, 0.0, 1.0) : 0.0;
+        const Vec3 c = h.position + t * ab;
+        const Vec3 d = p - c;
+        const double dn = d.norm();
+        if (dn - h.radius >= reach || dn < 1e-12) continue;
+        consider(i, dn - h.radius, d / dn, c + h.radius * d / dn, deepest);
+      }
+      for (const auto& pl : scene.plates) {
+        const Vec3 d = p - pl.centre;
+        if (std::abs(d.x()) > pl.half_x || std::abs(d.z()) > pl.half_z) continue;
+        if (d.y() < -pl.thickness) continue;  // below the plate: untouched
+        consider(i, d.y(), Vec3(0, 1, 0), Vec3(p.x(), pl.centre.y(), p.z()), deepest);
+      }
+      for (const auto& b : scene.boxes) {
+        const Vec3 d = p - b.centre;
+        const Vec3 q = d.cwiseAbs() - b.half;
+        if (q.maxCoeff() >= reach) continue;
+        if ((q.array() > 0).count() > 1) continue;  // near an edge/corner outside: skip
+        int ax = 0;
+        q.maxCoeff(&ax);
+        Vec3 nrm = Vec3::Zero();
+        nrm[ax] = d[ax] >= 0 ? 1 : -1;
+        Vec3 surf = p;
+        surf[ax] = b.centre[ax] + nrm[ax] * b.half[ax];
+        consider(i, q[ax], nrm, surf, deepest);
+      }
+      if (form_on) {
+        const DressForm& f = *scene.form;
+        if (p.y() < f.min_y() || p.y() > f.max_y()) continue;
+        const double sd = f.signed_distance(p);
+        if (!(sd < reach)) continue;
+        const Vec2 c = f.centre_at(p.y());
+        Vec3 r(p.x() - c.x(), 0, p.z() - c.y());
+        const double rn = r.norm();
+        if (rn < 1e-9) continue;
+        const Vec3 nrm = r / rn;
+        consider(i, sd, nrm, p - sd * nrm, deepest);
+      }
     }
-    for (const auto& h : scene.hands) {
-      if (!h.tracked || !h.collides) continue;
-      const Vec3 ab = h.tip - h.position;
-      const double L2 = ab.squaredNorm();
-      const double t = L2 > 0 ? std::clamp((p - h.position).dot(ab) / L2, 0.0, 1.0) : 0.0;
-      const Vec3 c = h.position + t * ab;
-      const Vec3 d = p - c;
-      const double dn = d.norm();
-      if (dn - h.radius >= reach || dn < 1e-12) continue;
-      consider(i, dn - h.radius, d / dn, c + h.radius * d / dn);
-    }
-    for (const auto& pl : scene.plates) {
-      const Vec3 d = p - pl.centre;
-      if (std::abs(d.x()) > pl.half_x || std::abs(d.z()) > pl.half_z) continue;
-      if (d.y() < -pl.thickness) continue;  // below the plate: untouched
-      consider(i, d.y(), Vec3(0, 1, 0), Vec3(p.x(), pl.centre.y(), p.z()));
-    }
-    for (const auto& b : scene.boxes) {
-      const Vec3 d = p - b.centre;
-      const Vec3 q = d.cwiseAbs() - b.half;
-      if (q.maxCoeff() >= reach) continue;
-      if ((q.array() > 0).count() > 1) continue;  // near an edge/corner outside: skip
-      int ax = 0;
-      q.maxCoeff(&ax);
-      Vec3 nrm = Vec3::Zero();
-      nrm[ax] = d[ax] >= 0 ? 1 : -1;
-      Vec3 surf = p;
-      surf[ax] = b.centre[ax] + nrm[ax] * b.half[ax];
-      consider(i, q[ax], nrm, surf);
-    }
-    if (form_on) {
-      const DressForm& f = *scene.form;
-      if (p.y() < f.min_y() || p.y() > f.max_y()) continue;
-      const double sd = f.signed_distance(p);
-      if (!(sd < reach)) continue;
-      const Vec2 c = f.centre_at(p.y());
-      Vec3 r(p.x() - c.x(), 0, p.z() - c.y());
-      const double rn = r.norm();
-      if (rn < 1e-9) continue;
-      const Vec3 nrm = r / rn;
-      consider(i, sd, nrm, p - sd * nrm);
-    }
+  };
+  double deepest = 0;
+  if (pool && pool->size() > 1) {
+    deepest_part_.assign(pool->size(), 0.0);
+    pool->parallel_for(n, [&](int b, int e, int w) { test(b, e, deepest_part_[w]); });
+    for (double d : deepest_part_) deepest = std::max(deepest, d);
+  } else {
+    test(0, n, deepest);
   }
+  for (int i = 0; i < n; ++i)
+    if (candidate_[i].vertex >= 0) {
+      contact_index_[i] = static_cast<int>(contacts_.size());
+      contacts_.push_back(candidate_[i]);
+    }
   return deepest;
 }
 

@@ -18,6 +18,8 @@
 
 namespace drape::sim {
 
+class ThreadPool;  // sim/parallel.hpp
+
 using Mat9 = Eigen::Matrix<double, 9, 9>;
 using Mat12 = Eigen::Matrix<double, 12, 12>;
 
@@ -193,8 +195,9 @@ class ClothEnergy {
 
   // --- contacts (penalty 1/2 k min(0, n.(x-p))^2, detected once per step) --------------------
   // Detects contacts of every non-kinematic vertex against the scene's objects; returns the
-  // deepest penetration (m). Reuses internal storage.
-  double detect_contacts(const Cloth& cloth, const SceneObjects& scene);
+  // deepest penetration (m). Reuses internal storage. With a pool the vertices are tested in
+  // parallel and the contacts then listed in vertex order (the same list as without).
+  double detect_contacts(const Cloth& cloth, const SceneObjects& scene, ThreadPool* pool = nullptr);
   void clear_contacts();
   double contact_stiffness() const { return k_contact_; }
   void set_contact_stiffness(double k) { k_contact_ = k; }
@@ -248,6 +251,8 @@ class ClothEnergy {
   // contacts
   std::vector<Contact> contacts_;
   std::vector<int> contact_index_;
+  std::vector<Contact> candidate_;    // per vertex, the deepest candidate (vertex -1: none)
+  std::vector<double> deepest_part_;  // per pool worker
   double k_contact_ = 1e3;
   int culled_ = 0;
 

@@ -209,7 +209,7 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
     return false;
   }
   std::fill(piece_awake_.begin(), piece_awake_.end(), 0);
-  fresh_penetration_ = energy_.detect_contacts(cloth, scene);
+  fresh_penetration_ = energy_.detect_contacts(cloth, scene, pool_.get());
   if (scene.self_collision)
     self_.detect(cloth, S.x, scene.offset, energy_.options().contact_margin);
   x_det_ = S.x;
@@ -473,7 +473,8 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     }
     if (detect) {
       const auto t0 = std::chrono::steady_clock::now();
-      st.max_penetration = std::max(st.max_penetration, energy_.detect_contacts(cloth, scene));
+      st.max_penetration =
+          std::max(st.max_penetration, energy_.detect_contacts(cloth, scene, pool_.get()));
       if (scene.self_collision) self_.detect(cloth, x, scene.offset, margin);
       if (opt_.settle && settle_scale() > 1.0) {
         // Something pushed into a settling piece (a hand, a moved form): a vertex deeper than
