@@ -366,6 +366,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   const xpbd::RowBlocks rb{row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
                            row_ai_.data()};
   auto project_tris = [&](int b, int e, int) { K.tris(tris_.data(), b, e, w, xp, ih2, lam_tri); };
+  const bool padded = !tris_.empty() || row_off_.size() > 1;  // (the springs model has neither)
   auto project_hinges = [&](int b, int e, int) {
     for (int k = b; k < e; ++k) {
       const Hinge& H = hinges_[k];
@@ -527,13 +528,15 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       std::fill(lambda_spring_.begin(), lambda_spring_.end(), 0.0);
     }
     for (int it = 0; it < opt_.iterations; ++it) {
-      pool_->parallel_for(n, [&](int b, int e, int) {
-        K.pack(reinterpret_cast<const double*>(x.data()), xp, b, e);
-      });
-      by_colour(tri_col_, project_tris);
-      if (s % be == be - 1 || s == ns - 1) by_colour(row_cols_, project_rows);
-      pool_->parallel_for(
-          n, [&](int b, int e, int) { K.unpack(xp, reinterpret_cast<double*>(x.data()), b, e); });
+      if (padded) {
+        pool_->parallel_for(n, [&](int b, int e, int) {
+          K.pack(reinterpret_cast<const double*>(x.data()), xp, b, e);
+        });
+        by_colour(tri_col_, project_tris);
+        if (s % be == be - 1 || s == ns - 1) by_colour(row_cols_, project_rows);
+        pool_->parallel_for(
+            n, [&](int b, int e, int) { K.unpack(xp, reinterpret_cast<double*>(x.data()), b, e); });
+      }
       // (Hinges exist only without bending rows: the order of the two does not matter.)
       by_colour(hinge_col_, project_hinges);
       by_colour(spring_col_, project_springs);

@@ -80,8 +80,8 @@ inline double lane(const V4& a, int c) {
 // other as in classic XPBD, but in the space of F = (fu, fv): every gradient is
 // w_q (D_uq a + D_vq b) for vectors a, b, so each projection changes F by a closed form
 // (S_uu, S_vv, S_uv below) and the vertices are moved once, by the sum.
-void project_tris_each(const Tri* tris, int b, int e, const double* w, P4* x, double ih2,
-                       double* lambda) {
+void project_tris(const Tri* tris, int b, int e, const double* w, P4* x, double ih2,
+                  double* lambda) {
   for (int k = b; k < e; ++k) {
     const Tri& T = tris[k];
     const double wq[3] = {w[T.v[0]], w[T.v[1]], w[T.v[2]]};
@@ -191,9 +191,4 @@ void pack(const double* x, P4* p, int b, int e) {
 void unpack(const P4* p, double* x, int b, int e) {
   for (int i = b; i < e; ++i)
     for (int c = 0; c < 3; ++c) x[3 * i + c] = p[i].c[c];
-}
-
-void project_tris(const Tri* tris, int b, int e, const double* w, P4* x, double ih2,
-                  double* lambda) {
-  project_tris_each(tris, b, e, w, x, ih2, lambda);
 }
