@@ -72,6 +72,7 @@ std::vector<Vec3> polished(const StudyScene& end, double& residual, int max_iter
   StudyScene sc = end;
   StaticOptions so;
   so.tolerance = 1e-8;
+  so.friction = true;  // the frictional equilibrium nearest to it (the scene's objects' mu)
   // 300: a less-settled 64^2 state needed 282 iterations (docs/solvers.md "Static solver speed").
   so.max_iterations =
       max_iterations > 0 ? max_iterations : static_cast<int>(env_num("REF_ITERS", 300));

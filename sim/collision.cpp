@@ -154,10 +154,24 @@ CollisionStats Collider::project(ClothState& state, const SceneObjects& scene) {
   const size_t n = state.x.size();
   for (size_t i = 0; i < n; ++i) {
     if (!collidable(state.flags[i])) continue;
+    const Vec3 before = state.x[i];
     const double pen = push_out(state.x[i], scene);
     if (pen > 0) {
       ++st.contacts;
       st.max_penetration = std::max(st.max_penetration, pen);
+      if (scene.friction > 0 && i < state.x_prev.size()) {
+        // Coulomb friction as in ClothEnergy::project_contacts: the step's tangential motion
+        // (from x_prev, the substep's start) removed while within mu times the push-out.
+        const Vec3 push = state.x[i] - before;
+        const double pl = push.norm();
+        if (pl > 0) {
+          const Vec3 nrm = push / pl;
+          const Vec3 dx = state.x[i] - state.x_prev[i];
+          const Vec3 t = dx - nrm.dot(dx) * nrm;
+          const double tl = t.norm(), lim = scene.friction * pl;
+          state.x[i] -= tl <= lim ? t : (lim / tl) * t;
+        }
+      }
     }
   }
   return st;

@@ -50,7 +50,8 @@ class Collider {
   // Moves p out of every active object in turn; returns its largest penetration.
   double push_out(Vec3& p, const SceneObjects& scene) const;
   // Projects every collidable vertex (not pinned, pinched, kinematic or kNoCollide) out of the
-  // objects, changing only x (for position-based solvers).
+  // objects, changing only x (for position-based solvers). With scene.friction > 0, Coulomb
+  // friction against the motion since x_prev (the substep's start).
   CollisionStats project(ClothState& state, const SceneObjects& scene);
   // eq. 3-7 of the study: for each collidable vertex closer than the offset, the response
   // displacement F_resp dt^2 / m = -(eps - d) n (it moves the vertex to distance eps) is written

@@ -52,6 +52,7 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
   opt_ = opt;
   num_vertices_ = cloth.num_vertices();
   built_version_ = cloth.topology_version;
+  friction_mu_ = 0;  // anchors and loads belong to the old vertices
   const auto& topo = cloth.topo;
   const FabricParams& fab = cloth.fabric;
   ku_ = fab.stretch_weft;
@@ -1002,11 +1003,83 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
   return deepest;
 }
 
-void ClothEnergy::project_contacts(std::vector<Vec3>& x) const {
+void ClothEnergy::project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start,
+                                   double mu) const {
+  const bool friction = start && mu > 0;
   for (const auto& c : contacts_) {
-    const double d = c.n.dot(x[c.vertex] - c.p);
-    if (d < 0) x[c.vertex] -= d * c.n;
+    Vec3& xi = x[c.vertex];
+    const double d = c.n.dot(xi - c.p);
+    if (d >= 0) continue;
+    xi -= d * c.n;
+    if (!friction) continue;
+    // The substep's tangential motion against the (static) surface, limited by mu times the
+    // normal correction: all of it removed while within (sticking), mu |d| of it otherwise.
+    const Vec3 dx = xi - (*start)[c.vertex];
+    const Vec3 t = dx - c.n.dot(dx) * c.n;
+    const double tl = t.norm();
+    const double lim = -mu * d;
+    xi -= tl <= lim ? t : (lim / tl) * t;
   }
+}
+
+void ClothEnergy::set_friction(double mu, double eps, const std::vector<Vec3>& anchor) {
+  friction_mu_ = mu;
+  friction_eps_ = eps;
+  friction_anchor_ = anchor;
+  friction_load_.assign(num_vertices_, 0.0);
+}
+
+void ClothEnergy::lag_friction_load(const std::vector<Vec3>& x, const std::vector<double>& mass) {
+  const double mu = friction_mu_, k = k_contact_;
+  friction_mu_ = 0;  // the load is -dE/dx without the friction and the contact terms
+  std::vector<Vec3> g;
+  gradient(x, mass, g);
+  friction_mu_ = mu;
+  friction_load_.assign(num_vertices_, 0.0);
+  for (const auto& c : contacts_) {
+    // Touching only: on the plane or within 0.2 mm of it (a position-based solver leaves its
+    // contacts on the plane it last projected to, which on a curved form sits up to ~0.1 mm
+    // off the plane found now); a vertex hovering further out within the detection margin
+    // carries no load, whatever pulls it toward the surface.
+    const double d = c.n.dot(x[c.vertex] - c.p);
+    if (d > 2e-4) continue;
+    const Vec3 gi = d < 0 ? Vec3(g[c.vertex] - k * d * c.n) : g[c.vertex];
+    friction_load_[c.vertex] = std::max(0.0, c.n.dot(gi));
+  }
+}
+
+void ClothEnergy::lag_friction_penalty(const std::vector<Vec3>& x) {
+  friction_load_.assign(num_vertices_, 0.0);
+  for (const auto& c : contacts_)
+    friction_load_[c.vertex] = std::max(0.0, -k_contact_ * c.n.dot(x[c.vertex] - c.p));
+}
+
+namespace {
+// IPC's smoothed friction: f0 (the potential per unit load) and f1(y)/y (the force's factor).
+double friction_f0(double y, double eps) {
+  return y < eps ? y * y / eps - y * y * y / (3 * eps * eps) + eps / 3 : y;
+}
+double friction_f1_over_y(double y, double eps) {
+  return y < eps ? 2 / eps - y / (eps * eps) : 1 / y;
+}
+}  // namespace
+
+void ClothEnergy::friction_gradient_hessian(int i, const Vec3& xi, Vec3& g, Mat3* H) const {
+  g.setZero();
+  if (H) H->setZero();
+  const int ci = friction_mu_ > 0 ? contact_index_[i] : -1;
+  if (ci < 0 || friction_load_[i] <= 0) return;
+  const Vec3& n = contacts_[ci].n;
+  const Mat3 T = Mat3::Identity() - n * n.transpose();
+  const Vec3 u = T * (xi - friction_anchor_[i]);
+  const double y = u.norm(), eps = friction_eps_, s = friction_mu_ * friction_load_[i];
+  const double a = friction_f1_over_y(y, eps);
+  g = s * a * u;
+  if (!H) return;
+  // d(a u)/dx = a T + a'(y)/y u u^T with a' = -1/eps^2 (y < eps) or -1/y^2: both PSD in the
+  // tangent plane (eigenvalue along u: 2 (eps - y)/eps^2 >= 0, or 0 beyond eps).
+  const double b = y < eps ? -1 / (eps * eps * std::max(y, 1e-300)) : -1 / (y * y * y);
+  *H = s * (a * T + (y > 0 ? b : 0.0) * u * u.transpose());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1029,6 +1102,11 @@ double ClothEnergy::energy(const std::vector<Vec3>& x, const std::vector<double>
   for (const auto& c : contacts_) {
     const double d = c.n.dot(x[c.vertex] - c.p);
     if (d < 0) e += 0.5 * k_contact_ * d * d;
+    if (friction_mu_ > 0 && friction_load_[c.vertex] > 0) {
+      const Vec3 r = x[c.vertex] - friction_anchor_[c.vertex];
+      const double y = (r - c.n.dot(r) * c.n).norm();
+      e += friction_mu_ * friction_load_[c.vertex] * friction_f0(y, friction_eps_);
+    }
   }
   return e;
 }
@@ -1051,6 +1129,11 @@ void ClothEnergy::gradient(const std::vector<Vec3>& x, const std::vector<double>
   for (const auto& c : contacts_) {
     const double d = c.n.dot(x[c.vertex] - c.p);
     if (d < 0) grad[c.vertex] += k_contact_ * d * c.n;
+    if (friction_mu_ > 0) {
+      Vec3 gf;
+      friction_gradient_hessian(c.vertex, x[c.vertex], gf, nullptr);
+      grad[c.vertex] += gf;
+    }
   }
 }
 
@@ -1103,6 +1186,13 @@ void ClothEnergy::vertex_force_hessian(int i, const std::vector<Vec3>& x, double
     if (d < 0) {
       f -= k_contact_ * d * c.n;
       H += k_contact_ * c.n * c.n.transpose();
+    }
+    if (friction_mu_ > 0) {
+      Vec3 gf;
+      Mat3 Hf;
+      friction_gradient_hessian(i, x[i], gf, &Hf);
+      f -= gf;
+      H += Hf;
     }
   }
 }

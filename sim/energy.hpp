@@ -204,8 +204,32 @@ class ClothEnergy {
   // Index of the contact of vertex i, or -1.
   int contact_of(int i) const { return contact_index_[i]; }
   const std::vector<Contact>& contacts() const { return contacts_; }
-  // Projects x onto every contact's half-space (used by position-based solvers).
-  void project_contacts(std::vector<Vec3>& x) const;
+  // Projects x onto every contact's half-space (used by position-based solvers). With `start`
+  // (the positions where the substep began) and mu > 0, Coulomb friction as a position
+  // correction: the tangential motion of the substep is removed when it is within mu times
+  // the normal correction (static), else shortened by that much (kinetic).
+  void project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start = nullptr,
+                        double mu = 0) const;
+
+  // --- friction for the energy-based solvers (Newton, VBD, the static solve) -----------------
+  // Coulomb friction as IPC's lagged dissipation potential: over the vertices with a contact,
+  // D = sum_i mu lambda_i f0(|u_i|), u_i = T_i (x_i - a_i), T_i = I - n_i n_i^T (n_i the normal
+  // of its current contact), a_i its anchor (where the step or the static solve started),
+  // lambda_i its normal load held fixed while minimising (lagged), and f0 smoothed below eps:
+  // f0(y) = y^2/eps - y^3/(3 eps^2) + eps/3 (y < eps), y beyond (C1; f0' = 1 beyond eps, so the
+  // force is mu lambda once sliding). energy(), gradient() and vertex_force_hessian() include
+  // it once set_friction() was called, until clear_friction().
+  void set_friction(double mu, double eps, const std::vector<Vec3>& anchor);
+  void clear_friction() { friction_mu_ = 0; }
+  bool friction_on() const { return friction_mu_ > 0; }
+  // Normal loads from the state: the part of -(dE/dx) without contact and friction terms that
+  // presses each contact vertex into its plane (a static load), or the penalty's k max(0, -d)
+  // (a step of a penalty solver, whose contacts carry the inertia too).
+  void lag_friction_load(const std::vector<Vec3>& x, const std::vector<double>& mass);
+  void lag_friction_penalty(const std::vector<Vec3>& x);
+  double friction_load(int i) const { return friction_load_[i]; }
+  // Vertex i's friction gradient (dD/dx_i) and its 3x3 Hessian block (PSD), zero without one.
+  void friction_gradient_hessian(int i, const Vec3& xi, Vec3& g, Mat3* H) const;
   int num_culled_objects() const { return culled_; }
 
   // --- per-vertex queries for block descent --------------------------------------------------
@@ -255,6 +279,10 @@ class ClothEnergy {
   std::vector<double> deepest_part_;  // per pool worker
   double k_contact_ = 1e3;
   int culled_ = 0;
+  // friction (set_friction)
+  double friction_mu_ = 0, friction_eps_ = 1e-4;
+  std::vector<Vec3> friction_anchor_;
+  std::vector<double> friction_load_;
 
   void build_vertex_lists();
   void build_tensor_bending(const Cloth& cloth);

@@ -42,6 +42,13 @@ struct HandProxy {
   bool collides = false;  // push cloth away (hand as obstacle)
 };
 
+// Coulomb friction of muslin on a dress form's linen cover (woven cotton on woven cotton or
+// linen: static coefficients of about 0.4-0.6 are reported; this is the middle).
+inline constexpr double kFormFriction = 0.5;
+// The energy-based solvers' friction (Newton, VBD) sticks below this tangential speed (m/s):
+// IPC's eps_v, the smoothing width of the lagged friction potential is eps_v h.
+inline constexpr double kFrictionSlipSpeed = 1e-3;
+
 // Everything the cloth can touch.
 struct SceneObjects {
   std::shared_ptr<const DressForm> form;  // may be null
@@ -51,6 +58,11 @@ struct SceneObjects {
   std::vector<HandProxy> hands;
   bool floor = true;      // the stage floor y = 0
   double offset = 0.002;  // cloth thickness / collision offset (m): kept-out distance
+  // Coulomb friction coefficient of the cloth on every object (0: frictionless). Muslin on a
+  // dress form's linen cover or on itself: ~0.4-0.6 (kFormFriction). Position-based solvers
+  // apply it in their contact projection, Newton and VBD through a lagged dissipation
+  // potential (ClothEnergy::set_friction), the static solve too (docs/solvers.md).
+  double friction = 0;
   // The cloth against itself (vertex-triangle pairs found through a spatial hash, kept
   // `offset` apart; sim/self_collision.hpp). Off unless the scene asks: it costs a hash build
   // per contact detection and a pass per substep. Solved by XPBD (the default solver); the

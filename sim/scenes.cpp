@@ -122,6 +122,7 @@ StudyScene make_form_drape(int res, const FabricParams& fabric, bool fall) {
   for (int i = 0; i < res; ++i) s.cloth.state.flags[(res - 1) * res + i] |= kFlagPinned;
   s.cloth.relump_masses();
   s.objects.floor = true;
+  s.objects.friction = kFormFriction;  // muslin does not slide on a dress form's cover
   return s;
 }
 
@@ -141,6 +142,7 @@ StudyScene make_sphere_drape(int res, const FabricParams& fabric) {
   s.cloth.state.flags[(n / 2) * n + n / 2] |= kFlagPinned;
   s.cloth.relump_masses();
   s.objects.floor = true;
+  s.objects.friction = kFormFriction;
   s.duration = 2.0;
   return s;
 }

@@ -7,6 +7,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -138,6 +140,12 @@ void NewtonSolver::assemble(const Cloth& cloth, double inv_h2, double mu, bool e
     if (ci >= 0 && contact_active_[ci]) {
       const Contact& c = energy_.contacts()[ci];
       B += energy_.contact_stiffness() * c.n * c.n.transpose();
+    }
+    if (energy_.friction_on()) {
+      Vec3 gf;
+      Mat3 Hf;
+      energy_.friction_gradient_hessian(i, S.x[i], gf, &Hf);
+      B += Hf;
     }
     add_block(i, i, B);
   }
@@ -433,6 +441,9 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
       ++counters_.projected_steps;
     const double step = alpha * dx_.cwiseAbs().maxCoeff();
     counters_.last_step = step;
+    if (trace_)
+      std::fprintf(stderr, "newton it %d res %.3e alpha %.3g step %.3e exact %d mu %.1e\n", it,
+                   residual, alpha, step, exact ? 1 : 0, mu);
     if (mu > 0) mu = std::max(mu * 0.3, 1e-9);
     if (mu < 1e-8) mu = 0;
     // Position rule: a full step below the tolerance whose length contracts (ratio r < 0.5
@@ -466,6 +477,16 @@ StepStats NewtonSolver::step(Cloth& cloth, const SceneObjects& scene, double dt)
     st.max_penetration = std::max(st.max_penetration, energy_.detect_contacts(cloth, scene));
     st.collision_ms +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (scene.friction > 0) {
+      // Friction anchored where the step starts, sticking below a slip speed of
+      // kFrictionSlipSpeed; the normal loads lagged from the forces there (the penalty's own
+      // force at the start of an implicit step is often zero: the step before ended on the
+      // plane, measured on a sliding cloth).
+      energy_.set_friction(scene.friction, kFrictionSlipSpeed * h, S.x);
+      energy_.lag_friction_load(S.x, S.mass);
+    } else {
+      energy_.clear_friction();
+    }
     const Vec3 g = opt_.energy.gravity ? opt_.energy.g : Vec3::Zero();
     for (int i = 0; i < n; ++i) {
       xt_[i] = S.x[i];
@@ -511,8 +532,18 @@ StaticResult relax_static(Cloth& cloth, const SceneObjects& scene, const StaticO
   int total = 0;
   double res = 0, prev_res = std::numeric_limits<double>::infinity();
   bool step_converged = false;
+  // Friction: anchored where the solve starts (the state it polishes), the normal loads lagged
+  // once per round (held fixed while minimising: a fixed objective for the line search; the
+  // rounds end when a re-lagged round has nothing left to do); within friction_eps of its
+  // anchor a contact vertex sticks.
+  const bool friction = opt.contacts && opt.friction && scene.friction > 0;
+  const std::vector<Vec3> anchor = friction ? S.x : std::vector<Vec3>{};
   for (int round = 0; round < 8; ++round) {
     if (opt.contacts) solver.energy().detect_contacts(cloth, scene);
+    if (friction) {
+      solver.energy().set_friction(scene.friction, opt.friction_eps, anchor);
+      solver.energy().lag_friction_load(S.x, S.mass);
+    }
     const int it =
         solver.minimise(cloth, scene, 0.0, nullptr, opt.tolerance, opt.max_iterations - total, res);
     total += it;

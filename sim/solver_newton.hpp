@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdlib>
 #include <memory>
 #include <vector>
 
@@ -90,6 +91,8 @@ class NewtonSolver : public Solver {
   bool analysed_ = false;
   double step_tolerance_ = 0;
   bool redetect_ = false;
+  // DRAPE_NEWTON_TRACE set: one line per Newton iteration on stderr (residual, step, Hessian).
+  bool trace_ = std::getenv("DRAPE_NEWTON_TRACE") != nullptr;
   Counters counters_;
   std::vector<Vec3> grad_, xtrial_, y_, xt_;
   std::vector<char> contact_active_;  // per contact: in the Newton model's active set
@@ -111,6 +114,15 @@ struct StaticOptions {
   EnergyOptions energy;  // e.g. pressure toward the form (method 2.1), gravity off/on
   bool contacts = true;  // penalty contact against the scene's objects (redetected)
   double contact_stiffness = 0;
+  // Coulomb friction (SceneObjects::friction > 0): contact vertices anchored where the solve
+  // starts, sticking while their tangential load is within mu times the normal one (the
+  // smoothed potential of ClothEnergy::set_friction, sticking within friction_eps). The
+  // minimum is then the frictional equilibrium nearest to the start: on a form with friction,
+  // not the far end of a frictionless slide.
+  // Off by default: a solve from far away (a flat panel onto a form: geometric draping) asks
+  // for the energy's minimum, not for where friction would have held the panel.
+  bool friction = false;
+  double friction_eps = 1e-4;  // m
 };
 
 struct StaticResult {

@@ -68,6 +68,14 @@ double VbdSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, Ste
     energy_.set_contact_stiffness(std::max(1e4, 1e3 * mmax / (h * h)));
   }
   st.max_penetration = std::max(st.max_penetration, energy_.detect_contacts(cloth, scene));
+  if (scene.friction > 0) {
+    // Friction anchored at the substep's start, loads from the penalty there (lagged, as in
+    // the VBD paper), sticking below kFrictionSlipSpeed.
+    energy_.set_friction(scene.friction, kFrictionSlipSpeed * h, S.x);
+    energy_.lag_friction_penalty(S.x);
+  } else {
+    energy_.clear_friction();
+  }
   st.collision_ms +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 

@@ -540,7 +540,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       // (Hinges exist only without bending rows: the order of the two does not matter.)
       by_colour(hinge_col_, project_hinges);
       by_colour(spring_col_, project_springs);
-      energy_.project_contacts(x);
+      energy_.project_contacts(x, &xt_, scene.friction);
       if (scene.self_collision) self_.project(cloth, x, w, scene.offset);
       ++st.iterations;
     }

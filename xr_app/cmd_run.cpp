@@ -125,6 +125,7 @@ int run_headless(int argc, char** argv) {
   World world;
   world.scene.form = std::make_shared<const DressForm>(std::move(form.value()));
   world.scene.offset = 0.003;
+  world.scene.friction = kFormFriction;  // muslin stays where the hand lays it on the form
   const DressForm& f = *world.scene.form;
   const double width = 0.6, height = 0.7;
   PanelSpec spec;
