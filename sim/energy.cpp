@@ -1032,7 +1032,7 @@ void ClothEnergy::set_friction(double mu, double eps, const std::vector<Vec3>& a
 void ClothEnergy::lag_friction_load(const std::vector<Vec3>& x, const std::vector<double>& mass) {
   const double mu = friction_mu_, k = k_contact_;
   friction_mu_ = 0;  // the load is -dE/dx without the friction and the contact terms
-  std::vector<Vec3> g;
+  std::vector<Vec3>& g = friction_grad_;
   gradient(x, mass, g);
   friction_mu_ = mu;
   friction_load_.assign(num_vertices_, 0.0);

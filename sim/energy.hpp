@@ -283,6 +283,8 @@ class ClothEnergy {
   double friction_mu_ = 0, friction_eps_ = 1e-4;
   std::vector<Vec3> friction_anchor_;
   std::vector<double> friction_load_;
+  std::vector<Vec3>
+      friction_grad_;  // lag_friction_load's scratch gradient (no allocation per step)
 
   void build_vertex_lists();
   void build_tensor_bending(const Cloth& cloth);
