@@ -19,7 +19,9 @@ struct VbdOptions {
   // kInertiaGravity x + h v + h^2 g (full gravity: biases an under-converged solve downwards,
   // so a cloth at rest is not a fixed point); kAdaptive x + h v + h^2 a~ with a~ the previous
   // substep's acceleration projected on gravity, clamped to [0, |g|] (the default: a cloth at
-  // rest stays exactly at rest, a falling one gets the full gravity term).
+  // rest stays exactly at rest, a falling one gets the full gravity term); for a vertex
+  // touching a surface, that term's normal part plus the slide of a block there (gravity's
+  // tangential part less the scene's friction times its normal part).
   enum class Init { kInertia, kInertiaGravity, kAdaptive };
   Init init = Init::kAdaptive;
   int substeps = 2;
