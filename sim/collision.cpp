@@ -160,17 +160,11 @@ CollisionStats Collider::project(ClothState& state, const SceneObjects& scene) {
       ++st.contacts;
       st.max_penetration = std::max(st.max_penetration, pen);
       if (scene.friction > 0 && i < state.x_prev.size()) {
-        // Coulomb friction as in ClothEnergy::project_contacts: the step's tangential motion
-        // (from x_prev, the substep's start) removed while within mu times the push-out.
+        // Against the motion since x_prev (the substep's start), along the push-out.
         const Vec3 push = state.x[i] - before;
         const double pl = push.norm();
-        if (pl > 0) {
-          const Vec3 nrm = push / pl;
-          const Vec3 dx = state.x[i] - state.x_prev[i];
-          const Vec3 t = dx - nrm.dot(dx) * nrm;
-          const double tl = t.norm(), lim = scene.friction * pl;
-          state.x[i] -= tl <= lim ? t : (lim / tl) * t;
-        }
+        if (pl > 0)
+          coulomb_position_friction(state.x[i], state.x_prev[i], push / pl, pl, scene.friction);
       }
     }
   }

@@ -1011,14 +1011,7 @@ void ClothEnergy::project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>
     const double d = c.n.dot(xi - c.p);
     if (d >= 0) continue;
     xi -= d * c.n;
-    if (!friction) continue;
-    // The substep's tangential motion against the (static) surface, limited by mu times the
-    // normal correction: all of it removed while within (sticking), mu |d| of it otherwise.
-    const Vec3 dx = xi - (*start)[c.vertex];
-    const Vec3 t = dx - c.n.dot(dx) * c.n;
-    const double tl = t.norm();
-    const double lim = -mu * d;
-    xi -= tl <= lim ? t : (lim / tl) * t;
+    if (friction) coulomb_position_friction(xi, (*start)[c.vertex], c.n, -d, mu);
   }
 }
 
@@ -1064,14 +1057,18 @@ double friction_f1_over_y(double y, double eps) {
 }
 }  // namespace
 
+Vec3 ClothEnergy::friction_slip(const Contact& c, const Vec3& xi) const {
+  const Vec3 r = xi - friction_anchor_[c.vertex];
+  return r - c.n.dot(r) * c.n;
+}
+
 void ClothEnergy::friction_gradient_hessian(int i, const Vec3& xi, Vec3& g, Mat3* H) const {
   g.setZero();
   if (H) H->setZero();
   const int ci = friction_mu_ > 0 ? contact_index_[i] : -1;
   if (ci < 0 || friction_load_[i] <= 0) return;
   const Vec3& n = contacts_[ci].n;
-  const Mat3 T = Mat3::Identity() - n * n.transpose();
-  const Vec3 u = T * (xi - friction_anchor_[i]);
+  const Vec3 u = friction_slip(contacts_[ci], xi);
   const double y = u.norm(), eps = friction_eps_, s = friction_mu_ * friction_load_[i];
   const double a = friction_f1_over_y(y, eps);
   g = s * a * u;
@@ -1079,6 +1076,7 @@ void ClothEnergy::friction_gradient_hessian(int i, const Vec3& xi, Vec3& g, Mat3
   // d(a u)/dx = a T + a'(y)/y u u^T with a' = -1/eps^2 (y < eps) or -1/y^2: both PSD in the
   // tangent plane (eigenvalue along u: 2 (eps - y)/eps^2 >= 0, or 0 beyond eps).
   const double b = y < eps ? -1 / (eps * eps * std::max(y, 1e-300)) : -1 / (y * y * y);
+  const Mat3 T = Mat3::Identity() - n * n.transpose();
   *H = s * (a * T + (y > 0 ? b : 0.0) * u * u.transpose());
 }
 
@@ -1102,11 +1100,9 @@ double ClothEnergy::energy(const std::vector<Vec3>& x, const std::vector<double>
   for (const auto& c : contacts_) {
     const double d = c.n.dot(x[c.vertex] - c.p);
     if (d < 0) e += 0.5 * k_contact_ * d * d;
-    if (friction_mu_ > 0 && friction_load_[c.vertex] > 0) {
-      const Vec3 r = x[c.vertex] - friction_anchor_[c.vertex];
-      const double y = (r - c.n.dot(r) * c.n).norm();
-      e += friction_mu_ * friction_load_[c.vertex] * friction_f0(y, friction_eps_);
-    }
+    if (friction_mu_ > 0 && friction_load_[c.vertex] > 0)
+      e += friction_mu_ * friction_load_[c.vertex] *
+           friction_f0(friction_slip(c, x[c.vertex]).norm(), friction_eps_);
   }
   return e;
 }

@@ -283,9 +283,11 @@ class ClothEnergy {
   double friction_mu_ = 0, friction_eps_ = 1e-4;
   std::vector<Vec3> friction_anchor_;
   std::vector<double> friction_load_;
-  std::vector<Vec3>
-      friction_grad_;  // lag_friction_load's scratch gradient (no allocation per step)
+  // lag_friction_load's scratch gradient (no allocation per step)
+  std::vector<Vec3> friction_grad_;
 
+  // The tangential part of contact c's vertex's motion from its friction anchor.
+  Vec3 friction_slip(const Contact& c, const Vec3& xi) const;
   void build_vertex_lists();
   void build_tensor_bending(const Cloth& cloth);
   void stress(int t, const std::vector<Vec3>& x, Eigen::Matrix<double, 3, 2>& F,

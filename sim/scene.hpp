@@ -49,6 +49,18 @@ inline constexpr double kFormFriction = 0.5;
 // IPC's eps_v, the smoothing width of the lagged friction potential is eps_v h.
 inline constexpr double kFrictionSlipSpeed = 1e-3;
 
+// Coulomb friction as a position correction (the position-based solvers' contact step): x was
+// just pushed `push` (m, > 0) along the unit normal n out of a surface at rest; the tangential
+// part of its motion since `start` is removed while within mu * push (sticking), else shortened
+// by mu * push (sliding). With push = g_n h^2 for a resting vertex this is Coulomb's law per step.
+inline void coulomb_position_friction(Vec3& x, const Vec3& start, const Vec3& n, double push,
+                                      double mu) {
+  const Vec3 dx = x - start;
+  const Vec3 t = dx - n.dot(dx) * n;
+  const double tl = t.norm(), lim = mu * push;
+  x -= tl <= lim ? t : (lim / tl) * t;
+}
+
 // Everything the cloth can touch.
 struct SceneObjects {
   std::shared_ptr<const DressForm> form;  // may be null
