@@ -275,7 +275,10 @@ int probe(int argc, char** argv) {
       xp->options().settle = env_num("XPBD_SETTLE", 1) > 0;
       xp->options().freeze = env_num("XPBD_FREEZE", 0) > 0;
       xp->options().settle_mass_scale = env_num("XPBD_SETTLE_SCALE", 64);
-      xp->options().settle_damping = env_num("XPBD_SETTLE_DAMP", 5);
+      xp->options().settle_damping = env_num("XPBD_SETTLE_DAMP", xp->options().settle_damping);
+      xp->options().contact_snap_depth = env_num("XPBD_SNAP", xp->options().contact_snap_depth);
+      xp->options().settle_sleep_steps =
+          static_cast<int>(env_num("XPBD_SLEEP_STEPS", xp->options().settle_sleep_steps));
       xp->options().settle_speed = env_num("XPBD_SETTLE_SPEED", xp->options().settle_speed);
       xp->options().settle_growth = env_num("XPBD_SETTLE_GROWTH", xp->options().settle_growth);
     }
@@ -318,16 +321,62 @@ int probe(int argc, char** argv) {
   }
   std::printf("%s %d %s %dx%d: wall %.3f ms/frame, cpu %.3f ms/frame\n", scene.c_str(), res,
               solver.c_str(), ns, it, wall / frames, cpu / frames);
+  {
+    // The fastest vertices at the end (a drape at rest should have none): speed, height, distance
+    // from the form's surface.
+    std::vector<int> idx(sc.cloth.state.x.size());
+    for (size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<int>(i);
+    const auto& v = sc.cloth.state.v;
+    const size_t k = std::min<size_t>(5, idx.size());
+    std::partial_sort(idx.begin(), idx.begin() + k, idx.end(),
+                      [&](int a, int b) { return v[a].squaredNorm() > v[b].squaredNorm(); });
+    std::printf("fastest vertices at the end:");
+    for (size_t j = 0; j < k; ++j) {
+      const int i = idx[j];
+      const double sd = sc.objects.form ? sc.objects.form->signed_distance(sc.cloth.state.x[i]) : 1;
+      std::printf(" [%d: %.2f mm/s, y %.3f m, sd %.2f mm]", i, v[i].norm() * 1e3,
+                  sc.cloth.state.x[i].y(), sd * 1e3);
+    }
+    std::printf("\n");
+  }
   if (auto* xp = xpbd_of(s.get()))
     std::printf("xpbd: %.2f contact detections per frame\n",
                 double(xp->contact_detections()) / frames);
   if (path_dependent(scene) && env_num("PROBE_POLISH", 1) > 0) {
     double res_polish = 0, rms = 0, mx = 0;
-    position_error(sc.cloth.state.x, polished(sc, res_polish), rms, mx);
+    const std::vector<Vec3> pol = polished(sc, res_polish);
+    position_error(sc.cloth.state.x, pol, rms, mx);
     std::printf(
         "error against the equilibrium nearest to the end state: rms %.3f mm, max %.3f mm "
         "(static polish residual %.1e)\n",
         rms * 1e3, mx * 1e3, res_polish);
+    // Where the error is: vertices touching an object (within 0.5 mm of the kept-out shell)
+    // and free ones, and the worst vertex's height and displacement.
+    double e_touch = 0, e_free = 0, worst = -1;
+    int n_touch = 0, n_free = 0, iw = 0;
+    for (size_t i = 0; i < pol.size(); ++i) {
+      const double e2 = (sc.cloth.state.x[i] - pol[i]).squaredNorm();
+      const double sd =
+          sc.objects.form ? sc.objects.form->signed_distance(sc.cloth.state.x[i]) : 1.0;
+      if (sd < sc.objects.offset + 5e-4) {
+        e_touch += e2;
+        ++n_touch;
+      } else {
+        e_free += e2;
+        ++n_free;
+      }
+      if (e2 > worst) {
+        worst = e2;
+        iw = static_cast<int>(i);
+      }
+    }
+    const Vec3 d = pol[iw] - sc.cloth.state.x[iw];
+    std::printf(
+        "  touching the form: %d vertices, rms %.3f mm; free: %d, rms %.3f mm; worst vertex %d at "
+        "y %.3f m moves (%.2f %.2f %.2f) mm\n",
+        n_touch, n_touch ? std::sqrt(e_touch / n_touch) * 1e3 : 0.0, n_free,
+        n_free ? std::sqrt(e_free / n_free) * 1e3 : 0.0, iw, sc.cloth.state.x[iw].y(), d.x() * 1e3,
+        d.y() * 1e3, d.z() * 1e3);
   }
   return 0;
 }

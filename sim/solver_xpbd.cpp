@@ -255,7 +255,21 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
       S.x_prev[i] = S.x[i];
     }
   }
+  snap_to_contacts(cloth);
+  x_det_ = S.x;
   return all_frozen;
+}
+
+void XpbdSolver::snap_to_contacts(Cloth& cloth) {
+  const double lim = opt_.contact_snap_depth;
+  if (lim <= 0) return;
+  auto& S = cloth.state;
+  for (const Contact& c : energy_.contacts()) {
+    const int i = c.vertex;
+    if (!cloth.is_free(i) || (S.flags[i] & kFlagFrozen)) continue;
+    const double d = c.n.dot(S.x[i] - c.p);
+    if (d < 0 && d > -lim) S.x[i] -= d * c.n;
+  }
 }
 
 void XpbdSolver::unsettle(int piece) {
@@ -490,6 +504,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
             unsettle(piece_of_[i]);
         }
       }
+      snap_to_contacts(cloth);
       x_det_ = x;
       ++detections_;
       st.collision_ms +=

@@ -52,6 +52,15 @@ struct XpbdOptions {
   // contact planes of the others are still tangent within a few hundredths of a mm. false:
   // detection every substep (the old behaviour, kept to measure against).
   bool reuse_contacts = true;
+  // At each contact detection, a simulated vertex found at most this deep (m) inside its fresh
+  // contact plane is moved onto it before the substep starts, as a correction of position and
+  // not as motion (its velocity is kept). Between detections a vertex slides on the plane
+  // found last; where the form curves inward (under the bust, at the waist) that tangent plane
+  // runs up to ~0.2 mm inside the surface, and the next detection's push, taken as motion,
+  // gave the vertex ~0.2 m/s for a substep: the settled drape never stopped jittering
+  // (docs/solvers.md section 3g). Deeper pushes (an object moving into the cloth) are motion as
+  // before. 0: off.
+  double contact_snap_depth = 1e-3;
   // Bending blocks projected every n-th substep with compliance alpha / (n h^2) (multi-rate: the
   // same bending impulse per n substeps). Measured (docs/solvers.md): n = 2 costs ~30 % less
   // per frame; at 32^2 the error is the same (form 40 substeps 1.45 vs 1.66 mm, sphere 20
@@ -83,10 +92,19 @@ struct XpbdOptions {
   double settle_growth = 1.05;
   int settle_grow_steps = 10;
   double settle_mass_scale = 64;
-  double settle_damping = 5.0;  // 1/s
+  // A settling piece's air drag (1/s). About critical for its slowest mode, the free flap's
+  // swing under gravity, sqrt(g / L / scale) ~ 0.7 rad/s at the full scale (L ~ 0.3 m): a
+  // heavier drag makes that mode creep (overdamped, rate ~ w^2 / c), a lighter one lets it
+  // swing. Measured on the form drape (10x1, error from the nearest equilibrium after 3 / 8 s,
+  // docs/solvers.md section 3g): 16^2 3.46 / 2.98 mm at 5/s -> 2.80 / 0.41 mm at 1.5/s, 32^2
+  // 1.46 / 0.89 -> 2.06 / 0.86 mm, 64^2 10.4 / 4.43 -> 6.19 / 1.87 mm.
+  double settle_damping = 1.5;
   // With freeze: a piece at the full scale for this many substeps sleeps even if it still
-  // creeps (a drape sliding along the frictionless form at mm/s).
-  int settle_sleep_steps = 900;
+  // moves (a safety net: a settled piece normally sleeps on the rest test above). It was 900
+  // while re-detected contacts kept a settled drape jittering (contact_snap_depth), which
+  // froze the 128^2 drape at 4.2 s, still 8.2 mm RMS from its equilibrium; at 4500 it rests
+  // at 8.2 s, 3.2 mm from it (docs/solvers.md section 3g).
+  int settle_sleep_steps = 4500;
 };
 
 class XpbdSolver : public Solver {
@@ -161,6 +179,9 @@ class XpbdSolver : public Solver {
   std::vector<int> piece_full_;      // settling: substeps at the full scale
   std::vector<uint8_t> fixed_prev_;  // settling: vertex was fixed at the last step
   void unsettle(int piece);
+  // Moves simulated vertices lying up to contact_snap_depth inside a fresh contact plane onto
+  // it (position only; see XpbdOptions::contact_snap_depth).
+  void snap_to_contacts(Cloth& cloth);
   int num_pieces_ = 0, frozen_count_ = 0;
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
   std::vector<Vec3> x_det_;      // positions at the last contact detection

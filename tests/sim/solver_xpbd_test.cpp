@@ -20,7 +20,9 @@ TEST(Xpbd, ChainSupportForceEqualsTotalWeight) {
   o.iterations = 20;
   o.damping = 2.0;
   XpbdSolver s(o);
-  expect_chain_carries_its_weight(s, 400, "XPBD", 0.02);
+  // 900 frames (10 s): with the settling drag near critical for the slowest mode (1.5/s) the
+  // chain still swings at 400 frames (support force 8.5 % off); at 900 it is 0.009 % off.
+  expect_chain_carries_its_weight(s, 900, "XPBD", 0.02);
 }
 
 TEST(Xpbd, HangingSheetNearNewtonReference) {
