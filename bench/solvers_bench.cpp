@@ -350,7 +350,7 @@ int probe(int argc, char** argv) {
         "error against the equilibrium nearest to the end state: rms %.3f mm, max %.3f mm "
         "(static polish residual %.1e)\n",
         rms * 1e3, mx * 1e3, res_polish);
-    // Where the error is: vertices touching an object (within 0.5 mm of the kept-out shell)
+    // Where the error is: vertices touching the form (within 0.5 mm of the kept-out shell)
     // and free ones, and the worst vertex's height and displacement.
     double e_touch = 0, e_free = 0, worst = -1;
     int n_touch = 0, n_free = 0, iw = 0;

@@ -212,8 +212,7 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
   fresh_penetration_ = energy_.detect_contacts(cloth, scene, pool_.get());
   if (scene.self_collision)
     self_.detect(cloth, S.x, scene.offset, energy_.options().contact_margin);
-  x_det_ = S.x;
-  ++detections_;
+  ++detections_;           // (x_det_ is taken at the end, after the snap)
   contacts_fresh_ = true;  // the first substep reuses them (same positions)
   for (int i = 0; i < n; ++i) {
     const int p = piece_of_[i];

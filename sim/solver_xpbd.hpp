@@ -94,7 +94,7 @@ struct XpbdOptions {
   double settle_mass_scale = 64;
   // A settling piece's air drag (1/s). About critical for its slowest mode, the free flap's
   // swing under gravity, sqrt(g / L / scale) ~ 0.7 rad/s at the full scale (L ~ 0.3 m): a
-  // heavier drag makes that mode creep (overdamped, rate ~ w^2 / c), a lighter one lets it
+  // heavier drag makes that mode creep (overdamped, rate ~ omega^2 / c), a lighter one lets it
   // swing. Measured on the form drape (10x1, error from the nearest equilibrium after 3 / 8 s,
   // docs/solvers.md section 3g): 16^2 3.46 / 2.98 mm at 5/s -> 2.80 / 0.41 mm at 1.5/s, 32^2
   // 1.46 / 0.89 -> 2.06 / 0.86 mm, 64^2 10.4 / 4.43 -> 6.19 / 1.87 mm.
