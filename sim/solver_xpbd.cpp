@@ -11,7 +11,7 @@ namespace drape::sim {
 
 XpbdSolver::XpbdSolver(XpbdOptions opt)
     : opt_(opt), pool_(std::make_unique<ThreadPool>(std::max(1, opt.threads))) {
-  pool_->set_min_parallel(256);
+  pool_->set_min_parallel(64);
 }
 XpbdSolver::~XpbdSolver() = default;
 
@@ -68,9 +68,19 @@ void XpbdSolver::cook(const Cloth& cloth) {
   tri_col_ = colour_sorted(n, static_cast<int>(tris_.size()), 3,
                            tris_.empty() ? nullptr : tris_[0].v, sizeof(Tri), order);
   apply_order(tris_, order);
+  // Packs of four triangles of one colour (sim/xpbd_kernels.hpp); padding lanes use the
+  // scratch vertex n.
+  tri_packs_.clear();
+  tri_packs_.reserve(tris_.size() / 4 + tri_col_.size());
+  tpack_col_.assign(1, 0);
+  for (size_t c = 0; c + 1 < tri_col_.size(); ++c) {
+    xpbd::pack_triangles(tris_.data(), tri_col_[c], tri_col_[c + 1], n, tri_packs_);
+    tpack_col_.push_back(static_cast<int>(tri_packs_.size()));
+  }
+  // (Items of the parallel loops: vertices, packs of four elements, hinges, springs.)
   pool_->set_min_parallel(static_cast<int>(tris_.size()) < opt_.min_parallel_triangles
                               ? std::numeric_limits<int>::max()
-                              : 256);
+                              : 64);
   hinges_.clear();
   // Bending: the energy's own rows when it has them (tensor bending), else its hinges. The
   // three rows of a triangle (uu, vv, uv) share their stencil: they are one block, solved
@@ -133,7 +143,13 @@ void XpbdSolver::cook(const Cloth& cloth) {
       for (int a = 0; a < 3; ++a) row_ik_.push_back(bik[3 * bk + a]);
     }
     lambda_row_.assign(row_ik_.size(), Vec3::Zero());
-    row_ai_.assign(2 * row_ik_.size(), 0.0);
+    row_packs_.clear();
+    rpack_col_.assign(1, 0);
+    for (size_t c = 0; c + 1 < row_cols_.size(); ++c) {
+      row_packs_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
+                        row_cols_[c], row_cols_[c + 1], n);
+      rpack_col_.push_back(row_packs_.packs());
+    }
     row_ai_h_ = -1;
   }
   for (int h = 0; h < (nrows > 0 ? 0 : energy_.num_hinges()); ++h) {
@@ -164,7 +180,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
   lambda_hinge_.assign(hinges_.size(), Vec3::Zero());
   lambda_spring_.assign(springs_.size(), 0.0);
   xt_.resize(n);
-  xp_.resize(n);
+  xp_.assign(n + 1, xpbd::P4{{0, 0, 0, 0}});  // + the scratch vertex of padding lanes
   w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
   // Connected pieces (union-find over the elements' vertices).
   std::vector<int> parent(n);
@@ -331,7 +347,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       w_[i] = wi;
     }
   };
-  // The bending blocks' inverse system matrices (see row_ai_), for the current w and h.
+  // The bending blocks' inverse system matrices (in row_packs_), for the current w and h.
   auto build_row_inverses = [&](int b, int e, int) {
     for (int r = b; r < e; ++r) {
       double A[6] = {0, 0, 0, 0, 0, 0};  // 00 01 02 11 12 22
@@ -346,9 +362,14 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         A[4] += wj * v[1] * v[2];
         A[5] += wj * v[2] * v[2];
       }
-      double* ai = &row_ai_[6 * r];
-      std::fill(ai, ai + 6, 0.0);
-      if (A[0] + A[3] + A[5] == 0) continue;  // every vertex of the block fixed
+      double ai[6] = {0, 0, 0, 0, 0, 0};
+      auto store = [&] {
+        for (int m = 0; m < 6; ++m) row_packs_.ai_of(r, m) = ai[m];
+      };
+      if (A[0] + A[3] + A[5] == 0) {  // every vertex of the block fixed
+        store();
+        continue;
+      }
       A[0] += ihb * row_ik_[3 * r];
       A[3] += ihb * row_ik_[3 * r + 1];
       A[5] += ihb * row_ik_[3 * r + 2];
@@ -357,7 +378,10 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       const double c01 = A[2] * A[4] - A[1] * A[5];
       const double c02 = A[1] * A[4] - A[2] * A[3];
       const double det = A[0] * c00 + A[1] * c01 + A[2] * c02;
-      if (!(det > 0)) continue;
+      if (!(det > 0)) {
+        store();
+        continue;
+      }
       const double id = 1.0 / det;
       ai[0] = c00 * id;
       ai[1] = c01 * id;
@@ -365,6 +389,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       ai[3] = (A[0] * A[5] - A[2] * A[2]) * id;
       ai[4] = (A[2] * A[1] - A[0] * A[4]) * id;
       ai[5] = (A[0] * A[3] - A[1] * A[1]) * id;
+      store();
     }
   };
   const double* w = w_.data();
@@ -376,9 +401,8 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   const xpbd::Kernels& K = *kern_;
   double* lam_tri = keep_lambda ? lambda_tri_.data() : nullptr;
   double* lam_row = keep_lambda && !lambda_row_.empty() ? lambda_row_[0].data() : nullptr;
-  const xpbd::RowBlocks rb{row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
-                           row_ai_.data()};
-  auto project_tris = [&](int b, int e, int) { K.tris(tris_.data(), b, e, w, xp, ih2, lam_tri); };
+  const xpbd::RowPacks rp = row_packs_.view();
+  auto project_tris = [&](int b, int e, int) { K.tris(tri_packs_.data(), b, e, xp, ih2, lam_tri); };
   const bool padded = !tris_.empty() || row_off_.size() > 1;  // (the springs model has neither)
   auto project_hinges = [&](int b, int e, int) {
     for (int k = b; k < e; ++k) {
@@ -396,7 +420,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       for (int q = 0; q < 4; ++q) x[H.v[q]] += (wq[q] * H.K[q]) * dl;
     }
   };
-  auto project_rows = [&](int b, int e, int) { K.rows(rb, b, e, w, xp, ihb, lam_row); };
+  auto project_rows = [&](int b, int e, int) { K.rows(rp, b, e, xp, ihb, lam_row); };
   // Spring k's unit direction (v0 - v1) and length; false when degenerate.
   auto spring_dir = [&](const Spring& Sp, Vec3& nn, double& l) {
     const Vec3 d = x[Sp.v[0]] - x[Sp.v[1]];
@@ -511,8 +535,8 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     }
     contacts_fresh_ = false;
     set_w();
-    if (!row_ai_.empty() && (w_changed_ || ihb != row_ai_h_)) {
-      pool_->parallel_for(static_cast<int>(row_ai_.size() / 6), build_row_inverses);
+    if (!row_ik_.empty() && (w_changed_ || ihb != row_ai_h_)) {
+      pool_->parallel_for(static_cast<int>(row_ik_.size() / 3), build_row_inverses);
       row_ai_h_ = ihb;
       w_changed_ = false;
     }
@@ -544,10 +568,10 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     for (int it = 0; it < opt_.iterations; ++it) {
       if (padded) {
         pool_->parallel_for(n, [&](int b, int e, int) {
-          K.pack(reinterpret_cast<const double*>(x.data()), xp, b, e);
+          K.pack(reinterpret_cast<const double*>(x.data()), w, xp, b, e);
         });
-        by_colour(tri_col_, project_tris);
-        if (s % be == be - 1 || s == ns - 1) by_colour(row_cols_, project_rows);
+        by_colour(tpack_col_, project_tris);
+        if (s % be == be - 1 || s == ns - 1) by_colour(rpack_col_, project_rows);
         pool_->parallel_for(
             n, [&](int b, int e, int) { K.unpack(xp, reinterpret_cast<double*>(x.data()), b, e); });
       }

@@ -146,22 +146,28 @@ class XpbdSolver : public Solver {
   std::vector<Hinge> hinges_;
   std::vector<Spring> springs_;
   std::vector<int> tri_col_, hinge_col_, spring_col_;  // colour offsets into the arrays
+  // The triangles in packs of four of one colour (xpbd_kernels.hpp), colour offsets in packs.
+  std::vector<xpbd::TriPack> tri_packs_;
+  std::vector<int> tpack_col_;
   // The energy's tensor bending as linear vector constraints (ClothEnergy bending rows), CSR in
   // colour order: row r is sum_k row_val_[k] x[row_col_[k]], inverse stiffness row_ik_[r].
   std::vector<int> row_off_, row_colv_, row_cols_;
   std::vector<double> row_val_, row_ik_;
-  // Per bending block the inverse of its 3x3 system matrix A = sum_j w_j v_j v_j^T + alpha/h^2
-  // (upper triangle, 6 entries; all zero when A is singular). A depends only on the inverse
-  // masses and the substep, so it is rebuilt only when one of them changes (a piece freezes or
-  // wakes, a vertex is pinned or released, the frame is split differently).
-  std::vector<double> row_ai_;
+  // The same blocks in packs of four of one colour (xpbd_kernels.hpp), colour offsets in packs.
+  // Per block the packs hold the inverse of its 3x3 system matrix A = sum_j w_j v_j v_j^T +
+  // alpha/h^2 (upper triangle, 6 entries; all zero when A is singular). A depends only on the
+  // inverse masses and the substep, so it is rebuilt only when one of them changes (a piece
+  // freezes or wakes, a vertex is pinned or released, the frame is split differently).
+  xpbd::RowPackData row_packs_;
+  std::vector<int> rpack_col_;
   double row_ai_h_ = -1;  // the 1/(be h^2) the cached inverses were built for
   bool w_changed_ = true;
   std::vector<Vec3> lambda_row_;
   std::vector<double> lambda_tri_, lambda_spring_;
   std::vector<Vec3> lambda_hinge_, xt_;
-  // Positions padded to four doubles for the triangle and bending kernels (xpbd_kernels.hpp),
-  // packed before and unpacked after them in every iteration.
+  // Positions padded to four doubles (the fourth: inverse mass) for the triangle and bending
+  // kernels (xpbd_kernels.hpp), packed before and unpacked after them in every iteration; one
+  // more, the scratch vertex (w = 0), for the packs' padding lanes.
   std::vector<xpbd::P4> xp_;
   const xpbd::Kernels* kern_ = &xpbd::kernels();
   double h_prev_ = 0;

@@ -1,6 +1,8 @@
-// XPBD's hot loops, portable build, and the run-time choice between it and the AVX2 build.
+// XPBD's hot loops, portable build, the packing of elements into lanes, and the run-time choice
+// between the portable and the AVX2 build.
 #include "sim/xpbd_kernels.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 
@@ -10,6 +12,63 @@ namespace portable {
 #include "sim/xpbd_kernels.inl"
 const Kernels kKernels{"portable", &project_tris, &project_rows, &pack, &unpack};
 }  // namespace portable
+
+void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPack>& out) {
+  for (int k0 = b; k0 < e; k0 += 4) {
+    TriPack P{};  // padding lanes: coefficients 0
+    for (int l = 0; l < 4; ++l) {
+      const int k = k0 + l;
+      P.k[l] = k < e ? k : -1;
+      for (int q = 0; q < 3; ++q) P.v[q][l] = k < e ? tris[k].v[q] : scratch;
+      if (k >= e) continue;
+      for (int j = 0; j < 6; ++j) P.D[j][l] = tris[k].D[j];
+      for (int a = 0; a < 3; ++a) P.ia[a][l] = tris[k].ia[a];
+    }
+    out.push_back(P);
+  }
+}
+
+void RowPackData::clear() {
+  off.assign(1, 0);
+  colv.clear();
+  blk.clear();
+  val.clear();
+  ik.clear();
+  ai.clear();
+  slot.clear();
+}
+
+void RowPackData::append(const int* boff, const int* bcol, const double* bval, const double* bik,
+                         int b, int e, int scratch) {
+  if (static_cast<int>(slot.size()) < e) slot.resize(e, -1);
+  for (int r0 = b; r0 < e; r0 += 4) {
+    const int p = packs();
+    const int lanes = std::min(4, e - r0);
+    int len = 0;
+    for (int l = 0; l < lanes; ++l) len = std::max(len, boff[r0 + l + 1] - boff[r0 + l]);
+    for (int i = 0; i < len; ++i) {
+      for (int l = 0; l < 4; ++l) {
+        const int r = r0 + l;
+        const bool real = l < lanes && i < boff[r + 1] - boff[r];
+        colv.push_back(real ? bcol[boff[r] + i] : scratch);
+      }
+      for (int a = 0; a < 3; ++a)
+        for (int l = 0; l < 4; ++l) {
+          const int r = r0 + l;
+          const bool real = l < lanes && i < boff[r + 1] - boff[r];
+          val.push_back(real ? bval[3 * (boff[r] + i) + a] : 0.0);
+        }
+    }
+    off.push_back(off.back() + len);
+    for (int a = 0; a < 3; ++a)
+      for (int l = 0; l < 4; ++l) ik.push_back(l < lanes ? bik[3 * (r0 + l) + a] : 0.0);
+    for (int l = 0; l < 4; ++l) {
+      blk.push_back(l < lanes ? r0 + l : -1);
+      if (l < lanes) slot[r0 + l] = 4 * p + l;
+    }
+    ai.resize(ai.size() + 24, 0.0);
+  }
+}
 
 #if defined(DRAPE_XPBD_AVX2)
 namespace avx2 {

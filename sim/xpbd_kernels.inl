@@ -1,190 +1,217 @@
 // The body of XPBD's hot loops (sim/xpbd_kernels.hpp), included once per instruction set by
 // sim/xpbd_kernels.cpp (portable) and sim/xpbd_kernels_avx2.cpp (AVX2+FMA) inside a namespace
-// of their own. Positions are GCC/Clang vector-extension values of four doubles (lane 3 = 0):
-// the compiler maps them to one AVX register or two SSE2 registers.
+// of their own. Values are GCC/Clang vector-extension vectors of four doubles, one element per
+// lane: the compiler maps one to an AVX register, or to two SSE2 registers.
 
-#if defined(DRAPE_XPBD_VECTOR_EXT)
 #if defined(__GNUC__) && !defined(__clang__)
-// The helpers below take and return V4 by value; GCC notes that this ABI differs between units
-// with and without AVX. They are inlined and never called across units.
+// The helpers below take and return vectors by value; GCC notes that this ABI differs between
+// units with and without AVX. They are inlined and never called across units.
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
-using V4 = double __attribute__((vector_size(32)));
-inline V4 load(const P4& p) {
-  return *reinterpret_cast<const V4*>(p.c);
+using D4 = double __attribute__((vector_size(32)));
+using M4 = long long __attribute__((vector_size(32)));  // a lane-wise comparison: all 0 or 1 bits
+
+inline D4 ld(const double* p) {  // any alignment (the packs' arrays are std::vector<double>)
+  D4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
 }
-inline void store(P4& p, V4 v) {
-  *reinterpret_cast<V4*>(p.c) = v;
+inline D4 ld(const P4& p) {  // 32-byte aligned
+  return *reinterpret_cast<const D4*>(p.c);
 }
-inline double dot(V4 a, V4 b) {
-  const V4 m = a * b;
-  return m[0] + m[1] + m[2];
+inline void st(P4& p, D4 v) {
+  *reinterpret_cast<D4*>(p.c) = v;
 }
-inline V4 make(double x, double y, double z) {
-  return V4{x, y, z, 0};
+inline D4 splat(double s) {
+  return D4{s, s, s, s};
 }
-inline double lane(V4 a, int c) {
-  return a[c];
+inline D4 sel(M4 m, D4 a, D4 b) {  // m ? a : b, lane by lane
+  return reinterpret_cast<D4>((reinterpret_cast<M4>(a) & m) | (reinterpret_cast<M4>(b) & ~m));
 }
-#else
-// Without AVX a 256-bit vector type is split into SSE halves through memory (measured: twice as
-// slow as scalar code), and an array member defeats scalar replacement (ten times as slow):
-// three named doubles.
-struct V4 {
-  double x = 0, y = 0, z = 0;
-  V4& operator+=(const V4& o) {
-    x += o.x;
-    y += o.y;
-    z += o.z;
-    return *this;
-  }
-  V4& operator*=(double s) {
-    x *= s;
-    y *= s;
-    z *= s;
-    return *this;
-  }
+
+// 4x4 transpose: rows r0..r3 in, columns out (its own inverse).
+inline void transpose(D4 r0, D4 r1, D4 r2, D4 r3, D4& a, D4& b, D4& c, D4& d) {
+  const D4 t0 = __builtin_shufflevector(r0, r1, 0, 4, 2, 6);  // x0 x1 z0 z1
+  const D4 t1 = __builtin_shufflevector(r0, r1, 1, 5, 3, 7);  // y0 y1 w0 w1
+  const D4 t2 = __builtin_shufflevector(r2, r3, 0, 4, 2, 6);  // x2 x3 z2 z3
+  const D4 t3 = __builtin_shufflevector(r2, r3, 1, 5, 3, 7);  // y2 y3 w2 w3
+  a = __builtin_shufflevector(t0, t2, 0, 1, 4, 5);
+  b = __builtin_shufflevector(t1, t3, 0, 1, 4, 5);
+  c = __builtin_shufflevector(t0, t2, 2, 3, 6, 7);
+  d = __builtin_shufflevector(t1, t3, 2, 3, 6, 7);
+}
+
+// The four vertices v[0..3] (one per lane) as x, y, z and inverse mass w.
+struct Lanes {
+  D4 X, Y, Z, W;
 };
-inline V4 operator+(V4 a, const V4& b) {
-  return a += b;
+inline Lanes gather(const P4* x, const int32_t* v) {
+  Lanes g;
+  transpose(ld(x[v[0]]), ld(x[v[1]]), ld(x[v[2]]), ld(x[v[3]]), g.X, g.Y, g.Z, g.W);
+  return g;
 }
-inline V4 operator*(double s, V4 a) {
-  return a *= s;
+// Writes the lanes back. Lanes sharing a vertex (only the scratch vertex of padding, which no
+// projection moves) write the same value.
+inline void scatter(P4* x, const int32_t* v, const Lanes& g) {
+  D4 r0, r1, r2, r3;
+  transpose(g.X, g.Y, g.Z, g.W, r0, r1, r2, r3);
+  st(x[v[0]], r0);
+  st(x[v[1]], r1);
+  st(x[v[2]], r2);
+  st(x[v[3]], r3);
 }
-inline V4 operator*(V4 a, double s) {
-  return a *= s;
-}
-inline V4 operator-(V4 a) {
-  return a *= -1.0;
-}
-inline V4 load(const P4& p) {
-  return V4{p.c[0], p.c[1], p.c[2]};
-}
-inline void store(P4& p, const V4& v) {
-  p.c[0] = v.x;
-  p.c[1] = v.y;
-  p.c[2] = v.z;
-}
-inline double dot(const V4& a, const V4& b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-inline V4 make(double x, double y, double z) {
-  return V4{x, y, z};
-}
-inline double lane(const V4& a, int c) {
-  return c == 0 ? a.x : c == 1 ? a.y : a.z;
-}
-#endif
 
 // The three strain constraints of a triangle (E_uu, E_vv, E_uv) are projected one after the
 // other as in classic XPBD, but in the space of F = (fu, fv): every gradient is
 // w_q (D_uq a + D_vq b) for vectors a, b, so each projection changes F by a closed form
-// (S_uu, S_vv, S_uv below) and the vertices are moved once, by the sum.
-void project_tris(const Tri* tris, int b, int e, const double* w, P4* x, double ih2,
-                  double* lambda) {
-  for (int k = b; k < e; ++k) {
-    const Tri& T = tris[k];
-    const double wq[3] = {w[T.v[0]], w[T.v[1]], w[T.v[2]]};
-    if (wq[0] + wq[1] + wq[2] == 0) continue;
-    const V4 p0 = load(x[T.v[0]]), p1 = load(x[T.v[1]]), p2 = load(x[T.v[2]]);
-    const double* D = T.D;
-    V4 fu = p0 * D[0] + p1 * D[2] + p2 * D[4];
-    V4 fv = p0 * D[1] + p1 * D[3] + p2 * D[5];
-    double Suu = 0, Svv = 0, Suv = 0;
+// (S_uu, S_vv, S_uv below) and the vertices are moved once, by the sum. Each lane is one
+// triangle; a lane whose denominator vanishes (all vertices fixed, padding) changes nothing.
+void project_tris(const TriPack* packs, int b, int e, P4* x, double ih2, double* lambda) {
+  const D4 zero = splat(0), one = splat(1), half = splat(0.5), tiny = splat(1e-20);
+  for (int p = b; p < e; ++p) {
+    const TriPack& T = packs[p];
+    Lanes g[3];
+    D4 Du[3], Dv[3];
     for (int q = 0; q < 3; ++q) {
-      Suu += wq[q] * D[2 * q] * D[2 * q];
-      Svv += wq[q] * D[2 * q + 1] * D[2 * q + 1];
-      Suv += wq[q] * D[2 * q] * D[2 * q + 1];
+      g[q] = gather(x, T.v[q]);
+      Du[q] = ld(T.D[2 * q]);
+      Dv[q] = ld(T.D[2 * q + 1]);
     }
-    V4 a{}, bb{};
-    double* L = lambda ? lambda + 3 * k : nullptr;
-    // E_uu = (|fu|^2 - 1) / 2 with gradient D_uq fu (c = 0; f = fu, g = fv, acc = a) and
-    // E_vv = (|fv|^2 - 1) / 2 with gradient D_vq fv (c = 1; f = fv, g = fu, acc = bb).
-    auto stretch = [&](int c, V4& f, V4& g, double Sff, V4& acc) {
-      const double alpha = ih2 * T.ia[c];
-      const double f2 = dot(f, f);
-      const double denom = alpha + Sff * f2;
-      if (denom < 1e-20) return;
-      const double lam = L ? L[c] : 0.0;
-      const double dl = (-0.5 * (f2 - 1) - alpha * lam) / denom;
-      if (L) L[c] = lam + dl;
-      acc += dl * f;
-      g += (dl * Suv) * f;
-      f *= 1 + dl * Sff;
+    D4 fux = g[0].X * Du[0] + g[1].X * Du[1] + g[2].X * Du[2];
+    D4 fuy = g[0].Y * Du[0] + g[1].Y * Du[1] + g[2].Y * Du[2];
+    D4 fuz = g[0].Z * Du[0] + g[1].Z * Du[1] + g[2].Z * Du[2];
+    D4 fvx = g[0].X * Dv[0] + g[1].X * Dv[1] + g[2].X * Dv[2];
+    D4 fvy = g[0].Y * Dv[0] + g[1].Y * Dv[1] + g[2].Y * Dv[2];
+    D4 fvz = g[0].Z * Dv[0] + g[1].Z * Dv[1] + g[2].Z * Dv[2];
+    const D4 Suu = g[0].W * Du[0] * Du[0] + g[1].W * Du[1] * Du[1] + g[2].W * Du[2] * Du[2];
+    const D4 Svv = g[0].W * Dv[0] * Dv[0] + g[1].W * Dv[1] * Dv[1] + g[2].W * Dv[2] * Dv[2];
+    const D4 Suv = g[0].W * Du[0] * Dv[0] + g[1].W * Du[1] * Dv[1] + g[2].W * Du[2] * Dv[2];
+    const M4 live = (g[0].W + g[1].W + g[2].W) > zero;
+    D4 lam[3] = {zero, zero, zero};
+    if (lambda)
+      for (int l = 0; l < 4; ++l)
+        if (T.k[l] >= 0)
+          for (int c = 0; c < 3; ++c) lam[c][l] = lambda[3 * T.k[l] + c];
+    // dl = (num - alpha lam) / denom where the lane is live and denom is not ~0, else 0.
+    auto solve = [&](D4 alpha, D4 num, D4 denom, int c) {
+      const M4 ok = (denom >= tiny) & live;
+      const D4 dl = sel(ok, (num - alpha * lam[c]) / sel(ok, denom, one), zero);
+      lam[c] += dl;
+      return dl;
     };
-    stretch(0, fu, fv, Suu, a);
-    stretch(1, fv, fu, Svv, bb);
+    D4 ax = zero, ay = zero, az = zero, bx = zero, by = zero, bz = zero;
+    // E_uu = (|fu|^2 - 1) / 2 with gradient D_uq fu: a += dl fu, fv += dl S_uv fu,
+    // fu *= 1 + dl S_uu.
+    {
+      const D4 alpha = ih2 * ld(T.ia[0]);
+      const D4 f2 = fux * fux + fuy * fuy + fuz * fuz;
+      const D4 dl = solve(alpha, -half * (f2 - one), alpha + Suu * f2, 0);
+      ax += dl * fux, ay += dl * fuy, az += dl * fuz;
+      const D4 cross = dl * Suv, grow = one + dl * Suu;
+      fvx += cross * fux, fvy += cross * fuy, fvz += cross * fuz;
+      fux *= grow, fuy *= grow, fuz *= grow;
+    }
+    // E_vv = (|fv|^2 - 1) / 2 with gradient D_vq fv: the same with u and v swapped.
+    {
+      const D4 alpha = ih2 * ld(T.ia[1]);
+      const D4 f2 = fvx * fvx + fvy * fvy + fvz * fvz;
+      const D4 dl = solve(alpha, -half * (f2 - one), alpha + Svv * f2, 1);
+      bx += dl * fvx, by += dl * fvy, bz += dl * fvz;
+      const D4 cross = dl * Suv, grow = one + dl * Svv;
+      fux += cross * fvx, fuy += cross * fvy, fuz += cross * fvz;
+      fvx *= grow, fvy *= grow, fvz *= grow;
+    }
     // E_uv = fu . fv / 2, gradient (D_uq fv + D_vq fu) / 2.
     {
-      const double alpha = ih2 * T.ia[2];
-      const double uv = dot(fu, fv);
-      const double denom = alpha + 0.25 * (Suu * dot(fv, fv) + 2 * Suv * uv + Svv * dot(fu, fu));
-      if (denom >= 1e-20) {
-        const double lam = L ? L[2] : 0.0;
-        const double dl = (-0.5 * uv - alpha * lam) / denom;
-        if (L) L[2] = lam + dl;
-        a += (0.5 * dl) * fv;
-        bb += (0.5 * dl) * fu;
-      }
+      const D4 alpha = ih2 * ld(T.ia[2]);
+      const D4 uv = fux * fvx + fuy * fvy + fuz * fvz;
+      const D4 uu = fux * fux + fuy * fuy + fuz * fuz;
+      const D4 vv = fvx * fvx + fvy * fvy + fvz * fvz;
+      const D4 denom = alpha + 0.25 * (Suu * vv + 2.0 * Suv * uv + Svv * uu);
+      const D4 dl = half * solve(alpha, -half * uv, denom, 2);
+      ax += dl * fvx, ay += dl * fvy, az += dl * fvz;
+      bx += dl * fux, by += dl * fuy, bz += dl * fuz;
     }
-    for (int q = 0; q < 3; ++q)
-      if (wq[q] > 0) {
-        P4& xq = x[T.v[q]];
-        store(xq, load(xq) + wq[q] * (D[2 * q] * a + D[2 * q + 1] * bb));
-      }
-  }
-}
-
-// Bending block r: C_a = sum_j v_aj x_j (a = 0, 1, 2); A dl = -C - alpha l with A^-1 cached.
-void project_rows(const RowBlocks& rb, int b, int e, const double* w, P4* x, double ihb,
-                  double* lambda) {
-  for (int r = b; r < e; ++r) {
-    const double* ai = rb.ai + 6 * r;
-    if (ai[0] == 0) continue;  // every vertex fixed (or A singular)
-    V4 C0{}, C1{}, C2{};
-    const int k0 = rb.off[r], k1 = rb.off[r + 1];
-    for (int k = k0; k < k1; ++k) {
-      const V4 xj = load(x[rb.colv[k]]);
-      const double* v = rb.val + 3 * k;
-      C0 += v[0] * xj;
-      C1 += v[1] * xj;
-      C2 += v[2] * xj;
-    }
-    double* lam = lambda ? lambda + 9 * r : nullptr;
-    if (lam) {
-      const double* ik = rb.ik + 3 * r;
-      const V4 l0 = make(lam[0], lam[1], lam[2]), l1 = make(lam[3], lam[4], lam[5]),
-               l2 = make(lam[6], lam[7], lam[8]);
-      C0 += (ihb * ik[0]) * l0;
-      C1 += (ihb * ik[1]) * l1;
-      C2 += (ihb * ik[2]) * l2;
-    }
-    // dl_a = -sum_b Ai_ab (C_b + alpha_b l_b): one vector per row a.
-    const V4 d0 = -(ai[0] * C0 + ai[1] * C1 + ai[2] * C2);
-    const V4 d1 = -(ai[1] * C0 + ai[3] * C1 + ai[4] * C2);
-    const V4 d2 = -(ai[2] * C0 + ai[4] * C1 + ai[5] * C2);
-    if (lam)
-      for (int c = 0; c < 3; ++c) {
-        lam[c] += lane(d0, c);
-        lam[3 + c] += lane(d1, c);
-        lam[6 + c] += lane(d2, c);
-      }
-    for (int k = k0; k < k1; ++k) {
-      const int j = rb.colv[k];
-      const double wj = w[j];
-      if (wj == 0) continue;
-      const double* v = rb.val + 3 * k;
-      store(x[j], load(x[j]) + wj * (v[0] * d0 + v[1] * d1 + v[2] * d2));
+    if (lambda)
+      for (int l = 0; l < 4; ++l)
+        if (T.k[l] >= 0)
+          for (int c = 0; c < 3; ++c) lambda[3 * T.k[l] + c] = lam[c][l];
+    for (int q = 0; q < 3; ++q) {
+      Lanes& v = g[q];
+      v.X += v.W * (Du[q] * ax + Dv[q] * bx);
+      v.Y += v.W * (Du[q] * ay + Dv[q] * by);
+      v.Z += v.W * (Du[q] * az + Dv[q] * bz);
+      scatter(x, T.v[q], v);
     }
   }
 }
 
-void pack(const double* x, P4* p, int b, int e) {
+// Bending block (one per lane): C_a = sum_j v_aj x_j (a = 0, 1, 2); A dl = -C - alpha l with
+// A^-1 cached (all 0 for a lane that does nothing).
+void project_rows(const RowPacks& rp, int b, int e, P4* x, double ihb, double* lambda) {
+  const D4 zero = splat(0);
+  for (int p = b; p < e; ++p) {
+    // C_a = (cax, cay, caz): named values, not arrays, so that they stay in registers.
+    D4 c0x = zero, c0y = zero, c0z = zero, c1x = zero, c1y = zero, c1z = zero, c2x = zero,
+       c2y = zero, c2z = zero;
+    const int k0 = rp.off[p], k1 = rp.off[p + 1];
+    for (int k = k0; k < k1; ++k) {
+      const Lanes g = gather(x, rp.colv + 4 * k);
+      const double* val = rp.val + 12 * k;
+      const D4 v0 = ld(val), v1 = ld(val + 4), v2 = ld(val + 8);
+      c0x += v0 * g.X, c0y += v0 * g.Y, c0z += v0 * g.Z;
+      c1x += v1 * g.X, c1y += v1 * g.Y, c1z += v1 * g.Z;
+      c2x += v2 * g.X, c2y += v2 * g.Y, c2z += v2 * g.Z;
+    }
+    const int32_t* blk = rp.blk + 4 * p;
+    D4 lam[9];  // [3 a + c] (only with lambda)
+    if (lambda) {
+      for (int j = 0; j < 9; ++j) {
+        lam[j] = zero;
+        for (int l = 0; l < 4; ++l)
+          if (blk[l] >= 0) lam[j][l] = lambda[9 * blk[l] + j];
+      }
+      const D4 al0 = ihb * ld(rp.ik + 12 * p), al1 = ihb * ld(rp.ik + 12 * p + 4),
+               al2 = ihb * ld(rp.ik + 12 * p + 8);
+      c0x += al0 * lam[0], c0y += al0 * lam[1], c0z += al0 * lam[2];
+      c1x += al1 * lam[3], c1y += al1 * lam[4], c1z += al1 * lam[5];
+      c2x += al2 * lam[6], c2y += al2 * lam[7], c2z += al2 * lam[8];
+    }
+    // dl_a = -sum_b Ai_ab (C_b + alpha_b l_b).
+    const double* A = rp.ai + 24 * p;
+    const D4 a00 = ld(A), a01 = ld(A + 4), a02 = ld(A + 8), a11 = ld(A + 12), a12 = ld(A + 16),
+             a22 = ld(A + 20);
+    const D4 d0x = -(a00 * c0x + a01 * c1x + a02 * c2x), d0y = -(a00 * c0y + a01 * c1y + a02 * c2y),
+             d0z = -(a00 * c0z + a01 * c1z + a02 * c2z);
+    const D4 d1x = -(a01 * c0x + a11 * c1x + a12 * c2x), d1y = -(a01 * c0y + a11 * c1y + a12 * c2y),
+             d1z = -(a01 * c0z + a11 * c1z + a12 * c2z);
+    const D4 d2x = -(a02 * c0x + a12 * c1x + a22 * c2x), d2y = -(a02 * c0y + a12 * c1y + a22 * c2y),
+             d2z = -(a02 * c0z + a12 * c1z + a22 * c2z);
+    if (lambda) {
+      const D4 d[9] = {d0x, d0y, d0z, d1x, d1y, d1z, d2x, d2y, d2z};
+      for (int l = 0; l < 4; ++l)
+        if (blk[l] >= 0)
+          for (int j = 0; j < 9; ++j) lambda[9 * blk[l] + j] = lam[j][l] + d[j][l];
+    }
+    for (int k = k0; k < k1; ++k) {
+      const int32_t* v = rp.colv + 4 * k;
+      Lanes g = gather(x, v);
+      const double* val = rp.val + 12 * k;
+      const D4 v0 = ld(val), v1 = ld(val + 4), v2 = ld(val + 8);
+      g.X += g.W * (v0 * d0x + v1 * d1x + v2 * d2x);
+      g.Y += g.W * (v0 * d0y + v1 * d1y + v2 * d2y);
+      g.Z += g.W * (v0 * d0z + v1 * d1z + v2 * d2z);
+      scatter(x, v, g);
+    }
+  }
+}
+
+void pack(const double* x, const double* w, P4* p, int b, int e) {
   for (int i = b; i < e; ++i) {
     p[i].c[0] = x[3 * i];
     p[i].c[1] = x[3 * i + 1];
     p[i].c[2] = x[3 * i + 2];
-    p[i].c[3] = 0;
+    p[i].c[3] = w[i];
   }
 }
 

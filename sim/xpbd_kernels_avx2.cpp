@@ -1,9 +1,10 @@
 // XPBD's hot loops built for AVX2+FMA (sim/xpbd_kernels.hpp); compiled with -mavx2 -mfma on
 // x86-64 only (sim/CMakeLists.txt) and called only when the CPU reports both.
+#include <cstring>
+
 #include "sim/xpbd_kernels.hpp"
 
 #if defined(DRAPE_XPBD_AVX2)
-#define DRAPE_XPBD_VECTOR_EXT
 namespace drape::sim::xpbd::avx2 {
 #include "sim/xpbd_kernels.inl"
 extern const Kernels kKernels;

@@ -1,5 +1,6 @@
-// XPBD's hot loops (sim/xpbd_kernels.hpp): the AVX2 build agrees with the portable one, and a
-// triangle projection does what the constraint says.
+// XPBD's hot loops (sim/xpbd_kernels.hpp): the packed kernels (four elements per pack, one per
+// lane) do what projecting the elements one after the other does, the AVX2 build agrees with
+// the portable one, and a triangle projection does what the constraint says.
 #include "sim/xpbd_kernels.hpp"
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -16,59 +18,60 @@ namespace {
 
 constexpr double kIh2 = 1e4, kIhb = 5e3;  // 1 / h^2 for the triangles and bending blocks
 
+// One colour of elements: no two share a vertex (what the kernels require of a range).
 struct Problem {
-  std::vector<P4> x;
+  int n = 0;  // vertices; index n is the scratch vertex of padding lanes
+  std::vector<Eigen::Vector3d> x;
   std::vector<double> w;
   std::vector<Tri> tris;
   std::vector<int> off{0}, colv;
-  std::vector<double> val, ik, ai;
+  std::vector<double> val, ik, ai;  // ai: 6 per block (upper triangle of A^-1)
 };
 
-// Random but well-posed data: positions in the unit cube, some vertices fixed (w = 0),
-// triangles and bending blocks over distinct vertices with compliances that keep every
-// denominator away from zero, and a symmetric positive definite "inverse" per block.
+// Random but well-posed data: positions in the unit cube, some vertices fixed (w = 0), 203
+// triangles and 101 bending blocks of 3 to 7 vertices (counts not multiples of four: the last
+// pack is padded) over vertices no two elements share, compliances that keep every denominator
+// away from zero, and each block's inverse system matrix as the solver builds it.
 Problem make_problem(unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, 1), s(-5, 5);
-  const int n = 300;
+  const int ntri = 203, nblk = 101;
+  std::uniform_int_distribution<int> len(3, 7);
+  std::vector<int> lens(nblk);
+  for (int& l : lens) l = len(rng);
   Problem p;
-  p.x.resize(n);
-  p.w.resize(n);
-  for (int i = 0; i < n; ++i) {
-    p.x[i] = P4{{u(rng), u(rng), u(rng), 0}};
+  p.n = 3 * ntri + std::accumulate(lens.begin(), lens.end(), 0);
+  std::vector<int> perm(p.n);
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), rng);
+  p.x.resize(p.n);
+  p.w.resize(p.n);
+  for (int i = 0; i < p.n; ++i) {
+    p.x[i] = Eigen::Vector3d(u(rng), u(rng), u(rng));
     p.w[i] = i % 7 == 0 ? 0.0 : 0.5 + u(rng);
   }
-  std::uniform_int_distribution<int> vi(0, n - 1);
-  auto distinct = [&](int k) {
-    std::vector<int> v;
-    while (static_cast<int>(v.size()) < k) {
-      const int c = vi(rng);
-      if (std::find(v.begin(), v.end(), c) == v.end()) v.push_back(c);
-    }
-    return v;
-  };
-  for (int t = 0; t < 200; ++t) {
+  int next = 0;
+  for (int t = 0; t < ntri; ++t) {
     Tri T{};
-    const auto v = distinct(3);
     for (int a = 0; a < 3; ++a) {
-      T.v[a] = v[a];
+      T.v[a] = perm[next++];
       T.ia[a] = 0.1 + u(rng);
     }
     for (double& d : T.D) d = s(rng);
     p.tris.push_back(T);
   }
-  std::uniform_int_distribution<int> len(3, 12);
-  for (int r = 0; r < 100; ++r) {
-    for (int c : distinct(len(rng))) {
-      p.colv.push_back(c);
+  // One triangle with all its vertices fixed: the kernels must leave it (and its multipliers)
+  // alone.
+  for (int a = 0; a < 3; ++a) p.w[p.tris[5].v[a]] = 0;
+  for (int r = 0; r < nblk; ++r) {
+    for (int i = 0; i < lens[r]; ++i) {
+      p.colv.push_back(perm[next++]);
       for (int a = 0; a < 3; ++a) p.val.push_back(s(rng));
     }
     p.off.push_back(static_cast<int>(p.colv.size()));
     for (int a = 0; a < 3; ++a) p.ik.push_back(0.1 + u(rng));
   }
-  // Each block's inverse system matrix as the solver builds it: A = sum_j w_j v_j v_j^T +
-  // diag(ihb ik).
-  for (size_t r = 0; r + 1 < p.off.size(); ++r) {
+  for (int r = 0; r < nblk; ++r) {
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
     for (int k = p.off[r]; k < p.off[r + 1]; ++k) {
       const Eigen::Vector3d v(p.val[3 * k], p.val[3 * k + 1], p.val[3 * k + 2]);
@@ -82,11 +85,142 @@ Problem make_problem(unsigned seed) {
   return p;
 }
 
-double max_diff(const std::vector<P4>& a, const std::vector<P4>& b) {
+// The projections written plainly, one element after the other (what the lanes must equal).
+void reference_tris(Problem& p, double ih2, double* lambda) {
+  for (size_t k = 0; k < p.tris.size(); ++k) {
+    const Tri& T = p.tris[k];
+    const double wq[3] = {p.w[T.v[0]], p.w[T.v[1]], p.w[T.v[2]]};
+    if (wq[0] + wq[1] + wq[2] == 0) continue;
+    const double* D = T.D;
+    Eigen::Vector3d fu = Eigen::Vector3d::Zero(), fv = Eigen::Vector3d::Zero();
+    double Suu = 0, Svv = 0, Suv = 0;
+    for (int q = 0; q < 3; ++q) {
+      fu += D[2 * q] * p.x[T.v[q]];
+      fv += D[2 * q + 1] * p.x[T.v[q]];
+      Suu += wq[q] * D[2 * q] * D[2 * q];
+      Svv += wq[q] * D[2 * q + 1] * D[2 * q + 1];
+      Suv += wq[q] * D[2 * q] * D[2 * q + 1];
+    }
+    double* L = lambda ? lambda + 3 * k : nullptr;
+    Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
+    auto stretch = [&](int c, Eigen::Vector3d& f, Eigen::Vector3d& g, double Sff,
+                       Eigen::Vector3d& acc) {
+      const double alpha = ih2 * T.ia[c], f2 = f.squaredNorm(), denom = alpha + Sff * f2;
+      if (denom < 1e-20) return;
+      const double lam = L ? L[c] : 0.0;
+      const double dl = (-0.5 * (f2 - 1) - alpha * lam) / denom;
+      if (L) L[c] = lam + dl;
+      acc += dl * f;
+      g += (dl * Suv) * f;
+      f *= 1 + dl * Sff;
+    };
+    stretch(0, fu, fv, Suu, a);
+    stretch(1, fv, fu, Svv, b);
+    const double alpha = ih2 * T.ia[2], uv = fu.dot(fv);
+    const double denom =
+        alpha + 0.25 * (Suu * fv.squaredNorm() + 2 * Suv * uv + Svv * fu.squaredNorm());
+    if (denom >= 1e-20) {
+      const double lam = L ? L[2] : 0.0;
+      const double dl = (-0.5 * uv - alpha * lam) / denom;
+      if (L) L[2] = lam + dl;
+      a += (0.5 * dl) * fv;
+      b += (0.5 * dl) * fu;
+    }
+    for (int q = 0; q < 3; ++q) p.x[T.v[q]] += wq[q] * (D[2 * q] * a + D[2 * q + 1] * b);
+  }
+}
+
+void reference_rows(Problem& p, double ihb, double* lambda) {
+  for (size_t r = 0; r + 1 < p.off.size(); ++r) {
+    Eigen::Vector3d C[3] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                            Eigen::Vector3d::Zero()};
+    for (int k = p.off[r]; k < p.off[r + 1]; ++k)
+      for (int a = 0; a < 3; ++a) C[a] += p.val[3 * k + a] * p.x[p.colv[k]];
+    if (lambda)
+      for (int a = 0; a < 3; ++a)
+        C[a] += ihb * p.ik[3 * r + a] * Eigen::Map<Eigen::Vector3d>(lambda + 9 * r + 3 * a);
+    const double* ai = &p.ai[6 * r];
+    Eigen::Matrix3d Ai;
+    Ai << ai[0], ai[1], ai[2], ai[1], ai[3], ai[4], ai[2], ai[4], ai[5];
+    Eigen::Vector3d d[3];
+    for (int a = 0; a < 3; ++a) d[a] = -(Ai(a, 0) * C[0] + Ai(a, 1) * C[1] + Ai(a, 2) * C[2]);
+    if (lambda)
+      for (int a = 0; a < 3; ++a) Eigen::Map<Eigen::Vector3d>(lambda + 9 * r + 3 * a) += d[a];
+    for (int k = p.off[r]; k < p.off[r + 1]; ++k) {
+      const double* v = &p.val[3 * k];
+      p.x[p.colv[k]] += p.w[p.colv[k]] * (v[0] * d[0] + v[1] * d[1] + v[2] * d[2]);
+    }
+  }
+}
+
+// The problem packed for the kernels, projected `iters` times.
+struct Packed {
+  std::vector<P4> xp;
+  std::vector<TriPack> tp;
+  RowPackData rp;
+};
+Packed pack_problem(const Problem& p) {
+  Packed k;
+  k.xp.resize(p.n + 1);
+  for (int i = 0; i < p.n; ++i) k.xp[i] = P4{{p.x[i][0], p.x[i][1], p.x[i][2], p.w[i]}};
+  k.xp[p.n] = P4{{0, 0, 0, 0}};
+  pack_triangles(p.tris.data(), 0, static_cast<int>(p.tris.size()), p.n, k.tp);
+  const int nb = static_cast<int>(p.off.size()) - 1;
+  k.rp.append(p.off.data(), p.colv.data(), p.val.data(), p.ik.data(), 0, nb, p.n);
+  for (int r = 0; r < nb; ++r)
+    for (int m = 0; m < 6; ++m) k.rp.ai_of(r, m) = p.ai[6 * r + m];
+  return k;
+}
+
+double max_diff(const std::vector<P4>& a, const std::vector<Eigen::Vector3d>& b) {
   double m = 0;
-  for (size_t i = 0; i < a.size(); ++i)
-    for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(a[i].c[c] - b[i].c[c]));
+  for (size_t i = 0; i < b.size(); ++i)
+    for (int c = 0; c < 3; ++c) m = std::max(m, std::abs(a[i].c[c] - b[i][c]));
   return m;
+}
+
+TEST(XpbdKernels, PacksProjectLikeOneElementAfterTheOther) {
+  for (const Kernels* K : {&kernels(false), &kernels(true)})
+    for (bool keep : {false, true}) {
+      Problem ref = make_problem(7);
+      const Problem orig = ref;
+      Packed pk = pack_problem(ref);
+      EXPECT_EQ(pk.tp.size(), 51u);  // 203 triangles: 50 full packs and one of three
+      EXPECT_EQ(pk.rp.packs(), 26);  // 101 blocks
+      std::vector<double> lt_ref(3 * ref.tris.size(), 0.0), lt = lt_ref;
+      std::vector<double> lr_ref(9 * (ref.off.size() - 1), 0.0), lr = lr_ref;
+      for (int it = 0; it < 3; ++it) {
+        reference_tris(ref, kIh2, keep ? lt_ref.data() : nullptr);
+        reference_rows(ref, kIhb, keep ? lr_ref.data() : nullptr);
+        K->tris(pk.tp.data(), 0, static_cast<int>(pk.tp.size()), pk.xp.data(), kIh2,
+                keep ? lt.data() : nullptr);
+        K->rows(pk.rp.view(), 0, pk.rp.packs(), pk.xp.data(), kIhb, keep ? lr.data() : nullptr);
+      }
+      double move = 0;
+      for (int i = 0; i < ref.n; ++i) move = std::max(move, (ref.x[i] - orig.x[i]).norm());
+      const double d = max_diff(pk.xp, ref.x);
+      double dl = 0;
+      for (size_t k = 0; k < lt.size(); ++k) dl = std::max(dl, std::abs(lt[k] - lt_ref[k]));
+      for (size_t k = 0; k < lr.size(); ++k) dl = std::max(dl, std::abs(lr[k] - lr_ref[k]));
+      std::printf(
+          "%s kernels (multipliers %s): positions moved up to %.3e, differ from one element "
+          "after the other by %.3e; multipliers by %.3e\n",
+          K->name, keep ? "kept" : "reset", move, d, dl);
+      EXPECT_GT(move, 1e-3);  // the projections did move the vertices
+      EXPECT_LT(d, 1e-12);    // round-off (FMA contraction, order of sums) only
+      if (keep) {
+        EXPECT_LT(dl, 1e-9);
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(lt[3 * 5 + c], 0.0);  // the fixed triangle
+      }
+      for (int i = 0; i <= ref.n; ++i) {
+        const double wi = i < ref.n ? ref.w[i] : 0.0;
+        EXPECT_EQ(pk.xp[i].c[3], wi);  // the inverse-mass lane is read, never written
+        if (wi == 0 && i < ref.n) {    // fixed vertices do not move
+          for (int c = 0; c < 3; ++c) EXPECT_EQ(pk.xp[i].c[c], orig.x[i][c]);
+        }
+      }
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(pk.xp[ref.n].c[c], 0.0);  // the scratch vertex
+    }
 }
 
 TEST(XpbdKernels, SimdBuildAgreesWithThePortableOne) {
@@ -95,40 +229,19 @@ TEST(XpbdKernels, SimdBuildAgreesWithThePortableOne) {
   EXPECT_STREQ(ref.name, "portable");
   if (fast.tris == ref.tris)
     GTEST_SKIP() << "this CPU (or DRAPE_XPBD_SIMD=0) has only the portable kernels";
-  for (bool keep : {false, true}) {
-    Problem a = make_problem(7), b = make_problem(7);
-    const double ih2 = kIh2, ihb = kIhb;
-    std::vector<double> lt_a(3 * a.tris.size(), 0.0), lt_b = lt_a;
-    std::vector<double> lr_a(9 * (a.off.size() - 1), 0.0), lr_b = lr_a;
-    const Problem orig = make_problem(7);
-    for (int it = 0; it < 3; ++it) {
-      const RowBlocks ra{a.off.data(), a.colv.data(), a.val.data(), a.ik.data(), a.ai.data()};
-      const RowBlocks rb{b.off.data(), b.colv.data(), b.val.data(), b.ik.data(), b.ai.data()};
-      const int nt = static_cast<int>(a.tris.size()), nr = static_cast<int>(a.off.size()) - 1;
-      fast.tris(a.tris.data(), 0, nt, a.w.data(), a.x.data(), ih2, keep ? lt_a.data() : nullptr);
-      ref.tris(b.tris.data(), 0, nt, b.w.data(), b.x.data(), ih2, keep ? lt_b.data() : nullptr);
-      fast.rows(ra, 0, nr, a.w.data(), a.x.data(), ihb, keep ? lr_a.data() : nullptr);
-      ref.rows(rb, 0, nr, b.w.data(), b.x.data(), ihb, keep ? lr_b.data() : nullptr);
-    }
-    const double move = max_diff(a.x, orig.x);
-    const double d = max_diff(a.x, b.x);
-    std::printf("%s vs portable (multipliers %s): positions moved up to %.3e, differ by %.3e\n",
-                fast.name, keep ? "kept" : "reset", move, d);
-    EXPECT_GT(move, 1e-3);  // the projections did move the vertices
-    EXPECT_LT(d, 1e-12);    // round-off (FMA contraction) only
-    for (size_t i = 0; i < a.x.size(); ++i) {
-      EXPECT_EQ(a.x[i].c[3], 0.0);  // the padding lane stays 0
-      if (a.w[i] == 0) {            // fixed vertices do not move
-        for (int c = 0; c < 3; ++c) EXPECT_EQ(a.x[i].c[c], orig.x[i].c[c]);
-      }
-    }
-    if (keep) {
-      double dl = 0;
-      for (size_t k = 0; k < lt_a.size(); ++k) dl = std::max(dl, std::abs(lt_a[k] - lt_b[k]));
-      for (size_t k = 0; k < lr_a.size(); ++k) dl = std::max(dl, std::abs(lr_a[k] - lr_b[k]));
-      EXPECT_LT(dl, 1e-9);
-    }
+  const Problem p = make_problem(11);
+  Packed a = pack_problem(p), b = pack_problem(p);
+  for (int it = 0; it < 3; ++it) {
+    fast.tris(a.tp.data(), 0, static_cast<int>(a.tp.size()), a.xp.data(), kIh2, nullptr);
+    ref.tris(b.tp.data(), 0, static_cast<int>(b.tp.size()), b.xp.data(), kIh2, nullptr);
+    fast.rows(a.rp.view(), 0, a.rp.packs(), a.xp.data(), kIhb, nullptr);
+    ref.rows(b.rp.view(), 0, b.rp.packs(), b.xp.data(), kIhb, nullptr);
   }
+  double d = 0;
+  for (size_t i = 0; i < a.xp.size(); ++i)
+    for (int c = 0; c < 4; ++c) d = std::max(d, std::abs(a.xp[i].c[c] - b.xp[i].c[c]));
+  std::printf("%s vs portable: positions differ by %.3e\n", fast.name, d);
+  EXPECT_LT(d, 1e-12);
 }
 
 // A unit right triangle (rest edges along u and v) stretched by 10 % along u, vertex 0 fixed:
@@ -137,8 +250,8 @@ TEST(XpbdKernels, SimdBuildAgreesWithThePortableOne) {
 // E_vv and E_uv are 0 and stay so.
 TEST(XpbdKernels, OneProjectionRemovesTheStretchOfATriangle) {
   for (const Kernels* k : {&kernels(false), &kernels(true)}) {
-    std::vector<P4> x{P4{{0, 0, 0, 0}}, P4{{1.1, 0, 0, 0}}, P4{{0, 1, 0, 0}}};
-    const std::vector<double> w{0.0, 1.0, 1.0};
+    // Vertices 0..2 (w = 0, 1, 1) and the scratch vertex 3 of the three padding lanes.
+    std::vector<P4> x{P4{{0, 0, 0, 0}}, P4{{1.1, 0, 0, 1}}, P4{{0, 1, 0, 1}}, P4{{0, 0, 0, 0}}};
     Tri T{};
     T.v[0] = 0;
     T.v[1] = 1;
@@ -146,8 +259,11 @@ TEST(XpbdKernels, OneProjectionRemovesTheStretchOfATriangle) {
     // fu = x1 - x0, fv = x2 - x0.
     const double D[6] = {-1, -1, 1, 0, 0, 1};
     std::copy(D, D + 6, T.D);
+    std::vector<TriPack> packs;
+    pack_triangles(&T, 0, 1, 3, packs);
+    ASSERT_EQ(packs.size(), 1u);
     const double eu0 = 0.5 * (1.1 * 1.1 - 1);
-    k->tris(&T, 0, 1, w.data(), x.data(), 1.0, nullptr);  // ia = 0: no compliance
+    k->tris(packs.data(), 0, 1, x.data(), 1.0, nullptr);  // ia = 0: no compliance
     const double fu[3] = {x[1].c[0] - x[0].c[0], x[1].c[1] - x[0].c[1], x[1].c[2] - x[0].c[2]};
     const double eu = 0.5 * (fu[0] * fu[0] + fu[1] * fu[1] + fu[2] * fu[2] - 1);
     std::printf("%s: E_uu %.4f -> %.2e, vertex 1 at x = %.5f\n", k->name, eu0, eu, x[1].c[0]);
@@ -157,6 +273,7 @@ TEST(XpbdKernels, OneProjectionRemovesTheStretchOfATriangle) {
     EXPECT_EQ(x[1].c[1], 0.0);
     EXPECT_EQ(x[2].c[0], 0.0);
     EXPECT_EQ(x[2].c[1], 1.0);
+    for (int c = 0; c < 4; ++c) EXPECT_EQ(x[3].c[c], 0.0);  // padding moved nothing
   }
 }
 
