@@ -30,6 +30,11 @@ DressForm::DressForm(double y0, double dy, std::vector<Vec2> centres, std::vecto
     radii_.clear();
   }
   if (!(dy_ > 0)) dy_ = 1.0;
+  max_radius_.resize(num_sections_);
+  for (int j = 0; j < num_sections_; ++j) {
+    const double* r = &radii_[static_cast<size_t>(j) * kAngles];
+    max_radius_[j] = *std::max_element(r, r + kAngles);
+  }
 }
 
 Vec3 DressForm::direction(double theta) {
@@ -166,6 +171,24 @@ double DressForm::signed_distance(const Vec3& p) const {
   const Vec2 c = centre_at(p.y());
   const double dx = p.x() - c.x(), dz = p.z() - c.y();
   return std::sqrt(dx * dx + dz * dz) - radius_at(p.y(), std::atan2(dx, dz));
+}
+
+double DressForm::signed_distance_within(const Vec3& p, double reach, Vec2* centre) const {
+  if (num_sections_ == 0) return std::numeric_limits<double>::infinity();
+  const double s = (p.y() - y0_) / dy_;
+  if (!(s >= 0.0) || s > num_sections_ - 1) return std::numeric_limits<double>::infinity();
+  int j;
+  double t;
+  locate(p.y(), y0_, dy_, num_sections_, j, t);
+  const int j1 = std::min(j + 1, num_sections_ - 1);
+  const Vec2 c = centres_[j] + (centres_[j1] - centres_[j]) * t;
+  if (centre) *centre = c;
+  const double dx = p.x() - c.x(), dz = p.z() - c.y();
+  const double rho = std::sqrt(dx * dx + dz * dz);
+  // The bilinear radius at any angle is at most the larger section maximum.
+  const double bound = rho - std::max(max_radius_[j], max_radius_[j1]);
+  if (bound >= reach) return bound;
+  return rho - radius_at(p.y(), std::atan2(dx, dz));
 }
 
 TriMesh DressForm::to_mesh() const {

@@ -127,6 +127,11 @@ class DressForm {
   double push_outside(Vec3& p, double offset) const;
   // Signed radial distance of p from the surface (< 0 inside); +inf outside the height range.
   double signed_distance(const Vec3& p) const;
+  // The same for a contact test that only needs distances below `reach`: a point farther than
+  // `reach` outside the widest radius of its two neighbouring sections gets that lower bound
+  // (>= reach) without the angle lookup (atan2 and the bilinear radius: most of the cost).
+  // centre: the interpolated section centre at p.y() (unset outside the height range).
+  double signed_distance_within(const Vec3& p, double reach, Vec2* centre = nullptr) const;
 
   // The form as a closed triangle mesh (sections x angles, capped), for rendering and export.
   TriMesh to_mesh() const;
@@ -136,6 +141,7 @@ class DressForm {
   int num_sections_ = 0;
   std::vector<Vec2> centres_;
   std::vector<double> radii_;
+  std::vector<double> max_radius_;  // per section, over its angles
   FormLandmarks landmarks_;
 };
 

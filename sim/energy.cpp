@@ -976,9 +976,9 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
       if (form_on) {
         const DressForm& f = *scene.form;
         if (p.y() < f.min_y() || p.y() > f.max_y()) continue;
-        const double sd = f.signed_distance(p);
+        Vec2 c;
+        const double sd = f.signed_distance_within(p, reach, &c);
         if (!(sd < reach)) continue;
-        const Vec2 c = f.centre_at(p.y());
         Vec3 r(p.x() - c.x(), 0, p.z() - c.y());
         const double rn = r.norm();
         if (rn < 1e-9) continue;
