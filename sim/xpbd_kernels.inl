@@ -45,20 +45,38 @@ inline void transpose(D4 r0, D4 r1, D4 r2, D4 r3, D4& a, D4& b, D4& c, D4& d) {
 struct Lanes {
   D4 X, Y, Z, W;
 };
+#if defined(__AVX__)
 inline Lanes gather(const P4* x, const int32_t* v) {
   Lanes g;
   transpose(ld(x[v[0]]), ld(x[v[1]]), ld(x[v[2]]), ld(x[v[3]]), g.X, g.Y, g.Z, g.W);
   return g;
 }
+#else
+// Without AVX a 256-bit shuffle is lowered through memory: element by element is faster.
+inline Lanes gather(const P4* x, const int32_t* v) {
+  const double *a = x[v[0]].c, *b = x[v[1]].c, *c = x[v[2]].c, *d = x[v[3]].c;
+  return Lanes{D4{a[0], b[0], c[0], d[0]}, D4{a[1], b[1], c[1], d[1]}, D4{a[2], b[2], c[2], d[2]},
+               D4{a[3], b[3], c[3], d[3]}};
+}
+#endif
 // Writes the lanes back. Lanes sharing a vertex (only the scratch vertex of padding, which no
 // projection moves) write the same value.
 inline void scatter(P4* x, const int32_t* v, const Lanes& g) {
+#if defined(__AVX__)
   D4 r0, r1, r2, r3;
   transpose(g.X, g.Y, g.Z, g.W, r0, r1, r2, r3);
   st(x[v[0]], r0);
   st(x[v[1]], r1);
   st(x[v[2]], r2);
   st(x[v[3]], r3);
+#else
+  for (int l = 0; l < 4; ++l) {  // (the fourth lane, w, is never changed)
+    double* p = x[v[l]].c;
+    p[0] = g.X[l];
+    p[1] = g.Y[l];
+    p[2] = g.Z[l];
+  }
+#endif
 }
 
 // The three strain constraints of a triangle (E_uu, E_vv, E_uv) are projected one after the
