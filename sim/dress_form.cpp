@@ -165,12 +165,8 @@ double DressForm::push_outside(Vec3& p, double offset) const {
 }
 
 double DressForm::signed_distance(const Vec3& p) const {
-  if (num_sections_ == 0) return std::numeric_limits<double>::infinity();
-  const double s = (p.y() - y0_) / dy_;
-  if (!(s >= 0.0) || s > num_sections_ - 1) return std::numeric_limits<double>::infinity();
-  const Vec2 c = centre_at(p.y());
-  const double dx = p.x() - c.x(), dz = p.z() - c.y();
-  return std::sqrt(dx * dx + dz * dz) - radius_at(p.y(), std::atan2(dx, dz));
+  // No reach: the bound never answers, so this is the exact radial distance.
+  return signed_distance_within(p, std::numeric_limits<double>::infinity());
 }
 
 double DressForm::signed_distance_within(const Vec3& p, double reach, Vec2* centre) const {
