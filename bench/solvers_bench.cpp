@@ -217,7 +217,8 @@ XpbdSolver* xpbd_of(Solver* s) {
 
 // --probe SCENE RES SOLVER SUBSTEPS ITERATIONS: one configuration with every VBD option from
 // the environment (VBD_INIT 0/1/2, VBD_RHO, VBD_DAMP, VBD_FREEZE, VBD_TOL, VBD_THREADS,
-// PROBE_FRAMES, REF_ITERS, PROBE_POLISH=0 skips the final scoring; XPBD: XPBD_WARM,
+// PROBE_FRAMES, REF_ITERS, PROBE_POLISH=0 skips the final scoring, PROBE_FRICTION the objects'
+// friction coefficient; XPBD: XPBD_WARM,
 // XPBD_REUSE 0/1, XPBD_BEND_EVERY, XPBD_WARM_FRAME + XPBD_WARM_LATE: warm start from a frame on),
 // printing wall and CPU time per frame and the error per 0.1 s.
 int probe(int argc, char** argv) {
@@ -283,6 +284,7 @@ int probe(int argc, char** argv) {
       xp->options().settle_growth = env_num("XPBD_SETTLE_GROWTH", xp->options().settle_growth);
     }
   }
+  sc.objects.friction = env_num("PROBE_FRICTION", sc.objects.friction);
   const double frame = 1.0 / 90;
   const int frames = static_cast<int>(env_num("PROBE_FRAMES", std::lround(sc.duration / frame)));
   double wall = 0, cpu = 0;

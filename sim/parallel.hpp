@@ -47,6 +47,8 @@ class ThreadPool {
     }
     run(n, &invoke<std::remove_reference_t<Fn>>, &fn);
   }
+  // Times a worker went to sleep after spinning idle (parallel.cpp, kSpinBeforeSleep).
+  long idle_sleeps() const { return idle_sleeps_.load(std::memory_order_relaxed); }
   // Below this many items the caller runs the range alone (sync costs more than it saves).
   void set_min_parallel(int n) { min_parallel_ = n; }
 
@@ -68,6 +70,7 @@ class ThreadPool {
   std::atomic<int> done_{0};       // chunks finished in this generation
   std::atomic<int> chunks_{0};     // chunks of this generation
   std::atomic<bool> stop_{false};
+  std::atomic<long> idle_sleeps_{0};
   Thunk thunk_ = nullptr;
   void* ctx_ = nullptr;
   int n_ = 0;

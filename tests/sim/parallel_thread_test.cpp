@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <set>
+#include <thread>
 #include <vector>
 
 #include "sim/parallel.hpp"
@@ -62,6 +64,23 @@ TEST(ThreadPool, TwoThreadsKeepToTheirOwnEndOfTheRange) {
     }
   }
   std::printf("calls in which both threads ran chunks: %d of 500\n", both);
+}
+
+// An idle worker spins briefly (so that it is awake for the next of a solver's many short
+// loops) and then sleeps: between steps it does not burn a core.
+TEST(ThreadPool, AnIdleWorkerSleepsAfterSpinning) {
+  ThreadPool pool(2);
+  pool.set_min_parallel(0);
+  std::atomic<long> sum{0};
+  for (int rep = 0; rep < 3; ++rep) {
+    const long before = pool.idle_sleeps();
+    pool.parallel_for(64, [&](int b, int e, int) { sum += e - b; });
+    // The spin lasts 200 us; allow a loaded machine 5 s to schedule the worker.
+    for (int ms = 0; ms < 5000 && pool.idle_sleeps() == before; ++ms)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    EXPECT_GT(pool.idle_sleeps(), before) << "rep " << rep;
+  }
+  EXPECT_EQ(sum.load(), 3 * 64);
 }
 
 TEST(Colouring, ElementsOfOneColourShareNoVertex) {
