@@ -1,8 +1,7 @@
 #include "sim/parallel.hpp"
 
-#include <chrono>
-
 #include <algorithm>
+#include <chrono>
 
 namespace drape::sim {
 
