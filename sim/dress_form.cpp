@@ -73,11 +73,9 @@ inline void locate_angle(double theta, int& n, double& u) {
 }
 }  // namespace
 
-double DressForm::radius_at(double y, double th) const {
-  if (num_sections_ == 0) return 0.0;
-  int j, n;
-  double t, u;
-  locate(y, y0_, dy_, num_sections_, j, t);
+double DressForm::radius_in(int j, double t, double th) const {
+  int n;
+  double u;
   locate_angle(th, n, u);
   const int n1 = (n + 1) & (kAngles - 1);
   const int j1 = std::min(j + 1, num_sections_ - 1);
@@ -88,13 +86,25 @@ double DressForm::radius_at(double y, double th) const {
   return a + (b - a) * t;
 }
 
+Vec2 DressForm::centre_in(int j, double t) const {
+  const int j1 = std::min(j + 1, num_sections_ - 1);
+  return centres_[j] + (centres_[j1] - centres_[j]) * t;
+}
+
+double DressForm::radius_at(double y, double th) const {
+  if (num_sections_ == 0) return 0.0;
+  int j;
+  double t;
+  locate(y, y0_, dy_, num_sections_, j, t);
+  return radius_in(j, t, th);
+}
+
 Vec2 DressForm::centre_at(double y) const {
   if (num_sections_ == 0) return Vec2::Zero();
   int j;
   double t;
   locate(y, y0_, dy_, num_sections_, j, t);
-  const int j1 = std::min(j + 1, num_sections_ - 1);
-  return centres_[j] + (centres_[j1] - centres_[j]) * t;
+  return centre_in(j, t);
 }
 
 Vec3 DressForm::surface_at(double y, double th) const {
@@ -136,21 +146,12 @@ double DressForm::push_outside(Vec3& p, double offset) const {
   int j = static_cast<int>(s);
   double t = s - j;
   if (j >= num_sections_ - 1) j = std::max(num_sections_ - 2, 0), t = num_sections_ >= 2 ? 1 : 0;
-  const int j1 = std::min(j + 1, num_sections_ - 1);
-  const Vec2 c = centres_[j] + (centres_[j1] - centres_[j]) * t;
+  const Vec2 c = centre_in(j, t);
   const double dx = p.x() - c.x(), dz = p.z() - c.y();
   const double d2 = dx * dx + dz * dz;
   if (!std::isfinite(d2)) return 0.0;  // NaN/inf coordinates: leave the point alone
-  double th = std::atan2(dx, dz);      // 0 at +z (centre front), +pi/2 at +x (left side)
-  int n;
-  double u;
-  locate_angle(th, n, u);
-  const int n1 = (n + 1) & (kAngles - 1);
-  const double* r0 = &radii_[static_cast<size_t>(j) * kAngles];
-  const double* r1 = &radii_[static_cast<size_t>(j1) * kAngles];
-  const double a = r0[n] + (r0[n1] - r0[n]) * u;
-  const double b = r1[n] + (r1[n1] - r1[n]) * u;
-  const double target = a + (b - a) * t + offset;
+  // th: 0 at +z (centre front), +pi/2 at +x (left side).
+  const double target = radius_in(j, t, std::atan2(dx, dz)) + offset;
   if (d2 >= target * target) return 0.0;
   const double d = std::sqrt(d2);
   double ux, uz;
@@ -177,14 +178,14 @@ double DressForm::signed_distance_within(const Vec3& p, double reach, Vec2* cent
   double t;
   locate(p.y(), y0_, dy_, num_sections_, j, t);
   const int j1 = std::min(j + 1, num_sections_ - 1);
-  const Vec2 c = centres_[j] + (centres_[j1] - centres_[j]) * t;
+  const Vec2 c = centre_in(j, t);
   if (centre) *centre = c;
   const double dx = p.x() - c.x(), dz = p.z() - c.y();
   const double rho = std::sqrt(dx * dx + dz * dz);
   // The bilinear radius at any angle is at most the larger section maximum.
   const double bound = rho - std::max(max_radius_[j], max_radius_[j1]);
   if (bound >= reach) return bound;
-  return rho - radius_at(p.y(), std::atan2(dx, dz));
+  return rho - radius_in(j, t, std::atan2(dx, dz));
 }
 
 TriMesh DressForm::to_mesh() const {

@@ -142,6 +142,10 @@ class DressForm {
   std::vector<Vec2> centres_;
   std::vector<double> radii_;
   std::vector<double> max_radius_;  // per section, over its angles
+  // Radius at angle th and centre between sections j and j + 1 at fraction t (located once by
+  // the callers: radius_at, centre_at, push_outside, signed_distance_within).
+  double radius_in(int j, double t, double th) const;
+  Vec2 centre_in(int j, double t) const;
   FormLandmarks landmarks_;
 };
 
