@@ -35,6 +35,31 @@ DressForm::DressForm(double y0, double dy, std::vector<Vec2> centres, std::vecto
     const double* r = &radii_[static_cast<size_t>(j) * kAngles];
     max_radius_[j] = *std::max_element(r, r + kAngles);
   }
+  // |grad F|^2 = 1 + (r_th / rho)^2 + g_y^2 with |g_y| <= |c'| (1 + |r_th| / rho) + |r_y|; within
+  // reach of the surface rho >= r - reach, so r_th / rho is bounded with the cell's smallest
+  // radius less a centimetre (contacts reach a few millimetres).
+  max_gradient_.assign(num_sections_, 1.0);
+  for (int j = 0; j + 1 < num_sections_; ++j) {
+    const double* r0 = &radii_[static_cast<size_t>(j) * kAngles];
+    const double* r1 = r0 + kAngles;
+    double rth = 0, ry = 0, rmin = std::numeric_limits<double>::infinity();
+    for (int n = 0; n < kAngles; ++n) {
+      const int n1 = (n + 1) & (kAngles - 1);
+      rth = std::max({rth, std::abs(r0[n1] - r0[n]), std::abs(r1[n1] - r1[n])});
+      ry = std::max(ry, std::abs(r1[n] - r0[n]));
+      rmin = std::min({rmin, r0[n], r1[n]});
+    }
+    const double a = rth * kAnglesPerRadian / std::max(rmin - 0.01, 1e-3);
+    const double cy = (centres_[j + 1] - centres_[j]).norm() / dy_;
+    const double gy = cy * (1 + a) + ry / dy_;
+    max_gradient_[j] = std::sqrt(1 + a * a + gy * gy);
+  }
+  // The normals use central differences, which mix a cell's slopes with its neighbours'.
+  if (num_sections_ >= 2) {
+    std::vector<double> own = max_gradient_;
+    for (int j = 0; j + 1 < num_sections_; ++j)
+      max_gradient_[j] = std::max({own[std::max(j - 1, 0)], own[j], own[j + 1]});
+  }
 }
 
 Vec3 DressForm::direction(double theta) {
@@ -186,6 +211,70 @@ double DressForm::signed_distance_within(const Vec3& p, double reach, Vec2* cent
   const double bound = rho - std::max(max_radius_[j], max_radius_[j1]);
   if (bound >= reach) return bound;
   return rho - radius_in(j, t, std::atan2(dx, dz));
+}
+
+double DressForm::radius_slope_y(int j, int n) const {
+  const int a = std::max(j - 1, 0), b = std::min(j + 1, num_sections_ - 1);
+  return (radii_[static_cast<size_t>(b) * kAngles + n] -
+          radii_[static_cast<size_t>(a) * kAngles + n]) /
+         (dy_ * (b - a));
+}
+
+double DressForm::radius_slope_theta(int j, int n) const {
+  const double* r = &radii_[static_cast<size_t>(j) * kAngles];
+  return (r[(n + 1) & (kAngles - 1)] - r[(n + kAngles - 1) & (kAngles - 1)]) *
+         (kAnglesPerRadian / 2);
+}
+
+Vec2 DressForm::centre_slope(int j) const {
+  const int a = std::max(j - 1, 0), b = std::min(j + 1, num_sections_ - 1);
+  return (centres_[b] - centres_[a]) / (dy_ * (b - a));
+}
+
+double DressForm::normal_distance_within(const Vec3& p, double reach, Vec3* normal) const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  if (num_sections_ < 2) return kInf;
+  const double s = (p.y() - y0_) / dy_;
+  if (!(s >= 0.0) || s > num_sections_ - 1) return kInf;
+  int j;
+  double t;
+  locate(p.y(), y0_, dy_, num_sections_, j, t);
+  const Vec2 c = centre_in(j, t);
+  const double dx = p.x() - c.x(), dz = p.z() - c.y();
+  const double rho = std::sqrt(dx * dx + dz * dz);
+  if (!(rho > 1e-9)) return kInf;
+  const double bound = (rho - std::max(max_radius_[j], max_radius_[j + 1])) / max_gradient_[j];
+  if (bound >= reach) return bound;
+  int n;
+  double u;
+  locate_angle(std::atan2(dx, dz), n, u);
+  const int n1 = (n + 1) & (kAngles - 1);
+  const double* r0 = &radii_[static_cast<size_t>(j) * kAngles];
+  const double* r1 = r0 + kAngles;
+  const double a = r0[n] + (r0[n1] - r0[n]) * u;
+  const double b = r1[n] + (r1[n1] - r1[n]) * u;
+  const double F = rho - (a + (b - a) * t);
+  // dr/dtheta, dr/dy and the centre's drift dc/dy: central differences at the four samples,
+  // interpolated bilinearly as the radius is. The bilinear cell's own slopes jump from one cell
+  // to the next (every 2.5 mm of height, every 1.4 degrees), and a contact plane that flips
+  // there kept the static solve's active set from settling; these normals are continuous.
+  const int j1 = j + 1;
+  const double ry00 = radius_slope_y(j, n), ry01 = radius_slope_y(j, n1);
+  const double ry10 = radius_slope_y(j1, n), ry11 = radius_slope_y(j1, n1);
+  const double rt00 = radius_slope_theta(j, n), rt01 = radius_slope_theta(j, n1);
+  const double rt10 = radius_slope_theta(j1, n), rt11 = radius_slope_theta(j1, n1);
+  const double ry_a = ry00 + (ry01 - ry00) * u, ry_b = ry10 + (ry11 - ry10) * u;
+  const double rt_a = rt00 + (rt01 - rt00) * u, rt_b = rt10 + (rt11 - rt10) * u;
+  const double r_y = ry_a + (ry_b - ry_a) * t;
+  const double r_th = rt_a + (rt_b - rt_a) * t;
+  const Vec2 dc = centre_slope(j) + (centre_slope(j1) - centre_slope(j)) * t;
+  // Radial unit u = (ux, 0, uz), angular unit w = (uz, 0, -ux) (toward growing theta).
+  const double ux = dx / rho, uz = dz / rho, k = r_th / rho;
+  const double gx = ux - k * uz, gz = uz + k * ux;
+  const double gy = -(ux * dc.x() + uz * dc.y()) + k * (uz * dc.x() - ux * dc.y()) - r_y;
+  const double g = std::sqrt(gx * gx + gy * gy + gz * gz);
+  *normal = Vec3(gx / g, gy / g, gz / g);
+  return F / g;
 }
 
 TriMesh DressForm::to_mesh() const {

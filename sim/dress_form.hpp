@@ -132,6 +132,19 @@ class DressForm {
   // (>= reach) without the angle lookup (atan2 and the bilinear radius: most of the cost).
   // centre: the interpolated section centre at p.y() (unset outside the height range).
   double signed_distance_within(const Vec3& p, double reach, Vec2* centre = nullptr) const;
+  // Contact test against the surface's own normal. With F = rho - r(theta, y) the radial
+  // distance (rho from the section centre at p.y()), returns F / |g| (the distance to the
+  // surface along its normal, to first order) and sets `normal` to g / |g|, where g is grad F
+  // with the radius's slopes taken as central differences at the samples and interpolated
+  // (a normal continuous across the bilinear cells' edges, where grad F itself jumps): outward,
+  // leaning up where the radius shrinks with height (shoulders, above the bust), down where it
+  // grows (under the bust, the hips), and sideways where it changes with the angle. The radial
+  // direction alone gives a vertical plane on a slope, which carries no weight: a cloth resting
+  // there slid down it between contact detections and was pushed out at the next one (a
+  // ratchet that kept a settled drape creeping; docs/solvers.md section 3j). Values >= reach
+  // may be a lower bound (the per-cell bound on |grad F|, no angle lookup); +inf outside the
+  // height range or on the axis (normal untouched then).
+  double normal_distance_within(const Vec3& p, double reach, Vec3* normal) const;
 
   // The form as a closed triangle mesh (sections x angles, capped), for rendering and export.
   TriMesh to_mesh() const;
@@ -142,10 +155,18 @@ class DressForm {
   std::vector<Vec2> centres_;
   std::vector<double> radii_;
   std::vector<double> max_radius_;  // per section, over its angles
+  // Per cell between sections j and j + 1: an upper bound of |grad F| within it (its radial
+  // slopes in height and angle and its centre's drift; normal_distance_within).
+  std::vector<double> max_gradient_;
   // Radius at angle th and centre between sections j and j + 1 at fraction t (located once by
   // the callers: radius_at, centre_at, push_outside, signed_distance_within).
   double radius_in(int j, double t, double th) const;
   Vec2 centre_in(int j, double t) const;
+  // Central-difference slopes at sample (j, n): dr/dy, dr/dtheta, and the centre's dc/dy
+  // (one-sided at the end sections).
+  double radius_slope_y(int j, int n) const;
+  double radius_slope_theta(int j, int n) const;
+  Vec2 centre_slope(int j) const;
   FormLandmarks landmarks_;
 };
 

@@ -976,13 +976,9 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
       if (form_on) {
         const DressForm& f = *scene.form;
         if (p.y() < f.min_y() || p.y() > f.max_y()) continue;
-        Vec2 c;
-        const double sd = f.signed_distance_within(p, reach, &c);
+        Vec3 nrm;
+        const double sd = f.normal_distance_within(p, reach, &nrm);
         if (!(sd < reach)) continue;
-        Vec3 r(p.x() - c.x(), 0, p.z() - c.y());
-        const double rn = r.norm();
-        if (rn < 1e-9) continue;
-        const Vec3 nrm = r / rn;
         consider(i, sd, nrm, p - sd * nrm, deepest);
       }
     }

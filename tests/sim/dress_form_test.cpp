@@ -255,6 +255,104 @@ TEST(DressForm, BoundedSignedDistanceIsExactWithinReach) {
   EXPECT_GT(bounded, 1000);
 }
 
+// The contact test's normal: on a cone (radius shrinking with height, the axis drifting
+// sideways) the distance along the normal is the exact distance to the surface and the normal
+// the cone's own, leaning upward; on the parametric form it is the finite-difference gradient of
+// the radial distance, and values beyond the reach are lower bounds of it.
+TEST(DressForm, NormalDistanceFollowsTheSurfaceSlope) {
+  // Radius 0.3 - 2 (y - 1) over 1.0 <= y <= 1.1, axis along (0.1, 1, 0.05) (the centre drifts
+  // 0.1 m in x and 0.05 m in z per metre of height).
+  const int ns = 41;
+  const double y0 = 1.0, dy = 0.0025, k = 2.0;
+  const Vec2 drift(0.1, 0.05);
+  std::vector<Vec2> centres(ns);
+  std::vector<double> radii(static_cast<size_t>(ns) * kN);
+  for (int j = 0; j < ns; ++j) {
+    centres[j] = drift * (dy * j);
+    for (int n = 0; n < kN; ++n) radii[static_cast<size_t>(j) * kN + n] = 0.3 - k * dy * j;
+  }
+  const DressForm f(y0, dy, centres, radii, FormLandmarks{});
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> ang(0, 2 * kPi), fy(1.02, 1.08), off(-0.004, 0.004);
+  double worst_n = 0, worst_d = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const double y = fy(rng), th = ang(rng), e = off(rng);
+    const Vec3 u = DressForm::direction(th);
+    // The horizontally sheared cone: F(x) = |(x - c(y))_xz| - r(y). Its gradient, from the
+    // shear: d rho / dy = -u . drift, so grad F = u + (k - u . drift) y_hat.
+    const Vec3 g = u + (k - (u.x() * drift.x() + u.z() * drift.y())) * Vec3::UnitY();
+    const Vec3 n_exact = g.normalized();
+    const Vec3 p = f.surface_at(y, th) + e * n_exact;  // e from the surface along its normal
+    Vec3 n;
+    const double d = f.normal_distance_within(p, 0.01, &n);
+    // The gradient at p itself (its level set leans a little from the surface's: the drift).
+    const Vec2 cp = f.centre_at(p.y());
+    const Vec3 up = Vec3(p.x() - cp.x(), 0, p.z() - cp.y()).normalized();
+    const Vec3 gp = up + (k - (up.x() * drift.x() + up.z() * drift.y())) * Vec3::UnitY();
+    worst_n = std::max(worst_n, (n - gp.normalized()).norm());
+    worst_d = std::max(worst_d, std::abs(d - e));
+  }
+  std::printf("sheared cone: normal error %.3g, distance error %.3g m (up to 4 mm off)\n", worst_n,
+              worst_d);
+  EXPECT_LT(worst_n, 1e-9);  // bilinear sections reproduce the cone exactly
+  EXPECT_LT(worst_d, 1e-6);  // to first order: 4 mm off, the drift tilts the level set ~2e-3
+
+  auto pf = DressForm::from_measurements(FormMeasurements{});
+  ASSERT_TRUE(pf.ok()) << pf.error();
+  std::uniform_real_distribution<double> py(pf->min_y() + 0.01, pf->max_y() - 0.01),
+      out(-0.01, 0.03);
+  const double reach = 0.012, hd = 1e-7;
+  int exact = 0, bounded = 0;
+  double worst_fd = 0, worst_jump = 0, worst_fd_d = 0;
+  for (int i = 0; i < 5000; ++i) {
+    const double y = py(rng), th = ang(rng);
+    const Vec2 c = pf->centre_at(y);
+    const double r = pf->radius_at(y, th) + out(rng);
+    const Vec3 p(c.x() + r * std::sin(th), y, c.y() + r * std::cos(th));
+    Vec3 n;
+    const double d = pf->normal_distance_within(p, reach, &n);
+    Vec3 n_full;
+    const double d_full = pf->normal_distance_within(p, 1e9, &n_full);
+    if (d >= reach) {  // a lower bound beyond the reach, or the exact value
+      EXPECT_GE(d_full, d - 1e-15);
+      if (d != d_full) ++bounded;
+      continue;
+    }
+    EXPECT_EQ(d, d_full);
+    ++exact;
+    // Against the gradient of the radial distance F = signed_distance by central differences
+    // over 0.1 um: the smoothed slopes differ from a cell's own by the curvature over a cell.
+    Vec3 g;
+    for (int a = 0; a < 3; ++a) {
+      Vec3 dp = Vec3::Zero();
+      dp[a] = hd;
+      g[a] = (pf->signed_distance(p + dp) - pf->signed_distance(p - dp)) / (2 * hd);
+    }
+    worst_fd = std::max(worst_fd, (n - g.normalized()).norm());
+    worst_fd_d = std::max(worst_fd_d, std::abs(d - pf->signed_distance(p) / g.norm()));
+    // Continuous across the nearest section line (the bilinear cells' gradient jumps there).
+    const double sy =
+        pf->section_y(static_cast<int>(std::lround((y - pf->min_y()) / pf->section_spacing())));
+    if (sy <= pf->min_y() || sy >= pf->max_y()) continue;
+    const Vec2 cs = pf->centre_at(sy);
+    Vec3 below(p.x() - c.x() + cs.x(), sy - 1e-9, p.z() - c.y() + cs.y()), above = below;
+    above.y() = sy + 1e-9;
+    Vec3 nb, na;
+    pf->normal_distance_within(below, 1e9, &nb);
+    pf->normal_distance_within(above, 1e9, &na);
+    worst_jump = std::max(worst_jump, (na - nb).norm());
+  }
+  std::printf(
+      "parametric form: %d within reach (normal vs the bilinear cell's gradient: up to %.3g, "
+      "distance up to %.3g m; jump across a section line %.3g), %d bounded\n",
+      exact, worst_fd, worst_fd_d, worst_jump, bounded);
+  EXPECT_GT(exact, 2000);
+  EXPECT_GT(bounded, 100);
+  EXPECT_LT(worst_fd, 0.3);     // the form's sharpest turns (neck, armholes) over one cell
+  EXPECT_LT(worst_fd_d, 1e-3);  // within reach (12 mm): the slope error times the distance
+  EXPECT_LT(worst_jump, 1e-6);
+}
+
 TEST(DressForm, LandmarksAndReferenceLines) {
   auto f = DressForm::from_measurements(FormMeasurements{});
   ASSERT_TRUE(f.ok());
