@@ -352,6 +352,26 @@ int probe(int argc, char** argv) {
         "error against the equilibrium nearest to the end state: rms %.3f mm, max %.3f mm "
         "(static polish residual %.1e)\n",
         rms * 1e3, mx * 1e3, res_polish);
+    // PROBE_POLISH_STEPS=1,2,4: how close a static solve of k Newton iterations from the end
+    // state gets to that equilibrium, and what it costs (a polish of a piece falling asleep).
+    if (const char* steps = std::getenv("PROBE_POLISH_STEPS")) {
+      for (const char* q = steps; *q;) {
+        const int k = std::atoi(q);
+        if (k > 0) {
+          double rk = 0, e_rms = 0, e_max = 0;
+          const double c0 = cpu_ms();
+          const std::vector<Vec3> xk = polished(sc, rk, k);
+          const double ms = cpu_ms() - c0;
+          position_error(xk, pol, e_rms, e_max);
+          std::printf(
+              "  polish of %d Newton iterations: %.0f ms CPU, residual %.1e, rms %.3f mm, "
+              "max %.3f mm from the equilibrium\n",
+              k, ms, rk, e_rms * 1e3, e_max * 1e3);
+        }
+        while (*q && *q != ',') ++q;
+        if (*q == ',') ++q;
+      }
+    }
     // Where the error is: vertices touching the form (within 0.5 mm of the kept-out shell)
     // and free ones, and the worst vertex's height and displacement.
     double e_touch = 0, e_free = 0, worst = -1;

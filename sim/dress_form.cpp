@@ -191,26 +191,15 @@ double DressForm::push_outside(Vec3& p, double offset) const {
 }
 
 double DressForm::signed_distance(const Vec3& p) const {
-  // No reach: the bound never answers, so this is the exact radial distance.
-  return signed_distance_within(p, std::numeric_limits<double>::infinity());
-}
-
-double DressForm::signed_distance_within(const Vec3& p, double reach, Vec2* centre) const {
   if (num_sections_ == 0) return std::numeric_limits<double>::infinity();
   const double s = (p.y() - y0_) / dy_;
   if (!(s >= 0.0) || s > num_sections_ - 1) return std::numeric_limits<double>::infinity();
   int j;
   double t;
   locate(p.y(), y0_, dy_, num_sections_, j, t);
-  const int j1 = std::min(j + 1, num_sections_ - 1);
   const Vec2 c = centre_in(j, t);
-  if (centre) *centre = c;
   const double dx = p.x() - c.x(), dz = p.z() - c.y();
-  const double rho = std::sqrt(dx * dx + dz * dz);
-  // The bilinear radius at any angle is at most the larger section maximum.
-  const double bound = rho - std::max(max_radius_[j], max_radius_[j1]);
-  if (bound >= reach) return bound;
-  return rho - radius_in(j, t, std::atan2(dx, dz));
+  return std::sqrt(dx * dx + dz * dz) - radius_in(j, t, std::atan2(dx, dz));
 }
 
 double DressForm::radius_slope_y(int j, int n) const {

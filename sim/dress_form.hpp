@@ -127,11 +127,6 @@ class DressForm {
   double push_outside(Vec3& p, double offset) const;
   // Signed radial distance of p from the surface (< 0 inside); +inf outside the height range.
   double signed_distance(const Vec3& p) const;
-  // The same for a contact test that only needs distances below `reach`: a point farther than
-  // `reach` outside the widest radius of its two neighbouring sections gets that lower bound
-  // (>= reach) without the angle lookup (atan2 and the bilinear radius: most of the cost).
-  // centre: the interpolated section centre at p.y() (unset outside the height range).
-  double signed_distance_within(const Vec3& p, double reach, Vec2* centre = nullptr) const;
   // Contact test against the surface's own normal. With F = rho - r(theta, y) the radial
   // distance (rho from the section centre at p.y()), returns F / |g| (the distance to the
   // surface along its normal, to first order) and sets `normal` to g / |g|, where g is grad F
@@ -142,7 +137,8 @@ class DressForm {
   // direction alone gives a vertical plane on a slope, which carries no weight: a cloth resting
   // there slid down it between contact detections and was pushed out at the next one (a
   // ratchet that kept a settled drape creeping; docs/solvers.md section 3j). Values >= reach
-  // may be a lower bound (the per-cell bound on |grad F|, no angle lookup); +inf outside the
+  // may be a lower bound (the widest radius of the two sections and a per-cell bound on |g|,
+  // without the angle lookup: atan2 and the interpolation, most of the cost); +inf outside the
   // height range or on the axis (normal untouched then).
   double normal_distance_within(const Vec3& p, double reach, Vec3* normal) const;
 
@@ -159,7 +155,7 @@ class DressForm {
   // slopes in height and angle and its centre's drift; normal_distance_within).
   std::vector<double> max_gradient_;
   // Radius at angle th and centre between sections j and j + 1 at fraction t (located once by
-  // the callers: radius_at, centre_at, push_outside, signed_distance_within).
+  // the callers: radius_at, centre_at, push_outside, signed_distance).
   double radius_in(int j, double t, double th) const;
   Vec2 centre_in(int j, double t) const;
   // Central-difference slopes at sample (j, n): dr/dy, dr/dtheta, and the centre's dc/dy

@@ -974,10 +974,8 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
         consider(i, q[ax], nrm, surf, deepest);
       }
       if (form_on) {
-        const DressForm& f = *scene.form;
-        if (p.y() < f.min_y() || p.y() > f.max_y()) continue;
-        Vec3 nrm;
-        const double sd = f.normal_distance_within(p, reach, &nrm);
+        Vec3 nrm;  // (+inf outside the form's height range)
+        const double sd = scene.form->normal_distance_within(p, reach, &nrm);
         if (!(sd < reach)) continue;
         consider(i, sd, nrm, p - sd * nrm, deepest);
       }

@@ -216,45 +216,6 @@ TEST(DressForm, PushOutsideParametricAgreesWithSurface) {
   EXPECT_EQ(pushed, 3000);
 }
 
-// The contact test's bounded distance: exact where it matters (below the reach), otherwise a
-// lower bound that is itself beyond the reach; points everywhere from inside the form to 0.3 m
-// outside it, and above and below it.
-TEST(DressForm, BoundedSignedDistanceIsExactWithinReach) {
-  auto f = DressForm::from_measurements(FormMeasurements{});
-  ASSERT_TRUE(f.ok()) << f.error();
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> ang(0, 2 * kPi), fy(f->min_y() - 0.05, f->max_y() + 0.05),
-      out(-0.1, 0.3);
-  const double reach = 0.006;
-  int exact = 0, bounded = 0;
-  for (int i = 0; i < 20000; ++i) {
-    const double y = fy(rng), th = ang(rng);
-    const Vec2 c = f->centre_at(y);
-    const double r = std::max(0.0, f->radius_at(y, th) + out(rng));
-    const Vec3 p(c.x() + r * std::sin(th), y, c.y() + r * std::cos(th));
-    const double sd = f->signed_distance(p);
-    Vec2 cw(-1, -1);
-    const double sw = f->signed_distance_within(p, reach, &cw);
-    if (std::isinf(sd)) {
-      EXPECT_TRUE(std::isinf(sw));
-      continue;
-    }
-    EXPECT_TRUE(cw.isApprox(c, 1e-12));
-    if (sd < reach) {
-      EXPECT_EQ(sw, sd);  // the same arithmetic
-      ++exact;
-    } else {
-      EXPECT_GE(sw, reach);
-      EXPECT_LE(sw, sd + 1e-12);
-      if (sw != sd) ++bounded;
-    }
-  }
-  std::printf("within reach: %d exact; beyond it: %d answered by the bound alone\n", exact,
-              bounded);
-  EXPECT_GT(exact, 1000);
-  EXPECT_GT(bounded, 1000);
-}
-
 // The contact test's normal: on a cone (radius shrinking with height, the axis drifting
 // sideways) the distance along the normal is the exact distance to the surface and the normal
 // the cone's own, leaning upward; on the parametric form it is the finite-difference gradient of
