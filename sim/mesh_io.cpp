@@ -26,12 +26,12 @@ namespace drape::sim {
 
 namespace {
 
-// Post-processing runs in two passes (see postprocess()): assimp 5.2's Triangulate step aborts
-// the process (ai_assert) on a face with no indices, which a malformed PLY produces (found by
-// fuzz_mesh), and in one ReadFile call the validation does not run before it.
 // The most corners a polygon of an imported mesh may have (postprocess).
 constexpr unsigned kMaxCorners = 1024;
 
+// Post-processing runs in two passes (see postprocess()): assimp 5.2's Triangulate step aborts
+// the process (ai_assert) on a face with no indices, which a malformed PLY produces (found by
+// fuzz_mesh), and in one ReadFile call the validation does not run before it.
 constexpr unsigned kImportFlags =
     aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType;
 
@@ -97,9 +97,9 @@ const aiScene* postprocess(Assimp::Importer& imp, const aiScene* scene, std::str
         error = "mesh " + std::to_string(m) + " face " + std::to_string(i) + " has no vertices";
         return nullptr;
       }
-      // assimp 5.2's Triangulate clips ears in time growing with the cube of a polygon's
-      // corners: 96 faces of 31019 corners each (a mangled PLY list count) hung it (fuzz_mesh
-      // timeout, seed fuzz/corpus/mesh/regress_ply_huge_face). A face cannot have more corners
+      // assimp 5.2's Triangulate (ear clipping) ran for more than two minutes on 96 faces of
+      // 31019 corners each, from a mangled PLY list count (fuzz_mesh timeout, seed
+      // fuzz/corpus/mesh/regress_ply_huge_face). A face cannot have more corners
       // than its mesh has vertices, and no form needs a polygon of more than kMaxCorners.
       if (face.mNumIndices > std::min(mesh->mNumVertices, kMaxCorners)) {
         error = "mesh " + std::to_string(m) + " face " + std::to_string(i) + " has " +
