@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -64,20 +65,62 @@ double env_num(const char* name, double def) {
 // the equilibrium of the same energy nearest to the solver's own end state: the static Newton
 // solver (contacts redetected, tolerance 1e-8) run from it. A solver that stopped short of
 // equilibrium (still creeping, biased by too few iterations) is as far from it as it is wrong.
+// Probe state files: a little-endian header (magic, vertex count) then x and v as doubles.
+constexpr std::uint32_t kStateMagic = 0x44525354;  // "DRST"
+
+bool save_state(const char* path, const Cloth& cloth) {
+  std::FILE* f = std::fopen(path, "wb");
+  if (!f) {
+    std::fprintf(stderr, "PROBE_SAVE: cannot write %s\n", path);
+    return false;
+  }
+  const std::uint32_t head[2] = {kStateMagic, static_cast<std::uint32_t>(cloth.num_vertices())};
+  bool ok = std::fwrite(head, sizeof head, 1, f) == 1;
+  for (const auto* vec : {&cloth.state.x, &cloth.state.v})
+    ok = ok && std::fwrite(vec->data(), sizeof(Vec3), vec->size(), f) == vec->size();
+  ok = std::fclose(f) == 0 && ok;
+  if (!ok) std::fprintf(stderr, "PROBE_SAVE: writing %s failed\n", path);
+  return ok;
+}
+
+bool load_state(const char* path, Cloth& cloth) {
+  std::FILE* f = std::fopen(path, "rb");
+  if (!f) {
+    std::fprintf(stderr, "PROBE_LOAD: cannot open %s\n", path);
+    return false;
+  }
+  std::uint32_t head[2] = {0, 0};
+  bool ok = std::fread(head, sizeof head, 1, f) == 1 && head[0] == kStateMagic &&
+            head[1] == static_cast<std::uint32_t>(cloth.num_vertices());
+  for (auto* vec : {&cloth.state.x, &cloth.state.v})
+    ok = ok && std::fread(vec->data(), sizeof(Vec3), vec->size(), f) == vec->size();
+  std::fclose(f);
+  if (!ok) {
+    std::fprintf(stderr, "PROBE_LOAD: %s is not a state of this scene (%u vertices; expected %d)\n",
+                 path, head[1], cloth.num_vertices());
+    return false;
+  }
+  cloth.state.x_prev = cloth.state.x;
+  return true;
+}
+
 bool path_dependent(const std::string& scene) {
   return scene == "form" || scene == "sphere";
 }
 
-std::vector<Vec3> polished(const StudyScene& end, double& residual, int max_iterations = 0) {
+std::vector<Vec3> polished(const StudyScene& end, double& residual, int max_iterations = 0,
+                           StaticResult* result = nullptr) {
   StudyScene sc = end;
   StaticOptions so;
   so.tolerance = 1e-8;
   so.friction = true;  // the frictional equilibrium nearest to it (the scene's objects' mu)
+  so.friction = env_num("PROBE_POLISH_FRICTION", 1) > 0;
   // 300: a less-settled 64^2 state needed 282 iterations (docs/solvers.md "Static solver speed").
   so.max_iterations =
       max_iterations > 0 ? max_iterations : static_cast<int>(env_num("REF_ITERS", 300));
   StaticResult r = relax_static(sc.cloth, sc.objects, so);
   residual = r.residual;
+  if (result) *result = r;
   return sc.cloth.state.x;
 }
 
@@ -290,6 +333,12 @@ int probe(int argc, char** argv) {
   double wall = 0, cpu = 0;
   long iters = 0;
   const int warm_frame = static_cast<int>(env_num("XPBD_WARM_FRAME", -1));
+  // PROBE_LOAD=file: start from a state PROBE_SAVE=file wrote (positions and velocities of the
+  // same scene and resolution), e.g. to study the polish of one end state without re-running
+  // the drape (PROBE_FRAMES=0).
+  if (const char* path = std::getenv("PROBE_LOAD")) {
+    if (!load_state(path, sc.cloth)) return 1;
+  }
   for (int f = 0; f < frames; ++f) {
     if (f == warm_frame) {
       if (auto* xp = xpbd_of(s.get())) xp->options().warm_start = env_num("XPBD_WARM_LATE", 1.0);
@@ -322,7 +371,10 @@ int probe(int argc, char** argv) {
     }
   }
   std::printf("%s %d %s %dx%d: wall %.3f ms/frame, cpu %.3f ms/frame\n", scene.c_str(), res,
-              solver.c_str(), ns, it, wall / frames, cpu / frames);
+              solver.c_str(), ns, it, frames ? wall / frames : 0.0, frames ? cpu / frames : 0.0);
+  if (const char* path = std::getenv("PROBE_SAVE")) {
+    if (!save_state(path, sc.cloth)) return 1;
+  }
   {
     // The fastest vertices at the end (a drape at rest should have none): speed, height, distance
     // from the form's surface.
@@ -346,8 +398,13 @@ int probe(int argc, char** argv) {
                 double(xp->contact_detections()) / frames);
   if (path_dependent(scene) && env_num("PROBE_POLISH", 1) > 0) {
     double res_polish = 0, rms = 0, mx = 0;
-    const std::vector<Vec3> pol = polished(sc, res_polish);
+    StaticResult pr;
+    const std::vector<Vec3> pol = polished(sc, res_polish, 0, &pr);
     position_error(sc.cloth.state.x, pol, rms, mx);
+    std::printf(
+        "static polish: %d Newton iterations (%d exact), %d rounds, %.0f ms wall (%.0f ms "
+        "factorising)\n",
+        pr.iterations, pr.exact_steps, pr.rounds, pr.ms, pr.factor_ms);
     std::printf(
         "error against the equilibrium nearest to the end state: rms %.3f mm, max %.3f mm "
         "(static polish residual %.1e)\n",

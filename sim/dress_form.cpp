@@ -60,6 +60,15 @@ DressForm::DressForm(double y0, double dy, std::vector<Vec2> centres, std::vecto
     for (int j = 0; j + 1 < num_sections_; ++j)
       max_gradient_[j] = std::max({own[std::max(j - 1, 0)], own[j], own[j + 1]});
   }
+  // The samples' slopes, once (each contact test interpolates four of them).
+  slopes_.resize(radii_.size());
+  centre_slopes_.resize(num_sections_);
+  for (int j = 0; j < num_sections_; ++j) {
+    centre_slopes_[j] = centre_slope(j);
+    for (int n = 0; n < kAngles; ++n)
+      slopes_[static_cast<size_t>(j) * kAngles + n] = {radius_slope_y(j, n),
+                                                       radius_slope_theta(j, n)};
+  }
 }
 
 Vec3 DressForm::direction(double theta) {
@@ -165,6 +174,40 @@ double DressForm::girth_at(double y) const {
 }
 
 double DressForm::push_outside(Vec3& p, double offset) const {
+  // Along the surface's normal (as the energy's contacts: normal_distance_within), so that a
+  // point on a slope (shoulders, bust) is lifted off it rather than shoved sideways. The
+  // distance along the normal is first order, and the normal's slopes are interpolated (within
+  // ~15 % of the radial distance's own gradient): corrections take it to the offset within
+  // kPushTolerance, each gaining ~10x. Deeper than kNormalPushDepth, or when six corrections
+  // do not settle it there, or it moves > 1.5x
+  // the first push (a point deep under a steep slope, where the first-order distance is far
+  // off), the radial push below, which always ends on the shell.
+  if (num_sections_ >= 2) {
+    Vec3 n;
+    const double d = normal_distance_within(p, offset, &n);
+    if (!(d < offset)) return 0.0;  // clear of the shell, outside the height range or NaN
+    const double pen = offset - d;
+    if (pen < kNormalPushDepth) {
+      Vec3 q = p + pen * n;
+      bool settled = false;
+      for (int k = 0; k < 6; ++k) {
+        const double dk = normal_distance_within(q, offset, &n);
+        if (std::abs(dk - offset) < kPushTolerance || std::isinf(dk)) {
+          settled = true;
+          break;
+        }
+        q += (offset - dk) * n;
+      }
+      if (settled && q.allFinite() && (q - p).norm() <= 1.5 * pen) {
+        p = q;
+        return pen;
+      }
+    }
+  }
+  return push_radially(p, offset);
+}
+
+double DressForm::push_radially(Vec3& p, double offset) const {
   if (num_sections_ == 0) return 0.0;
   const double s = (p.y() - y0_) / dy_;
   if (!(s >= 0.0) || s > num_sections_ - 1) return 0.0;  // outside the height range (or NaN)
@@ -247,16 +290,15 @@ double DressForm::normal_distance_within(const Vec3& p, double reach, Vec3* norm
   // interpolated bilinearly as the radius is. The bilinear cell's own slopes jump from one cell
   // to the next (every 2.5 mm of height, every 1.4 degrees), and a contact plane that flips
   // there kept the static solve's active set from settling; these normals are continuous.
-  const int j1 = j + 1;
-  const double ry00 = radius_slope_y(j, n), ry01 = radius_slope_y(j, n1);
-  const double ry10 = radius_slope_y(j1, n), ry11 = radius_slope_y(j1, n1);
-  const double rt00 = radius_slope_theta(j, n), rt01 = radius_slope_theta(j, n1);
-  const double rt10 = radius_slope_theta(j1, n), rt11 = radius_slope_theta(j1, n1);
-  const double ry_a = ry00 + (ry01 - ry00) * u, ry_b = ry10 + (ry11 - ry10) * u;
-  const double rt_a = rt00 + (rt01 - rt00) * u, rt_b = rt10 + (rt11 - rt10) * u;
+  const auto* s0 = &slopes_[static_cast<size_t>(j) * kAngles];
+  const auto* s1 = s0 + kAngles;
+  const double ry_a = s0[n][0] + (s0[n1][0] - s0[n][0]) * u;
+  const double ry_b = s1[n][0] + (s1[n1][0] - s1[n][0]) * u;
+  const double rt_a = s0[n][1] + (s0[n1][1] - s0[n][1]) * u;
+  const double rt_b = s1[n][1] + (s1[n1][1] - s1[n][1]) * u;
   const double r_y = ry_a + (ry_b - ry_a) * t;
   const double r_th = rt_a + (rt_b - rt_a) * t;
-  const Vec2 dc = centre_slope(j) + (centre_slope(j1) - centre_slope(j)) * t;
+  const Vec2 dc = centre_slopes_[j] + (centre_slopes_[j + 1] - centre_slopes_[j]) * t;
   // Radial unit u = (ux, 0, uz), angular unit w = (uz, 0, -ux) (toward growing theta).
   const double ux = dx / rho, uz = dz / rho, k = r_th / rho;
   const double gx = ux - k * uz, gz = uz + k * ux;

@@ -121,10 +121,16 @@ class DressForm {
   // Tape-measure girth at height y: perimeter of the interpolated section.
   double girth_at(double y) const;
 
-  // O(1) collision by section lookup: if p is closer to its section centre than the surface
-  // plus `offset`, moves it radially to surface + offset and returns the penetration depth
-  // (> 0); else returns 0 and leaves p. Points outside the form's height range are untouched.
+  // O(1) collision by section lookup: if p is closer to the surface than `offset` along the
+  // surface's normal (normal_distance_within), moves it along that normal to the offset and
+  // returns the penetration depth (> 0); else returns 0 and leaves p. Deeper than
+  // kNormalPushDepth (a point that tunnelled in), radially instead (push_radially). Points
+  // outside the form's height range are untouched.
   double push_outside(Vec3& p, double offset) const;
+  static constexpr double kNormalPushDepth = 0.02;  // m
+  static constexpr double kPushTolerance = 1e-7;    // m, on the distance along the normal
+  // Radial push-out: to surface + offset along the horizontal from the section's centre.
+  double push_radially(Vec3& p, double offset) const;
   // Signed radial distance of p from the surface (< 0 inside); +inf outside the height range.
   double signed_distance(const Vec3& p) const;
   // Contact test against the surface's own normal. With F = rho - r(theta, y) the radial
@@ -159,10 +165,13 @@ class DressForm {
   double radius_in(int j, double t, double th) const;
   Vec2 centre_in(int j, double t) const;
   // Central-difference slopes at sample (j, n): dr/dy, dr/dtheta, and the centre's dc/dy
-  // (one-sided at the end sections).
+  // (one-sided at the end sections); tabulated once by the constructor in slopes_ (dr/dy,
+  // dr/dtheta per sample, laid out as radii_) and centre_slopes_.
   double radius_slope_y(int j, int n) const;
   double radius_slope_theta(int j, int n) const;
   Vec2 centre_slope(int j) const;
+  std::vector<std::array<double, 2>> slopes_;
+  std::vector<Vec2> centre_slopes_;
   FormLandmarks landmarks_;
 };
 

@@ -68,6 +68,11 @@ struct NewtonSolver::Linear {
       chol = std::make_unique<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>>();
       chol->cholmod().print = 0;  // "not positive definite" is expected (exact H): no message
       chol->analyzePattern(H);
+      if (std::getenv("DRAPE_NEWTON_TRACE"))
+        std::fprintf(stderr, "cholmod: n %ld nnz(H) %ld nnz(L) %.0f flops %.3g ordering %d\n",
+                     static_cast<long>(H.rows()), static_cast<long>(H.nonZeros()),
+                     chol->cholmod().lnz, chol->cholmod().fl,
+                     chol->cholmod().method[chol->cholmod().selected].ordering);
     } else {
       ldlt = std::make_unique<Eigen::SimplicialLDLT<SpMat, Eigen::Lower>>();
       ldlt->analyzePattern(H);

@@ -197,23 +197,76 @@ TEST(DressForm, BilinearInterpolationExactForBilinearField) {
   EXPECT_TRUE(DressForm::direction(kPi / 2).isApprox(Vec3(1, 0, 0)));
 }
 
+// Deep inside (a point that tunnelled through): pushed radially, onto the offset shell. A few
+// millimetres in (a step's penetration): along the surface's normal, to the offset along it.
 TEST(DressForm, PushOutsideParametricAgreesWithSurface) {
   auto f = DressForm::from_measurements(FormMeasurements{});
   ASSERT_TRUE(f.ok()) << f.error();
+  const double off = 0.002;
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> ang(0, 2 * kPi), fy(0.61, 1.33), fr(0.0, 0.99);
-  int pushed = 0;
+  std::uniform_real_distribution<double> shallow(0.0, 0.006);
+  int shallow_checked = 0, along_normal = 0;
+  double max_off = 0, min_along = 1;
   for (int i = 0; i < 3000; ++i) {
     const double y = fy(rng), th = ang(rng);
     const Vec2 c = f->centre_at(y);
-    const double r = f->radius_at(y, th) * fr(rng);
+    const bool inner = i % 2 == 0;
+    const double r =
+        inner ? f->radius_at(y, th) * fr(rng) : f->radius_at(y, th) + off - shallow(rng);
     Vec3 p(c.x() + r * std::sin(th), y, c.y() + r * std::cos(th));
-    const double pen = f->push_outside(p, 0.002);
+    const Vec3 p0 = p;
+    Vec3 n0, n;
+    const double d0 = f->normal_distance_within(p0, off, &n0);
+    const double pen = f->push_outside(p, off);
+    if (!(d0 < off)) {
+      EXPECT_EQ(pen, 0.0);
+      continue;
+    }
     ASSERT_GT(pen, 0);
-    ++pushed;
-    EXPECT_NEAR(f->signed_distance(p), 0.002, 1e-9);
+    // Always ends on or outside the shell.
+    EXPECT_GT(f->signed_distance(p), off - DressForm::kPushTolerance);
+    if (off - d0 < 0.004) {
+      ++shallow_checked;
+      // The radial fallback (in concave creases, where a step along the normal goes deeper)
+      // reports its own, radial, depth.
+      if (std::abs(pen - (off - d0)) > 1e-12) continue;
+      ++along_normal;
+      const double d = f->normal_distance_within(p, 1.0, &n);
+      max_off = std::max(max_off, std::abs(d - off));
+      const Vec3 move = p - p0;
+      min_along = std::min(min_along, move.dot(n0) / move.norm());
+    }
   }
-  EXPECT_EQ(pushed, 3000);
+  std::printf(
+      "push_outside: %d shallow points, %d along the normal, max |d - offset| %.3g m, min "
+      "cos(move, n) %.6f\n",
+      shallow_checked, along_normal, max_off, min_along);
+  EXPECT_GT(shallow_checked, 500);
+  EXPECT_GT(along_normal, 0.95 * shallow_checked);
+  EXPECT_LT(max_off, DressForm::kPushTolerance);
+  EXPECT_GT(min_along, 0.99);
+}
+
+// On the shoulder's slope (the radius shrinking with height) the push lifts the point: the
+// radial push moved it only sideways, a plane that carries no weight.
+TEST(DressForm, PushOutsideLiftsAPointOffTheShoulderSlope) {
+  auto f = DressForm::from_measurements(FormMeasurements{});
+  ASSERT_TRUE(f.ok()) << f.error();
+  const double off = 0.002, th = kPi / 2;  // the form's left side
+  int checked = 0;
+  for (double y = 0.61; y < 1.33; y += 0.01) {
+    const double slope = (f->radius_at(y + 1e-3, th) - f->radius_at(y - 1e-3, th)) / 2e-3;
+    if (slope > -0.5) continue;  // only where the radius falls by > 0.5 mm per mm of height
+    const Vec2 c = f->centre_at(y);
+    const double r = f->radius_at(y, th) - 0.003;
+    Vec3 p(c.x() + r * std::sin(th), y, c.y() + r * std::cos(th));
+    ASSERT_GT(f->push_outside(p, off), 0);
+    EXPECT_GT(p.y() - y, 1e-4) << "at y " << y << ", slope " << slope;
+    ++checked;
+  }
+  std::printf("shoulder slope: %d heights checked\n", checked);
+  EXPECT_GE(checked, 3);
 }
 
 // The contact test's normal: on a cone (radius shrinking with height, the axis drifting
