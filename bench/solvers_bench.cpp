@@ -115,6 +115,9 @@ std::vector<Vec3> polished(const StudyScene& end, double& residual, int max_iter
   so.tolerance = 1e-8;
   so.friction = true;  // the frictional equilibrium nearest to it (the scene's objects' mu)
   so.friction = env_num("PROBE_POLISH_FRICTION", 1) > 0;
+  so.reuse_factorisation = env_num("POLISH_REUSE", 1) > 0;
+  so.reuse_max_cg = static_cast<int>(env_num("POLISH_CG_MAX", so.reuse_max_cg));
+  so.reuse_cg_tolerance = env_num("POLISH_CG_TOL", so.reuse_cg_tolerance);
   // 300: a less-settled 64^2 state needed 282 iterations (docs/solvers.md "Static solver speed").
   so.max_iterations =
       max_iterations > 0 ? max_iterations : static_cast<int>(env_num("REF_ITERS", 300));
@@ -402,9 +405,11 @@ int probe(int argc, char** argv) {
     const std::vector<Vec3> pol = polished(sc, res_polish, 0, &pr);
     position_error(sc.cloth.state.x, pol, rms, mx);
     std::printf(
-        "static polish: %d Newton iterations (%d exact), %d rounds, %.0f ms wall (%.0f ms "
-        "factorising)\n",
-        pr.iterations, pr.exact_steps, pr.rounds, pr.ms, pr.factor_ms);
+        "static polish: %d Newton iterations (%d exact), %d rounds, %.0f ms wall, %d "
+        "factorisations (%.0f ms), %d systems by CG on a stale factorisation (%d CG "
+        "iterations, %.0f ms)\n",
+        pr.iterations, pr.exact_steps, pr.rounds, pr.ms, pr.factorisations, pr.factor_ms,
+        pr.cg_solves, pr.cg_iterations, pr.cg_ms);
     std::printf(
         "error against the equilibrium nearest to the end state: rms %.3f mm, max %.3f mm "
         "(static polish residual %.1e)\n",

@@ -64,6 +64,7 @@ struct NewtonSolver::Linear {
     entries.shrink_to_fit();
   }
   void analyse() {
+    factor_ok = false;
     if (kind == LinearSolver::kCholmod) {
       chol = std::make_unique<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>>();
       chol->cholmod().print = 0;  // "not positive definite" is expected (exact H): no message
@@ -100,6 +101,38 @@ struct NewtonSolver::Linear {
     else
       x = ldlt->solve(b);
   }
+  // H x = b by conjugate gradients preconditioned with the current factorisation (of an
+  // earlier H). False when the relative residual is not below `tol` within `max_it`
+  // iterations, or on a direction of non-positive curvature (H not positive definite there).
+  // On success x (started from 0) has b.x > 0: a descent direction of the model.
+  bool pcg(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tol, int max_it, int& its) {
+    const auto Hs = H.selfadjointView<Eigen::Lower>();
+    x.setZero(b.size());
+    r = b;
+    solve(r, z);
+    p = z;
+    double rz = r.dot(z);
+    const double bn = b.norm();
+    its = 0;
+    if (!(bn > 0)) return true;
+    while (its < max_it) {
+      ++its;
+      q.noalias() = Hs * p;
+      const double pq = p.dot(q);
+      if (!(pq > 0)) return false;
+      const double a = rz / pq;
+      x += a * p;
+      r -= a * q;
+      if (r.norm() <= tol * bn) return true;
+      solve(r, z);
+      const double rz1 = r.dot(z);
+      p = z + (rz1 / rz) * p;
+      rz = rz1;
+    }
+    return false;
+  }
+  bool factor_ok = false;  // the factorisation is of a positive definite matrix
+  Eigen::VectorXd r, z, p, q;
 };
 
 NewtonSolver::NewtonSolver(NewtonOptions opt) : opt_(opt) {}
@@ -313,11 +346,32 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
     bool exact = allow_exact && exact_hold == 0;
     assemble(cloth, inv_h2, mu, exact, false);
     counters_.assemble_ms += ms_since(ta);
+    // The system by CG on the last factorisation when there is one (static mode).
+    const bool reuse = opt_.reuse_factorisation && inv_h2 == 0;
+    auto try_cg = [&](const Eigen::VectorXd& b) {
+      if (!reuse || !lin_->factor_ok) return false;
+      const auto tc = std::chrono::steady_clock::now();
+      int its = 0;
+      const bool ok = lin_->pcg(b, cg_x_, opt_.reuse_cg_tolerance, opt_.reuse_max_cg, its);
+      counters_.cg_iterations += its;
+      counters_.cg_ms += ms_since(tc);
+      if (ok) {
+        ++counters_.cg_solves;
+        std::swap(dx_, cg_x_);  // else dx_ keeps the last solved system's step
+      }
+      return ok;
+    };
+    if (predict) model_rhs();
+    bool solved = try_cg(predict ? model_rhs_ : rhs_);
     auto tf = std::chrono::steady_clock::now();
-    bool positive = false;
-    bool factored = lin_->factorize(positive);
-    ++counters_.factorisations;
-    if (exact && !positive) {
+    bool positive = solved;
+    bool factored = solved;
+    if (!solved) {
+      factored = lin_->factorize(positive);
+      lin_->factor_ok = factored && positive;
+      ++counters_.factorisations;
+    }
+    if (!solved && exact && !positive) {
       // Not positive definite (wrinkles still moving, or a saddle): projected Hessian for a
       // while; retry the exact one later.
       ++counters_.not_positive;
@@ -330,6 +384,7 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
       counters_.assemble_ms += ms_since(ta2);
       tf = std::chrono::steady_clock::now();
       factored = lin_->factorize(positive);
+      lin_->factor_ok = factored && positive;
       ++counters_.factorisations;
     } else if (exact_hold > 0) {
       --exact_hold;
@@ -340,10 +395,9 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
       continue;
     }
     if (!predict) {
-      lin_->solve(rhs_, dx_);
+      if (!solved) lin_->solve(rhs_, dx_);
     } else {
-      model_rhs();
-      lin_->solve(model_rhs_, dx_);
+      if (!solved) lin_->solve(model_rhs_, dx_);
       // The model's contact term is the penalty itself, 1/2 k min(0, d + n.dx)^2 (same value
       // and gradient as E at dx = 0, convex): minimise it by updating the active set to the
       // contacts the step ends up penetrating (a step through a contact the model thought
@@ -365,11 +419,15 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
         const auto ta2 = std::chrono::steady_clock::now();
         assemble(cloth, inv_h2, mu, exact, false);
         counters_.assemble_ms += ms_since(ta2);
+        ++counters_.contact_passes;
+        // A few changed contact blocks: CG on the factorisation usually converges in a few
+        // iterations (the change is of low rank).
+        if (try_cg(model_rhs_)) continue;
         const auto tf2 = std::chrono::steady_clock::now();
         bool pos2 = false;
         const bool ok2 = lin_->factorize(pos2);
+        lin_->factor_ok = ok2 && pos2;
         ++counters_.factorisations;
-        ++counters_.contact_passes;
         counters_.factor_ms += ms_since(tf2);
         if (!ok2 || (exact && !pos2)) break;
         lin_->solve(model_rhs_, dx_);
@@ -524,6 +582,9 @@ StaticResult relax_static(Cloth& cloth, const SceneObjects& scene, const StaticO
   no.linear_solver = opt.linear_solver;
   no.exact_hessian = opt.exact_hessian;
   no.contact_prediction = opt.contact_prediction;
+  no.reuse_factorisation = opt.reuse_factorisation;
+  no.reuse_max_cg = opt.reuse_max_cg;
+  no.reuse_cg_tolerance = opt.reuse_cg_tolerance;
   NewtonSolver solver(no);
   solver.set_step_tolerance(opt.step_tolerance);
   solver.set_contact_redetection(opt.contacts && opt.redetect_every_iteration);
@@ -556,6 +617,10 @@ StaticResult relax_static(Cloth& cloth, const SceneObjects& scene, const StaticO
     const auto& c = solver.counters();
     r.exact_steps += c.exact_steps;
     r.factor_ms += c.factor_ms;
+    r.factorisations += c.factorisations;
+    r.cg_solves += c.cg_solves;
+    r.cg_iterations += c.cg_iterations;
+    r.cg_ms += c.cg_ms;
     r.last_step = c.last_step;
     step_converged = opt.step_tolerance > 0 && c.last_step > 0 && c.last_step < opt.step_tolerance;
     if (!opt.contacts || total >= opt.max_iterations || (round > 0 && it == 0)) break;
