@@ -178,10 +178,10 @@ double DressForm::push_outside(Vec3& p, double offset) const {
   // point on a slope (shoulders, bust) is lifted off it rather than shoved sideways. The
   // distance along the normal is first order, and the normal's slopes are interpolated (within
   // ~15 % of the radial distance's own gradient): corrections take it to the offset within
-  // kPushTolerance, each gaining ~10x. Deeper than kNormalPushDepth, or when six corrections
-  // do not settle it there, or it moves > 1.5x
-  // the first push (a point deep under a steep slope, where the first-order distance is far
-  // off), the radial push below, which always ends on the shell.
+  // kPushTolerance, each gaining ~10x. The radial push instead (it always ends on the shell)
+  // deeper than kNormalPushDepth, or when six corrections do not settle the point or move it
+  // more than 1.5x the first push (a concave crease, where a step along the normal goes
+  // deeper; ~1 % of points 0-4 mm in, DressForm tests).
   if (num_sections_ >= 2) {
     Vec3 n;
     const double d = normal_distance_within(p, offset, &n);

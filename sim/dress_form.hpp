@@ -124,8 +124,9 @@ class DressForm {
   // O(1) collision by section lookup: if p is closer to the surface than `offset` along the
   // surface's normal (normal_distance_within), moves it along that normal to the offset and
   // returns the penetration depth (> 0); else returns 0 and leaves p. Deeper than
-  // kNormalPushDepth (a point that tunnelled in), radially instead (push_radially). Points
-  // outside the form's height range are untouched.
+  // kNormalPushDepth (a point that tunnelled in), or in a concave crease where steps along the
+  // normal do not settle, radially instead (push_radially; it then returns the radial depth,
+  // 0 when the point is radially clear). Points outside the form's height range are untouched.
   double push_outside(Vec3& p, double offset) const;
   static constexpr double kNormalPushDepth = 0.02;  // m
   static constexpr double kPushTolerance = 1e-7;    // m, on the distance along the normal
