@@ -58,14 +58,8 @@ double env_num(const char* name, double def) {
   return v ? std::atof(v) : def;
 }
 
-// Converged reference. Sheet and chain: the static minimum of the scene's energy (see
-// reference() below). Form and sphere: the cloth falls onto an object and the drape it settles
-// into depends on the path (where the folds form: explicit, XPBD and a VBD-settled reference
-// end 8-10 mm apart, all at rest), so one fixed state is not "the" answer. Their reference is
-// the equilibrium of the same energy nearest to the solver's own end state: the static Newton
-// solver (contacts redetected, tolerance 1e-8) run from it. A solver that stopped short of
-// equilibrium (still creeping, biased by too few iterations) is as far from it as it is wrong.
-// Probe state files: a little-endian header (magic, vertex count) then x and v as doubles.
+// Probe state files (PROBE_SAVE / PROBE_LOAD): a header (magic, vertex count) then x and v as
+// doubles, in the machine's byte order (scratch files of one build, not an exchange format).
 constexpr std::uint32_t kStateMagic = 0x44525354;  // "DRST"
 
 bool save_state(const char* path, const Cloth& cloth) {
@@ -92,7 +86,9 @@ bool load_state(const char* path, Cloth& cloth) {
   std::uint32_t head[2] = {0, 0};
   bool ok = std::fread(head, sizeof head, 1, f) == 1 && head[0] == kStateMagic &&
             head[1] == static_cast<std::uint32_t>(cloth.num_vertices());
-  for (auto* vec : {&cloth.state.x, &cloth.state.v})
+  // Read into copies: a short or foreign file leaves the cloth as it was.
+  std::vector<Vec3> x(cloth.state.x.size()), v(cloth.state.v.size());
+  for (auto* vec : {&x, &v})
     ok = ok && std::fread(vec->data(), sizeof(Vec3), vec->size(), f) == vec->size();
   std::fclose(f);
   if (!ok) {
@@ -100,10 +96,19 @@ bool load_state(const char* path, Cloth& cloth) {
                  path, head[1], cloth.num_vertices());
     return false;
   }
-  cloth.state.x_prev = cloth.state.x;
+  cloth.state.x = x;
+  cloth.state.x_prev = std::move(x);
+  cloth.state.v = std::move(v);
   return true;
 }
 
+// Converged reference. Sheet and chain: the static minimum of the scene's energy (see
+// reference() below). Form and sphere: the cloth falls onto an object and the drape it settles
+// into depends on the path (where the folds form: explicit, XPBD and a VBD-settled reference
+// end 8-10 mm apart, all at rest), so one fixed state is not "the" answer. Their reference is
+// the equilibrium of the same energy nearest to the solver's own end state: the static Newton
+// solver (contacts redetected, tolerance 1e-8) run from it. A solver that stopped short of
+// equilibrium (still creeping, biased by too few iterations) is as far from it as it is wrong.
 bool path_dependent(const std::string& scene) {
   return scene == "form" || scene == "sphere";
 }
@@ -113,7 +118,8 @@ std::vector<Vec3> polished(const StudyScene& end, double& residual, int max_iter
   StudyScene sc = end;
   StaticOptions so;
   so.tolerance = 1e-8;
-  so.friction = true;  // the frictional equilibrium nearest to it (the scene's objects' mu)
+  // The frictional equilibrium nearest to it (the scene's objects' mu); PROBE_POLISH_FRICTION=0:
+  // the frictionless one (a probe study).
   so.friction = env_num("PROBE_POLISH_FRICTION", 1) > 0;
   so.reuse_factorisation = env_num("POLISH_REUSE", 1) > 0;
   so.reuse_max_cg = static_cast<int>(env_num("POLISH_CG_MAX", so.reuse_max_cg));
