@@ -191,7 +191,9 @@ double DressForm::push_outside(Vec3& p, double offset) const {
       Vec3 q = p + pen * n;
       bool settled = false;
       for (int k = 0; k < 6; ++k) {
-        const double dk = normal_distance_within(q, offset, &n);
+        // Reach past the offset: a correction that overshot gets the exact distance and a
+        // fresh normal, not the lower bound (which leaves `n` as it was).
+        const double dk = normal_distance_within(q, offset + kNormalPushDepth, &n);
         if (std::abs(dk - offset) < kPushTolerance || std::isinf(dk)) {
           settled = true;
           break;
