@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "bench/bullet_peer.hpp"
+#include "sim/coarse_correction.hpp"
 #include "sim/dress_form.hpp"
 #include "sim/scenes.hpp"
 #include "sim/solver_factory.hpp"
@@ -334,6 +335,12 @@ int probe(int argc, char** argv) {
           static_cast<int>(env_num("XPBD_SLEEP_STEPS", xp->options().settle_sleep_steps));
       xp->options().settle_speed = env_num("XPBD_SETTLE_SPEED", xp->options().settle_speed);
       xp->options().settle_growth = env_num("XPBD_SETTLE_GROWTH", xp->options().settle_growth);
+      xp->options().coarse_factor =
+          static_cast<int>(env_num("XPBD_COARSE", xp->options().coarse_factor));
+      xp->options().coarse_frames =
+          static_cast<int>(env_num("XPBD_COARSE_FRAMES", xp->options().coarse_frames));
+      xp->options().coarse.reuse =
+          static_cast<int>(env_num("XPBD_COARSE_REUSE", xp->options().coarse.reuse));
     }
   }
   sc.objects.friction = env_num("PROBE_FRICTION", sc.objects.friction);
@@ -348,6 +355,7 @@ int probe(int argc, char** argv) {
   if (const char* path = std::getenv("PROBE_LOAD")) {
     if (!load_state(path, sc.cloth)) return 1;
   }
+  const std::vector<Vec3> start_x = sc.cloth.state.x;
   for (int f = 0; f < frames; ++f) {
     if (f == warm_frame) {
       if (auto* xp = xpbd_of(s.get())) xp->options().warm_start = env_num("XPBD_WARM_LATE", 1.0);
@@ -379,6 +387,11 @@ int probe(int argc, char** argv) {
           ke, sd * 1e3, lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
     }
   }
+  if (env_num("PROBE_DRIFT", 0) > 0) {
+    double rms = 0, mx = 0;
+    position_error(sc.cloth.state.x, start_x, rms, mx);
+    std::printf("drift from the start state: rms %.3f mm, max %.3f mm\n", rms * 1e3, mx * 1e3);
+  }
   std::printf("%s %d %s %dx%d: wall %.3f ms/frame, cpu %.3f ms/frame\n", scene.c_str(), res,
               solver.c_str(), ns, it, frames ? wall / frames : 0.0, frames ? cpu / frames : 0.0);
   if (const char* path = std::getenv("PROBE_SAVE")) {
@@ -402,13 +415,66 @@ int probe(int argc, char** argv) {
     }
     std::printf("\n");
   }
-  if (auto* xp = xpbd_of(s.get()))
+  if (auto* xp = xpbd_of(s.get())) {
     std::printf("xpbd: %.2f contact detections per frame\n",
                 double(xp->contact_detections()) / frames);
+    if (xp->options().coarse_factor > 0) {
+      const CoarseStats& c = xp->last_coarse();
+      std::printf(
+          "xpbd coarse correction: %d applied, %.1f ms in all (%.2f ms/frame); last: %d nodes, "
+          "alpha %.3g, moved %.4f mm, residual %.2e N, build %.1f ms, assemble %.1f ms, factor "
+          "%.1f "
+          "ms, total %.1f ms\n",
+          xp->coarse_count(), xp->coarse_ms(), frames ? xp->coarse_ms() / frames : 0.0, c.nodes,
+          c.alpha, c.max_move * 1e3, c.residual, c.build_ms, c.assemble_ms, c.factor_ms,
+          c.total_ms);
+    }
+  }
+  // PROBE_COARSE_ONLY=k: k coarse corrections (sim/coarse_correction.hpp, lattice
+  // PROBE_COARSE_FACTOR) of the end state alone, contacts re-detected before each (a study of
+  // the correction without the solver's sweeps).
+  CoarseCorrection probe_cc;
+  bool probe_cc_used = false;
+  if (const int kc = static_cast<int>(env_num("PROBE_COARSE_ONLY", 0)); kc > 0) {
+    probe_cc_used = true;
+    ClothEnergy e;
+    EnergyOptions eo;
+    e.build(sc.cloth, eo);
+    e.set_form(&sc.objects);
+    e.set_contact_stiffness(env_num("PROBE_COARSE_K", 1e4));
+    CoarseCorrection& cc = probe_cc;
+    cc.options().factor = static_cast<int>(env_num("PROBE_COARSE_FACTOR", 4));
+    std::vector<int> group(sc.cloth.num_vertices());
+    for (int i = 0; i < sc.cloth.num_vertices(); ++i) group[i] = sc.cloth.is_free(i) ? 0 : -1;
+    for (int k = 0; k < kc; ++k) {
+      e.detect_contacts(sc.cloth, sc.objects);
+      if (sc.objects.friction > 0 && env_num("PROBE_COARSE_MU", 1) > 0) {
+        e.set_friction(sc.objects.friction, 1e-4, sc.cloth.state.x);
+        e.lag_friction_load(sc.cloth.state.x, sc.cloth.state.mass);
+      }
+      const CoarseStats c = cc.apply(sc.cloth, e, group, sc.cloth.state.x);
+      e.clear_friction();
+      std::printf(
+          "coarse %d: applied %d alpha %.3g moved %.4f mm residual %.3e N  E %.9f -> %.9f J  "
+          "%.1f ms (assemble %.1f, factor %.1f), %d nodes\n",
+          k, c.applied ? 1 : 0, c.alpha, c.max_move * 1e3, c.residual, c.energy_before,
+          c.energy_after, c.total_ms, c.assemble_ms, c.factor_ms, c.nodes);
+    }
+    sc.cloth.state.x_prev = sc.cloth.state.x;
+  }
   if (path_dependent(scene) && env_num("PROBE_POLISH", 1) > 0) {
     double res_polish = 0, rms = 0, mx = 0;
     StaticResult pr;
     const std::vector<Vec3> pol = polished(sc, res_polish, 0, &pr);
+    // PROBE_SAVE_POLISHED=file: the equilibrium itself (velocities zero), e.g. to start a solver
+    // at it and see where the solver's own fixed point lies (PROBE_DRIFT).
+    if (const char* path = std::getenv("PROBE_SAVE_POLISHED")) {
+      Cloth eq = sc.cloth;
+      eq.state.x = pol;
+      eq.state.x_prev = pol;
+      std::fill(eq.state.v.begin(), eq.state.v.end(), Vec3::Zero());
+      if (!save_state(path, eq)) return 1;
+    }
     position_error(sc.cloth.state.x, pol, rms, mx);
     std::printf(
         "static polish: %d Newton iterations (%d exact), %d rounds, %.0f ms wall, %d "
@@ -418,8 +484,8 @@ int probe(int argc, char** argv) {
         pr.cg_solves, pr.cg_iterations, pr.cg_ms);
     std::printf(
         "error against the equilibrium nearest to the end state: rms %.3f mm, max %.3f mm "
-        "(static polish residual %.1e)\n",
-        rms * 1e3, mx * 1e3, res_polish);
+        "(static polish residual %.1e, energy there %.9f J)\n",
+        rms * 1e3, mx * 1e3, res_polish, pr.energy);
     // PROBE_POLISH_STEPS=1,2,4: how close a static solve of k Newton iterations from the end
     // state gets to that equilibrium, and what it costs (a polish of a piece falling asleep).
     if (const char* steps = std::getenv("PROBE_POLISH_STEPS")) {
@@ -438,6 +504,48 @@ int probe(int argc, char** argv) {
         }
         while (*q && *q != ',') ++q;
         if (*q == ',') ++q;
+      }
+    }
+    // PROBE_SMOOTH=k: how smooth the error field is: k Jacobi passes of neighbour averaging
+    // (over the triangles' edges) keep its long wavelengths; printed: rms of the smoothed field
+    // and of what the smoothing removed.
+    if (const int ks = static_cast<int>(env_num("PROBE_SMOOTH", 0)); ks > 0) {
+      const int nv = sc.cloth.num_vertices();
+      std::vector<Vec3> e(nv), acc(nv);
+      std::vector<int> cnt(nv);
+      for (int i = 0; i < nv; ++i) e[i] = pol[i] - sc.cloth.state.x[i];
+      const std::vector<Vec3> e0 = e;
+      for (int pass = 0; pass < ks; ++pass) {
+        std::fill(acc.begin(), acc.end(), Vec3::Zero());
+        std::fill(cnt.begin(), cnt.end(), 0);
+        for (const auto& t : sc.cloth.topo.triangles)
+          for (int a = 0; a < 3; ++a) {
+            acc[t[a]] += e[t[(a + 1) % 3]] + e[t[(a + 2) % 3]];
+            cnt[t[a]] += 2;
+          }
+        for (int i = 0; i < nv; ++i)
+          if (cnt[i]) e[i] = 0.5 * e[i] + 0.5 * acc[i] / cnt[i];
+      }
+      double s2 = 0, r2 = 0;
+      for (int i = 0; i < nv; ++i) {
+        s2 += e[i].squaredNorm();
+        r2 += (e0[i] - e[i]).squaredNorm();
+      }
+      std::printf(
+          "  error field after %d smoothing passes: smooth part rms %.3f mm, rest %.3f mm\n", ks,
+          std::sqrt(s2 / nv) * 1e3, std::sqrt(r2 / nv) * 1e3);
+    }
+    if (probe_cc_used) {
+      std::vector<Vec3> e(pol.size()), fe;
+      for (size_t i = 0; i < pol.size(); ++i) e[i] = pol[i] - sc.cloth.state.x[i];
+      if (probe_cc.fit(e, fe)) {
+        double f2 = 0, r2 = 0;
+        for (size_t i = 0; i < e.size(); ++i) {
+          f2 += fe[i].squaredNorm();
+          r2 += (e[i] - fe[i]).squaredNorm();
+        }
+        std::printf("  error field fitted by the coarse space: fit rms %.3f mm, rest %.3f mm\n",
+                    std::sqrt(f2 / e.size()) * 1e3, std::sqrt(r2 / e.size()) * 1e3);
       }
     }
     // Where the error is: vertices touching the form (within 0.5 mm of the kept-out shell)

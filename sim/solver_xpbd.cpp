@@ -212,6 +212,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
   motion_.assign(num_pieces_, PieceMotion{});
   fixed_prev_.assign(n, 0);
   piece_full_.assign(num_pieces_, 0);
+  piece_coarse_.assign(num_pieces_, 0);
 }
 
 bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
@@ -291,6 +292,47 @@ void XpbdSolver::unsettle(int piece) {
   piece_scale_[piece] = 1.0;
   piece_full_[piece] = 0;
   piece_slow_[piece] = 0;
+  piece_coarse_[piece] = 0;
+}
+
+void XpbdSolver::coarse_step(Cloth& cloth, const SceneObjects& scene) {
+  if (opt_.coarse_factor <= 0 || !opt_.settle || scene.self_collision) return;
+  auto& S = cloth.state;
+  const int n = cloth.num_vertices();
+  bool any = false;
+  for (int p = 0; p < num_pieces_; ++p)
+    any = any || (!piece_frozen_[p] && piece_scale_[p] >= opt_.settle_mass_scale &&
+                  piece_coarse_[p] < opt_.coarse_frames);
+  if (!any) return;
+  coarse_group_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const int p = piece_of_[i];
+    const bool moves = cloth.is_free(i) && !piece_frozen_[p] &&
+                       piece_scale_[p] >= opt_.settle_mass_scale &&
+                       piece_coarse_[p] < opt_.coarse_frames;
+    coarse_group_[i] = moves ? p : -1;
+  }
+  if (!coarse_) coarse_ = std::make_unique<CoarseCorrection>();
+  coarse_->options() = opt_.coarse;
+  coarse_->options().factor = opt_.coarse_factor;
+  if (scene.friction > 0) {
+    energy_.set_friction(scene.friction, 1e-4, S.x);
+    energy_.lag_friction_load(S.x, S.mass);
+  }
+  coarse_last_ = coarse_->apply(cloth, energy_, coarse_group_, S.x);
+  energy_.clear_friction();
+  coarse_ms_ += coarse_last_.total_ms;
+  // Counted whether or not a step was taken (a piece the correction cannot improve is not
+  // tried again until it settles anew).
+  for (int p = 0; p < num_pieces_; ++p)
+    if (!piece_frozen_[p] && piece_scale_[p] >= opt_.settle_mass_scale &&
+        piece_coarse_[p] < opt_.coarse_frames)
+      ++piece_coarse_[p];
+  if (coarse_last_.applied) {
+    ++coarse_count_;
+    for (int i = 0; i < n; ++i)
+      if (coarse_group_[i] >= 0) S.v[i].setZero();
+  }
 }
 
 double XpbdSolver::settle_scale() const {
@@ -533,6 +575,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       st.collision_ms +=
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     }
+    if (s == 0) coarse_step(cloth, scene);
     contacts_fresh_ = false;
     set_w();
     if (!row_ik_.empty() && (w_changed_ || ihb != row_ai_h_)) {

@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "sim/coarse_correction.hpp"
 #include "sim/energy.hpp"
 #include "sim/parallel.hpp"
 #include "sim/self_collision.hpp"
@@ -105,6 +106,19 @@ struct XpbdOptions {
   // froze the 128^2 drape at 4.2 s, still 8.2 mm RMS from its equilibrium; at 4500 it rests
   // at 8.2 s, 3.2 mm from it (docs/solvers.md section 3g).
   int settle_sleep_steps = 4500;
+  // Coarse-grid correction of settled pieces (sim/coarse_correction.hpp): on each of the first
+  // coarse_frames frames after a piece has settled to the full inertia scale, at the frame's
+  // contact detection, the piece's static residual is reduced on a lattice of nodes every
+  // coarse_factor fine edges (a Galerkin Newton step with a line search; positions only, and
+  // the corrected vertices' velocities are zeroed: a settled piece is quasi-static). It moves
+  // the long-wavelength part of what is left between the settled drape and its equilibrium,
+  // which the sweeps would take seconds of settling to move (docs/solvers.md section 3l).
+  // Correcting every frame while a piece settles was measured and is worse: the corrections
+  // and the sweeps' own fixed point pull against each other and the piece never sleeps.
+  // Not done in scenes with self-collision (the coarse model has none). 0: off.
+  int coarse_factor = 4;
+  int coarse_frames = 1;
+  CoarseOptions coarse;  // the correction's own options (coarse.factor is set from coarse_factor)
 };
 
 class XpbdSolver : public Solver {
@@ -120,6 +134,10 @@ class XpbdSolver : public Solver {
   double settle_scale() const;
   // Self-collision pairs found at the last detection (scenes with self_collision on).
   const SelfCollision& self_collision() const { return self_; }
+  // The last coarse correction (XpbdOptions::coarse_factor) and how many were applied.
+  const CoarseStats& last_coarse() const { return coarse_last_; }
+  int coarse_count() const { return coarse_count_; }
+  double coarse_ms() const { return coarse_ms_; }
   int num_colours() const {
     return static_cast<int>(tri_col_.size() + hinge_col_.size() + spring_col_.size() +
                             row_cols_.size()) -
@@ -192,6 +210,14 @@ class XpbdSolver : public Solver {
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
   std::vector<Vec3> x_det_;      // positions at the last contact detection
   SelfCollision self_;
+  // Coarse correction of settled pieces (XpbdOptions::coarse_factor).
+  std::unique_ptr<CoarseCorrection> coarse_;
+  std::vector<int> coarse_group_;
+  std::vector<int> piece_coarse_;  // corrections in the piece's current settling episode
+  CoarseStats coarse_last_;
+  int coarse_count_ = 0;
+  double coarse_ms_ = 0;
+  void coarse_step(Cloth& cloth, const SceneObjects& scene);
   int detections_ = 0;  // contact detections so far (for tests and the bench)
   double fresh_penetration_ = 0;
   // Wakes frozen pieces that something disturbs; true when every piece is (still) frozen.

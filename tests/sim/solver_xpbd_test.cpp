@@ -267,3 +267,44 @@ TEST(Xpbd, ContactSnapCorrectsPositionWithoutVelocity) {
   EXPECT_GT(speed[1], 0.2);
   EXPECT_GT(dist[0], 2e-3 - 1e-5);  // on or outside the kept-out shell (offset 2 mm)
 }
+
+// The coarse-grid correction of a piece that has settled to the full inertia scale
+// (XpbdOptions::coarse_factor, sim/coarse_correction.hpp): the form drape at 32^2 after 12 s,
+// asleep either way, ends nearer its nearest frictional equilibrium with it (measured
+// 2.12 / 7.38 -> 1.64 / 5.91 mm RMS / max; at 128^2 4.86 / 16.2 -> 2.81 / 5.40 mm, docs/solvers.md
+// section 3l); one correction per settling episode.
+TEST(Xpbd, CoarseCorrectionBringsTheSettledDrapeNearerItsEquilibrium) {
+  double err[2] = {0, 0};
+  for (int on = 0; on < 2; ++on) {
+    StudyScene sc = make_scene("form", 32);
+    XpbdOptions o;
+    o.damping = sc.air_damping;
+    o.threads = 1;
+    o.freeze = true;
+    o.coarse_factor = on ? 4 : 0;
+    XpbdSolver s(o);
+    for (int f = 0; f < 1080; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+    int free_vertices = 0;
+    for (int i = 0; i < sc.cloth.num_vertices(); ++i) free_vertices += sc.cloth.is_free(i);
+    EXPECT_EQ(s.frozen_count(), free_vertices) << "asleep at 12 s, correction " << on;
+    EXPECT_EQ(s.coarse_count(), on) << "corrections";
+    const std::vector<Vec3> end = sc.cloth.state.x;
+    StaticOptions so;
+    so.tolerance = 1e-8;
+    so.friction = true;
+    so.max_iterations = 300;
+    const StaticResult r = relax_static(sc.cloth, sc.objects, so);
+    EXPECT_LT(r.residual, 1e-7);
+    double mx = 0;
+    position_error(end, sc.cloth.state.x, err[on], mx);
+    std::printf("correction %s: %.3f mm RMS, %.3f mm max from the nearest equilibrium",
+                on ? "on " : "off", err[on] * 1e3, mx * 1e3);
+    if (on) {
+      const CoarseStats& c = s.last_coarse();
+      std::printf(" (%d nodes, moved up to %.3f mm, %.1f ms)", c.nodes, c.max_move * 1e3,
+                  c.total_ms);
+    }
+    std::printf("\n");
+  }
+  EXPECT_LT(err[1], 0.9 * err[0]);
+}

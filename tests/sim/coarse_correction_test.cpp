@@ -1,0 +1,185 @@
+// The coarse-grid correction: on the fine lattice it is a Newton step (it reaches the static
+// minimum), on a coarse one it lowers the energy to the minimum over its space, it leaves
+// fixed vertices and other groups alone, and contact vertices slide on their planes.
+#include "sim/coarse_correction.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "sim/scenes.hpp"
+#include "sim/solver_newton.hpp"
+#include "sim/solver_xpbd.hpp"
+#include "solver_checks.hpp"
+
+using namespace drape::sim;
+using namespace drape::sim::test;
+
+namespace {
+
+// A square sheet hanging from its whole top edge in the x-y plane, started 3 % overstretched
+// along the warp: it contracts to its static minimum, stretched along the warp by gravity only
+// (no Poisson coupling: the membrane is in tension everywhere, so the PSD projection of its
+// Hessian changes nothing and Newton converges quadratically).
+Cloth hanging_from_an_edge(int res) {
+  PanelSpec p;
+  p.width = p.height = 0.3;
+  p.nx = p.ny = res;
+  Cloth c = make_panel(p, FabricParams{});
+  place_spread(c, Vec3(0, 1.0, 0), Vec3::UnitX(), Vec3::UnitY());
+  for (int i = 0; i < res; ++i) c.state.flags[(res - 1) * res + i] |= kFlagPinned;
+  const double top = c.state.x.back().y();
+  for (Vec3& x : c.state.x) x.y() = top - 1.03 * (top - x.y());
+  c.state.x_prev = c.state.x;
+  c.relump_masses();
+  return c;
+}
+
+std::vector<int> free_group(const Cloth& c) {
+  std::vector<int> g(c.num_vertices());
+  for (int i = 0; i < c.num_vertices(); ++i) g[i] = c.is_free(i) ? 0 : -1;
+  return g;
+}
+
+std::vector<Vec3> static_minimum(const Cloth& c) {
+  Cloth ref = c;
+  StaticOptions so;
+  so.tolerance = 1e-8;  // (the solve's round-off floor is 1e-9 .. 3e-8 of a vertex weight)
+  so.contacts = false;
+  const StaticResult r = relax_static(ref, SceneObjects{}, so);
+  EXPECT_LT(r.residual, 1e-7);
+  return ref.state.x;
+}
+
+}  // namespace
+
+TEST(CoarseCorrection, OnTheFineLatticeItIsNewtonAndReachesTheStaticMinimum) {
+  Cloth c = hanging_from_an_edge(8);
+  const std::vector<Vec3> ref = static_minimum(c);
+  ClothEnergy e;
+  e.build(c, EnergyOptions{});
+  CoarseOptions o;
+  o.factor = 1;  // a node on every vertex: P is the identity on the free vertices
+  CoarseCorrection cc(o);
+  const std::vector<int> g = free_group(c);
+  double first = 0, last = 0;
+  for (int k = 0; k < 12; ++k) {
+    const CoarseStats st = cc.apply(c, e, g, c.state.x);
+    if (k == 0) {
+      first = st.residual;
+      EXPECT_EQ(st.nodes, 8 * 7);  // the free vertices
+    }
+    last = st.residual;
+    std::printf("step %d: residual %.3e N, alpha %.3g, moved %.3e m\n", k, st.residual, st.alpha,
+                st.max_move);
+  }
+  double rms, mx;
+  position_error(c.state.x, ref, rms, mx);
+  std::printf(
+      "fine lattice after 12 steps: %.3e m from the static minimum (max); residual %.2e -> "
+      "%.2e N\n",
+      mx, first, last);
+  EXPECT_LT(mx, 1e-9);
+  EXPECT_LT(last, 1e-8 * first);
+}
+
+TEST(CoarseCorrection, CoarseStepsLowerTheEnergyAndConvergeOnTheirSpace) {
+  Cloth c = hanging_from_an_edge(25);  // 24 edges: the lattice (every 4 edges) fits exactly
+  const std::vector<Vec3> ref = static_minimum(c);
+  double rms0, mx0;
+  position_error(c.state.x, ref, rms0, mx0);
+  ClothEnergy e;
+  e.build(c, EnergyOptions{});
+  CoarseCorrection cc;  // factor 4
+  const std::vector<int> g = free_group(c);
+  double first = 0, last = 0, e_prev = e.energy(c.state.x, c.state.mass);
+  for (int k = 0; k < 10; ++k) {
+    const CoarseStats st = cc.apply(c, e, g, c.state.x);
+    std::printf("step %d: applied %d, residual %.3e N, alpha %.3g, moved %.3e m, E %.12f\n", k,
+                st.applied ? 1 : 0, st.residual, st.alpha, st.max_move, st.energy_after);
+    // (Once at round-off, ~1e-10 of the start, no step lowers E any more: none is taken.)
+    if (k < 3) {
+      EXPECT_TRUE(st.applied) << "step " << k;
+    }
+    if (k == 0) {
+      first = st.residual;
+      EXPECT_EQ(st.nodes, 7 * 7);  // lattice lines every 0.05 m; the pinned top row has none
+    }
+    if (st.applied) {
+      EXPECT_LT(st.energy_after, e_prev + 1e-15) << "step " << k;
+      e_prev = st.energy_after;
+    }
+    last = st.residual;
+  }
+  double rms, mx;
+  position_error(c.state.x, ref, rms, mx);
+  std::printf(
+      "coarse (every 4 edges) after 10 steps: %.3e m rms from the static minimum (start "
+      "%.3e m); coarse residual %.2e -> %.2e N\n",
+      rms, rms0, first, last);
+  EXPECT_LT(last, 1e-8 * first);
+  EXPECT_LT(rms, 0.2 * rms0);
+}
+
+TEST(CoarseCorrection, FixedVerticesStayAndGroupsMayNotShareAnElement) {
+  Cloth c = hanging_from_an_edge(13);
+  ClothEnergy e;
+  e.build(c, EnergyOptions{});
+  // Only the left half may move.
+  std::vector<int> g = free_group(c);
+  for (int i = 0; i < c.num_vertices(); ++i)
+    if (c.topo.material[i].x() > 0.15 + 1e-9) g[i] = -1;
+  const std::vector<Vec3> before = c.state.x;
+  CoarseCorrection cc;
+  const CoarseStats st = cc.apply(c, e, g, c.state.x);
+  EXPECT_TRUE(st.applied);
+  int moved = 0;
+  for (int i = 0; i < c.num_vertices(); ++i) {
+    if (g[i] < 0)
+      EXPECT_EQ(c.state.x[i], before[i]) << "vertex " << i;
+    else
+      moved += (c.state.x[i] - before[i]).norm() > 1e-6;
+  }
+  EXPECT_GT(moved, 20);
+  // Two groups joined by the triangles along the middle column: rejected, x untouched.
+  for (int i = 0; i < c.num_vertices(); ++i)
+    if (c.is_free(i)) g[i] = c.topo.material[i].x() > 0.15 + 1e-9 ? 1 : 0;
+  const std::vector<Vec3> kept = c.state.x;
+  EXPECT_THROW(cc.apply(c, e, g, c.state.x), std::invalid_argument);
+  EXPECT_EQ(c.state.x, kept);
+}
+
+TEST(CoarseCorrection, ContactVerticesSlideOnTheirPlanes) {
+  // A cloth draped on the form by XPBD for a second; then one correction with the contacts
+  // detected there.
+  StudyScene sc = make_scene("form", 24);
+  XpbdSolver s;
+  for (int k = 0; k < 90; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  ClothEnergy e;
+  e.build(sc.cloth, EnergyOptions{});
+  e.set_form(&sc.objects);
+  e.detect_contacts(sc.cloth, sc.objects);
+  CoarseOptions o;
+  const std::vector<Vec3> before = sc.cloth.state.x;
+  std::vector<int> g = free_group(sc.cloth);
+  CoarseCorrection cc(o);
+  const CoarseStats st = cc.apply(sc.cloth, e, g, sc.cloth.state.x);
+  ASSERT_TRUE(st.applied);
+  int sliding = 0;
+  double worst = 0, moved = 0;
+  for (const Contact& ct : e.contacts()) {
+    const int i = ct.vertex;
+    if (!sc.cloth.is_free(i) || ct.n.dot(before[i] - ct.p) >= o.contact_reach) continue;
+    ++sliding;
+    const Vec3 d = sc.cloth.state.x[i] - before[i];
+    worst = std::max(worst, std::abs(ct.n.dot(d)));
+    moved = std::max(moved, d.norm());
+  }
+  std::printf("%d contact vertices: largest move %.3e m, largest normal part %.3e m\n", sliding,
+              moved, worst);
+  EXPECT_GT(sliding, 10);
+  EXPECT_GT(moved, 1e-7);
+  EXPECT_LT(worst, 1e-12);
+}
