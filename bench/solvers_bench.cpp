@@ -339,8 +339,6 @@ int probe(int argc, char** argv) {
           static_cast<int>(env_num("XPBD_COARSE", xp->options().coarse_factor));
       xp->options().coarse_frames =
           static_cast<int>(env_num("XPBD_COARSE_FRAMES", xp->options().coarse_frames));
-      xp->options().coarse.reuse =
-          static_cast<int>(env_num("XPBD_COARSE_REUSE", xp->options().coarse.reuse));
     }
   }
   sc.objects.friction = env_num("PROBE_FRICTION", sc.objects.friction);

@@ -36,8 +36,6 @@ struct CoarseCorrection::Impl {
   // CHOLMOD's supernodal LL^T (as the Newton solver's): 128^2 with nodes every 4 edges, 3267
   // unknowns, factorises in ~8 ms against ~48 ms for Eigen's SimplicialLDLT.
   Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> ldlt;
-  bool factor_ok = false;
-  int uses = 0;  // apply() calls since the last assembly
   Eigen::VectorXd rhs, d;
   std::vector<Vec3> grad, xt, dx;
   // Scratch of the bending rows' restriction: their nodes, block indices, coefficients.
@@ -121,7 +119,6 @@ struct CoarseCorrection::Impl {
     version = cloth.topology_version;
     factor = f;
     group = grp;
-    factor_ok = false;
     const auto& mat = cloth.topo.material;
     const double Hs = std::max(1, f) * cloth.topo.spacing;
     double u0 = 0, v0 = 0;
@@ -449,10 +446,6 @@ CoarseCorrection::CoarseCorrection(CoarseOptions opt)
     : opt_(opt), impl_(std::make_unique<Impl>()) {}
 CoarseCorrection::~CoarseCorrection() = default;
 
-void CoarseCorrection::invalidate() {
-  impl_->factor_ok = false;
-}
-
 CoarseStats CoarseCorrection::apply(const Cloth& cloth, const ClothEnergy& energy,
                                     const std::vector<int>& group, std::vector<Vec3>& x) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -469,19 +462,13 @@ CoarseStats CoarseCorrection::apply(const Cloth& cloth, const ClothEnergy& energ
   st.nodes = P.m;
   if (P.m == 0) return st;
 
-  if (!P.factor_ok || P.uses >= opt_.reuse) {
-    const auto ta = std::chrono::steady_clock::now();
-    P.assemble(energy, x, opt_.contact_reach);
-    st.assemble_ms = ms_since(ta);
-    const auto tf = std::chrono::steady_clock::now();
-    P.ldlt.factorize(P.H);
-    st.factor_ms = ms_since(tf);
-    P.factor_ok = P.ldlt.info() == Eigen::Success;
-    P.uses = 0;
-    st.assembled = true;
-  }
-  ++P.uses;
-  if (!P.factor_ok) {
+  const auto ta = std::chrono::steady_clock::now();
+  P.assemble(energy, x, opt_.contact_reach);
+  st.assemble_ms = ms_since(ta);
+  const auto tf = std::chrono::steady_clock::now();
+  P.ldlt.factorize(P.H);
+  st.factor_ms = ms_since(tf);
+  if (P.ldlt.info() != Eigen::Success) {
     st.total_ms = ms_since(t0);
     return st;
   }
@@ -532,8 +519,7 @@ CoarseStats CoarseCorrection::apply(const Cloth& cloth, const ClothEnergy& energ
 bool CoarseCorrection::fit(const std::vector<Vec3>& f, std::vector<Vec3>& fitted) {
   Impl& P = *impl_;
   if (P.m == 0 || static_cast<int>(f.size()) != P.n) return false;
-  // (Uses the coarse matrix's storage: the next apply() assembles again.)
-  P.factor_ok = false;
+  // (Uses the coarse matrix's storage; apply() assembles it anew every time.)
   std::fill(P.H.valuePtr(), P.H.valuePtr() + P.H.nonZeros(), 0.0);
   P.rhs.setZero();
   for (int i = 0; i < P.n; ++i) {

@@ -37,9 +37,6 @@ struct CoarseOptions {
   // A contact vertex closer than this to its plane (m) slides on the plane in the coarse space.
   double contact_reach = 1e-4;
   int line_search_steps = 8;  // halvings of the step before giving up
-  // Calls that reuse the last coarse matrix and its factorisation (and the contact
-  // projection it was built with) before it is assembled again; 0: every call assembles.
-  int reuse = 0;
 };
 
 struct CoarseStats {
@@ -50,8 +47,7 @@ struct CoarseStats {
   double max_move = 0;                         // largest vertex displacement (m)
   double residual = 0;                         // |P^T grad E|_inf before the step (N)
   double build_ms = 0, assemble_ms = 0, factor_ms = 0, total_ms = 0;
-  bool rebuilt = false;    // the lattice and its pattern were built for this call
-  bool assembled = false;  // the coarse matrix was assembled and factorised for this call
+  bool rebuilt = false;  // the lattice and its pattern were built for this call
 };
 
 class CoarseCorrection {
@@ -67,8 +63,6 @@ class CoarseCorrection {
   // topology, the groups or the lattice factor changed since the last call.
   CoarseStats apply(const Cloth& cloth, const ClothEnergy& energy, const std::vector<int>& group,
                     std::vector<Vec3>& x);
-  // Forgets the last matrix: the next apply() assembles it (its reuse count starts again).
-  void invalidate();
   // Diagnostics: the least-squares fit P d of a vertex field f by the coarse space of the last
   // apply() (same lattice, same contact projection); false when there is none.
   bool fit(const std::vector<Vec3>& f, std::vector<Vec3>& fitted);

@@ -209,15 +209,22 @@ double DressForm::push_outside(Vec3& p, double offset) const {
   return push_radially(p, offset);
 }
 
+bool DressForm::section_of(const Vec3& p, int& j, double& t, double& dx, double& dz) const {
+  const double s = (p.y() - y0_) / dy_;
+  if (!(s >= 0.0) || s > num_sections_ - 1) return false;  // outside the height range (or NaN)
+  locate(p.y(), y0_, dy_, num_sections_, j, t);
+  const Vec2 c = centre_in(j, t);
+  dx = p.x() - c.x();
+  dz = p.z() - c.y();
+  return true;
+}
+
 double DressForm::push_radially(Vec3& p, double offset) const {
   if (num_sections_ == 0) return 0.0;
-  const double s = (p.y() - y0_) / dy_;
-  if (!(s >= 0.0) || s > num_sections_ - 1) return 0.0;  // outside the height range (or NaN)
-  int j = static_cast<int>(s);
-  double t = s - j;
-  if (j >= num_sections_ - 1) j = std::max(num_sections_ - 2, 0), t = num_sections_ >= 2 ? 1 : 0;
+  int j;
+  double t, dx, dz;
+  if (!section_of(p, j, t, dx, dz)) return 0.0;
   const Vec2 c = centre_in(j, t);
-  const double dx = p.x() - c.x(), dz = p.z() - c.y();
   const double d2 = dx * dx + dz * dz;
   if (!std::isfinite(d2)) return 0.0;  // NaN/inf coordinates: leave the point alone
   // th: 0 at +z (centre front), +pi/2 at +x (left side).
@@ -236,14 +243,10 @@ double DressForm::push_radially(Vec3& p, double offset) const {
 }
 
 double DressForm::signed_distance(const Vec3& p) const {
-  if (num_sections_ == 0) return std::numeric_limits<double>::infinity();
-  const double s = (p.y() - y0_) / dy_;
-  if (!(s >= 0.0) || s > num_sections_ - 1) return std::numeric_limits<double>::infinity();
   int j;
-  double t;
-  locate(p.y(), y0_, dy_, num_sections_, j, t);
-  const Vec2 c = centre_in(j, t);
-  const double dx = p.x() - c.x(), dz = p.z() - c.y();
+  double t, dx, dz;
+  if (num_sections_ == 0 || !section_of(p, j, t, dx, dz))
+    return std::numeric_limits<double>::infinity();
   return std::sqrt(dx * dx + dz * dz) - radius_in(j, t, std::atan2(dx, dz));
 }
 
@@ -267,14 +270,9 @@ Vec2 DressForm::centre_slope(int j) const {
 
 double DressForm::normal_distance_within(const Vec3& p, double reach, Vec3* normal) const {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  if (num_sections_ < 2) return kInf;
-  const double s = (p.y() - y0_) / dy_;
-  if (!(s >= 0.0) || s > num_sections_ - 1) return kInf;
   int j;
-  double t;
-  locate(p.y(), y0_, dy_, num_sections_, j, t);
-  const Vec2 c = centre_in(j, t);
-  const double dx = p.x() - c.x(), dz = p.z() - c.y();
+  double t, dx, dz;
+  if (num_sections_ < 2 || !section_of(p, j, t, dx, dz)) return kInf;
   const double rho = std::sqrt(dx * dx + dz * dz);
   if (!(rho > 1e-9)) return kInf;
   const double bound = (rho - std::max(max_radius_[j], max_radius_[j + 1])) / max_gradient_[j];

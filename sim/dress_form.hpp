@@ -165,6 +165,10 @@ class DressForm {
   // the callers: radius_at, centre_at, push_outside, signed_distance).
   double radius_in(int j, double t, double th) const;
   Vec2 centre_in(int j, double t) const;
+  // The cell (j, t) of height y, and p's horizontal offset (dx, dz) from the centre there;
+  // false outside the form's height range (or NaN): the shared lookup of push_radially,
+  // signed_distance and normal_distance_within.
+  bool section_of(const Vec3& p, int& j, double& t, double& dx, double& dz) const;
   // Central-difference slopes at sample (j, n): dr/dy, dr/dtheta, and the centre's dc/dy
   // (one-sided at the end sections); tabulated once by the constructor in slopes_ (dr/dy,
   // dr/dtheta per sample, laid out as radii_) and centre_slopes_.
