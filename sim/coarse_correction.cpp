@@ -34,8 +34,8 @@ struct CoarseCorrection::Impl {
   std::vector<int> b_off, b_col, b_val;
   SpMat H;
   // CHOLMOD's supernodal LL^T (as the Newton solver's): 128^2 with nodes every 4 edges, 3267
-  // unknowns, factorises in ~8 ms against ~48 ms for Eigen's SimplicialLDLT.
-  Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> ldlt;
+  // unknowns, factorises in 25-30 ms against 44-48 ms for Eigen's SimplicialLDLT (measured).
+  Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> chol;
   Eigen::VectorXd rhs, d;
   std::vector<Vec3> grad, xt, dx;
   // Scratch of the bending rows' restriction: their nodes, block indices, coefficients.
@@ -120,15 +120,27 @@ struct CoarseCorrection::Impl {
     factor = f;
     group = grp;
     const auto& mat = cloth.topo.material;
-    const double Hs = std::max(1, f) * cloth.topo.spacing;
-    double u0 = 0, v0 = 0;
+    double u0 = 0, v0 = 0, u1 = 0, v1 = 0;
     bool any = false;
     for (int i = 0; i < n; ++i)
       if (group[i] >= 0) {
         u0 = any ? std::min(u0, mat[i].x()) : mat[i].x();
         v0 = any ? std::min(v0, mat[i].y()) : mat[i].y();
+        u1 = any ? std::max(u1, mat[i].x()) : mat[i].x();
+        v1 = any ? std::max(v1, mat[i].y()) : mat[i].y();
         any = true;
       }
+    // The lattice spacing: `f` nominal edges; a cloth without a nominal spacing (imported,
+    // remeshed) uses its mean material edge; at most 4096 cells per axis whatever the input.
+    double edge = cloth.topo.spacing;
+    if (!(edge > 0)) {
+      double sum = 0;
+      int cnt = 0;
+      for (const auto& t : cloth.topo.triangles)
+        for (int a = 0; a < 3; ++a, ++cnt) sum += (mat[t[a]] - mat[t[(a + 1) % 3]]).norm();
+      edge = cnt > 0 && sum > 0 ? sum / cnt : 1.0;
+    }
+    const double Hs = std::max(std::max(1, f) * edge, std::max(u1 - u0, v1 - v0) / 4096);
     std::unordered_map<uint64_t, int> index;
     std::vector<std::array<int, 3>> nodes;  // group, iu, iv
     auto key = [](int g, int iu, int iv) {
@@ -234,7 +246,8 @@ struct CoarseCorrection::Impl {
         }
       }
     }
-    const int R = 1 + static_cast<int>(std::ceil(reach / Hs - 1e-9));
+    const int cells = 1 + static_cast<int>(std::ceil(std::max(u1 - u0, v1 - v0) / Hs));
+    const int R = std::min(1 + static_cast<int>(std::ceil(reach / Hs - 1e-9)), cells);
     b_off.assign(m + 1, 0);
     b_col.clear();
     std::vector<int> cols;
@@ -271,8 +284,8 @@ struct CoarseCorrection::Impl {
           b_val[3 * k + c] = static_cast<int>(
               std::lower_bound(inner + outer[cc], inner + outer[cc + 1], 3 * I) - inner);
         }
-    ldlt.cholmod().print = 0;
-    ldlt.analyzePattern(H);
+    chol.cholmod().print = 0;
+    chol.analyzePattern(H);
     rhs.resize(3 * m);
     d.resize(3 * m);
     T.assign(n, Mat3::Identity());
@@ -466,9 +479,9 @@ CoarseStats CoarseCorrection::apply(const Cloth& cloth, const ClothEnergy& energ
   P.assemble(energy, x, opt_.contact_reach);
   st.assemble_ms = ms_since(ta);
   const auto tf = std::chrono::steady_clock::now();
-  P.ldlt.factorize(P.H);
+  P.chol.factorize(P.H);
   st.factor_ms = ms_since(tf);
-  if (P.ldlt.info() != Eigen::Success) {
+  if (P.chol.info() != Eigen::Success) {
     st.total_ms = ms_since(t0);
     return st;
   }
@@ -481,7 +494,7 @@ CoarseStats CoarseCorrection::apply(const Cloth& cloth, const ClothEnergy& energ
       P.rhs.segment<3>(3 * P.p_node[p]) -=
           P.p_w[p] * (P.tangential[i] ? Vec3(P.T[i] * P.grad[i]) : P.grad[i]);
   st.residual = P.rhs.lpNorm<Eigen::Infinity>();
-  P.d = P.ldlt.solve(P.rhs);
+  P.d = P.chol.solve(P.rhs);
   const double slope = -P.rhs.dot(P.d);  // grad E . P d
   if (!(slope < 0) || !P.d.allFinite()) {
     st.total_ms = ms_since(t0);
@@ -531,9 +544,9 @@ bool CoarseCorrection::fit(const std::vector<Vec3>& f, std::vector<Vec3>& fitted
   }
   // A node whose every vertex slides on one plane has no normal direction: a tiny shift.
   for (int I = 0; I < P.m; ++I) P.add_identity(I, I, 1e-9);
-  P.ldlt.factorize(P.H);
-  if (P.ldlt.info() != Eigen::Success) return false;
-  P.d = P.ldlt.solve(P.rhs);
+  P.chol.factorize(P.H);
+  if (P.chol.info() != Eigen::Success) return false;
+  P.d = P.chol.solve(P.rhs);
   fitted.assign(P.n, Vec3::Zero());
   for (int i = 0; i < P.n; ++i) {
     for (int p = P.p_off[i]; p < P.p_off[i + 1]; ++p)

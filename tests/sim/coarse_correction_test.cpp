@@ -183,3 +183,22 @@ TEST(CoarseCorrection, ContactVerticesSlideOnTheirPlanes) {
   EXPECT_GT(moved, 1e-7);
   EXPECT_LT(worst, 1e-12);
 }
+
+// A cloth without a nominal grid spacing (imported, remeshed): the lattice takes its mean
+// material edge, and the step still lowers the energy.
+TEST(CoarseCorrection, ClothWithoutANominalSpacingUsesItsMeanEdge) {
+  Cloth c = hanging_from_an_edge(13);
+  c.topo.spacing = 0;
+  ClothEnergy e;
+  e.build(c, EnergyOptions{});
+  CoarseCorrection cc;
+  const double e0 = e.energy(c.state.x, c.state.mass);
+  const CoarseStats st = cc.apply(c, e, free_group(c), c.state.x);
+  // Mean edge of the criss-cross grid (0.025 m sides, 0.035 m diagonals) ~0.028 m: nodes every
+  // ~0.11 m over 0.3 m, 4-5 per axis.
+  std::printf("%d nodes, E %.9f -> %.9f J\n", st.nodes, e0, st.energy_after);
+  EXPECT_GE(st.nodes, 16);
+  EXPECT_LE(st.nodes, 25);
+  EXPECT_TRUE(st.applied);
+  EXPECT_LT(st.energy_after, e0);
+}
