@@ -115,11 +115,49 @@ struct CoarseCorrection::Impl {
   }
 
   void build(const Cloth& cloth, const ClothEnergy& energy, const std::vector<int>& grp, int f) {
-    n = cloth.num_vertices();
+    const auto& mat = cloth.topo.material;
+    // One pass over the elements, before anything is changed (a rejected call leaves the last
+    // lattice as it was): no element may join two groups, which are coarsened apart (fixed
+    // vertices, -1, may be anywhere); and the farthest apart (per material axis) two vertices
+    // of one element lie, which bounds the nodes that can couple.
+    double reach = 0;
+    auto element = [&](const int* v, int k) {
+      int g = -1;
+      Vec2 lo = mat[v[0]], hi = lo;
+      for (int a = 0; a < k; ++a) {
+        lo = lo.cwiseMin(mat[v[a]]);
+        hi = hi.cwiseMax(mat[v[a]]);
+        const int ga = grp[v[a]];
+        if (ga < 0) continue;
+        if (g >= 0 && ga != g)
+          throw std::invalid_argument("CoarseCorrection: an element joins vertex groups " +
+                                      std::to_string(g) + " and " + std::to_string(ga));
+        g = ga;
+      }
+      reach = std::max(reach, (hi - lo).maxCoeff());
+    };
+    const int nv = cloth.num_vertices();
+    for (int t = 0; t < energy.num_triangles(); ++t) element(energy.tri(t).data(), 3);
+    for (int h = 0; h < energy.num_hinges(); ++h) element(energy.hinge(h).data(), 4);
+    for (int s = 0; s < energy.num_springs(); ++s) element(energy.spring(s).data(), 2);
+    if (energy.tensor_bending() && energy.has_bending_matrix()) {
+      const auto& off = energy.bending_offsets();
+      const auto& col = energy.bending_columns();
+      for (int i = 0; i < nv; ++i)
+        for (int k = off[i]; k < off[i + 1]; ++k) {
+          const int v[2] = {i, col[k]};
+          element(v, 2);
+        }
+    } else if (energy.tensor_bending()) {
+      const auto& off = energy.bending_row_offsets();
+      const auto& col = energy.bending_row_columns();
+      for (int r = 0; r + 1 < static_cast<int>(off.size()); ++r)
+        if (off[r + 1] > off[r]) element(col.data() + off[r], off[r + 1] - off[r]);
+    }
+    n = nv;
     version = cloth.topology_version;
     factor = f;
     group = grp;
-    const auto& mat = cloth.topo.material;
     double u0 = 0, v0 = 0, u1 = 0, v1 = 0;
     bool any = false;
     for (int i = 0; i < n; ++i)
@@ -180,72 +218,6 @@ struct CoarseCorrection::Impl {
     }
     p_off[n] = static_cast<int>(p_node.size());
     m = static_cast<int>(nodes.size());
-    // Groups are coarsened apart, so no element may join two of them (fixed vertices, -1, may
-    // be anywhere).
-    auto one_group = [&](const int* v, int k) {
-      int g = -1;
-      for (int a = 0; a < k; ++a) {
-        const int ga = group[v[a]];
-        if (ga < 0) continue;
-        if (g >= 0 && ga != g)
-          throw std::invalid_argument("CoarseCorrection: an element joins vertex groups " +
-                                      std::to_string(g) + " and " + std::to_string(ga));
-        g = ga;
-      }
-    };
-    for (int t = 0; t < energy.num_triangles(); ++t) one_group(energy.tri(t).data(), 3);
-    for (int h = 0; h < energy.num_hinges(); ++h) one_group(energy.hinge(h).data(), 4);
-    for (int s = 0; s < energy.num_springs(); ++s) one_group(energy.spring(s).data(), 2);
-    if (energy.tensor_bending() && !energy.has_bending_matrix()) {
-      const auto& off = energy.bending_row_offsets();
-      const auto& col = energy.bending_row_columns();
-      for (int r = 0; r + 1 < static_cast<int>(off.size()); ++r)
-        one_group(col.data() + off[r], off[r + 1] - off[r]);
-    } else if (energy.tensor_bending()) {
-      const auto& off = energy.bending_offsets();
-      const auto& col = energy.bending_columns();
-      for (int i = 0; i < n; ++i)
-        for (int k = off[i]; k < off[i + 1]; ++k) {
-          const int v[2] = {i, col[k]};
-          one_group(v, 2);
-        }
-    }
-
-    // The farthest (per material axis) two vertices of one element lie apart: nodes of one
-    // group closer than 2 cells plus that reach on both axes may couple; all others cannot.
-    double reach = 0;
-    auto spread = [&](const int* v, int k) {
-      for (int a = 0; a < k; ++a)
-        for (int b = a + 1; b < k; ++b)
-          reach = std::max(reach, (mat[v[a]] - mat[v[b]]).cwiseAbs().maxCoeff());
-    };
-    for (int t = 0; t < energy.num_triangles(); ++t) spread(energy.tri(t).data(), 3);
-    for (int h = 0; h < energy.num_hinges(); ++h) spread(energy.hinge(h).data(), 4);
-    for (int s = 0; s < energy.num_springs(); ++s) spread(energy.spring(s).data(), 2);
-    if (energy.tensor_bending()) {
-      if (energy.has_bending_matrix()) {
-        const auto& off = energy.bending_offsets();
-        const auto& col = energy.bending_columns();
-        for (int i = 0; i < n; ++i)
-          for (int k = off[i]; k < off[i + 1]; ++k) {
-            const int v[2] = {i, col[k]};
-            spread(v, 2);
-          }
-      } else {
-        // A row's columns: the extent of their box (cheaper than every pair).
-        const auto& off = energy.bending_row_offsets();
-        const auto& col = energy.bending_row_columns();
-        for (int r = 0; r + 1 < static_cast<int>(off.size()); ++r) {
-          if (off[r + 1] == off[r]) continue;
-          Vec2 lo = mat[col[off[r]]], hi = lo;
-          for (int k = off[r]; k < off[r + 1]; ++k) {
-            lo = lo.cwiseMin(mat[col[k]]);
-            hi = hi.cwiseMax(mat[col[k]]);
-          }
-          reach = std::max(reach, (hi - lo).maxCoeff());
-        }
-      }
-    }
     const int cells = 1 + static_cast<int>(std::ceil(std::max(u1 - u0, v1 - v0) / Hs));
     const int R = std::min(1 + static_cast<int>(std::ceil(reach / Hs - 1e-9)), cells);
     b_off.assign(m + 1, 0);
@@ -509,7 +481,7 @@ CoarseStats CoarseCorrection::apply(const Cloth& cloth, const ClothEnergy& energ
 
   // Backtracking (Armijo) on E.
   st.energy_before = energy.energy(x, mass);
-  P.xt = x;
+  P.xt.resize(n);
   double alpha = 1.0;
   for (int ls = 0; ls <= opt_.line_search_steps; ++ls, alpha *= 0.5) {
     for (int i = 0; i < n; ++i) P.xt[i] = x[i] + alpha * P.dx[i];

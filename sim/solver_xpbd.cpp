@@ -297,21 +297,19 @@ void XpbdSolver::unsettle(int piece) {
 
 void XpbdSolver::coarse_step(Cloth& cloth, const SceneObjects& scene) {
   if (opt_.coarse_factor <= 0 || !opt_.settle || scene.self_collision) return;
+  // A piece is due when it is awake, at the full scale and not yet corrected this episode.
+  auto due = [&](int p) {
+    return !piece_frozen_[p] && piece_scale_[p] >= opt_.settle_mass_scale &&
+           piece_coarse_[p] < opt_.coarse_frames;
+  };
+  bool any = false;
+  for (int p = 0; p < num_pieces_ && !any; ++p) any = due(p);
+  if (!any) return;
   auto& S = cloth.state;
   const int n = cloth.num_vertices();
-  bool any = false;
-  for (int p = 0; p < num_pieces_; ++p)
-    any = any || (!piece_frozen_[p] && piece_scale_[p] >= opt_.settle_mass_scale &&
-                  piece_coarse_[p] < opt_.coarse_frames);
-  if (!any) return;
   coarse_group_.resize(n);
-  for (int i = 0; i < n; ++i) {
-    const int p = piece_of_[i];
-    const bool moves = cloth.is_free(i) && !piece_frozen_[p] &&
-                       piece_scale_[p] >= opt_.settle_mass_scale &&
-                       piece_coarse_[p] < opt_.coarse_frames;
-    coarse_group_[i] = moves ? p : -1;
-  }
+  for (int i = 0; i < n; ++i)
+    coarse_group_[i] = cloth.is_free(i) && due(piece_of_[i]) ? piece_of_[i] : -1;
   if (!coarse_) coarse_ = std::make_unique<CoarseCorrection>();
   coarse_->options() = opt_.coarse;
   coarse_->options().factor = opt_.coarse_factor;
@@ -325,9 +323,7 @@ void XpbdSolver::coarse_step(Cloth& cloth, const SceneObjects& scene) {
   // Counted whether or not a step was taken (a piece the correction cannot improve is not
   // tried again until it settles anew).
   for (int p = 0; p < num_pieces_; ++p)
-    if (!piece_frozen_[p] && piece_scale_[p] >= opt_.settle_mass_scale &&
-        piece_coarse_[p] < opt_.coarse_frames)
-      ++piece_coarse_[p];
+    if (due(p)) ++piece_coarse_[p];
   if (coarse_last_.applied) {
     ++coarse_count_;
     for (int i = 0; i < n; ++i)

@@ -149,6 +149,9 @@ TEST(CoarseCorrection, FixedVerticesStayAndGroupsMayNotShareAnElement) {
   const std::vector<Vec3> kept = c.state.x;
   EXPECT_THROW(cc.apply(c, e, g, c.state.x), std::invalid_argument);
   EXPECT_EQ(c.state.x, kept);
+  // A rejected call leaves nothing half built: the same groups are rejected again.
+  EXPECT_THROW(cc.apply(c, e, g, c.state.x), std::invalid_argument);
+  EXPECT_EQ(c.state.x, kept);
 }
 
 TEST(CoarseCorrection, ContactVerticesSlideOnTheirPlanes) {
