@@ -23,6 +23,7 @@
 #include "bench/bullet_peer.hpp"
 #include "sim/coarse_correction.hpp"
 #include "sim/dress_form.hpp"
+#include "sim/equilibrium_finisher.hpp"
 #include "sim/scenes.hpp"
 #include "sim/solver_factory.hpp"
 #include "sim/solver_newton.hpp"
@@ -339,6 +340,10 @@ int probe(int argc, char** argv) {
           static_cast<int>(env_num("XPBD_COARSE", xp->options().coarse_factor));
       xp->options().coarse_frames =
           static_cast<int>(env_num("XPBD_COARSE_FRAMES", xp->options().coarse_frames));
+      xp->options().coarse.rotations = env_num("XPBD_COARSE_ROT", 0) > 0;
+      xp->options().finish = env_num("XPBD_FINISH", 1) > 0;
+      xp->options().finisher.cycles =
+          static_cast<int>(env_num("XPBD_FINISH_CYCLES", xp->options().finisher.cycles));
     }
   }
   sc.objects.friction = env_num("PROBE_FRICTION", sc.objects.friction);
@@ -427,6 +432,14 @@ int probe(int argc, char** argv) {
           c.alpha, c.max_move * 1e3, c.residual, c.build_ms, c.assemble_ms, c.factor_ms,
           c.total_ms);
     }
+    if (xp->finish_count() > 0) {
+      const FinisherStats& f = xp->last_finish();
+      std::printf(
+          "xpbd static finish: %d pieces, %d cycles, %.0f ms in all; last cycle: E %.9f -> %.9f "
+          "J, moved %.4f mm, sweeps %.0f ms, coarse %.0f ms\n",
+          xp->finish_count(), xp->finish_cycles(), xp->finish_ms(), f.energy_before, f.energy_after,
+          f.last_move * 1e3, f.sweep_ms, f.coarse_ms);
+    }
   }
   // PROBE_COARSE_ONLY=k: k coarse corrections (sim/coarse_correction.hpp, lattice
   // PROBE_COARSE_FACTOR) of the end state alone, contacts re-detected before each (a study of
@@ -442,15 +455,93 @@ int probe(int argc, char** argv) {
     e.set_contact_stiffness(env_num("PROBE_COARSE_K", 1e4));
     CoarseCorrection& cc = probe_cc;
     cc.options().factor = static_cast<int>(env_num("PROBE_COARSE_FACTOR", 4));
+    cc.options().rotations = env_num("PROBE_COARSE_ROT", 0) > 0;
     std::vector<int> group(sc.cloth.num_vertices());
     for (int i = 0; i < sc.cloth.num_vertices(); ++i) group[i] = sc.cloth.is_free(i) ? 0 : -1;
+    const std::vector<Vec3> anchor = sc.cloth.state.x;  // friction's, as the polish's
+    // PROBE_MG_AA=m: Anderson acceleration (Peng et al. 2018) of the cycle x -> G(x) over the
+    // last m cycles, kept only when it lowers E below G(x)'s (else the history restarts).
+    const int aa_m = static_cast<int>(env_num("PROBE_MG_AA", 0));
+    const int nx = 3 * sc.cloth.num_vertices();
+    std::vector<Eigen::VectorXd> dF, dG;
+    Eigen::VectorXd f_prev, g_prev;
+    int aa_taken = 0;
+    auto flat = [&](const std::vector<Vec3>& v) {
+      return Eigen::Map<const Eigen::VectorXd>(v[0].data(), nx);
+    };
     for (int k = 0; k < kc; ++k) {
+      const Eigen::VectorXd xin = flat(sc.cloth.state.x);
       e.detect_contacts(sc.cloth, sc.objects);
       if (sc.objects.friction > 0 && env_num("PROBE_COARSE_MU", 1) > 0) {
-        e.set_friction(sc.objects.friction, 1e-4, sc.cloth.state.x);
+        e.set_friction(sc.objects.friction, 1e-4, anchor);
         e.lag_friction_load(sc.cloth.state.x, sc.cloth.state.mass);
       }
-      const CoarseStats c = cc.apply(sc.cloth, e, group, sc.cloth.state.x);
+      // PROBE_MG_SWEEPS=v: v Gauss-Seidel sweeps of per-vertex Newton steps on the static
+      // energy before each correction (a two-level cycle's smoother; the equilibrium is its
+      // fixed point).
+      const int sweeps = static_cast<int>(env_num("PROBE_MG_SWEEPS", 0));
+      const double tau2 = std::pow(env_num("PROBE_MG_TAU", 0.05), 2);
+      const double e0 = e.energy(sc.cloth.state.x, sc.cloth.state.mass);
+      const double cs0 = cpu_ms();
+      for (int sw = 0; sw < sweeps; ++sw)
+        for (int i = 0; i < sc.cloth.num_vertices(); ++i) {
+          if (group[i] < 0) continue;
+          Vec3 fi;
+          Mat3 Hi;
+          const double mi = sc.cloth.state.mass[i];
+          e.vertex_force_hessian(i, sc.cloth.state.x, mi, fi, Hi);
+          Hi.diagonal().array() += mi / tau2;
+          sc.cloth.state.x[i] += Hi.ldlt().solve(fi);
+        }
+      if (sweeps > 0)
+        std::printf("  %d sweeps: E %.9f -> %.9f J, %.1f ms CPU\n", sweeps, e0,
+                    e.energy(sc.cloth.state.x, sc.cloth.state.mass), cpu_ms() - cs0);
+      // PROBE_MG_NOCOARSE=1: the sweeps alone (the cycle without its coarse step).
+      const CoarseStats c =
+          env_num("PROBE_MG_NOCOARSE", 0) > 0
+              ? CoarseStats{}
+              : cc.apply(sc.cloth, e, group, sc.cloth.state.x,
+                         k % static_cast<int>(env_num("PROBE_MG_REFRESH", 1)) != 0);
+      if (aa_m > 0) {
+        const Eigen::VectorXd g = flat(sc.cloth.state.x);
+        const Eigen::VectorXd fk = g - xin;
+        if (f_prev.size() == nx) {
+          dF.push_back(fk - f_prev);
+          dG.push_back(g - g_prev);
+          if (static_cast<int>(dF.size()) > aa_m) {
+            dF.erase(dF.begin());
+            dG.erase(dG.begin());
+          }
+        }
+        f_prev = fk;
+        g_prev = g;
+        const int h = static_cast<int>(dF.size());
+        if (h > 0) {
+          Eigen::MatrixXd A(h, h);
+          Eigen::VectorXd b(h);
+          for (int a = 0; a < h; ++a) {
+            b[a] = dF[a].dot(fk);
+            for (int bb = 0; bb < h; ++bb) A(a, bb) = dF[a].dot(dF[bb]);
+          }
+          A.diagonal().array() += 1e-10 * A.diagonal().maxCoeff() + 1e-30;
+          const Eigen::VectorXd gam = A.ldlt().solve(b);
+          Eigen::VectorXd xa = g;
+          for (int a = 0; a < h; ++a) xa -= gam[a] * dG[a];
+          std::vector<Vec3> xav(sc.cloth.num_vertices());
+          Eigen::Map<Eigen::VectorXd>(xav[0].data(), nx) = xa;
+          const double eg = e.energy(sc.cloth.state.x, sc.cloth.state.mass);
+          const double ea = e.energy(xav, sc.cloth.state.mass);
+          if (ea < eg) {
+            sc.cloth.state.x = xav;
+            ++aa_taken;
+          } else {
+            dF.clear();
+            dG.clear();
+          }
+          std::printf("  anderson (%d): E %.9f vs cycle %.9f: %s\n", h, ea, eg,
+                      ea < eg ? "taken" : "restart");
+        }
+      }
       e.clear_friction();
       std::printf(
           "coarse %d: applied %d alpha %.3g moved %.4f mm residual %.3e N  E %.9f -> %.9f J  "
@@ -459,6 +550,26 @@ int probe(int argc, char** argv) {
           c.energy_after, c.total_ms, c.assemble_ms, c.factor_ms, c.nodes);
     }
     sc.cloth.state.x_prev = sc.cloth.state.x;
+    if (aa_m > 0) std::printf("anderson steps taken: %d of %d\n", aa_taken, kc);
+  }
+  // PROBE_FINISH=k: the static finish (sim/equilibrium_finisher.hpp) of the end state, at most
+  // k cycles (PROBE_FINISH_SWEEPS, PROBE_COARSE_FACTOR, PROBE_COARSE_ROT=0 for translations).
+  if (const int kf = static_cast<int>(env_num("PROBE_FINISH", 0)); kf > 0) {
+    EquilibriumFinisher fin;
+    fin.options().cycles = kf;
+    fin.options().sweeps = static_cast<int>(env_num("PROBE_FINISH_SWEEPS", fin.options().sweeps));
+    fin.options().coarse_factor = static_cast<int>(env_num("PROBE_COARSE_FACTOR", 0));
+    fin.options().rotations = env_num("PROBE_COARSE_ROT", 1) > 0;
+    fin.options().extrapolate = env_num("PROBE_FINISH_EXTRA", fin.options().extrapolate);
+    std::vector<int> group(sc.cloth.num_vertices());
+    for (int i = 0; i < sc.cloth.num_vertices(); ++i) group[i] = sc.cloth.is_free(i) ? 0 : -1;
+    ThreadPool pool(static_cast<int>(env_num("SOLVERS_THREADS", 1)));
+    const FinisherStats fs = fin.run(sc.cloth, sc.objects, group, EnergyOptions{}, &pool);
+    std::printf(
+        "finish: %d cycles, E %.9f -> %.9f J, moved %.3f mm (last cycle %.4f mm), sweeps %.0f ms, "
+        "coarse %.0f ms, total %.0f ms\n",
+        fs.cycles, fs.energy_before, fs.energy_after, fs.max_move * 1e3, fs.last_move * 1e3,
+        fs.sweep_ms, fs.coarse_ms, fs.total_ms);
   }
   if (path_dependent(scene) && env_num("PROBE_POLISH", 1) > 0) {
     double res_polish = 0, rms = 0, mx = 0;

@@ -28,7 +28,17 @@ struct CoarseCorrection::Impl {
   // empty).
   std::vector<int> p_off, p_node;
   std::vector<double> p_w;
-  int m = 0;  // coarse nodes
+  int m = 0;              // coarse nodes
+  bool factored = false;  // chol holds the last assembled matrix (fit() spoils it)
+  int nb = 3;             // unknowns per node: 3 (translation) or 6 (and a rotation, CoarseOptions)
+  // With rotations: entry p's 3 x 6 prolongation block w [T, -T [x_i - c_n]x / s] (T the
+  // vertex's projector, s the lattice spacing that gives the rotation a length's units) and
+  // the nodes' centres.
+  using G36 = Eigen::Matrix<double, 3, 6>;
+  std::vector<G36> G;
+  std::vector<Vec3> centre;
+  std::vector<double> wsum;
+  double spacing = 1;
   // Coarse block pattern, CSR over nodes (sorted columns), and for block k the value index of
   // its entry (3 I, 3 J + c) in the compressed column 3 J + c (rows 3 I .. 3 I + 2 follow it).
   std::vector<int> b_off, b_col, b_val;
@@ -114,7 +124,8 @@ struct CoarseCorrection::Impl {
       for (int j = 0; j < nn; ++j) add(nodes[i], nodes[j], 1.0, L.block<3, 3>(3 * i, 3 * j));
   }
 
-  void build(const Cloth& cloth, const ClothEnergy& energy, const std::vector<int>& grp, int f) {
+  void build(const Cloth& cloth, const ClothEnergy& energy, const std::vector<int>& grp, int f,
+             int blocksize) {
     const auto& mat = cloth.topo.material;
     // One pass over the elements, before anything is changed (a rejected call leaves the last
     // lattice as it was): no element may join two groups, which are coarsened apart (fixed
@@ -158,6 +169,7 @@ struct CoarseCorrection::Impl {
     version = cloth.topology_version;
     factor = f;
     group = grp;
+    nb = blocksize;
     double u0 = 0, v0 = 0, u1 = 0, v1 = 0;
     bool any = false;
     for (int i = 0; i < n; ++i)
@@ -179,6 +191,7 @@ struct CoarseCorrection::Impl {
       edge = cnt > 0 && sum > 0 ? sum / cnt : 1.0;
     }
     const double Hs = std::max(std::max(1, f) * edge, std::max(u1 - u0, v1 - v0) / 4096);
+    spacing = Hs;
     std::unordered_map<uint64_t, int> index;
     std::vector<std::array<int, 3>> nodes;  // group, iu, iv
     auto key = [](int g, int iu, int iv) {
@@ -238,28 +251,36 @@ struct CoarseCorrection::Impl {
     b_off[m] = static_cast<int>(b_col.size());
     // The scalar pattern: every block full (both triangles; the factorisation reads the lower).
     std::vector<Eigen::Triplet<double>> trip;
-    trip.reserve(b_col.size() * 9);
+    trip.reserve(b_col.size() * nb * nb);
     for (int I = 0; I < m; ++I)
       for (int k = b_off[I]; k < b_off[I + 1]; ++k)
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) trip.emplace_back(3 * I + r, 3 * b_col[k] + c, 0.0);
-    H.resize(3 * m, 3 * m);
+        for (int r = 0; r < nb; ++r)
+          for (int c = 0; c < nb; ++c) trip.emplace_back(nb * I + r, nb * b_col[k] + c, 0.0);
+    H.resize(nb * m, nb * m);
     H.setFromTriplets(trip.begin(), trip.end());
     H.makeCompressed();
-    b_val.resize(3 * b_col.size());
+    b_val.resize(nb * b_col.size());
     const int* outer = H.outerIndexPtr();
     const int* inner = H.innerIndexPtr();
     for (int I = 0; I < m; ++I)
       for (int k = b_off[I]; k < b_off[I + 1]; ++k)
-        for (int c = 0; c < 3; ++c) {
-          const int cc = 3 * b_col[k] + c;
-          b_val[3 * k + c] = static_cast<int>(
-              std::lower_bound(inner + outer[cc], inner + outer[cc + 1], 3 * I) - inner);
+        for (int c = 0; c < nb; ++c) {
+          const int cc = nb * b_col[k] + c;
+          b_val[nb * k + c] = static_cast<int>(
+              std::lower_bound(inner + outer[cc], inner + outer[cc + 1], nb * I) - inner);
         }
     chol.cholmod().print = 0;
     chol.analyzePattern(H);
-    rhs.resize(3 * m);
-    d.resize(3 * m);
+    rhs.resize(nb * m);
+    d.resize(nb * m);
+    if (nb == 6) {
+      G.resize(p_node.size());
+      centre.resize(m);
+      wsum.assign(m, 0.0);
+      for (int i = 0; i < n; ++i)
+        for (int p = p_off[i]; p < p_off[i + 1]; ++p) wsum[p_node[p]] += p_w[p];
+      build_fine(energy);
+    }
     T.assign(n, Mat3::Identity());
     tangential.assign(n, 0);
   }
@@ -273,6 +294,10 @@ struct CoarseCorrection::Impl {
         T[c.vertex] = Mat3::Identity() - c.n * c.n.transpose();
       }
     std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
+    if (nb == 6) {
+      assemble6(energy, x);
+      return;
+    }
     Mat9 H9;
     for (int t = 0; t < energy.num_triangles(); ++t) {
       const auto& v = energy.tri(t);
@@ -417,13 +442,240 @@ struct CoarseCorrection::Impl {
       }
       add_fine(i, i, B);
     }
-    // A node whose every vertex slides on one plane (a flat piece on the floor) has no
-    // stiffness along the plane's normal: a shift of 1e-9 of the mean diagonal keeps the
-    // matrix definite without changing any other step.
+    shift();
+  }
+
+  // ---- Nodes with rotations (nb == 6) ----
+  void add6(int I, int J, const double* M, int ld) {  // M: 6 x 6 column-major, leading dim ld
+    double* v = H.valuePtr();
+    const int k = block(I, J);
+    for (int c = 0; c < 6; ++c) {
+      double* col = v + b_val[6 * k + c];
+      const double* mc = M + c * ld;
+      for (int r = 0; r < 6; ++r) col[r] += mc[r];
+    }
+  }
+  // The prolongation blocks at x: node centres, then w T [I, -[x_i - c]x / s].
+  void prolong6(const std::vector<Vec3>& x) {
+    std::fill(centre.begin(), centre.end(), Vec3::Zero());
+    for (int i = 0; i < n; ++i)
+      for (int p = p_off[i]; p < p_off[i + 1]; ++p) centre[p_node[p]] += p_w[p] * x[i];
+    for (int I = 0; I < m; ++I) centre[I] /= wsum[I];
+    for (int i = 0; i < n; ++i)
+      for (int p = p_off[i]; p < p_off[i + 1]; ++p) {
+        const Vec3 r = (x[i] - centre[p_node[p]]) / spacing;
+        Mat3 S;  // -[r]x
+        S << 0, r.z(), -r.y(), -r.z(), 0, r.x(), r.y(), -r.x(), 0;
+        G36& g = G[p];
+        if (tangential[i]) {
+          g.leftCols<3>() = p_w[p] * T[i];
+          g.rightCols<3>() = p_w[p] * (T[i] * S);
+        } else {
+          g.leftCols<3>() = p_w[p] * Mat3::Identity();
+          g.rightCols<3>() = p_w[p] * S;
+        }
+      }
+  }
+  // The fine Hessian as 3x3 blocks over vertex pairs that share an element (CSR, sorted),
+  // then P^T F P through Y = F P row by row: ~8x fewer flops than restricting every element's
+  // (and bending row's) Hessian to its nodes separately.
+  std::vector<int> f_off, f_col, tri_fb, bm_fb;
+  std::vector<Mat3> F;
+  std::vector<int> y_node;
+  std::vector<G36> y_val;
+  int fblock(int i, int j) const {
+    const int* b = f_col.data() + f_off[i];
+    const int* e = f_col.data() + f_off[i + 1];
+    return static_cast<int>(std::lower_bound(b, e, j) - f_col.data());
+  }
+  void build_fine(const ClothEnergy& energy) {
+    std::vector<std::vector<int>> rows(n);
+    auto link = [&](const int* v, int k) {
+      for (int a = 0; a < k; ++a)
+        for (int b = 0; b < k; ++b) rows[v[a]].push_back(v[b]);
+    };
+    for (int t = 0; t < energy.num_triangles(); ++t) link(energy.tri(t).data(), 3);
+    for (int h = 0; h < energy.num_hinges(); ++h) link(energy.hinge(h).data(), 4);
+    for (int sp = 0; sp < energy.num_springs(); ++sp) link(energy.spring(sp).data(), 2);
+    if (energy.tensor_bending() && energy.has_bending_matrix()) {
+      const auto& off = energy.bending_offsets();
+      const auto& col = energy.bending_columns();
+      for (int i = 0; i < n; ++i)
+        for (int k = off[i]; k < off[i + 1]; ++k) rows[i].push_back(col[k]);
+    } else if (energy.tensor_bending()) {
+      const auto& off = energy.bending_row_offsets();
+      const auto& col = energy.bending_row_columns();
+      for (int r = 0; r + 1 < static_cast<int>(off.size()); ++r)
+        link(col.data() + off[r], off[r + 1] - off[r]);
+    }
+    f_off.assign(n + 1, 0);
+    f_col.clear();
+    for (int i = 0; i < n; ++i) {
+      rows[i].push_back(i);
+      std::sort(rows[i].begin(), rows[i].end());
+      rows[i].erase(std::unique(rows[i].begin(), rows[i].end()), rows[i].end());
+      f_off[i] = static_cast<int>(f_col.size());
+      f_col.insert(f_col.end(), rows[i].begin(), rows[i].end());
+    }
+    f_off[n] = static_cast<int>(f_col.size());
+    F.resize(f_col.size());
+    tri_fb.resize(9 * energy.num_triangles());
+    for (int t = 0; t < energy.num_triangles(); ++t)
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          tri_fb[9 * t + 3 * a + b] = fblock(energy.tri(t)[a], energy.tri(t)[b]);
+    bm_fb.clear();
+    if (energy.tensor_bending() && energy.has_bending_matrix()) {
+      const auto& off = energy.bending_offsets();
+      const auto& col = energy.bending_columns();
+      bm_fb.resize(col.size());
+      for (int i = 0; i < n; ++i)
+        for (int k = off[i]; k < off[i + 1]; ++k) bm_fb[k] = fblock(i, col[k]);
+    }
+  }
+  template <class M>
+  void add_fine_element(const int32_t* v, int k, const M& He) {
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b) F[fblock(v[a], v[b])] += He.template block<3, 3>(3 * a, 3 * b);
+  }
+  void assemble6(const ClothEnergy& energy, const std::vector<Vec3>& x) {
+    prolong6(x);
+    std::fill(F.begin(), F.end(), Mat3::Zero());
+    Mat9 H9;
+    for (int t = 0; t < energy.num_triangles(); ++t) {
+      const auto& v = energy.tri(t);
+      if (!moves(v[0]) && !moves(v[1]) && !moves(v[2])) continue;
+      energy.tri_hessian(t, x, H9, true);
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) F[tri_fb[9 * t + 3 * a + b]] += H9.block<3, 3>(3 * a, 3 * b);
+    }
+    if (energy.tensor_bending()) {
+      if (energy.has_bending_matrix()) {
+        const auto& val = energy.bending_values();
+        for (size_t k = 0; k < bm_fb.size(); ++k) F[bm_fb[k]].diagonal().array() += val[k];
+      } else {
+        // Rows sharing their columns (a triangle's uu, vv, uv): their scalar products summed.
+        const auto& off = energy.bending_row_offsets();
+        const auto& col = energy.bending_row_columns();
+        const auto& val = energy.bending_row_values();
+        const int rows = static_cast<int>(off.size()) - 1;
+        for (int r = 0; r < rows;) {
+          int g = 1;
+          while (
+              g < 3 && r + g < rows && off[r + g + 1] - off[r + g] == off[r + 1] - off[r] &&
+              std::equal(col.begin() + off[r], col.begin() + off[r + 1], col.begin() + off[r + g]))
+            ++g;
+          const int len = off[r + 1] - off[r];
+          for (int a = 0; a < len; ++a) {
+            const int ja = col[off[r] + a];
+            if (!moves(ja)) continue;
+            for (int b = 0; b < len; ++b) {
+              double sab = 0;
+              for (int rr = r; rr < r + g; ++rr)
+                sab += energy.bending_row_stiffness(rr) * val[off[rr] + a] * val[off[rr] + b];
+              F[fblock(ja, col[off[r] + b])].diagonal().array() += sab;
+            }
+          }
+          r += g;
+        }
+      }
+    } else {
+      Mat12 H12;
+      for (int h = 0; h < energy.num_hinges(); ++h) {
+        const auto& v = energy.hinge(h);
+        energy.hinge_hessian(h, x, H12, true);
+        add_fine_element(v.data(), 4, H12);
+      }
+    }
+    Eigen::Matrix<double, 6, 6> H6;
+    for (int sp = 0; sp < energy.num_springs(); ++sp) {
+      const auto& v = energy.spring(sp);
+      energy.spring_hessian(sp, x, H6, true);
+      add_fine_element(v.data(), 2, H6);
+    }
+    for (const Contact& c : energy.contacts()) {
+      const int i = c.vertex;
+      if (!moves(i)) continue;
+      Mat3& B = F[fblock(i, i)];
+      if (!tangential[i] && c.n.dot(x[i] - c.p) < 0)
+        B += energy.contact_stiffness() * c.n * c.n.transpose();
+      if (energy.friction_on()) {
+        Vec3 gf;
+        Mat3 Hf;
+        energy.friction_gradient_hessian(i, x[i], gf, &Hf);
+        B += Hf;
+      }
+    }
+    // P^T F P: row i of Y = F P gathered over its nodes, then G_ip^T Y_i into node row I.
+    Eigen::Matrix<double, 6, 6> M;
+    for (int i = 0; i < n; ++i) {
+      if (!moves(i)) continue;
+      y_node.clear();
+      y_val.clear();
+      for (int k = f_off[i]; k < f_off[i + 1]; ++k) {
+        const int j = f_col[k];
+        for (int q = p_off[j]; q < p_off[j + 1]; ++q) {
+          const int J = p_node[q];
+          size_t l = 0;
+          while (l < y_node.size() && y_node[l] != J) ++l;
+          if (l == y_node.size()) {
+            y_node.push_back(J);
+            y_val.push_back(G36::Zero());
+          }
+          y_val[l].noalias() += F[k] * G[q];
+        }
+      }
+      for (int p = p_off[i]; p < p_off[i + 1]; ++p) {
+        const int I = p_node[p];
+        for (size_t l = 0; l < y_node.size(); ++l) {
+          M.noalias() = G[p].transpose() * y_val[l];
+          add6(I, y_node[l], M.data(), 6);
+        }
+      }
+    }
+    shift();
+  }
+  void add_fine6(int a, int b, const Mat3& B) {
+    for (int p = p_off[a]; p < p_off[a + 1]; ++p)
+      for (int q = p_off[b]; q < p_off[b + 1]; ++q) {
+        const Eigen::Matrix<double, 6, 6> Mab = G[p].transpose() * B * G[q];
+        add6(p_node[p], p_node[q], Mab.data(), 6);
+      }
+  }
+  // A node without stiffness in some direction (its vertices all slide on one plane, or lie on
+  // one line for a rotation): a shift of 1e-9 of the mean diagonal keeps the matrix definite
+  // without changing any other step.
+  void shift() {
     double mean = 0;
-    for (int k = 0; k < 3 * m; ++k) mean += H.coeff(k, k);
-    mean = mean > 0 ? mean / (3 * m) : 1.0;
-    for (int I = 0; I < m; ++I) add_identity(I, I, 1e-9 * mean);
+    for (int k = 0; k < nb * m; ++k) mean += H.coeff(k, k);
+    mean = mean > 0 ? mean / (nb * m) : 1.0;
+    double* v = H.valuePtr();
+    for (int I = 0; I < m; ++I) {
+      const int k = block(I, I);
+      for (int c = 0; c < nb; ++c) v[b_val[nb * k + c] + c] += 1e-9 * mean;
+    }
+  }
+  // r = -P^T g and dx = P d for either kind of node.
+  void restrict_neg(const std::vector<Vec3>& g) {
+    rhs.setZero();
+    for (int i = 0; i < n; ++i)
+      for (int p = p_off[i]; p < p_off[i + 1]; ++p) {
+        if (nb == 6)
+          rhs.segment<6>(6 * p_node[p]) -= G[p].transpose() * g[i];
+        else
+          rhs.segment<3>(3 * p_node[p]) -= p_w[p] * (tangential[i] ? Vec3(T[i] * g[i]) : g[i]);
+      }
+  }
+  void prolong(std::vector<Vec3>& out) const {
+    out.assign(n, Vec3::Zero());
+    for (int i = 0; i < n; ++i) {
+      if (nb == 6) {
+        for (int p = p_off[i]; p < p_off[i + 1]; ++p) out[i] += G[p] * d.segment<6>(6 * p_node[p]);
+        continue;
+      }
+      for (int p = p_off[i]; p < p_off[i + 1]; ++p) out[i] += p_w[p] * d.segment<3>(3 * p_node[p]);
+      if (tangential[i]) out[i] = T[i] * out[i];
+    }
   }
 };
 
@@ -432,39 +684,44 @@ CoarseCorrection::CoarseCorrection(CoarseOptions opt)
 CoarseCorrection::~CoarseCorrection() = default;
 
 CoarseStats CoarseCorrection::apply(const Cloth& cloth, const ClothEnergy& energy,
-                                    const std::vector<int>& group, std::vector<Vec3>& x) {
+                                    const std::vector<int>& group, std::vector<Vec3>& x,
+                                    bool reuse) {
   const auto t0 = std::chrono::steady_clock::now();
   CoarseStats st;
   Impl& P = *impl_;
   const int n = cloth.num_vertices();
   const auto& mass = cloth.state.mass;
-  if (P.n != n || P.version != cloth.topology_version || P.factor != opt_.factor ||
+  const int nb = opt_.rotations ? 6 : 3;
+  if (P.n != n || P.version != cloth.topology_version || P.factor != opt_.factor || P.nb != nb ||
       P.group != group) {
-    P.build(cloth, energy, group, opt_.factor);
+    P.build(cloth, energy, group, opt_.factor, nb);
+    P.factored = false;
     st.rebuilt = true;
     st.build_ms = ms_since(t0);
   }
   st.nodes = P.m;
   if (P.m == 0) return st;
 
-  const auto ta = std::chrono::steady_clock::now();
-  P.assemble(energy, x, opt_.contact_reach);
-  st.assemble_ms = ms_since(ta);
-  const auto tf = std::chrono::steady_clock::now();
-  P.chol.factorize(P.H);
-  st.factor_ms = ms_since(tf);
-  if (P.chol.info() != Eigen::Success) {
-    st.total_ms = ms_since(t0);
-    return st;
+  if (!reuse || !P.factored) {
+    P.factored = false;
+    const auto ta = std::chrono::steady_clock::now();
+    P.assemble(energy, x, opt_.contact_reach);
+    st.assemble_ms = ms_since(ta);
+    const auto tf = std::chrono::steady_clock::now();
+    P.chol.factorize(P.H);
+    st.factor_ms = ms_since(tf);
+    if (P.chol.info() != Eigen::Success) {
+      st.total_ms = ms_since(t0);
+      return st;
+    }
+    P.factored = true;
+  } else {
+    st.reused = true;
   }
 
   // -P^T grad E, the coarse step, and its prolongation.
   energy.gradient(x, mass, P.grad);
-  P.rhs.setZero();
-  for (int i = 0; i < n; ++i)
-    for (int p = P.p_off[i]; p < P.p_off[i + 1]; ++p)
-      P.rhs.segment<3>(3 * P.p_node[p]) -=
-          P.p_w[p] * (P.tangential[i] ? Vec3(P.T[i] * P.grad[i]) : P.grad[i]);
+  P.restrict_neg(P.grad);
   st.residual = P.rhs.lpNorm<Eigen::Infinity>();
   P.d = P.chol.solve(P.rhs);
   const double slope = -P.rhs.dot(P.d);  // grad E . P d
@@ -472,12 +729,7 @@ CoarseStats CoarseCorrection::apply(const Cloth& cloth, const ClothEnergy& energ
     st.total_ms = ms_since(t0);
     return st;
   }
-  P.dx.assign(n, Vec3::Zero());
-  for (int i = 0; i < n; ++i) {
-    for (int p = P.p_off[i]; p < P.p_off[i + 1]; ++p)
-      P.dx[i] += P.p_w[p] * P.d.segment<3>(3 * P.p_node[p]);
-    if (P.tangential[i]) P.dx[i] = P.T[i] * P.dx[i];
-  }
+  P.prolong(P.dx);
 
   // Backtracking (Armijo) on E.
   st.energy_before = energy.energy(x, mass);
@@ -504,27 +756,24 @@ CoarseStats CoarseCorrection::apply(const Cloth& cloth, const ClothEnergy& energ
 bool CoarseCorrection::fit(const std::vector<Vec3>& f, std::vector<Vec3>& fitted) {
   Impl& P = *impl_;
   if (P.m == 0 || static_cast<int>(f.size()) != P.n) return false;
+  P.factored = false;
   // (Uses the coarse matrix's storage; apply() assembles it anew every time.)
   std::fill(P.H.valuePtr(), P.H.valuePtr() + P.H.nonZeros(), 0.0);
-  P.rhs.setZero();
   for (int i = 0; i < P.n; ++i) {
     if (!P.moves(i)) continue;
-    P.add_fine(i, i, Mat3::Identity());
-    for (int p = P.p_off[i]; p < P.p_off[i + 1]; ++p)
-      P.rhs.segment<3>(3 * P.p_node[p]) +=
-          P.p_w[p] * (P.tangential[i] ? Vec3(P.T[i] * f[i]) : f[i]);
+    if (P.nb == 6)
+      P.add_fine6(i, i, Mat3::Identity());
+    else
+      P.add_fine(i, i, Mat3::Identity());
   }
-  // A node whose every vertex slides on one plane has no normal direction: a tiny shift.
-  for (int I = 0; I < P.m; ++I) P.add_identity(I, I, 1e-9);
+  std::vector<Vec3> neg(f.size());
+  for (size_t i = 0; i < f.size(); ++i) neg[i] = -f[i];
+  P.restrict_neg(neg);
+  P.shift();
   P.chol.factorize(P.H);
   if (P.chol.info() != Eigen::Success) return false;
   P.d = P.chol.solve(P.rhs);
-  fitted.assign(P.n, Vec3::Zero());
-  for (int i = 0; i < P.n; ++i) {
-    for (int p = P.p_off[i]; p < P.p_off[i + 1]; ++p)
-      fitted[i] += P.p_w[p] * P.d.segment<3>(3 * P.p_node[p]);
-    if (P.tangential[i]) fitted[i] = P.T[i] * fitted[i];
-  }
+  P.prolong(fitted);
   return true;
 }
 

@@ -213,6 +213,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
   fixed_prev_.assign(n, 0);
   piece_full_.assign(num_pieces_, 0);
   piece_coarse_.assign(num_pieces_, 0);
+  piece_finish_.assign(num_pieces_, 0);
 }
 
 bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
@@ -293,6 +294,42 @@ void XpbdSolver::unsettle(int piece) {
   piece_full_[piece] = 0;
   piece_slow_[piece] = 0;
   piece_coarse_[piece] = 0;
+  piece_finish_[piece] = 0;
+}
+
+void XpbdSolver::finish_sleeping(Cloth& cloth, const SceneObjects& scene) {
+  if (!opt_.finish || !opt_.freeze || scene.self_collision) return;
+  const int n = cloth.num_vertices();
+  bool any = false, fresh = false;
+  for (int p = 0; p < num_pieces_; ++p)
+    if (piece_frozen_[p] && piece_finish_[p] >= 0) {
+      any = true;
+      fresh = fresh || piece_finish_[p] == 0;
+    }
+  if (!any) return;
+  if (!finisher_) finisher_ = std::make_unique<EquilibriumFinisher>();
+  finisher_->options() = opt_.finisher;
+  coarse_group_.resize(n);
+  if (fresh) {  // friction anchored where a piece fell asleep
+    for (int i = 0; i < n; ++i) {
+      const int p = piece_of_[i];
+      coarse_group_[i] = cloth.is_free(i) && piece_frozen_[p] && piece_finish_[p] == 0 ? p : -1;
+    }
+    finisher_->anchor(cloth, coarse_group_);
+  }
+  for (int i = 0; i < n; ++i) {
+    const int p = piece_of_[i];
+    coarse_group_[i] = cloth.is_free(i) && piece_frozen_[p] && piece_finish_[p] >= 0 ? p : -1;
+  }
+  finish_last_ = finisher_->cycle(cloth, scene, coarse_group_, opt_.energy, pool_.get());
+  finish_ms_ += finish_last_.total_ms;
+  ++finish_cycles_;
+  const bool done = finish_last_.last_move < opt_.finisher.move_tolerance;
+  for (int p = 0; p < num_pieces_; ++p) {
+    if (!piece_frozen_[p] || piece_finish_[p] < 0) continue;
+    if (piece_finish_[p] == 0) ++finish_count_;
+    if (done || ++piece_finish_[p] >= opt_.finisher.cycles) piece_finish_[p] = -1;
+  }
 }
 
 void XpbdSolver::coarse_step(Cloth& cloth, const SceneObjects& scene) {
@@ -357,11 +394,15 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     std::fill(piece_frozen_.begin(), piece_frozen_.end(), 0);
     frozen_count_ = 0;
   } else if (wake(cloth, scene)) {
-    // Every piece sleeps and nothing disturbed it: nothing to compute this frame.
+    // Every piece sleeps and nothing disturbed it: nothing to compute this frame but the static
+    // finish of pieces that have just fallen asleep.
+    finish_sleeping(cloth, scene);
     for (int i = 0; i < n; ++i)
       if (!cloth.is_free(i)) S.x_prev[i] = S.x[i];
     S.time += dt;
     return st;
+  } else {
+    finish_sleeping(cloth, scene);  // pieces asleep while others move
   }
   if (opt_.settle) {
     // A fixed vertex that moved since the last frame (pinched, dragged) or was let go ends its

@@ -14,6 +14,7 @@
 
 #include "sim/coarse_correction.hpp"
 #include "sim/energy.hpp"
+#include "sim/equilibrium_finisher.hpp"
 #include "sim/parallel.hpp"
 #include "sim/self_collision.hpp"
 #include "sim/solver.hpp"
@@ -119,6 +120,14 @@ struct XpbdOptions {
   int coarse_factor = 4;
   int coarse_frames = 1;
   CoarseOptions coarse;  // the correction's own options (coarse.factor is set from coarse_factor)
+  // With freeze on: a piece that has fallen asleep is finished statically while it sleeps
+  // (sim/equilibrium_finisher.hpp: Gauss-Seidel sweeps on the static energy and a coarse
+  // correction with node rotations per cycle, friction anchored where it fell asleep), one
+  // cycle per frame until a cycle moves no vertex farther than finisher.move_tolerance or
+  // finisher.cycles were run; waking ends it. XPBD's own sweeps would pull an awake piece back
+  // toward their biased fixed point, hence only while it sleeps (docs/solvers.md section 3m).
+  bool finish = true;
+  FinisherOptions finisher;
 };
 
 class XpbdSolver : public Solver {
@@ -138,6 +147,11 @@ class XpbdSolver : public Solver {
   const CoarseStats& last_coarse() const { return coarse_last_; }
   int coarse_count() const { return coarse_count_; }
   double coarse_ms() const { return coarse_ms_; }
+  // The last static finish cycle (XpbdOptions::finish), the pieces finished, the time.
+  const FinisherStats& last_finish() const { return finish_last_; }
+  int finish_count() const { return finish_count_; }    // pieces whose finish started
+  int finish_cycles() const { return finish_cycles_; }  // cycles run
+  double finish_ms() const { return finish_ms_; }
   int num_colours() const {
     return static_cast<int>(tri_col_.size() + hinge_col_.size() + spring_col_.size() +
                             row_cols_.size()) -
@@ -217,6 +231,12 @@ class XpbdSolver : public Solver {
   CoarseStats coarse_last_;
   int coarse_count_ = 0;
   double coarse_ms_ = 0;
+  std::unique_ptr<EquilibriumFinisher> finisher_;
+  FinisherStats finish_last_;
+  int finish_count_ = 0, finish_cycles_ = 0;
+  std::vector<int> piece_finish_;  // cycles run in the piece's sleep; -1: finished
+  void finish_sleeping(Cloth& cloth, const SceneObjects& scene);
+  double finish_ms_ = 0;
   void coarse_step(Cloth& cloth, const SceneObjects& scene);
   int detections_ = 0;  // contact detections so far (for tests and the bench)
   double fresh_penetration_ = 0;

@@ -282,6 +282,7 @@ TEST(Xpbd, CoarseCorrectionBringsTheSettledDrapeNearerItsEquilibrium) {
     o.threads = 1;
     o.freeze = true;
     o.coarse_factor = on ? 4 : 0;
+    o.finish = false;  // the single correction alone (the finish: next test)
     XpbdSolver s(o);
     for (int f = 0; f < 1080; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
     int free_vertices = 0;
@@ -307,4 +308,43 @@ TEST(Xpbd, CoarseCorrectionBringsTheSettledDrapeNearerItsEquilibrium) {
     std::printf("\n");
   }
   EXPECT_LT(err[1], 0.9 * err[0]);
+}
+
+// With sleeping on, a piece that falls asleep is finished toward its static equilibrium
+// (sim/equilibrium_finisher.hpp) one cycle per frame; the drape then stays asleep, and the
+// distance to the nearest frictional equilibrium drops (docs/solvers.md section 3m).
+TEST(Xpbd, SleepingPiecesAreFinishedTowardTheirEquilibrium) {
+  double err[2] = {0, 0};
+  for (int on = 0; on < 2; ++on) {
+    StudyScene sc = make_scene("form", 32);
+    XpbdOptions o;
+    o.damping = sc.air_damping;
+    o.threads = 1;
+    o.freeze = true;
+    o.finish = on == 1;
+    XpbdSolver s(o);
+    for (int f = 0; f < 1080; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+    int free_vertices = 0;
+    for (int i = 0; i < sc.cloth.num_vertices(); ++i) free_vertices += sc.cloth.is_free(i);
+    EXPECT_EQ(s.frozen_count(), free_vertices) << "asleep at 12 s, finish " << on;
+    EXPECT_EQ(s.finish_count(), on) << "pieces finished";
+    if (on) {
+      EXPECT_GE(s.finish_cycles(), 5);
+      EXPECT_LE(s.finish_cycles(), o.finisher.cycles);
+    }
+    const std::vector<Vec3> end = sc.cloth.state.x;
+    StaticOptions so;
+    so.tolerance = 1e-8;
+    so.friction = true;
+    so.max_iterations = 300;
+    const StaticResult r = relax_static(sc.cloth, sc.objects, so);
+    EXPECT_LT(r.residual, 1e-7);
+    double mx = 0;
+    position_error(end, sc.cloth.state.x, err[on], mx);
+    std::printf("finish %s: %.3f mm RMS, %.3f mm max from the nearest equilibrium",
+                on ? "on " : "off", err[on] * 1e3, mx * 1e3);
+    if (on) std::printf(" (%d cycles, %.0f ms in all)", s.finish_cycles(), s.finish_ms());
+    std::printf("\n");
+  }
+  EXPECT_LT(err[1], 0.85 * err[0]);
 }
