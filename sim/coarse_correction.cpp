@@ -30,7 +30,14 @@ struct CoarseCorrection::Impl {
   std::vector<double> p_w;
   int m = 0;              // coarse nodes
   bool factored = false;  // chol holds the last assembled matrix (fit() spoils it)
-  int nb = 3;             // unknowns per node: 3 (translation) or 6 (and a rotation, CoarseOptions)
+  // With rotations the fine block pattern is the energy's: which energy it was built for.
+  const ClothEnergy* fine_energy = nullptr;
+  size_t fine_elements = 0;
+  static size_t elements_of(const ClothEnergy& e) {
+    return static_cast<size_t>(e.num_triangles()) + e.num_hinges() + e.num_springs() +
+           e.bending_columns().size() + e.bending_row_columns().size();
+  }
+  int nb = 3;  // unknowns per node: 3 (translation) or 6 (and a rotation, CoarseOptions)
   // With rotations: entry p's 3 x 6 prolongation block w [T, -T [x_i - c_n]x / s] (T the
   // vertex's projector, s the lattice spacing that gives the rotation a length's units) and
   // the nodes' centres.
@@ -280,6 +287,8 @@ struct CoarseCorrection::Impl {
       for (int i = 0; i < n; ++i)
         for (int p = p_off[i]; p < p_off[i + 1]; ++p) wsum[p_node[p]] += p_w[p];
       build_fine(energy);
+      fine_energy = &energy;
+      fine_elements = elements_of(energy);
     }
     T.assign(n, Mat3::Identity());
     tangential.assign(n, 0);
@@ -693,7 +702,8 @@ CoarseStats CoarseCorrection::apply(const Cloth& cloth, const ClothEnergy& energ
   const auto& mass = cloth.state.mass;
   const int nb = opt_.rotations ? 6 : 3;
   if (P.n != n || P.version != cloth.topology_version || P.factor != opt_.factor || P.nb != nb ||
-      P.group != group) {
+      P.group != group ||
+      (nb == 6 && (P.fine_energy != &energy || P.fine_elements != Impl::elements_of(energy)))) {
     P.build(cloth, energy, group, opt_.factor, nb);
     P.factored = false;
     st.rebuilt = true;
