@@ -41,22 +41,33 @@ FinisherStats EquilibriumFinisher::cycle(Cloth& cloth, const SceneObjects& scene
   }
   energy_.set_form(&scene);
   energy_.set_contact_stiffness(opt_.contact_stiffness);
+  // The nominal edge (a cloth without one, imported or remeshed: its mean material edge).
+  const auto& mat = cloth.topo.material;
+  double edge = cloth.topo.spacing;
+  if (!(edge > 0)) {
+    double sum = 0;
+    int cnt = 0;
+    for (const auto& t : cloth.topo.triangles)
+      for (int a = 0; a < 3; ++a, ++cnt) sum += (mat[t[a]] - mat[t[(a + 1) % 3]]).norm();
+    edge = cnt > 0 && sum > 0 ? sum / cnt : 0.01;
+  }
   int factor = opt_.coarse_factor;
   if (factor <= 0) {
-    const auto& mat = cloth.topo.material;
     Vec2 lo(1e30, 1e30), hi(-1e30, -1e30);
     for (int i = 0; i < n; ++i)
       if (group[i] >= 0) {
         lo = lo.cwiseMin(mat[i]);
         hi = hi.cwiseMax(mat[i]);
       }
-    const double edge = cloth.topo.spacing > 0 ? cloth.topo.spacing : 0.01;
     const double side = hi.x() >= lo.x() ? (hi - lo).maxCoeff() / edge : 0.0;
     factor = std::clamp(static_cast<int>(std::lround(side / 16)), 2, 4);
   }
   coarse_.options().factor = factor;
   coarse_.options().rotations = opt_.rotations;
   const double inv_tau2 = 1.0 / (opt_.tau * opt_.tau);
+  // A vertex's step is at most half an edge (its block can be nearly singular where the
+  // projected membrane has no stiffness, e.g. under compression).
+  const double max_step2 = 0.25 * edge * edge;
   auto sweep_range = [&](const int* items, int b, int e) {
     for (int k = b; k < e; ++k) {
       const int i = items[k];
@@ -67,7 +78,11 @@ FinisherStats EquilibriumFinisher::cycle(Cloth& cloth, const SceneObjects& scene
       energy_.vertex_force_hessian(i, S.x, m, f, H);
       H.diagonal().array() += m * inv_tau2;
       const Eigen::LLT<Mat3> llt(H);
-      if (llt.info() == Eigen::Success) S.x[i] += llt.solve(f);
+      if (llt.info() != Eigen::Success) continue;
+      Vec3 dx = llt.solve(f);
+      const double d2 = dx.squaredNorm();
+      if (d2 > max_step2) dx *= std::sqrt(max_step2 / d2);
+      S.x[i] += dx;
     }
   };
   before_ = S.x;
