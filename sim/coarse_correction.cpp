@@ -92,6 +92,38 @@ struct CoarseCorrection::Impl {
       for (int q = p_off[b]; q < p_off[b + 1]; ++q) add(p_node[p], p_node[q], p_w[p] * p_w[q], B);
   }
   bool moves(int i) const { return p_off[i + 1] > p_off[i]; }
+  // Hinges (when the energy has them) and springs: fn(vertices, count, projected Hessian).
+  template <class Fn>
+  static void hinges_and_springs(const ClothEnergy& energy, const std::vector<Vec3>& x, Fn&& fn) {
+    if (!energy.tensor_bending()) {
+      Mat12 H12;
+      for (int h = 0; h < energy.num_hinges(); ++h) {
+        energy.hinge_hessian(h, x, H12, true);
+        fn(energy.hinge(h).data(), 4, H12);
+      }
+    }
+    Eigen::Matrix<double, 6, 6> H6;
+    for (int s = 0; s < energy.num_springs(); ++s) {
+      energy.spring_hessian(s, x, H6, true);
+      fn(energy.spring(s).data(), 2, H6);
+    }
+  }
+  // A contact vertex's own block: the penalty's normal stiffness when it is not projected but
+  // inside its plane, and friction's tangential one (when set).
+  Mat3 contact_block(const ClothEnergy& energy, const Contact& c,
+                     const std::vector<Vec3>& x) const {
+    const int i = c.vertex;
+    Mat3 B = Mat3::Zero();
+    if (!tangential[i] && c.n.dot(x[i] - c.p) < 0)
+      B += energy.contact_stiffness() * c.n * c.n.transpose();
+    if (energy.friction_on()) {
+      Vec3 gf;
+      Mat3 Hf;
+      energy.friction_gradient_hessian(i, x[i], gf, &Hf);
+      B += Hf;
+    }
+    return B;
+  }
   // An element's (3k x 3k) Hessian over its k vertices: first restricted to the element's own
   // nodes (a vertex's slot s gets coefficient blocks w T), then each node pair added once (a
   // triangle inside one lattice cell touches 4 nodes: 16 block additions instead of up to 81).
@@ -189,14 +221,8 @@ struct CoarseCorrection::Impl {
       }
     // The lattice spacing: `f` nominal edges; a cloth without a nominal spacing (imported,
     // remeshed) uses its mean material edge; at most 4096 cells per axis whatever the input.
-    double edge = cloth.topo.spacing;
-    if (!(edge > 0)) {
-      double sum = 0;
-      int cnt = 0;
-      for (const auto& t : cloth.topo.triangles)
-        for (int a = 0; a < 3; ++a, ++cnt) sum += (mat[t[a]] - mat[t[(a + 1) % 3]]).norm();
-      edge = cnt > 0 && sum > 0 ? sum / cnt : 1.0;
-    }
+    double edge = nominal_edge(cloth);
+    if (!(edge > 0)) edge = 1.0;
     const double Hs = std::max(std::max(1, f) * edge, std::max(u1 - u0, v1 - v0) / 4096);
     spacing = Hs;
     std::unordered_map<uint64_t, int> index;
@@ -421,36 +447,11 @@ struct CoarseCorrection::Impl {
           r += g;
         }
       }
-    } else {
-      Mat12 H12;
-      for (int h = 0; h < energy.num_hinges(); ++h) {
-        const auto& v = energy.hinge(h);
-        energy.hinge_hessian(h, x, H12, true);
-        add_element(v.data(), 4, H12);
-      }
     }
-    Eigen::Matrix<double, 6, 6> H6;
-    for (int s = 0; s < energy.num_springs(); ++s) {
-      const auto& v = energy.spring(s);
-      energy.spring_hessian(s, x, H6, true);
-      add_element(v.data(), 2, H6);
-    }
-    // Contacts: a vertex that is not projected but near its plane keeps the penalty's normal
-    // stiffness; friction (when set) its tangential one.
-    for (const Contact& c : energy.contacts()) {
-      const int i = c.vertex;
-      if (!moves(i)) continue;
-      Mat3 B = Mat3::Zero();
-      if (!tangential[i] && c.n.dot(x[i] - c.p) < 0)
-        B += energy.contact_stiffness() * c.n * c.n.transpose();
-      if (energy.friction_on()) {
-        Vec3 gf;
-        Mat3 Hf;
-        energy.friction_gradient_hessian(i, x[i], gf, &Hf);
-        B += Hf;
-      }
-      add_fine(i, i, B);
-    }
+    hinges_and_springs(energy, x,
+                       [&](const int32_t* v, int k, const auto& He) { add_element(v, k, He); });
+    for (const Contact& c : energy.contacts())
+      if (moves(c.vertex)) add_fine(c.vertex, c.vertex, contact_block(energy, c, x));
     shift();
   }
 
@@ -588,33 +589,11 @@ struct CoarseCorrection::Impl {
           r += g;
         }
       }
-    } else {
-      Mat12 H12;
-      for (int h = 0; h < energy.num_hinges(); ++h) {
-        const auto& v = energy.hinge(h);
-        energy.hinge_hessian(h, x, H12, true);
-        add_fine_element(v.data(), 4, H12);
-      }
     }
-    Eigen::Matrix<double, 6, 6> H6;
-    for (int sp = 0; sp < energy.num_springs(); ++sp) {
-      const auto& v = energy.spring(sp);
-      energy.spring_hessian(sp, x, H6, true);
-      add_fine_element(v.data(), 2, H6);
-    }
-    for (const Contact& c : energy.contacts()) {
-      const int i = c.vertex;
-      if (!moves(i)) continue;
-      Mat3& B = F[fblock(i, i)];
-      if (!tangential[i] && c.n.dot(x[i] - c.p) < 0)
-        B += energy.contact_stiffness() * c.n * c.n.transpose();
-      if (energy.friction_on()) {
-        Vec3 gf;
-        Mat3 Hf;
-        energy.friction_gradient_hessian(i, x[i], gf, &Hf);
-        B += Hf;
-      }
-    }
+    hinges_and_springs(
+        energy, x, [&](const int32_t* v, int k, const auto& He) { add_fine_element(v, k, He); });
+    for (const Contact& c : energy.contacts())
+      if (moves(c.vertex)) F[fblock(c.vertex, c.vertex)] += contact_block(energy, c, x);
     // P^T F P: row i of Y = F P gathered over its nodes, then G_ip^T Y_i into node row I.
     Eigen::Matrix<double, 6, 6> M;
     for (int i = 0; i < n; ++i) {
@@ -687,6 +666,16 @@ struct CoarseCorrection::Impl {
     }
   }
 };
+
+double nominal_edge(const Cloth& cloth) {
+  if (cloth.topo.spacing > 0) return cloth.topo.spacing;
+  const auto& mat = cloth.topo.material;
+  double sum = 0;
+  int cnt = 0;
+  for (const auto& t : cloth.topo.triangles)
+    for (int a = 0; a < 3; ++a, ++cnt) sum += (mat[t[a]] - mat[t[(a + 1) % 3]]).norm();
+  return cnt > 0 && sum > 0 ? sum / cnt : 0.0;
+}
 
 CoarseCorrection::CoarseCorrection(CoarseOptions opt)
     : opt_(opt), impl_(std::make_unique<Impl>()) {}

@@ -60,6 +60,10 @@ struct CoarseStats {
   bool reused = false;   // the last call's matrix and prolongation were used
 };
 
+// The cloth's nominal grid spacing (m); a cloth without one (imported, remeshed): its mean
+// material edge; 0 without triangles.
+double nominal_edge(const Cloth& cloth);
+
 class CoarseCorrection {
  public:
   explicit CoarseCorrection(CoarseOptions opt = {});

@@ -43,14 +43,8 @@ FinisherStats EquilibriumFinisher::cycle(Cloth& cloth, const SceneObjects& scene
   energy_.set_contact_stiffness(opt_.contact_stiffness);
   // The nominal edge (a cloth without one, imported or remeshed: its mean material edge).
   const auto& mat = cloth.topo.material;
-  double edge = cloth.topo.spacing;
-  if (!(edge > 0)) {
-    double sum = 0;
-    int cnt = 0;
-    for (const auto& t : cloth.topo.triangles)
-      for (int a = 0; a < 3; ++a, ++cnt) sum += (mat[t[a]] - mat[t[(a + 1) % 3]]).norm();
-    edge = cnt > 0 && sum > 0 ? sum / cnt : 0.01;
-  }
+  double edge = nominal_edge(cloth);
+  if (!(edge > 0)) edge = 0.01;
   int factor = opt_.coarse_factor;
   if (factor <= 0) {
     Vec2 lo(1e30, 1e30), hi(-1e30, -1e30);

@@ -19,30 +19,9 @@ using namespace drape::sim::test;
 
 namespace {
 
-// A square sheet hanging from its whole top edge in the x-y plane, started 3 % overstretched
-// along the warp: it contracts to its static minimum, stretched along the warp by gravity only
-// (no Poisson coupling: the membrane is in tension everywhere, so the PSD projection of its
-// Hessian changes nothing and Newton converges quadratically).
-Cloth hanging_from_an_edge(int res) {
-  PanelSpec p;
-  p.width = p.height = 0.3;
-  p.nx = p.ny = res;
-  Cloth c = make_panel(p, FabricParams{});
-  place_spread(c, Vec3(0, 1.0, 0), Vec3::UnitX(), Vec3::UnitY());
-  for (int i = 0; i < res; ++i) c.state.flags[(res - 1) * res + i] |= kFlagPinned;
-  const double top = c.state.x.back().y();
-  for (Vec3& x : c.state.x) x.y() = top - 1.03 * (top - x.y());
-  c.state.x_prev = c.state.x;
-  c.relump_masses();
-  return c;
-}
-
-std::vector<int> free_group(const Cloth& c) {
-  std::vector<int> g(c.num_vertices());
-  for (int i = 0; i < c.num_vertices(); ++i) g[i] = c.is_free(i) ? 0 : -1;
-  return g;
-}
-
+// hanging_from_an_edge (solver_checks.hpp): it contracts to its static minimum, stretched along
+// the warp by gravity only (no Poisson coupling: the membrane is in tension everywhere, so the
+// PSD projection of its Hessian changes nothing and Newton converges quadratically).
 std::vector<Vec3> static_minimum(const Cloth& c) {
   Cloth ref = c;
   StaticOptions so;

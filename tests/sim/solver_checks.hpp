@@ -64,4 +64,32 @@ double expect_frozen_then_woken_by_a_drag(StudyScene& sc, S& solver) {
   return moved;
 }
 
+// A square sheet (0.3 m, res x res vertices) hanging from its whole top edge in the x-y plane,
+// started 3 % overstretched along the warp and, with `curl` > 0, bent toward +z by curl * depth^2
+// (m) down the sheet: a start away from its static minimum.
+inline Cloth hanging_from_an_edge(int res, double curl = 0) {
+  PanelSpec p;
+  p.width = p.height = 0.3;
+  p.nx = p.ny = res;
+  Cloth c = make_panel(p, FabricParams{});
+  place_spread(c, Vec3(0, 1.0, 0), Vec3::UnitX(), Vec3::UnitY());
+  for (int i = 0; i < res; ++i) c.state.flags[(res - 1) * res + i] |= kFlagPinned;
+  const double top = c.state.x.back().y();
+  for (Vec3& x : c.state.x) {
+    const double depth = top - x.y();
+    x.y() = top - 1.03 * depth;
+    x.z() += curl * depth * depth;
+  }
+  c.state.x_prev = c.state.x;
+  c.relump_masses();
+  return c;
+}
+
+// Group 0 for every free vertex, -1 for the fixed ones (CoarseCorrection, EquilibriumFinisher).
+inline std::vector<int> free_group(const Cloth& c) {
+  std::vector<int> g(c.num_vertices());
+  for (int i = 0; i < c.num_vertices(); ++i) g[i] = c.is_free(i) ? 0 : -1;
+  return g;
+}
+
 }  // namespace drape::sim::test

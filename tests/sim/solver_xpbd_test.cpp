@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <memory>
 
 #include "sim/dress_form.hpp"
 #include "sim/scenes.hpp"
@@ -273,35 +274,47 @@ TEST(Xpbd, ContactSnapCorrectsPositionWithoutVelocity) {
 // asleep either way, ends nearer its nearest frictional equilibrium with it (measured
 // 2.12 / 7.38 -> 1.64 / 5.91 mm RMS / max; at 128^2 4.86 / 16.2 -> 2.81 / 5.40 mm, docs/solvers.md
 // section 3l); one correction per settling episode.
+// The 32^2 form drape after 12 s with sleeping on and the given options, all its free vertices
+// asleep by then; returns its RMS distance (and `mx` the max) from the frictional equilibrium
+// nearest to that end state; `s` is the solver that ran it.
+namespace {
+double settled_drape_error(XpbdOptions o, std::unique_ptr<XpbdSolver>& s, double& mx) {
+  StudyScene sc = make_scene("form", 32);
+  o.damping = sc.air_damping;
+  o.threads = 1;
+  o.freeze = true;
+  s = std::make_unique<XpbdSolver>(o);
+  for (int f = 0; f < 1080; ++f) s->step(sc.cloth, sc.objects, 1.0 / 90);
+  int free_vertices = 0;
+  for (int i = 0; i < sc.cloth.num_vertices(); ++i) free_vertices += sc.cloth.is_free(i);
+  EXPECT_EQ(s->frozen_count(), free_vertices) << "asleep at 12 s";
+  const std::vector<Vec3> end = sc.cloth.state.x;
+  StaticOptions so;
+  so.tolerance = 1e-8;
+  so.friction = true;
+  so.max_iterations = 300;
+  const StaticResult r = relax_static(sc.cloth, sc.objects, so);
+  EXPECT_LT(r.residual, 1e-7);
+  double rms = 0;
+  position_error(end, sc.cloth.state.x, rms, mx);
+  return rms;
+}
+}  // namespace
+
 TEST(Xpbd, CoarseCorrectionBringsTheSettledDrapeNearerItsEquilibrium) {
   double err[2] = {0, 0};
   for (int on = 0; on < 2; ++on) {
-    StudyScene sc = make_scene("form", 32);
     XpbdOptions o;
-    o.damping = sc.air_damping;
-    o.threads = 1;
-    o.freeze = true;
     o.coarse_factor = on ? 4 : 0;
     o.finish = false;  // the single correction alone (the finish: next test)
-    XpbdSolver s(o);
-    for (int f = 0; f < 1080; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
-    int free_vertices = 0;
-    for (int i = 0; i < sc.cloth.num_vertices(); ++i) free_vertices += sc.cloth.is_free(i);
-    EXPECT_EQ(s.frozen_count(), free_vertices) << "asleep at 12 s, correction " << on;
-    EXPECT_EQ(s.coarse_count(), on) << "corrections";
-    const std::vector<Vec3> end = sc.cloth.state.x;
-    StaticOptions so;
-    so.tolerance = 1e-8;
-    so.friction = true;
-    so.max_iterations = 300;
-    const StaticResult r = relax_static(sc.cloth, sc.objects, so);
-    EXPECT_LT(r.residual, 1e-7);
+    std::unique_ptr<XpbdSolver> s;
     double mx = 0;
-    position_error(end, sc.cloth.state.x, err[on], mx);
+    err[on] = settled_drape_error(o, s, mx);
+    EXPECT_EQ(s->coarse_count(), on) << "corrections";
     std::printf("correction %s: %.3f mm RMS, %.3f mm max from the nearest equilibrium",
                 on ? "on " : "off", err[on] * 1e3, mx * 1e3);
     if (on) {
-      const CoarseStats& c = s.last_coarse();
+      const CoarseStats& c = s->last_coarse();
       std::printf(" (%d nodes, moved up to %.3f mm, %.1f ms)", c.nodes, c.max_move * 1e3,
                   c.total_ms);
     }
@@ -316,34 +329,19 @@ TEST(Xpbd, CoarseCorrectionBringsTheSettledDrapeNearerItsEquilibrium) {
 TEST(Xpbd, SleepingPiecesAreFinishedTowardTheirEquilibrium) {
   double err[2] = {0, 0};
   for (int on = 0; on < 2; ++on) {
-    StudyScene sc = make_scene("form", 32);
     XpbdOptions o;
-    o.damping = sc.air_damping;
-    o.threads = 1;
-    o.freeze = true;
     o.finish = on == 1;
-    XpbdSolver s(o);
-    for (int f = 0; f < 1080; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
-    int free_vertices = 0;
-    for (int i = 0; i < sc.cloth.num_vertices(); ++i) free_vertices += sc.cloth.is_free(i);
-    EXPECT_EQ(s.frozen_count(), free_vertices) << "asleep at 12 s, finish " << on;
-    EXPECT_EQ(s.finish_count(), on) << "pieces finished";
-    if (on) {
-      EXPECT_GE(s.finish_cycles(), 5);
-      EXPECT_LE(s.finish_cycles(), o.finisher.cycles);
-    }
-    const std::vector<Vec3> end = sc.cloth.state.x;
-    StaticOptions so;
-    so.tolerance = 1e-8;
-    so.friction = true;
-    so.max_iterations = 300;
-    const StaticResult r = relax_static(sc.cloth, sc.objects, so);
-    EXPECT_LT(r.residual, 1e-7);
+    std::unique_ptr<XpbdSolver> s;
     double mx = 0;
-    position_error(end, sc.cloth.state.x, err[on], mx);
+    err[on] = settled_drape_error(o, s, mx);
+    EXPECT_EQ(s->finish_count(), on) << "pieces finished";
+    if (on) {
+      EXPECT_GE(s->finish_cycles(), 5);
+      EXPECT_LE(s->finish_cycles(), o.finisher.cycles);
+    }
     std::printf("finish %s: %.3f mm RMS, %.3f mm max from the nearest equilibrium",
                 on ? "on " : "off", err[on] * 1e3, mx * 1e3);
-    if (on) std::printf(" (%d cycles, %.0f ms in all)", s.finish_cycles(), s.finish_ms());
+    if (on) std::printf(" (%d cycles, %.0f ms in all)", s->finish_cycles(), s->finish_ms());
     std::printf("\n");
   }
   EXPECT_LT(err[1], 0.85 * err[0]);
