@@ -151,12 +151,14 @@ FinisherStats EquilibriumFinisher::cycle(Cloth& cloth, const SceneObjects& scene
 
 FinisherStats EquilibriumFinisher::run(Cloth& cloth, const SceneObjects& scene,
                                        const std::vector<int>& group,
-                                       const EnergyOptions& energy_options, ThreadPool* pool) {
+                                       const EnergyOptions& energy_options, ThreadPool* pool,
+                                       const std::atomic<bool>* stop) {
   FinisherStats all;
   if (static_cast<int>(group.size()) != cloth.num_vertices()) return all;
   anchor(cloth, group);
   const std::vector<Vec3> start = cloth.state.x;
   for (int c = 0; c < opt_.cycles; ++c) {
+    if (stop && stop->load(std::memory_order_relaxed)) break;
     const FinisherStats st = cycle(cloth, scene, group, energy_options, pool);
     if (c == 0) all.energy_before = st.energy_before;
     all.energy_after = st.energy_after;

@@ -15,6 +15,7 @@
 // Positions only: velocities of the finished vertices are zeroed.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <vector>
 
@@ -65,9 +66,11 @@ class EquilibriumFinisher {
   // Finishes the vertices with group[i] >= 0 (pieces, coarsened apart; -1: stays) toward the
   // static equilibrium of the cloth's energy (`energy_options` as the solver's; the bending
   // matrix is built here) with the scene's objects: anchor(), then cycles until one moves no
-  // vertex farther than move_tolerance or `cycles` were run. `pool` may be null (one thread).
+  // vertex farther than move_tolerance or `cycles` were run, or `stop` (may be null) was set
+  // (checked before each cycle). `pool` may be null (one thread).
   FinisherStats run(Cloth& cloth, const SceneObjects& scene, const std::vector<int>& group,
-                    const EnergyOptions& energy_options, ThreadPool* pool);
+                    const EnergyOptions& energy_options, ThreadPool* pool,
+                    const std::atomic<bool>* stop = nullptr);
   // The same in steps, for a caller that spreads the cycles over frames: anchor() the
   // vertices of group >= 0 where they are now (friction's anchors; others keep theirs), then
   // one cycle() per call. The returned stats describe that cycle.

@@ -299,6 +299,7 @@ void XpbdSolver::unsettle(int piece) {
 
 void XpbdSolver::finish_sleeping(Cloth& cloth, const SceneObjects& scene) {
   if (!opt_.finish || !opt_.freeze || scene.self_collision) return;
+  if (opt_.finish_thread) return finish_on_thread(cloth, scene);
   const int n = cloth.num_vertices();
   bool any = false, fresh = false;
   for (int p = 0; p < num_pieces_; ++p)
@@ -330,6 +331,67 @@ void XpbdSolver::finish_sleeping(Cloth& cloth, const SceneObjects& scene) {
     if (piece_finish_[p] == 0) ++finish_count_;
     if (done || ++piece_finish_[p] >= opt_.finisher.cycles) piece_finish_[p] = -1;
   }
+}
+
+void XpbdSolver::finish_on_thread(Cloth& cloth, const SceneObjects& scene) {
+  auto& S = cloth.state;
+  const int n = cloth.num_vertices();
+  if (!finish_thread_) finish_thread_ = std::make_unique<FinishThread>();
+  FinishThread& job = *finish_thread_;
+  if (job.busy()) {
+    // A piece of the job is still worth its result while it sleeps on, untouched since: not
+    // woken (unsettle() resets its mark), not re-cooked (a cut or sew: another version).
+    const bool same = finish_version_ == cloth.topology_version &&
+                      static_cast<int>(job.group().size()) == n &&
+                      static_cast<int>(piece_finish_.size()) == num_pieces_;
+    auto valid = [&](int p) {
+      return same && p >= 0 && p < num_pieces_ && piece_frozen_[p] &&
+             piece_finish_[p] == kFinishing;
+    };
+    bool any_valid = false;
+    for (int p = 0; p < num_pieces_ && !any_valid; ++p) any_valid = valid(p);
+    if (!any_valid) job.cancel();
+    if (!job.ended()) return;
+    finish_last_ = job.collect();
+    finish_ms_ += finish_last_.total_ms;
+    finish_cycles_ += finish_last_.cycles;
+    const bool use = any_valid && job.completed();
+    if (use) {
+      const auto& g = job.group();
+      const auto& xf = job.cloth().state.x;
+      for (int i = 0; i < n; ++i)
+        if (g[i] >= 0 && valid(g[i])) {
+          S.x[i] = xf[i];
+          S.x_prev[i] = xf[i];
+          S.v[i].setZero();
+        }
+    }
+    bool dropped = !use;
+    for (int p = 0; p < num_pieces_; ++p) {
+      if (piece_finish_[p] != kFinishing) continue;
+      if (use && valid(p)) {
+        piece_finish_[p] = -1;
+        ++finish_count_;
+      } else {
+        piece_finish_[p] = 0;  // asleep but not finished: a new job takes it
+        dropped = true;
+      }
+    }
+    if (dropped) ++finish_dropped_;
+  }
+  // Pieces asleep and not finished yet: one job for all of them.
+  bool any = false;
+  for (int p = 0; p < num_pieces_ && !any; ++p) any = piece_frozen_[p] && piece_finish_[p] == 0;
+  if (!any) return;
+  coarse_group_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const int p = piece_of_[i];
+    coarse_group_[i] = cloth.is_free(i) && piece_frozen_[p] && piece_finish_[p] == 0 ? p : -1;
+  }
+  job.start(cloth, scene, coarse_group_, opt_.energy, opt_.finisher);
+  finish_version_ = cloth.topology_version;
+  for (int p = 0; p < num_pieces_; ++p)
+    if (piece_frozen_[p] && piece_finish_[p] == 0) piece_finish_[p] = kFinishing;
 }
 
 void XpbdSolver::coarse_step(Cloth& cloth, const SceneObjects& scene) {

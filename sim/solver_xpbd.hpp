@@ -15,6 +15,7 @@
 #include "sim/coarse_correction.hpp"
 #include "sim/energy.hpp"
 #include "sim/equilibrium_finisher.hpp"
+#include "sim/finish_thread.hpp"
 #include "sim/parallel.hpp"
 #include "sim/self_collision.hpp"
 #include "sim/solver.hpp"
@@ -128,6 +129,12 @@ struct XpbdOptions {
   // toward their biased fixed point, hence only while it sleeps (docs/solvers.md section 3m).
   bool finish = true;
   FinisherOptions finisher;
+  // Where the finish runs: on a thread of its own (sim/finish_thread.hpp; all its cycles on a
+  // copy taken when the pieces fall asleep, copied back in the frame after it ends, dropped if
+  // a piece woke meanwhile), so that the fixed-rate loop keeps its ticks while a drape is
+  // finished; or, when false, one cycle per step on the solver's own threads (deterministic
+  // frame by frame; the end state is the same).
+  bool finish_thread = true;
 };
 
 class XpbdSolver : public Solver {
@@ -147,11 +154,16 @@ class XpbdSolver : public Solver {
   const CoarseStats& last_coarse() const { return coarse_last_; }
   int coarse_count() const { return coarse_count_; }
   double coarse_ms() const { return coarse_ms_; }
-  // The last static finish cycle (XpbdOptions::finish), the pieces finished, the time.
+  // The last static finish cycle (XpbdOptions::finish; with finish_thread: the last job, all
+  // its cycles), the pieces finished, the cycles and their time (on the finish's thread too).
   const FinisherStats& last_finish() const { return finish_last_; }
   int finish_count() const { return finish_count_; }    // pieces whose finish started
   int finish_cycles() const { return finish_cycles_; }  // cycles run
   double finish_ms() const { return finish_ms_; }
+  // With finish_thread: jobs whose result was dropped (a piece woke, the cloth was cut), and
+  // whether a job is running now.
+  int finish_dropped() const { return finish_dropped_; }
+  bool finishing() const { return finish_thread_ && finish_thread_->busy(); }
   int num_colours() const {
     return static_cast<int>(tri_col_.size() + hinge_col_.size() + spring_col_.size() +
                             row_cols_.size()) -
@@ -234,9 +246,16 @@ class XpbdSolver : public Solver {
   std::unique_ptr<EquilibriumFinisher> finisher_;
   FinisherStats finish_last_;
   int finish_count_ = 0, finish_cycles_ = 0;
-  std::vector<int> piece_finish_;  // cycles run in the piece's sleep; -1: finished
+  // Per piece: cycles run in its sleep (0: none yet); -1: finished; kFinishing: in the job of
+  // finish_thread_.
+  std::vector<int> piece_finish_;
+  static constexpr int kFinishing = -2;
   void finish_sleeping(Cloth& cloth, const SceneObjects& scene);
+  void finish_on_thread(Cloth& cloth, const SceneObjects& scene);
+  std::unique_ptr<FinishThread> finish_thread_;
+  uint64_t finish_version_ = 0;  // topology_version of the cloth the job copied
   double finish_ms_ = 0;
+  int finish_dropped_ = 0;
   void coarse_step(Cloth& cloth, const SceneObjects& scene);
   int detections_ = 0;  // contact detections so far (for tests and the bench)
   double fresh_penetration_ = 0;

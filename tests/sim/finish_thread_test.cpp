@@ -1,0 +1,115 @@
+// The static finish on a thread of its own (sim/finish_thread.hpp): the job's result is the
+// finisher's, the caller's cloth is not touched while it runs, a cancelled job stops early and
+// its result is not used, and the XPBD solver drops the result for a piece that woke
+// meanwhile. Run in the TSan build (the file name carries "thread").
+#include "sim/finish_thread.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <stdexcept>
+#include <thread>
+
+#include "sim/solver_xpbd.hpp"
+#include "solver_checks.hpp"
+
+using namespace drape::sim;
+using namespace drape::sim::test;
+
+namespace {
+SceneObjects nothing() {
+  SceneObjects none;
+  none.floor = false;
+  return none;
+}
+}  // namespace
+
+TEST(FinishThread, AJobEndsInTheFinishersStateAndLeavesTheCallersClothAlone) {
+  Cloth c = hanging_from_an_edge(17, 0.2);
+  const std::vector<int> g = free_group(c);
+  const SceneObjects none = nothing();
+  FinisherOptions fo;
+  fo.cycles = 8;
+  Cloth direct = c;
+  EquilibriumFinisher fin(fo);
+  const FinisherStats want = fin.run(direct, none, g, EnergyOptions{}, nullptr);
+
+  const uint64_t before = state_hash(c);
+  FinishThread job;
+  EXPECT_FALSE(job.busy());
+  job.start(c, none, g, EnergyOptions{}, fo);
+  EXPECT_TRUE(job.busy());
+  EXPECT_THROW(job.start(c, none, g, EnergyOptions{}, fo), std::logic_error);
+  const FinisherStats got = job.collect();
+  EXPECT_FALSE(job.busy());
+  EXPECT_TRUE(job.completed());
+  EXPECT_EQ(state_hash(c), before) << "the caller's cloth";
+  EXPECT_EQ(got.cycles, want.cycles);
+  double rms = 0, mx = 0;
+  position_error(job.cloth().state.x, direct.state.x, rms, mx);
+  std::printf("job: %d cycles, moved up to %.3f mm, %.3g m from the finisher run here\n",
+              got.cycles, got.max_move * 1e3, mx);
+  EXPECT_EQ(mx, 0.0);
+  EXPECT_GT(got.max_move, 1e-3);
+}
+
+TEST(FinishThread, ACancelledJobStopsEarlyAndIsNotCompleted) {
+  Cloth c = hanging_from_an_edge(25, 0.2);
+  FinisherOptions fo;
+  fo.cycles = 100000;     // far more than it would run
+  fo.move_tolerance = 0;  // never converged
+  FinishThread job;
+  job.start(c, nothing(), free_group(c), EnergyOptions{}, fo);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  job.cancel();
+  const FinisherStats st = job.collect();
+  std::printf("cancelled after %d cycles\n", st.cycles);
+  EXPECT_TRUE(job.ended());
+  EXPECT_FALSE(job.completed());
+  EXPECT_LT(st.cycles, fo.cycles);
+  // A new job may start once the last was collected.
+  fo.cycles = 2;
+  job.start(c, nothing(), free_group(c), EnergyOptions{}, fo);
+  EXPECT_EQ(job.collect().cycles, 2);
+  EXPECT_TRUE(job.completed());
+}
+
+TEST(FinishThread, AGroupOfTheWrongSizeIsRefused) {
+  Cloth c = hanging_from_an_edge(5);
+  FinishThread job;
+  EXPECT_THROW(job.start(c, nothing(), std::vector<int>(3, 0), EnergyOptions{}, FinisherOptions{}),
+               std::invalid_argument);
+  EXPECT_FALSE(job.busy());
+}
+
+// The XPBD solver's use of it: a sheet falls asleep, its finish starts on the thread; the sheet
+// is woken (its pinned corner dragged) before the job ends: the job's result is dropped and the
+// sheet is not moved by it; once it sleeps again a new job finishes it.
+TEST(FinishThread, XpbdDropsTheResultOfAPieceThatWokeAndFinishesItWhenItSleepsAgain) {
+  StudyScene sc = make_hanging_sheet(12);
+  XpbdOptions o;
+  o.freeze = true;
+  o.threads = 2;
+  o.finisher.cycles = 100000;  // the first job runs until it is cancelled
+  o.finisher.move_tolerance = 0;
+  XpbdSolver s(o);
+  int f = 0;
+  for (; f < 3000 && !s.finishing(); ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  ASSERT_TRUE(s.finishing()) << "asleep and finishing after " << f << " frames";
+  const double moved = drag_sheet_corner(sc, s, 30);
+  EXPECT_GT(moved, 1e-3);
+  s.options().finisher.cycles = 10;
+  s.options().finisher.move_tolerance = 1e-5;
+  for (f = 0; f < 30000 && (s.finish_count() == 0); ++f) {
+    s.step(sc.cloth, sc.objects, 1.0 / 90);
+    if (s.finishing()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  std::printf("dropped %d, finished %d pieces, %d cycles in all, %d frames after the drag\n",
+              s.finish_dropped(), s.finish_count(), s.finish_cycles(), f);
+  EXPECT_EQ(s.finish_dropped(), 1);
+  EXPECT_EQ(s.finish_count(), 1);
+  int free_vertices = 0;
+  for (int i = 0; i < sc.cloth.num_vertices(); ++i) free_vertices += sc.cloth.is_free(i);
+  EXPECT_EQ(s.frozen_count(), free_vertices) << "asleep again";
+}
