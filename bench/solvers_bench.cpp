@@ -4,7 +4,8 @@
 // sheet. Writes out/bench/solvers.csv and Pareto charts out/bench/solvers.svg (form) and
 // solvers_sheet.svg (error vs time, log axes, one curve per solver), prints time-at-equal-
 // error ratios of the default solver against the explicit baseline, Bullet and XPBD.
-// Usage: solvers_bench [--quick] [--max-res N] | --probe SCENE RES SOLVER SUBSTEPS ITERATIONS
+// Usage: solvers_bench [--quick] [--max-res N] [--sleep-only] | --probe SCENE RES SOLVER SUBSTEPS
+// ITERATIONS
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -719,17 +720,93 @@ int probe(int argc, char** argv) {
   return 0;
 }
 
+// Sleeping ("skip what a scene doesn't need"): the default solver on the form scene with and
+// without freezing for 8 s, CPU ms per frame while the panel drapes (0-3 s), while it settles
+// (3-6 s; at 128^2 its last wrinkles stop at ~4.5 s) and at rest (6-8 s), the fraction of
+// vertices asleep at the end and when the whole panel first slept. With freezing, the static
+// finish of the sleeping drape runs on its own thread (the app's default): its CPU time is not in
+// the rows' (this thread's) and is reported beside them, with how long after 8 s it landed.
+void sleep_rows(int sres) {
+  std::ofstream sl("out/bench/solvers_sleep.csv");
+  sl << "scene,solver,resolution,freeze,ms_per_frame_drape,ms_per_frame_settling,"
+        "ms_per_frame_rest,ms_per_frame_mean,frozen_fraction,all_asleep_s,rms_error_mm,"
+        "max_error_mm,finish_thread_ms,finish_landed_ms\n";
+  double rest[2] = {0, 0};
+  for (int fr = 0; fr < 2; ++fr) {
+    StudyScene sc = make_scene("form", sres);
+    SolverConfig cfg;
+    cfg.freeze = fr == 1;
+    cfg.threads = 1;
+    cfg.air_damping = sc.air_damping;
+    auto s = make_solver("default", cfg);
+    const int marks[4] = {0, 270, 540, 720};
+    double ms[3] = {0, 0, 0}, asleep_at = -1;
+    int frozen = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double c0 = cpu_ms();
+      for (int f = marks[k]; f < marks[k + 1]; ++f) {
+        (*s)->step(sc.cloth, sc.objects, 1.0 / 90);
+        if (asleep_at < 0 && fr == 1) {
+          bool all = true;
+          for (int i = 0; i < sc.cloth.num_vertices() && all; ++i)
+            all = !sc.cloth.is_free(i) || (sc.cloth.state.flags[i] & kFlagFrozen);
+          if (all) asleep_at = (f + 1) / 90.0;
+        }
+      }
+      ms[k] = (cpu_ms() - c0) / (marks[k + 1] - marks[k]);
+    }
+    // The static finish runs on its own thread (not in this thread's CPU time): its cycles'
+    // time, and how long after the 8 s its result landed.
+    double land_ms = 0, finish_ms = 0;
+    land_finish(**s, sc, land_ms);
+    if (XpbdSolver* xp = xpbd_of(s->get())) finish_ms = xp->finish_ms();
+    for (uint8_t fl : sc.cloth.state.flags) frozen += (fl & kFlagFrozen) ? 1 : 0;
+    const double frac = double(frozen) / sc.cloth.num_vertices();
+    rest[fr] = ms[2];
+    const double mean = (ms[0] * 270 + ms[1] * 270 + ms[2] * 180) / 720;
+    // The settled drape (freezing run) scored against the equilibrium nearest to it.
+    double rms = std::numeric_limits<double>::quiet_NaN(), mx = rms;
+    if (fr == 1) {
+      double res_polish = 0;
+      position_error(sc.cloth.state.x,
+                     polished(sc, res_polish, static_cast<int>(env_num("SLEEP_REF_ITERS", 100))),
+                     rms, mx);
+      rms *= 1e3;
+      mx *= 1e3;
+      std::printf(
+          "    settled %d^2 drape: %.3f mm rms, %.3f mm max from the nearest equilibrium "
+          "(polish residual %.1e)\n",
+          sres, rms, mx, res_polish);
+    }
+    std::printf(
+        "sleep    %4d %s freeze %d: %8.3f ms/frame draping (0-3 s), %8.3f settling (3-6 s), "
+        "%8.3f at rest (6-8 s), %.0f %% asleep, all asleep at %.2f s; static finish %.0f ms on "
+        "its thread, landed %.0f ms after 8 s\n",
+        sres, kDefaultSolver, fr, ms[0], ms[1], ms[2], 100 * frac, asleep_at, finish_ms, land_ms);
+    sl << "form," << kDefaultSolver << "," << sres << "," << fr << "," << ms[0] << "," << ms[1]
+       << "," << ms[2] << "," << mean << "," << frac << "," << asleep_at << "," << rms << "," << mx
+       << "," << finish_ms << "," << land_ms << std::endl;
+  }
+  if (rest[1] > 0)
+    std::printf("    cost at rest without / with freezing = %.1fx\n", rest[0] / rest[1]);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc > 1 && !std::strcmp(argv[1], "--probe")) return probe(argc, argv);
-  bool quick = false;
+  bool quick = false, sleep_only = false;
   int max_res = 64;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--quick")) quick = true;
     if (!std::strcmp(argv[i], "--max-res") && i + 1 < argc) max_res = std::atoi(argv[++i]);
+    if (!std::strcmp(argv[i], "--sleep-only")) sleep_only = true;
   }
   std::filesystem::create_directories("out/bench");
+  if (sleep_only) {  // the sleeping rows alone (out/bench/solvers_sleep.csv)
+    sleep_rows(quick ? 32 : 128);
+    return 0;
+  }
   std::vector<Row> rows;
   struct Job {
     std::string scene;
@@ -827,76 +904,7 @@ int main(int argc, char** argv) {
       }
     }
   }
-  // Sleeping ("skip what a scene doesn't need"): the default solver on the form scene with and
-  // without freezing for 8 s, CPU ms per frame while the panel drapes (0-3 s), while it settles
-  // (3-6 s; at 128^2 its last wrinkles stop at ~4.5 s) and at rest (6-8 s), the fraction of
-  // vertices asleep at the end and when the whole panel first slept.
-  {
-    const int sres = quick ? 32 : 128;
-    std::ofstream sl("out/bench/solvers_sleep.csv");
-    sl << "scene,solver,resolution,freeze,ms_per_frame_drape,ms_per_frame_settling,ms_per_frame_"
-          "rest,ms_per_frame_mean,frozen_fraction,all_asleep_s,rms_error_mm,max_error_mm,finish_"
-          "thread_ms,"
-          "finish_landed_ms\n";
-    double rest[2] = {0, 0};
-    for (int fr = 0; fr < 2; ++fr) {
-      StudyScene sc = make_scene("form", sres);
-      SolverConfig cfg;
-      cfg.freeze = fr == 1;
-      cfg.threads = 1;
-      cfg.air_damping = sc.air_damping;
-      auto s = make_solver("default", cfg);
-      const int marks[4] = {0, 270, 540, 720};
-      double ms[3] = {0, 0, 0}, asleep_at = -1;
-      int frozen = 0;
-      for (int k = 0; k < 3; ++k) {
-        const double c0 = cpu_ms();
-        for (int f = marks[k]; f < marks[k + 1]; ++f) {
-          (*s)->step(sc.cloth, sc.objects, 1.0 / 90);
-          if (asleep_at < 0 && fr == 1) {
-            bool all = true;
-            for (int i = 0; i < sc.cloth.num_vertices() && all; ++i)
-              all = !sc.cloth.is_free(i) || (sc.cloth.state.flags[i] & kFlagFrozen);
-            if (all) asleep_at = (f + 1) / 90.0;
-          }
-        }
-        ms[k] = (cpu_ms() - c0) / (marks[k + 1] - marks[k]);
-      }
-      // The static finish runs on its own thread (not in this thread's CPU time): its cycles'
-      // time, and how long after the 8 s its result landed.
-      double land_ms = 0, finish_ms = 0;
-      land_finish(**s, sc, land_ms);
-      if (XpbdSolver* xp = xpbd_of(s->get())) finish_ms = xp->finish_ms();
-      for (uint8_t fl : sc.cloth.state.flags) frozen += (fl & kFlagFrozen) ? 1 : 0;
-      const double frac = double(frozen) / sc.cloth.num_vertices();
-      rest[fr] = ms[2];
-      const double mean = (ms[0] * 270 + ms[1] * 270 + ms[2] * 180) / 720;
-      // The settled drape (freezing run) scored against the equilibrium nearest to it.
-      double rms = std::numeric_limits<double>::quiet_NaN(), mx = rms;
-      if (fr == 1) {
-        double res_polish = 0;
-        position_error(sc.cloth.state.x,
-                       polished(sc, res_polish, static_cast<int>(env_num("SLEEP_REF_ITERS", 100))),
-                       rms, mx);
-        rms *= 1e3;
-        mx *= 1e3;
-        std::printf(
-            "    settled %d^2 drape: %.3f mm rms, %.3f mm max from the nearest equilibrium "
-            "(polish residual %.1e)\n",
-            sres, rms, mx, res_polish);
-      }
-      std::printf(
-          "sleep    %4d %s freeze %d: %8.3f ms/frame draping (0-3 s), %8.3f settling (3-6 s), "
-          "%8.3f at rest (6-8 s), %.0f %% asleep, all asleep at %.2f s; static finish %.0f ms on "
-          "its thread, landed %.0f ms after 8 s\n",
-          sres, kDefaultSolver, fr, ms[0], ms[1], ms[2], 100 * frac, asleep_at, finish_ms, land_ms);
-      sl << "form," << kDefaultSolver << "," << sres << "," << fr << "," << ms[0] << "," << ms[1]
-         << "," << ms[2] << "," << mean << "," << frac << "," << asleep_at << "," << rms << ","
-         << mx << "," << finish_ms << "," << land_ms << std::endl;
-    }
-    if (rest[1] > 0)
-      std::printf("    cost at rest without / with freezing = %.1fx\n", rest[0] / rest[1]);
-  }
+  sleep_rows(quick ? 32 : 128);
   // Switches of "skip what a scene doesn't need", on and off: XPBD 10x1 on the form scene with
   // contact reuse (detection only after half the margin of motion) on/off, and self-collision
   // (spatial hash) off/on; CPU ms per frame, detections per frame, self pairs at the end.

@@ -32,6 +32,7 @@ Result<std::unique_ptr<Solver>> make_solver(const std::string& name_in, const So
     if (cfg.air_damping >= 0) o.damping = cfg.air_damping;
     o.threads = cfg.threads;
     o.freeze = cfg.freeze;
+    o.finish_thread = cfg.finish_thread;
     o.settle = cfg.settle;
     s = std::make_unique<XpbdSolver>(o);
   } else if (name == "newton") {

@@ -15,7 +15,11 @@ struct SolverConfig {
   int iterations = 0;    // 0: the solver's default
   double tolerance = 0;  // 0: default
   bool watchdog = true;
-  bool freeze = false;         // VBD: freeze regions at rest
+  bool freeze = false;  // VBD: freeze regions at rest; XPBD: pieces at rest sleep
+  // XPBD with freeze: the static finish of sleeping pieces on a thread of its own (lands when
+  // its job ends: wall time) or, when false, one cycle per step (the same frames on every run:
+  // lock-step replays). XpbdOptions::finish_thread.
+  bool finish_thread = true;
   bool settle = true;          // XPBD: settle pieces at rest (XpbdOptions::settle)
   bool chebyshev = false;      // VBD
   bool springs_model = false;  // the study's 8-spring energy instead of FEM + bending

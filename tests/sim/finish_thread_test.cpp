@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "sim/cut.hpp"
 #include "sim/solver_xpbd.hpp"
 #include "solver_checks.hpp"
 
@@ -112,4 +113,32 @@ TEST(FinishThread, XpbdDropsTheResultOfAPieceThatWokeAndFinishesItWhenItSleepsAg
   int free_vertices = 0;
   for (int i = 0; i < sc.cloth.num_vertices(); ++i) free_vertices += sc.cloth.is_free(i);
   EXPECT_EQ(s.frozen_count(), free_vertices) << "asleep again";
+}
+
+// A cut while the job runs: the cloth is re-cooked (another topology version), the job's
+// positions belong to the old mesh and are dropped; the sheet's vertices keep the positions
+// the cut left them at until the solver moves them.
+TEST(FinishThread, XpbdDropsTheResultWhenTheClothIsCutMeanwhile) {
+  StudyScene sc = make_hanging_sheet(12);
+  XpbdOptions o;
+  o.freeze = true;
+  o.finisher.cycles = 100000;  // runs until it is cancelled
+  o.finisher.move_tolerance = 0;
+  XpbdSolver s(o);
+  int f = 0;
+  for (; f < 3000 && !s.finishing(); ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  ASSERT_TRUE(s.finishing());
+  const double w = sc.cloth.topo.material.back().x();
+  ASSERT_TRUE(cut_along_material(sc.cloth, {Vec2(-0.01, 0.1), Vec2(w + 0.01, 0.1)}).ok);
+  const uint64_t version = sc.cloth.topology_version;
+  s.step(sc.cloth, sc.objects, 1.0 / 90);  // re-cooks, cancels the job
+  for (f = 0; f < 5000 && s.finishing(); ++f) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    s.step(sc.cloth, sc.objects, 1.0 / 90);
+  }
+  EXPECT_FALSE(s.finishing());
+  EXPECT_EQ(sc.cloth.topology_version, version);
+  EXPECT_EQ(s.finish_dropped(), 1);
+  EXPECT_EQ(s.finish_count(), 0);
+  for (const Vec3& x : sc.cloth.state.x) ASSERT_TRUE(x.allFinite());
 }

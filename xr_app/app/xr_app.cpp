@@ -830,6 +830,9 @@ bool App::create_vulkan() {
     auto scene = sim::make_form_drape(opt_.cloth_res);
     sim::SolverConfig solver_cfg;
     solver_cfg.freeze = true;  // pieces at rest sleep until a hand, pin or cut disturbs them
+    // A lock-step run replays bit for bit: the static finish of a sleeping piece then runs one
+    // cycle per tick instead of landing whenever its thread ends.
+    solver_cfg.finish_thread = !opt_.sim_lock_step;
     auto solver = sim::make_solver("default", solver_cfg);
     if (!solver) {
       r_.error = "solver: " + solver.error();
