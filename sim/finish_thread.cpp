@@ -21,6 +21,7 @@ void FinishThread::start(const Cloth& cloth, const SceneObjects& scene,
                                 " vertices");
   // Written before the thread exists (its creation orders them before anything it reads).
   cloth_ = cloth;
+  start_ = cloth.state.x;
   scene_ = scene;
   group_ = group;
   energy_options_ = energy_options;

@@ -52,6 +52,10 @@ class FinishThread {
   // the topology version they belong to, and the group it was started with.
   const Cloth& cloth() const { return cloth_; }
   const std::vector<int>& group() const { return group_; }
+  // The positions the job started from (the caller compares them with its cloth's before it
+  // uses the result: a vertex moved meanwhile by anything but the solver means the job's
+  // result is stale for its piece).
+  const std::vector<Vec3>& start_positions() const { return start_; }
   // The job ran to its end (converged or out of cycles) rather than being cancelled.
   bool completed() const { return completed_; }
 
@@ -63,6 +67,7 @@ class FinishThread {
   Cloth cloth_;
   SceneObjects scene_;
   std::vector<int> group_;
+  std::vector<Vec3> start_;
   EnergyOptions energy_options_;
   EquilibriumFinisher finisher_;  // kept from job to job (its cooked energy, its pattern)
   FinisherStats stats_;

@@ -355,7 +355,21 @@ void XpbdSolver::finish_on_thread(Cloth& cloth, const SceneObjects& scene) {
     finish_last_ = job.collect();
     finish_ms_ += finish_last_.total_ms;
     finish_cycles_ += finish_last_.cycles;
-    const bool use = any_valid && job.completed();
+    bool use = any_valid && job.completed(), stale_found = false;
+    if (use) {
+      // A piece is stale too when anything else changed it meanwhile without waking it: a
+      // vertex pinned or freed where it lay, a position set by an operation or a restore.
+      const auto& g = job.group();
+      const auto& x0 = job.start_positions();
+      for (int i = 0; i < n; ++i) {
+        const int p = piece_of_[i];
+        if (piece_finish_[p] == kFinishing && ((g[i] >= 0) != cloth.is_free(i) || S.x[i] != x0[i]))
+          piece_finish_[p] = 0;
+      }
+      any_valid = false;
+      for (int p = 0; p < num_pieces_ && !any_valid; ++p) any_valid = valid(p);
+      use = any_valid;
+    }
     if (use) {
       const auto& g = job.group();
       const auto& xf = job.cloth().state.x;
@@ -366,7 +380,7 @@ void XpbdSolver::finish_on_thread(Cloth& cloth, const SceneObjects& scene) {
           S.v[i].setZero();
         }
     }
-    bool dropped = !use;
+    bool dropped = !use || stale_found;
     for (int p = 0; p < num_pieces_; ++p) {
       if (piece_finish_[p] != kFinishing) continue;
       if (use && valid(p)) {

@@ -142,3 +142,36 @@ TEST(FinishThread, XpbdDropsTheResultWhenTheClothIsCutMeanwhile) {
   EXPECT_EQ(s.finish_count(), 0);
   for (const Vec3& x : sc.cloth.state.x) ASSERT_TRUE(x.allFinite());
 }
+
+// Something changes the sleeping sheet without waking it while the job runs: a free vertex is
+// pinned where it lies (a pin does not move it, so the piece sleeps on). The job ends by itself
+// but its result is dropped (it moved that vertex), the pinned vertex stays put, and a new job
+// finishes the sheet with the vertex pinned.
+TEST(FinishThread, XpbdDropsTheResultWhenAVertexWasPinnedMeanwhile) {
+  StudyScene sc = make_hanging_sheet(12);
+  XpbdOptions o;
+  o.freeze = true;
+  o.finisher.cycles = 300;  // long enough to pin the vertex before the job ends
+  o.finisher.move_tolerance = 0;
+  XpbdSolver s(o);
+  for (int f = 0; f < 3000 && !s.finishing(); ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  ASSERT_TRUE(s.finishing());
+  const int v = sc.cloth.num_vertices() / 2 + 3;
+  ASSERT_TRUE(sc.cloth.is_free(v));
+  sc.cloth.state.flags[v] |= kFlagPinned;
+  const Vec3 at = sc.cloth.state.x[v];
+  s.options().finisher.cycles = 5;
+  s.options().finisher.move_tolerance = 1e-5;
+  int frames = 0;
+  for (; frames < 60000 && s.finish_count() == 0; ++frames) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    s.step(sc.cloth, sc.objects, 1.0 / 90);
+    EXPECT_EQ(sc.cloth.state.x[v], at) << "the pinned vertex, frame " << frames;
+    if (sc.cloth.state.x[v] != at) break;
+  }
+  std::printf("dropped %d, finished %d, %d cycles in all, %d frames\n", s.finish_dropped(),
+              s.finish_count(), s.finish_cycles(), frames);
+  EXPECT_EQ(s.finish_dropped(), 1);
+  EXPECT_EQ(s.finish_count(), 1);
+  EXPECT_GE(s.finish_cycles(), 300) << "the first job ran to its end";
+}
