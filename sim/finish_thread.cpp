@@ -1,6 +1,14 @@
 #include "sim/finish_thread.hpp"
 
+#include <algorithm>
+#include <cerrno>
 #include <stdexcept>
+
+#if defined(__linux__)
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
 
 namespace drape::sim {
 
@@ -34,6 +42,18 @@ void FinishThread::start(const Cloth& cloth, const SceneObjects& scene,
 }
 
 void FinishThread::work() {
+#if defined(__linux__)
+  // Linux keeps a nice value per thread: PRIO_PROCESS with this thread's id changes only it
+  // (and the threads it creates: CHOLMOD's OpenMP team inherits it).
+  const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+  if (nice_ != 0) {
+    errno = 0;
+    const int now = getpriority(PRIO_PROCESS, tid);
+    if (errno == 0) setpriority(PRIO_PROCESS, tid, std::min(19, now + nice_));
+  }
+  errno = 0;
+  job_nice_ = getpriority(PRIO_PROCESS, tid);
+#endif
   stats_ = finisher_.run(cloth_, scene_, group_, energy_options_, nullptr, &cancel_);
   completed_ = !cancel_.load(std::memory_order_relaxed);
   done_.store(true, std::memory_order_release);

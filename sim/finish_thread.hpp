@@ -58,6 +58,14 @@ class FinishThread {
   const std::vector<Vec3>& start_positions() const { return start_; }
   // The job ran to its end (converged or out of cycles) rather than being cancelled.
   bool completed() const { return completed_; }
+  // The job's thread runs at a lower priority than the fixed-rate simulation and the renderer
+  // (Linux: its nice value raised by this much; 0 keeps the caller's), so that on two cores the
+  // finish takes the time they leave rather than stretching their ticks. With nice +10 the
+  // kernel's fair scheduler still gives it about a tenth of a core under full load, so a finish
+  // is delayed, never starved. Applies to jobs started after it is set.
+  void set_nice(int n) { nice_ = n; }
+  // The nice value the last job's thread ran at (Linux; 0 elsewhere).
+  int job_nice() const { return job_nice_; }
 
  private:
   void work();
@@ -72,6 +80,7 @@ class FinishThread {
   EquilibriumFinisher finisher_;  // kept from job to job (its cooked energy, its pattern)
   FinisherStats stats_;
   bool completed_ = false;
+  int nice_ = 10, job_nice_ = 0;
 };
 
 }  // namespace drape::sim

@@ -402,6 +402,7 @@ void XpbdSolver::finish_on_thread(Cloth& cloth, const SceneObjects& scene) {
     const int p = piece_of_[i];
     coarse_group_[i] = cloth.is_free(i) && piece_frozen_[p] && piece_finish_[p] == 0 ? p : -1;
   }
+  job.set_nice(opt_.finish_nice);
   job.start(cloth, scene, coarse_group_, opt_.energy, opt_.finisher);
   finish_version_ = cloth.topology_version;
   for (int p = 0; p < num_pieces_; ++p)

@@ -133,8 +133,10 @@ struct XpbdOptions {
   // copy taken when the pieces fall asleep, copied back in the frame after it ends, dropped if
   // a piece woke meanwhile), so that the fixed-rate loop keeps its ticks while a drape is
   // finished; or, when false, one cycle per step on the solver's own threads (deterministic
-  // frame by frame; the end state is the same).
+  // frame by frame; the end state is the same). The thread runs at nice + finish_nice (Linux),
+  // below the simulation and the renderer (FinishThread::set_nice).
   bool finish_thread = true;
+  int finish_nice = 10;
 };
 
 class XpbdSolver : public Solver {

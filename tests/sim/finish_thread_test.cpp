@@ -6,10 +6,18 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <stdexcept>
 #include <thread>
+
+#if defined(__linux__)
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
 
 #include "sim/cut.hpp"
 #include "sim/solver_xpbd.hpp"
@@ -53,6 +61,14 @@ TEST(FinishThread, AJobEndsInTheFinishersStateAndLeavesTheCallersClothAlone) {
               got.cycles, got.max_move * 1e3, mx);
   EXPECT_EQ(mx, 0.0);
   EXPECT_GT(got.max_move, 1e-3);
+#if defined(__linux__)
+  // The job ran at a lower priority (nice + 10); this thread's own is unchanged.
+  errno = 0;
+  const int mine = getpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)));
+  ASSERT_EQ(errno, 0);
+  std::printf("nice: this thread %d, the job %d\n", mine, job.job_nice());
+  EXPECT_EQ(job.job_nice(), std::min(19, mine + 10));
+#endif
 }
 
 TEST(FinishThread, ACancelledJobStopsEarlyAndIsNotCompleted) {
