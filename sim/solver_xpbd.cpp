@@ -363,8 +363,11 @@ void XpbdSolver::finish_on_thread(Cloth& cloth, const SceneObjects& scene) {
       const auto& x0 = job.start_positions();
       for (int i = 0; i < n; ++i) {
         const int p = piece_of_[i];
-        if (piece_finish_[p] == kFinishing && ((g[i] >= 0) != cloth.is_free(i) || S.x[i] != x0[i]))
-          piece_finish_[p] = 0;
+        if (piece_finish_[p] == kFinishing &&
+            ((g[i] >= 0) != cloth.is_free(i) || S.x[i] != x0[i])) {
+          piece_finish_[p] = 0;  // a new job takes it
+          stale_found = true;
+        }
       }
       any_valid = false;
       for (int p = 0; p < num_pieces_ && !any_valid; ++p) any_valid = valid(p);
