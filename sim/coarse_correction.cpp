@@ -10,12 +10,30 @@
 #include <string>
 #include <unordered_map>
 
+#include "sim/stopwatch.hpp"
+
 namespace drape::sim {
 
 namespace {
 using SpMat = Eigen::SparseMatrix<double>;
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+// Index of entry (i, j) in a CSR pattern with sorted columns (the entry must exist).
+int csr_index(const std::vector<int>& off, const std::vector<int>& col, int i, int j) {
+  const int* b = col.data() + off[i];
+  const int* e = col.data() + off[i + 1];
+  return static_cast<int>(std::lower_bound(b, e, j) - col.data());
+}
+
+// The tensor bending's rows come in groups of up to three (a triangle's uu, vv, uv) over the
+// same columns: the size of the group that starts at row r.
+int bending_row_group(const std::vector<int>& off, const std::vector<int>& col, int r) {
+  const int rows = static_cast<int>(off.size()) - 1;
+  const int len = off[r + 1] - off[r];
+  int g = 1;
+  while (g < 3 && r + g < rows && off[r + g + 1] - off[r + g] == len &&
+         std::equal(col.begin() + off[r], col.begin() + off[r + 1], col.begin() + off[r + g]))
+    ++g;
+  return g;
 }
 }  // namespace
 
@@ -64,11 +82,7 @@ struct CoarseCorrection::Impl {
   std::vector<Mat3> T;
   std::vector<uint8_t> tangential;
 
-  int block(int I, int J) const {
-    const int* b = b_col.data() + b_off[I];
-    const int* e = b_col.data() + b_off[I + 1];
-    return static_cast<int>(std::lower_bound(b, e, J) - b_col.data());
-  }
+  int block(int I, int J) const { return csr_index(b_off, b_col, I, J); }
   void add(int I, int J, double s, const Mat3& B) {
     double* v = H.valuePtr();
     const int k = block(I, J);
@@ -365,13 +379,8 @@ struct CoarseCorrection::Impl {
         const auto& col = energy.bending_row_columns();
         const auto& val = energy.bending_row_values();
         const int rows = static_cast<int>(off.size()) - 1;
-        auto same_columns = [&](int a, int b) {
-          return off[a + 1] - off[a] == off[b + 1] - off[b] &&
-                 std::equal(col.begin() + off[a], col.begin() + off[a + 1], col.begin() + off[b]);
-        };
         for (int r = 0; r < rows;) {
-          int g = 1;
-          while (g < 3 && r + g < rows && same_columns(r, r + g)) ++g;
+          const int g = bending_row_group(off, col, r);
           const int len = off[r + 1] - off[r];
           // The nodes of the columns, ascending, and each (column, node) entry's local index.
           un.clear();
@@ -493,11 +502,7 @@ struct CoarseCorrection::Impl {
   std::vector<Mat3> F;
   std::vector<int> y_node;
   std::vector<G36> y_val;
-  int fblock(int i, int j) const {
-    const int* b = f_col.data() + f_off[i];
-    const int* e = f_col.data() + f_off[i + 1];
-    return static_cast<int>(std::lower_bound(b, e, j) - f_col.data());
-  }
+  int fblock(int i, int j) const { return csr_index(f_off, f_col, i, j); }
   void build_fine(const ClothEnergy& energy) {
     std::vector<std::vector<int>> rows(n);
     auto link = [&](const int* v, int k) {
@@ -570,11 +575,7 @@ struct CoarseCorrection::Impl {
         const auto& val = energy.bending_row_values();
         const int rows = static_cast<int>(off.size()) - 1;
         for (int r = 0; r < rows;) {
-          int g = 1;
-          while (
-              g < 3 && r + g < rows && off[r + g + 1] - off[r + g] == off[r + 1] - off[r] &&
-              std::equal(col.begin() + off[r], col.begin() + off[r + 1], col.begin() + off[r + g]))
-            ++g;
+          const int g = bending_row_group(off, col, r);
           const int len = off[r + 1] - off[r];
           for (int a = 0; a < len; ++a) {
             const int ja = col[off[r] + a];

@@ -12,6 +12,8 @@
 #include <numeric>
 #include <queue>
 
+#include "sim/stopwatch.hpp"
+
 namespace drape::sim {
 namespace {
 
@@ -643,10 +645,6 @@ CutResult cut_runs(Cloth& cloth, const std::vector<int32_t>& anchors) {
   total.components_after = I.components;
   if (!total.ok) total.reason = why.empty() ? "cut: stroke covers a single particle" : why;
   return total;
-}
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace

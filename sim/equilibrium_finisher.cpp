@@ -4,13 +4,9 @@
 #include <algorithm>
 #include <chrono>
 
-namespace drape::sim {
+#include "sim/stopwatch.hpp"
 
-namespace {
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-}  // namespace
+namespace drape::sim {
 
 EquilibriumFinisher::EquilibriumFinisher(FinisherOptions opt) : opt_(opt) {}
 EquilibriumFinisher::~EquilibriumFinisher() = default;

@@ -11,15 +11,13 @@
 
 #include "sim/dress_form.hpp"
 #include "sim/mesh_io.hpp"
+#include "sim/stopwatch.hpp"
 
 namespace drape::sim {
 namespace {
 constexpr double kPi = 3.141592653589793;
 using json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 // Reads an optional number field; errors name source and field.
 std::string get_num(const json& j, const char* key, const std::string& where, double* out) {

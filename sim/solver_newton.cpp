@@ -12,14 +12,13 @@
 #include <limits>
 #include <stdexcept>
 
+#include "sim/stopwatch.hpp"
+
 namespace drape::sim {
 
 namespace {
 using SpMat = Eigen::SparseMatrix<double>;
 constexpr double kStickyReach = 1e-3;  // m, see minimise()
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 }  // namespace
 
 // The Newton matrix (lower triangle only: both factorisations read nothing else) with a pattern

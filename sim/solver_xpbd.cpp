@@ -300,7 +300,6 @@ void XpbdSolver::unsettle(int piece) {
 void XpbdSolver::finish_sleeping(Cloth& cloth, const SceneObjects& scene) {
   if (!opt_.finish || !opt_.freeze || scene.self_collision) return;
   if (opt_.finish_thread) return finish_on_thread(cloth, scene);
-  const int n = cloth.num_vertices();
   bool any = false, fresh = false;
   for (int p = 0; p < num_pieces_; ++p)
     if (piece_frozen_[p] && piece_finish_[p] >= 0) {
@@ -310,18 +309,11 @@ void XpbdSolver::finish_sleeping(Cloth& cloth, const SceneObjects& scene) {
   if (!any) return;
   if (!finisher_) finisher_ = std::make_unique<EquilibriumFinisher>();
   finisher_->options() = opt_.finisher;
-  coarse_group_.resize(n);
   if (fresh) {  // friction anchored where a piece fell asleep
-    for (int i = 0; i < n; ++i) {
-      const int p = piece_of_[i];
-      coarse_group_[i] = cloth.is_free(i) && piece_frozen_[p] && piece_finish_[p] == 0 ? p : -1;
-    }
+    sleeping_group(cloth, false);
     finisher_->anchor(cloth, coarse_group_);
   }
-  for (int i = 0; i < n; ++i) {
-    const int p = piece_of_[i];
-    coarse_group_[i] = cloth.is_free(i) && piece_frozen_[p] && piece_finish_[p] >= 0 ? p : -1;
-  }
+  sleeping_group(cloth, true);
   finish_last_ = finisher_->cycle(cloth, scene, coarse_group_, opt_.energy, pool_.get());
   finish_ms_ += finish_last_.total_ms;
   ++finish_cycles_;
@@ -339,54 +331,42 @@ void XpbdSolver::finish_on_thread(Cloth& cloth, const SceneObjects& scene) {
   if (!finish_thread_) finish_thread_ = std::make_unique<FinishThread>();
   FinishThread& job = *finish_thread_;
   if (job.busy()) {
-    // A piece of the job is still worth its result while it sleeps on, untouched since: not
-    // woken (unsettle() resets its mark), not re-cooked (a cut or sew: another version).
+    // A piece's result is kept only while it sleeps on, untouched since the job started: not
+    // woken (unsettle() clears its mark), not re-cooked (a cut or sew: another version), and
+    // (checked when the job has ended) every vertex where it was, free or fixed as it was: a
+    // vertex pinned where it lay or a position set by an operation does not wake a piece.
     const bool same = finish_version_ == cloth.topology_version &&
                       static_cast<int>(job.group().size()) == n &&
                       static_cast<int>(piece_finish_.size()) == num_pieces_;
-    auto valid = [&](int p) {
-      return same && p >= 0 && p < num_pieces_ && piece_frozen_[p] &&
-             piece_finish_[p] == kFinishing;
-    };
-    bool any_valid = false;
-    for (int p = 0; p < num_pieces_ && !any_valid; ++p) any_valid = valid(p);
-    if (!any_valid) job.cancel();
+    piece_ok_.assign(num_pieces_, 0);
+    bool any = false;
+    for (int p = 0; p < num_pieces_ && same; ++p) {
+      piece_ok_[p] = piece_frozen_[p] && piece_finish_[p] == kFinishing;
+      any = any || piece_ok_[p];
+    }
+    if (!any) job.cancel();
     if (!job.ended()) return;
     finish_last_ = job.collect();
     finish_ms_ += finish_last_.total_ms;
     finish_cycles_ += finish_last_.cycles;
-    bool use = any_valid && job.completed(), stale_found = false;
-    if (use) {
-      // A piece is stale too when anything else changed it meanwhile without waking it: a
-      // vertex pinned or freed where it lay, a position set by an operation or a restore.
-      const auto& g = job.group();
+    if (!job.completed()) std::fill(piece_ok_.begin(), piece_ok_.end(), 0);
+    const auto& g = job.group();
+    if (any && job.completed()) {
       const auto& x0 = job.start_positions();
-      for (int i = 0; i < n; ++i) {
-        const int p = piece_of_[i];
-        if (piece_finish_[p] == kFinishing &&
-            ((g[i] >= 0) != cloth.is_free(i) || S.x[i] != x0[i])) {
-          piece_finish_[p] = 0;  // a new job takes it
-          stale_found = true;
-        }
-      }
-      any_valid = false;
-      for (int p = 0; p < num_pieces_ && !any_valid; ++p) any_valid = valid(p);
-      use = any_valid;
-    }
-    if (use) {
-      const auto& g = job.group();
+      for (int i = 0; i < n; ++i)
+        if ((g[i] >= 0) != cloth.is_free(i) || S.x[i] != x0[i]) piece_ok_[piece_of_[i]] = 0;
       const auto& xf = job.cloth().state.x;
       for (int i = 0; i < n; ++i)
-        if (g[i] >= 0 && valid(g[i])) {
+        if (g[i] >= 0 && piece_ok_[g[i]]) {
           S.x[i] = xf[i];
           S.x_prev[i] = xf[i];
           S.v[i].setZero();
         }
     }
-    bool dropped = !use || stale_found;
+    bool dropped = false;
     for (int p = 0; p < num_pieces_; ++p) {
       if (piece_finish_[p] != kFinishing) continue;
-      if (use && valid(p)) {
+      if (piece_ok_[p]) {
         piece_finish_[p] = -1;
         ++finish_count_;
       } else {
@@ -394,22 +374,28 @@ void XpbdSolver::finish_on_thread(Cloth& cloth, const SceneObjects& scene) {
         dropped = true;
       }
     }
-    if (dropped) ++finish_dropped_;
+    if (dropped || !any) ++finish_dropped_;
   }
   // Pieces asleep and not finished yet: one job for all of them.
   bool any = false;
   for (int p = 0; p < num_pieces_ && !any; ++p) any = piece_frozen_[p] && piece_finish_[p] == 0;
   if (!any) return;
-  coarse_group_.resize(n);
-  for (int i = 0; i < n; ++i) {
-    const int p = piece_of_[i];
-    coarse_group_[i] = cloth.is_free(i) && piece_frozen_[p] && piece_finish_[p] == 0 ? p : -1;
-  }
+  sleeping_group(cloth, false);
   job.set_nice(opt_.finish_nice);
   job.start(cloth, scene, coarse_group_, opt_.energy, opt_.finisher);
   finish_version_ = cloth.topology_version;
   for (int p = 0; p < num_pieces_; ++p)
     if (piece_frozen_[p] && piece_finish_[p] == 0) piece_finish_[p] = kFinishing;
+}
+
+void XpbdSolver::sleeping_group(const Cloth& cloth, bool started) {
+  const int n = cloth.num_vertices();
+  coarse_group_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const int p = piece_of_[i];
+    const bool in = piece_frozen_[p] && (started ? piece_finish_[p] >= 0 : piece_finish_[p] == 0);
+    coarse_group_[i] = cloth.is_free(i) && in ? p : -1;
+  }
 }
 
 void XpbdSolver::coarse_step(Cloth& cloth, const SceneObjects& scene) {

@@ -254,6 +254,10 @@ class XpbdSolver : public Solver {
   static constexpr int kFinishing = -2;
   void finish_sleeping(Cloth& cloth, const SceneObjects& scene);
   void finish_on_thread(Cloth& cloth, const SceneObjects& scene);
+  // coarse_group_ = the piece of every free vertex of a sleeping piece whose finish has not
+  // started (started false) or is not finished (true), else -1.
+  void sleeping_group(const Cloth& cloth, bool started);
+  std::vector<uint8_t> piece_ok_;  // finish_on_thread: the job's result stands for the piece
   std::unique_ptr<FinishThread> finish_thread_;
   uint64_t finish_version_ = 0;  // topology_version of the cloth the job copied
   double finish_ms_ = 0;

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <stdexcept>
 #include <thread>
 
@@ -32,6 +33,28 @@ SceneObjects nothing() {
   none.floor = false;
   return none;
 }
+
+// The XPBD tests' set-up: a 12 x 12 hanging sheet and a solver with sleeping whose first finish
+// runs `cycles` cycles without converging (move tolerance 0), stepped until the sheet sleeps
+// and its finish has started on the thread.
+struct SleepingSheet {
+  StudyScene sc = make_hanging_sheet(12);
+  std::unique_ptr<XpbdSolver> s;
+  int frames = 0;  // until the finish started
+  explicit SleepingSheet(int cycles) {
+    XpbdOptions o;
+    o.freeze = true;
+    o.finisher.cycles = cycles;
+    o.finisher.move_tolerance = 0;
+    s = std::make_unique<XpbdSolver>(o);
+    for (; frames < 3000 && !s->finishing(); ++frames) s->step(sc.cloth, sc.objects, 1.0 / 90);
+  }
+  // Later jobs converge as usual, in at most `cycles` cycles.
+  void later_jobs(int cycles) {
+    s->options().finisher.cycles = cycles;
+    s->options().finisher.move_tolerance = 1e-5;
+  }
+};
 }  // namespace
 
 TEST(FinishThread, AJobEndsInTheFinishersStateAndLeavesTheCallersClothAlone) {
@@ -104,21 +127,15 @@ TEST(FinishThread, AGroupOfTheWrongSizeIsRefused) {
 // is woken (its pinned corner dragged) before the job ends: the job's result is dropped and the
 // sheet is not moved by it; once it sleeps again a new job finishes it.
 TEST(FinishThread, XpbdDropsTheResultOfAPieceThatWokeAndFinishesItWhenItSleepsAgain) {
-  StudyScene sc = make_hanging_sheet(12);
-  XpbdOptions o;
-  o.freeze = true;
-  o.threads = 2;
-  o.finisher.cycles = 100000;  // the first job runs until it is cancelled
-  o.finisher.move_tolerance = 0;
-  XpbdSolver s(o);
-  int f = 0;
-  for (; f < 3000 && !s.finishing(); ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
-  ASSERT_TRUE(s.finishing()) << "asleep and finishing after " << f << " frames";
+  SleepingSheet sh(100000);  // the first job runs until it is cancelled
+  auto& sc = sh.sc;
+  auto& s = *sh.s;
+  ASSERT_TRUE(s.finishing()) << "asleep and finishing after " << sh.frames << " frames";
   const double moved = drag_sheet_corner(sc, s, 30);
   EXPECT_GT(moved, 1e-3);
-  s.options().finisher.cycles = 10;
-  s.options().finisher.move_tolerance = 1e-5;
-  for (f = 0; f < 30000 && (s.finish_count() == 0); ++f) {
+  sh.later_jobs(10);
+  int f = 0;
+  for (; f < 30000 && (s.finish_count() == 0); ++f) {
     s.step(sc.cloth, sc.objects, 1.0 / 90);
     if (s.finishing()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
@@ -135,20 +152,15 @@ TEST(FinishThread, XpbdDropsTheResultOfAPieceThatWokeAndFinishesItWhenItSleepsAg
 // positions belong to the old mesh and are dropped; the sheet's vertices keep the positions
 // the cut left them at until the solver moves them.
 TEST(FinishThread, XpbdDropsTheResultWhenTheClothIsCutMeanwhile) {
-  StudyScene sc = make_hanging_sheet(12);
-  XpbdOptions o;
-  o.freeze = true;
-  o.finisher.cycles = 100000;  // runs until it is cancelled
-  o.finisher.move_tolerance = 0;
-  XpbdSolver s(o);
-  int f = 0;
-  for (; f < 3000 && !s.finishing(); ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  SleepingSheet sh(100000);  // runs until it is cancelled
+  auto& sc = sh.sc;
+  auto& s = *sh.s;
   ASSERT_TRUE(s.finishing());
   const double w = sc.cloth.topo.material.back().x();
   ASSERT_TRUE(cut_along_material(sc.cloth, {Vec2(-0.01, 0.1), Vec2(w + 0.01, 0.1)}).ok);
   const uint64_t version = sc.cloth.topology_version;
   s.step(sc.cloth, sc.objects, 1.0 / 90);  // re-cooks, cancels the job
-  for (f = 0; f < 5000 && s.finishing(); ++f) {
+  for (int f = 0; f < 5000 && s.finishing(); ++f) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
     s.step(sc.cloth, sc.objects, 1.0 / 90);
   }
@@ -164,20 +176,15 @@ TEST(FinishThread, XpbdDropsTheResultWhenTheClothIsCutMeanwhile) {
 // but its result is dropped (it moved that vertex), the pinned vertex stays put, and a new job
 // finishes the sheet with the vertex pinned.
 TEST(FinishThread, XpbdDropsTheResultWhenAVertexWasPinnedMeanwhile) {
-  StudyScene sc = make_hanging_sheet(12);
-  XpbdOptions o;
-  o.freeze = true;
-  o.finisher.cycles = 300;  // long enough to pin the vertex before the job ends
-  o.finisher.move_tolerance = 0;
-  XpbdSolver s(o);
-  for (int f = 0; f < 3000 && !s.finishing(); ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  SleepingSheet sh(300);  // long enough to pin the vertex before the job ends
+  auto& sc = sh.sc;
+  auto& s = *sh.s;
   ASSERT_TRUE(s.finishing());
   const int v = sc.cloth.num_vertices() / 2 + 3;
   ASSERT_TRUE(sc.cloth.is_free(v));
   sc.cloth.state.flags[v] |= kFlagPinned;
   const Vec3 at = sc.cloth.state.x[v];
-  s.options().finisher.cycles = 5;
-  s.options().finisher.move_tolerance = 1e-5;
+  sh.later_jobs(5);
   int frames = 0;
   for (; frames < 60000 && s.finish_count() == 0; ++frames) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
