@@ -4,8 +4,8 @@
 // sheet. Writes out/bench/solvers.csv and Pareto charts out/bench/solvers.svg (form) and
 // solvers_sheet.svg (error vs time, log axes, one curve per solver), prints time-at-equal-
 // error ratios of the default solver against the explicit baseline, Bullet and XPBD.
-// Usage: solvers_bench [--quick] [--max-res N] [--sleep-only] | --probe SCENE RES SOLVER SUBSTEPS
-// ITERATIONS
+// Usage: solvers_bench [--quick] [--max-res N] [--sleep-only] [--threads-only] | --probe SCENE RES
+// SOLVER SUBSTEPS ITERATIONS
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -365,6 +365,7 @@ int probe(int argc, char** argv) {
       xp->options().finisher.cycles =
           static_cast<int>(env_num("XPBD_FINISH_CYCLES", xp->options().finisher.cycles));
       xp->options().finish_thread = env_num("XPBD_FINISH_THREAD", 1) > 0;
+      xp->options().single_precision = env_num("XPBD_F32", 1) > 0;
     }
   }
   sc.objects.friction = env_num("PROBE_FRICTION", sc.objects.friction);
@@ -791,20 +792,65 @@ void sleep_rows(int sres) {
     std::printf("    cost at rest without / with freezing = %.1fx\n", rest[0] / rest[1]);
 }
 
+void thread_rows(int max_res) {
+  // Both cores: the default solver 10x1 on the form scene with 1 and 2 threads (colour-parallel,
+  // same result), wall and CPU ms per frame at 128^2 and 256^2, with XPBD's kernels in single
+  // precision (the default) and in double, side by side. The study's other rows are CPU time of
+  // one thread (the machine is shared); this is what one frame takes on this 2-core machine.
+  std::ofstream tc("out/bench/solvers_threads.csv");
+  tc << "scene,solver,resolution,substeps,threads,precision,wall_ms_per_frame,cpu_ms_per_frame\n";
+  for (int res : {128, 256}) {
+    if (res > max_res) continue;
+    double wall_of[2][2] = {{0, 0}, {0, 0}};  // [double][threads - 1]
+    for (int dbl : {0, 1})
+      for (int threads : {1, 2}) {
+        StudyScene sc = make_scene("form", res);
+        SolverConfig cfg;
+        cfg.substeps = 10;
+        cfg.threads = threads;
+        cfg.air_damping = sc.air_damping;
+        auto s = make_solver("default", cfg);
+        if (auto* xp = xpbd_of(s->get())) xp->options().single_precision = !dbl;
+        const int frames = static_cast<int>(std::lround(sc.duration * 90));
+        const double c0 = cpu_ms();
+        const auto w0 = std::chrono::steady_clock::now();
+        for (int f = 0; f < frames; ++f) (*s)->step(sc.cloth, sc.objects, 1.0 / 90);
+        const double wall =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0)
+                .count() /
+            frames;
+        const double cpu = (cpu_ms() - c0) / frames;
+        const char* prec = dbl ? "double" : "single";
+        wall_of[dbl][threads - 1] = wall;
+        std::printf("threads  %4d %s 10x1 %s, %d thread%s: %8.3f ms/frame wall, %8.3f ms CPU\n",
+                    res, kDefaultSolver, prec, threads, threads > 1 ? "s" : "", wall, cpu);
+        tc << "form," << kDefaultSolver << "," << res << ",10," << threads << "," << prec << ","
+           << wall << "," << cpu << std::endl;
+      }
+    std::printf("    ratio double / single precision = %.2fx (1 thread), %.2fx (2 threads)\n",
+                wall_of[1][0] / wall_of[0][0], wall_of[1][1] / wall_of[0][1]);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc > 1 && !std::strcmp(argv[1], "--probe")) return probe(argc, argv);
-  bool quick = false, sleep_only = false;
+  bool quick = false, sleep_only = false, threads_only = false;
   int max_res = 64;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--quick")) quick = true;
     if (!std::strcmp(argv[i], "--max-res") && i + 1 < argc) max_res = std::atoi(argv[++i]);
     if (!std::strcmp(argv[i], "--sleep-only")) sleep_only = true;
+    if (!std::strcmp(argv[i], "--threads-only")) threads_only = true;
   }
   std::filesystem::create_directories("out/bench");
   if (sleep_only) {  // the sleeping rows alone (out/bench/solvers_sleep.csv)
     sleep_rows(quick ? 32 : 128);
+    return 0;
+  }
+  if (threads_only) {  // the thread and precision rows alone (out/bench/solvers_threads.csv)
+    thread_rows(std::max(max_res, 256));
     return 0;
   }
   std::vector<Row> rows;
@@ -941,37 +987,7 @@ int main(int argc, char** argv) {
          << det << "," << pairs << std::endl;
     }
   }
-  // Both cores: the default solver 10x1 on the form scene with 1 and 2 threads (colour-parallel,
-  // same result), wall and CPU ms per frame at 128^2 and 256^2. The rows above are CPU time of
-  // one thread (the machine is shared); this is what one frame takes on this 2-core machine.
-  if (!quick && max_res >= 128) {
-    std::ofstream tc("out/bench/solvers_threads.csv");
-    tc << "scene,solver,resolution,substeps,threads,wall_ms_per_frame,cpu_ms_per_frame\n";
-    for (int res : {128, 256}) {
-      if (res > max_res) continue;
-      for (int threads : {1, 2}) {
-        StudyScene sc = make_scene("form", res);
-        SolverConfig cfg;
-        cfg.substeps = 10;
-        cfg.threads = threads;
-        cfg.air_damping = sc.air_damping;
-        auto s = make_solver("default", cfg);
-        const int frames = static_cast<int>(std::lround(sc.duration * 90));
-        const double c0 = cpu_ms();
-        const auto w0 = std::chrono::steady_clock::now();
-        for (int f = 0; f < frames; ++f) (*s)->step(sc.cloth, sc.objects, 1.0 / 90);
-        const double wall =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0)
-                .count() /
-            frames;
-        const double cpu = (cpu_ms() - c0) / frames;
-        std::printf("threads  %4d %s 10x1, %d thread%s: %8.3f ms/frame wall, %8.3f ms CPU\n", res,
-                    kDefaultSolver, threads, threads > 1 ? "s" : "", wall, cpu);
-        tc << "form," << kDefaultSolver << "," << res << ",10," << threads << "," << wall << ","
-           << cpu << std::endl;
-      }
-    }
-  }
+  if (!quick && max_res >= 128) thread_rows(max_res);
   int top = 0;  // the chart: the finest form resolution that is scored (not time only)
   for (const auto& j : jobs)
     if (j.scene == "form" && j.error) top = std::max(top, j.res);

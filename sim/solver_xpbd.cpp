@@ -70,12 +70,19 @@ void XpbdSolver::cook(const Cloth& cloth) {
   apply_order(tris_, order);
   // Packs of four triangles of one colour (sim/xpbd_kernels.hpp); padding lanes use the
   // scratch vertex n.
+  cooked_f32_ = opt_.single_precision;
   tri_packs_.clear();
-  tri_packs_.reserve(tris_.size() / 4 + tri_col_.size());
+  tri_packs8_.clear();
   tpack_col_.assign(1, 0);
+  tpack8_col_.assign(1, 0);
   for (size_t c = 0; c + 1 < tri_col_.size(); ++c) {
-    xpbd::pack_triangles(tris_.data(), tri_col_[c], tri_col_[c + 1], n, tri_packs_);
-    tpack_col_.push_back(static_cast<int>(tri_packs_.size()));
+    if (cooked_f32_) {
+      xpbd::pack_triangles<float, 8>(tris_.data(), tri_col_[c], tri_col_[c + 1], n, tri_packs8_);
+      tpack8_col_.push_back(static_cast<int>(tri_packs8_.size()));
+    } else {
+      xpbd::pack_triangles(tris_.data(), tri_col_[c], tri_col_[c + 1], n, tri_packs_);
+      tpack_col_.push_back(static_cast<int>(tri_packs_.size()));
+    }
   }
   // (Items of the parallel loops: vertices, packs of four elements, hinges, springs.)
   pool_->set_min_parallel(static_cast<int>(tris_.size()) < opt_.min_parallel_triangles
@@ -144,11 +151,19 @@ void XpbdSolver::cook(const Cloth& cloth) {
     }
     lambda_row_.assign(row_ik_.size(), Vec3::Zero());
     row_packs_.clear();
+    row_packs8_.clear();
     rpack_col_.assign(1, 0);
+    rpack8_col_.assign(1, 0);
     for (size_t c = 0; c + 1 < row_cols_.size(); ++c) {
-      row_packs_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
-                        row_cols_[c], row_cols_[c + 1], n);
-      rpack_col_.push_back(row_packs_.packs());
+      if (cooked_f32_) {
+        row_packs8_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
+                           row_cols_[c], row_cols_[c + 1], n);
+        rpack8_col_.push_back(row_packs8_.packs());
+      } else {
+        row_packs_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
+                          row_cols_[c], row_cols_[c + 1], n);
+        rpack_col_.push_back(row_packs_.packs());
+      }
     }
     row_ai_h_ = -1;
   }
@@ -180,7 +195,9 @@ void XpbdSolver::cook(const Cloth& cloth) {
   lambda_hinge_.assign(hinges_.size(), Vec3::Zero());
   lambda_spring_.assign(springs_.size(), 0.0);
   xt_.resize(n);
-  xp_.assign(n + 1, xpbd::P4{{0, 0, 0, 0}});  // + the scratch vertex of padding lanes
+  // + the scratch vertex of padding lanes
+  xp_.assign(cooked_f32_ ? 0 : n + 1, xpbd::P4{{0, 0, 0, 0}});
+  xp8_.assign(cooked_f32_ ? n + 1 : 0, xpbd::P4f{{0, 0, 0, 0}});
   w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
   // Connected pieces (union-find over the elements' vertices).
   std::vector<int> parent(n);
@@ -290,6 +307,7 @@ void XpbdSolver::snap_to_contacts(Cloth& cloth) {
 }
 
 void XpbdSolver::unsettle(int piece) {
+  w_dirty_ = true;
   piece_scale_[piece] = 1.0;
   piece_full_[piece] = 0;
   piece_slow_[piece] = 0;
@@ -442,7 +460,8 @@ double XpbdSolver::settle_scale() const {
 
 StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   StepStats st;
-  if (!energy_.up_to_date(cloth)) cook(cloth);
+  if (!energy_.up_to_date(cloth) || opt_.single_precision != cooked_f32_) cook(cloth);
+  w_dirty_ = true;  // pins, releases, wakes and finishes happen between frames
   energy_.set_form(&scene);
   auto& S = cloth.state;
   auto& x = S.x;
@@ -509,7 +528,12 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       }
       double ai[6] = {0, 0, 0, 0, 0, 0};
       auto store = [&] {
-        for (int m = 0; m < 6; ++m) row_packs_.ai_of(r, m) = ai[m];
+        for (int m = 0; m < 6; ++m) {
+          if (cooked_f32_)
+            row_packs8_.ai_of(r, m) = static_cast<float>(ai[m]);
+          else
+            row_packs_.ai_of(r, m) = ai[m];
+        }
       };
       if (A[0] + A[3] + A[5] == 0) {  // every vertex of the block fixed
         store();
@@ -548,6 +572,16 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   double* lam_row = keep_lambda && !lambda_row_.empty() ? lambda_row_[0].data() : nullptr;
   const xpbd::RowPacks rp = row_packs_.view();
   auto project_tris = [&](int b, int e, int) { K.tris(tri_packs_.data(), b, e, xp, ih2, lam_tri); };
+  xpbd::P4f* xp8 = xp8_.data();
+  const xpbd::RowPacksT<float> rp8 = row_packs8_.view();
+  auto project_tris8 = [&](int b, int e, int) {
+    K.tris8(tri_packs8_.data(), b, e, xp8, ih2, lam_tri);
+  };
+  auto project_rows8 = [&](int b, int e, int) { K.rows8(rp8, b, e, xp8, ihb, lam_row); };
+  // The packed positions' origin: the cloth's first vertex at the frame's start (a float then
+  // resolves every vertex of a cloth a metre or two across to ~1e-7 m or better).
+  if (n > 0)
+    for (int c = 0; c < 3; ++c) origin_[c] = x[0][c];
   const bool padded = !tris_.empty() || row_off_.size() > 1;  // (the springs model has neither)
   auto project_hinges = [&](int b, int e, int) {
     for (int k = b; k < e; ++k) {
@@ -680,7 +714,10 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     }
     if (s == 0) coarse_step(cloth, scene);
     contacts_fresh_ = false;
-    set_w();
+    if (w_dirty_) {
+      set_w();
+      w_dirty_ = false;
+    }
     if (!row_ik_.empty() && (w_changed_ || ihb != row_ai_h_)) {
       pool_->parallel_for(static_cast<int>(row_ik_.size() / 3), build_row_inverses);
       row_ai_h_ = ihb;
@@ -712,7 +749,16 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       std::fill(lambda_spring_.begin(), lambda_spring_.end(), 0.0);
     }
     for (int it = 0; it < opt_.iterations; ++it) {
-      if (padded) {
+      if (padded && cooked_f32_) {
+        pool_->parallel_for(n, [&](int b, int e, int) {
+          K.pack8(reinterpret_cast<const double*>(x.data()), w, origin_, xp8, b, e);
+        });
+        by_colour(tpack8_col_, project_tris8);
+        if (s % be == be - 1 || s == ns - 1) by_colour(rpack8_col_, project_rows8);
+        pool_->parallel_for(n, [&](int b, int e, int) {
+          K.unpack8(xp8, origin_, reinterpret_cast<double*>(x.data()), b, e);
+        });
+      } else if (padded) {
         pool_->parallel_for(n, [&](int b, int e, int) {
           K.pack(reinterpret_cast<const double*>(x.data()), w, xp, b, e);
         });
@@ -749,15 +795,32 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       // a second).
       std::fill(motion_.begin(), motion_.end(), PieceMotion{});
       const double slow2 = opt_.settle_speed * opt_.settle_speed;
-      for (int i = 0; i < n; ++i)
-        if (w[i] > 0) {
-          PieceMotion& pm = motion_[piece_of_[i]];
-          const double v2 = S.v[i].squaredNorm();
-          pm.max_v2 = std::max(pm.max_v2, v2);
-          pm.mv2 += S.mass[i] * v2;
-          pm.mv2_capped += S.mass[i] * std::min(v2, slow2);
-          pm.m += S.mass[i];
+      // Summed in registers over each run of vertices of one piece (a piece's vertices are
+      // mostly contiguous), not through memory vertex by vertex.
+      int cur = -1;
+      PieceMotion acc;
+      auto flush = [&] {
+        if (cur < 0) return;
+        PieceMotion& pm = motion_[cur];
+        pm.max_v2 = std::max(pm.max_v2, acc.max_v2);
+        pm.mv2 += acc.mv2;
+        pm.mv2_capped += acc.mv2_capped;
+        pm.m += acc.m;
+      };
+      for (int i = 0; i < n; ++i) {
+        if (!(w[i] > 0)) continue;
+        if (piece_of_[i] != cur) {
+          flush();
+          cur = piece_of_[i];
+          acc = PieceMotion{};
         }
+        const double v2 = S.v[i].squaredNorm(), m = S.mass[i];
+        acc.max_v2 = std::max(acc.max_v2, v2);
+        acc.mv2 += m * v2;
+        acc.mv2_capped += m * std::min(v2, slow2);
+        acc.m += m;
+      }
+      flush();
     }
     if (opt_.settle) {
       const double exit2 = opt_.settle_exit_speed * opt_.settle_exit_speed;
@@ -770,6 +833,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
           } else if (piece_scale_[p] == 1.0 || (piece_scale_[p] < opt_.settle_mass_scale &&
                                                 ++piece_slow_[p] >= opt_.settle_grow_steps)) {
             // Start or grow; w changes, the bending inverses are rebuilt once for it.
+            w_dirty_ = true;
             piece_scale_[p] = std::min(std::max(opt_.settle_growth, 1.0 + 1e-9) * piece_scale_[p],
                                        opt_.settle_mass_scale);
             piece_slow_[p] = 0;
@@ -799,15 +863,22 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
           if (moving && pm.m > 0 && pm.mv2_capped < v2 * pm.m) moving = false;
         }
         piece_rest_[p] = moving ? 0 : piece_rest_[p] + 1;
-        if (piece_rest_[p] >= opt_.freeze_steps || settled_long) piece_frozen_[p] = 1;
-      }
-      frozen_count_ = 0;
-      for (int i = 0; i < n; ++i)
-        if (piece_frozen_[piece_of_[i]] && cloth.is_free(i)) {
-          S.flags[i] |= kFlagFrozen;
-          S.v[i].setZero();
-          ++frozen_count_;
+        if (piece_rest_[p] >= opt_.freeze_steps || settled_long) {
+          piece_frozen_[p] = 1;
+          w_dirty_ = true;
         }
+      }
+      // (Once per frame, and in a substep in which a piece fell asleep: nothing else changes
+      // the flags between substeps.)
+      if (s == 0 || w_dirty_) {
+        frozen_count_ = 0;
+        for (int i = 0; i < n; ++i)
+          if (piece_frozen_[piece_of_[i]] && cloth.is_free(i)) {
+            S.flags[i] |= kFlagFrozen;
+            S.v[i].setZero();
+            ++frozen_count_;
+          }
+      }
     }
     S.time += h;
     ++st.substeps;

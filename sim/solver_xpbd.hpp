@@ -70,6 +70,11 @@ struct XpbdOptions {
   // substeps 5.8 vs 6.4 mm) but at 16^2 it grows (form 20 substeps 2.1 vs 1.3 mm), so plain
   // XPBD (1) stays the default.
   int bending_every = 1;
+  // Triangles and bending blocks projected in single precision, eight per pack (AVX: one
+  // register), on positions taken relative to a vertex of the cloth (xpbd_kernels.hpp, P4f);
+  // the state stays double and receives the kernels' moves. false: the double kernels, four per
+  // pack. Measured in docs/solvers.md section 3o.
+  bool single_precision = true;
   bool freeze = false;
   double freeze_speed = 1e-3;  // m/s
   int freeze_steps = 30;
@@ -208,6 +213,9 @@ class XpbdSolver : public Solver {
   std::vector<int> rpack_col_;
   double row_ai_h_ = -1;  // the 1/(be h^2) the cached inverses were built for
   bool w_changed_ = true;
+  // The inverse masses w_ must be recomputed (each frame's start; a piece's settling scale
+  // changed or a piece fell asleep within the frame); otherwise they are kept between substeps.
+  bool w_dirty_ = true;
   std::vector<Vec3> lambda_row_;
   std::vector<double> lambda_tri_, lambda_spring_;
   std::vector<Vec3> lambda_hinge_, xt_;
@@ -215,6 +223,15 @@ class XpbdSolver : public Solver {
   // kernels (xpbd_kernels.hpp), packed before and unpacked after them in every iteration; one
   // more, the scratch vertex (w = 0), for the packs' padding lanes.
   std::vector<xpbd::P4> xp_;
+  // The single-precision forms (XpbdOptions::single_precision; only those of the precision the
+  // solver was cooked for are filled) and the origin of the packed positions.
+  bool cooked_f32_ = false;
+  std::vector<xpbd::TriPack8> tri_packs8_;
+  std::vector<int> tpack8_col_;
+  xpbd::RowPackData8 row_packs8_;
+  std::vector<int> rpack8_col_;
+  std::vector<xpbd::P4f> xp8_;
+  double origin_[3] = {0, 0, 0};
   const xpbd::Kernels* kern_ = &xpbd::kernels();
   double h_prev_ = 0;
   std::vector<double> w_;  // inverse mass of each vertex, 0 when not free or frozen

@@ -10,25 +10,30 @@ namespace drape::sim::xpbd {
 
 namespace portable {
 #include "sim/xpbd_kernels.inl"
-const Kernels kKernels{"portable", &project_tris, &project_rows, &pack, &unpack};
+const Kernels kKernels{"portable",     &project_tris,  &project_rows, &pack,   &unpack,
+                       &project_tris8, &project_rows8, &pack8,        &unpack8};
 }  // namespace portable
 
-void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPack>& out) {
-  for (int k0 = b; k0 < e; k0 += 4) {
-    TriPack P{};  // padding lanes: coefficients 0
-    for (int l = 0; l < 4; ++l) {
+template <class T, int L>
+void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPackT<T, L>>& out) {
+  for (int k0 = b; k0 < e; k0 += L) {
+    TriPackT<T, L> P{};  // padding lanes: coefficients 0
+    for (int l = 0; l < L; ++l) {
       const int k = k0 + l;
       P.k[l] = k < e ? k : -1;
       for (int q = 0; q < 3; ++q) P.v[q][l] = k < e ? tris[k].v[q] : scratch;
       if (k >= e) continue;
-      for (int j = 0; j < 6; ++j) P.D[j][l] = tris[k].D[j];
-      for (int a = 0; a < 3; ++a) P.ia[a][l] = tris[k].ia[a];
+      for (int j = 0; j < 6; ++j) P.D[j][l] = static_cast<T>(tris[k].D[j]);
+      for (int a = 0; a < 3; ++a) P.ia[a][l] = static_cast<T>(tris[k].ia[a]);
     }
     out.push_back(P);
   }
 }
+template void pack_triangles<double, 4>(const Tri*, int, int, int, std::vector<TriPack>&);
+template void pack_triangles<float, 8>(const Tri*, int, int, int, std::vector<TriPack8>&);
 
-void RowPackData::clear() {
+template <class T, int L>
+void RowPackDataT<T, L>::clear() {
   off.assign(1, 0);
   colv.clear();
   blk.clear();
@@ -38,37 +43,41 @@ void RowPackData::clear() {
   slot.clear();
 }
 
-void RowPackData::append(const int* boff, const int* bcol, const double* bval, const double* bik,
-                         int b, int e, int scratch) {
+template <class T, int L>
+void RowPackDataT<T, L>::append(const int* boff, const int* bcol, const double* bval,
+                                const double* bik, int b, int e, int scratch) {
   if (static_cast<int>(slot.size()) < e) slot.resize(e, -1);
-  for (int r0 = b; r0 < e; r0 += 4) {
+  for (int r0 = b; r0 < e; r0 += L) {
     const int p = packs();
-    const int lanes = std::min(4, e - r0);
+    const int lanes = std::min(L, e - r0);
     int len = 0;
     for (int l = 0; l < lanes; ++l) len = std::max(len, boff[r0 + l + 1] - boff[r0 + l]);
     for (int i = 0; i < len; ++i) {
-      for (int l = 0; l < 4; ++l) {
+      for (int l = 0; l < L; ++l) {
         const int r = r0 + l;
         const bool real = l < lanes && i < boff[r + 1] - boff[r];
         colv.push_back(real ? bcol[boff[r] + i] : scratch);
       }
       for (int a = 0; a < 3; ++a)
-        for (int l = 0; l < 4; ++l) {
+        for (int l = 0; l < L; ++l) {
           const int r = r0 + l;
           const bool real = l < lanes && i < boff[r + 1] - boff[r];
-          val.push_back(real ? bval[3 * (boff[r] + i) + a] : 0.0);
+          val.push_back(real ? static_cast<T>(bval[3 * (boff[r] + i) + a]) : T(0));
         }
     }
     off.push_back(off.back() + len);
     for (int a = 0; a < 3; ++a)
-      for (int l = 0; l < 4; ++l) ik.push_back(l < lanes ? bik[3 * (r0 + l) + a] : 0.0);
-    for (int l = 0; l < 4; ++l) {
+      for (int l = 0; l < L; ++l)
+        ik.push_back(l < lanes ? static_cast<T>(bik[3 * (r0 + l) + a]) : T(0));
+    for (int l = 0; l < L; ++l) {
       blk.push_back(l < lanes ? r0 + l : -1);
-      if (l < lanes) slot[r0 + l] = 4 * p + l;
+      if (l < lanes) slot[r0 + l] = L * p + l;
     }
-    ai.resize(ai.size() + 24, 0.0);
+    ai.resize(ai.size() + 6 * L, T(0));
   }
 }
+template struct RowPackDataT<double, 4>;
+template struct RowPackDataT<float, 8>;
 
 #if defined(DRAPE_XPBD_AVX2)
 namespace avx2 {

@@ -1,9 +1,11 @@
-// XPBD's two hot loops (membrane triangles, tensor-bending blocks: ~70 % of a substep at 128^2,
-// measured with perf), vectorised ACROSS elements: four elements of one colour (which share no
-// vertex) are one pack and each SIMD lane computes one of them, so the divisions, dot products
-// and 3x3 solves of four elements run side by side instead of as one long dependency chain.
-// Positions are padded to four doubles (P4) with the inverse mass in the fourth lane: a 4x4
-// transpose of four vertices gives the lanes' x, y, z and w.
+// XPBD's two hot loops (membrane triangles, tensor-bending blocks: ~60 % of a substep at 128^2,
+// measured with perf), vectorised ACROSS elements: the elements of one colour (which share no
+// vertex) are packed, each SIMD lane computing one of them, so the divisions, dot products and
+// 3x3 solves of a pack run side by side instead of as one long dependency chain.
+// Two precisions: four doubles per pack, positions padded to four doubles (P4) with the inverse
+// mass in the fourth lane (a 4x4 transpose of four vertices gives the lanes' x, y, z and w); or
+// (the solver's default, XpbdOptions::single_precision) eight floats per pack on 16-byte P4f
+// positions relative to an origin near the cloth, the state itself staying double.
 // The same source (sim/xpbd_kernels.inl) is compiled twice: portable (x86-64 baseline: SSE2, or
 // any other target) and, on x86-64, with AVX2+FMA; kernels() picks the AVX2 build at run time
 // when the CPU has it. Results of the two differ by round-off only (FMA contraction).
@@ -21,6 +23,11 @@ namespace drape::sim::xpbd {
 struct alignas(32) P4 {
   double c[4];
 };
+// The single-precision form (XpbdOptions::single_precision): 16 bytes, the position relative to
+// an origin near the cloth (pack8), so that a float resolves it to ~3e-8 m.
+struct alignas(16) P4f {
+  float c[4];
+};
 
 // One membrane triangle: the three strain constraints E_uu, E_vv, E_uv of F = sum_k x_k D_k.
 struct Tri {
@@ -29,40 +36,51 @@ struct Tri {
   double ia[3];  // 1 / (k A) for E_uu, E_vv, E_uv
 };
 
-// Four triangles of one colour, lane l holding triangle k[l] (-1: padding, whose vertices are the
-// scratch vertex and whose coefficients are 0).
-struct alignas(32) TriPack {
-  double D[6][4];
-  double ia[3][4];
-  int32_t v[3][4];
-  int32_t k[4];
+// L triangles of one colour (scalar T), lane l holding triangle k[l] (-1: padding, whose vertices
+// are the scratch vertex and whose coefficients are 0). TriPack: four doubles; TriPack8: eight
+// floats.
+template <class T, int L>
+struct alignas(32) TriPackT {
+  T D[6][L];
+  T ia[3][L];
+  int32_t v[3][L];
+  int32_t k[L];
 };
+using TriPack = TriPackT<double, 4>;
+using TriPack8 = TriPackT<float, 8>;
 
-// Appends triangles [b, e) (one colour) as packs of four; padding lanes use vertex `scratch`
+// Appends triangles [b, e) (one colour) as packs of L; padding lanes use vertex `scratch`
 // (an extra P4 whose inverse mass is 0).
-void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPack>& out);
+template <class T, int L>
+void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPackT<T, L>>& out);
+inline void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPack>& out) {
+  pack_triangles<double, 4>(tris, b, e, scratch, out);
+}
 
 // Tensor-bending blocks (three linear vector constraints sharing one stencil each; see
-// XpbdSolver::cook) packed four per pack, one block per lane: pack p's stencil entries are
+// XpbdSolver::cook) packed L per pack, one block per lane: pack p's stencil entries are
 // [off[p], off[p + 1]) (the longest of its blocks; shorter ones are padded with the scratch
-// vertex and coefficient 0). Entry k: vertices colv[4k + l], coefficients val[12k + 4a + l] of
-// rows a = 0, 1, 2. Per pack: the inverse stiffnesses ik[12p + 4a + l], the inverse of the 3x3
-// system matrix ai[24p + 4m + l] (m: 00 01 02 11 12 22; all 0: the lane does nothing) and the
-// block index blk[4p + l] (-1: padding).
-struct RowPacks {
+// vertex and coefficient 0). Entry k: vertices colv[L k + l], coefficients val[3L k + L a + l] of
+// rows a = 0, 1, 2. Per pack: the inverse stiffnesses ik[3L p + L a + l], the inverse of the 3x3
+// system matrix ai[6L p + L m + l] (m: 00 01 02 11 12 22; all 0: the lane does nothing) and the
+// block index blk[L p + l] (-1: padding).
+template <class T>
+struct RowPacksT {
   const int* off;
   const int32_t* colv;
-  const double* val;
-  const double* ik;
-  const double* ai;
+  const T* val;
+  const T* ik;
+  const T* ai;
   const int32_t* blk;
 };
+using RowPacks = RowPacksT<double>;
 
-struct RowPackData {
+template <class T, int L>
+struct RowPackDataT {
   std::vector<int> off{0};
   std::vector<int32_t> colv, blk;
-  std::vector<double> val, ik, ai;
-  std::vector<int> slot;  // per block: 4 * pack + lane
+  std::vector<T> val, ik, ai;
+  std::vector<int> slot;  // per block: L * pack + lane
   void clear();
   // Appends blocks [b, e) (one colour) of the CSR (boff, bcol, bval: 3 per entry; bik: 3 per
   // block).
@@ -70,14 +88,16 @@ struct RowPackData {
               int scratch);
   int packs() const { return static_cast<int>(off.size()) - 1; }
   // The inverse system matrix entry m of a block.
-  double& ai_of(int block, int m) {
+  T& ai_of(int block, int m) {
     const int s = slot[block];
-    return ai[24 * (s / 4) + 4 * m + s % 4];
+    return ai[6 * L * (s / L) + L * m + s % L];
   }
-  RowPacks view() const {
-    return RowPacks{off.data(), colv.data(), val.data(), ik.data(), ai.data(), blk.data()};
+  RowPacksT<T> view() const {
+    return RowPacksT<T>{off.data(), colv.data(), val.data(), ik.data(), ai.data(), blk.data()};
   }
 };
+using RowPackData = RowPackDataT<double, 4>;
+using RowPackData8 = RowPackDataT<float, 8>;
 
 struct Kernels {
   const char* name;  // "avx2" or "portable"
@@ -90,6 +110,17 @@ struct Kernels {
   // Positions (3 doubles per vertex) and inverse masses to and from the padded form, [b, e).
   void (*pack)(const double* x, const double* w, P4* p, int b, int e);
   void (*unpack)(const P4* p, double* x, int b, int e);
+  // The same in single precision, eight elements per pack, on positions relative to an origin
+  // near the cloth; so the elements must not change under a translation (sum_k D_k = 0, used by
+  // the triangle kernel, which forms F from the edges; bending rows that annihilate constants,
+  // as ClothEnergy's: P 1 = 0). pack8 stores float(x - origin); unpack8 adds to x
+  // the change of each float since pack8 (x += p - float(x - origin), in double), so a vertex the
+  // kernels did not move keeps its double position exactly, and the kernels' moves land to float
+  // round-off.
+  void (*tris8)(const TriPack8* packs, int b, int e, P4f* x, double ih2, double* lambda);
+  void (*rows8)(const RowPacksT<float>& rp, int b, int e, P4f* x, double ihb, double* lambda);
+  void (*pack8)(const double* x, const double* w, const double* origin, P4f* p, int b, int e);
+  void (*unpack8)(const P4f* p, const double* origin, double* x, int b, int e);
 };
 
 // The fastest build this CPU runs; simd = false: the portable one (tests compare the two).

@@ -237,3 +237,222 @@ void unpack(const P4* p, double* x, int b, int e) {
   for (int i = b; i < e; ++i)
     for (int c = 0; c < 3; ++c) x[3 * i + c] = p[i].c[c];
 }
+
+// ---- Single precision: eight elements per pack (XpbdOptions::single_precision) ----
+using F8 = float __attribute__((vector_size(32)));
+using F4 = float __attribute__((vector_size(16)));
+using M8 = int __attribute__((vector_size(32)));
+
+inline F8 ld8(const float* p) {
+  F8 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline F4 ld4(const P4f& p) {  // 16-byte aligned
+  return *reinterpret_cast<const F4*>(p.c);
+}
+inline void st4(P4f& p, F4 v) {
+  *reinterpret_cast<F4*>(p.c) = v;
+}
+inline F8 splat8(float s) {
+  return F8{s, s, s, s, s, s, s, s};
+}
+inline F8 sel8(M8 m, F8 a, F8 b) {  // m ? a : b, lane by lane
+  return reinterpret_cast<F8>((reinterpret_cast<M8>(a) & m) | (reinterpret_cast<M8>(b) & ~m));
+}
+
+// Four rows, each [vertex l | vertex l + 4] as (x, y, z, w | x, y, z, w), to the columns
+// X = (x0 .. x7), Y, Z, W: a 4x4 transpose inside each 128-bit half (its own inverse). With
+// AVX these are in-lane shuffles; without, each half is one SSE register.
+inline void transpose8(F8 a, F8 b, F8 c, F8 d, F8& X, F8& Y, F8& Z, F8& W) {
+  const F8 t0 = __builtin_shufflevector(a, b, 0, 8, 1, 9, 4, 12, 5, 13);
+  const F8 t1 = __builtin_shufflevector(a, b, 2, 10, 3, 11, 6, 14, 7, 15);
+  const F8 t2 = __builtin_shufflevector(c, d, 0, 8, 1, 9, 4, 12, 5, 13);
+  const F8 t3 = __builtin_shufflevector(c, d, 2, 10, 3, 11, 6, 14, 7, 15);
+  X = __builtin_shufflevector(t0, t2, 0, 1, 8, 9, 4, 5, 12, 13);
+  Y = __builtin_shufflevector(t0, t2, 2, 3, 10, 11, 6, 7, 14, 15);
+  Z = __builtin_shufflevector(t1, t3, 0, 1, 8, 9, 4, 5, 12, 13);
+  W = __builtin_shufflevector(t1, t3, 2, 3, 10, 11, 6, 7, 14, 15);
+}
+
+struct Lanes8 {
+  F8 X, Y, Z, W;
+};
+inline F8 join(F4 a, F4 b) {
+  return __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7);
+}
+inline Lanes8 gather8(const P4f* x, const int32_t* v) {
+  Lanes8 g;
+  transpose8(join(ld4(x[v[0]]), ld4(x[v[4]])), join(ld4(x[v[1]]), ld4(x[v[5]])),
+             join(ld4(x[v[2]]), ld4(x[v[6]])), join(ld4(x[v[3]]), ld4(x[v[7]])), g.X, g.Y, g.Z,
+             g.W);
+  return g;
+}
+// Lanes sharing a vertex (only padding's scratch vertex, which no projection moves) write the
+// same value.
+inline void scatter8(P4f* x, const int32_t* v, const Lanes8& g) {
+  F8 a, b, c, d;
+  transpose8(g.X, g.Y, g.Z, g.W, a, b, c, d);
+  st4(x[v[0]], __builtin_shufflevector(a, a, 0, 1, 2, 3));
+  st4(x[v[4]], __builtin_shufflevector(a, a, 4, 5, 6, 7));
+  st4(x[v[1]], __builtin_shufflevector(b, b, 0, 1, 2, 3));
+  st4(x[v[5]], __builtin_shufflevector(b, b, 4, 5, 6, 7));
+  st4(x[v[2]], __builtin_shufflevector(c, c, 0, 1, 2, 3));
+  st4(x[v[6]], __builtin_shufflevector(c, c, 4, 5, 6, 7));
+  st4(x[v[3]], __builtin_shufflevector(d, d, 0, 1, 2, 3));
+  st4(x[v[7]], __builtin_shufflevector(d, d, 4, 5, 6, 7));
+}
+
+// project_tris in single precision, F formed from the edges: (x1 - x0) D_1 + (x2 - x0) D_2
+// (D_0 = -D_1 - D_2).
+void project_tris8(const TriPack8* packs, int b, int e, P4f* x, double ih2d, double* lambda) {
+  const F8 zero = splat8(0), one = splat8(1), half = splat8(0.5f), tiny = splat8(1e-20f);
+  const float ih2 = static_cast<float>(ih2d);
+  for (int p = b; p < e; ++p) {
+    const TriPack8& T = packs[p];
+    Lanes8 g[3];
+    F8 Du[3], Dv[3];
+    for (int q = 0; q < 3; ++q) {
+      g[q] = gather8(x, T.v[q]);
+      Du[q] = ld8(T.D[2 * q]);
+      Dv[q] = ld8(T.D[2 * q + 1]);
+    }
+    const F8 e1x = g[1].X - g[0].X, e1y = g[1].Y - g[0].Y, e1z = g[1].Z - g[0].Z;
+    const F8 e2x = g[2].X - g[0].X, e2y = g[2].Y - g[0].Y, e2z = g[2].Z - g[0].Z;
+    F8 fux = e1x * Du[1] + e2x * Du[2], fuy = e1y * Du[1] + e2y * Du[2],
+       fuz = e1z * Du[1] + e2z * Du[2];
+    F8 fvx = e1x * Dv[1] + e2x * Dv[2], fvy = e1y * Dv[1] + e2y * Dv[2],
+       fvz = e1z * Dv[1] + e2z * Dv[2];
+    const F8 Suu = g[0].W * Du[0] * Du[0] + g[1].W * Du[1] * Du[1] + g[2].W * Du[2] * Du[2];
+    const F8 Svv = g[0].W * Dv[0] * Dv[0] + g[1].W * Dv[1] * Dv[1] + g[2].W * Dv[2] * Dv[2];
+    const F8 Suv = g[0].W * Du[0] * Dv[0] + g[1].W * Du[1] * Dv[1] + g[2].W * Du[2] * Dv[2];
+    const M8 live = (g[0].W + g[1].W + g[2].W) > zero;
+    F8 lam[3] = {zero, zero, zero};
+    if (lambda)
+      for (int l = 0; l < 8; ++l)
+        if (T.k[l] >= 0)
+          for (int c = 0; c < 3; ++c) lam[c][l] = static_cast<float>(lambda[3 * T.k[l] + c]);
+    auto solve = [&](F8 alpha, F8 num, F8 denom, int c) {
+      const M8 ok = (denom >= tiny) & live;
+      const F8 dl = sel8(ok, (num - alpha * lam[c]) / sel8(ok, denom, one), zero);
+      lam[c] += dl;
+      return dl;
+    };
+    F8 ax = zero, ay = zero, az = zero, bx = zero, by = zero, bz = zero;
+    {
+      const F8 alpha = ih2 * ld8(T.ia[0]);
+      const F8 f2 = fux * fux + fuy * fuy + fuz * fuz;
+      const F8 dl = solve(alpha, -half * (f2 - one), alpha + Suu * f2, 0);
+      ax += dl * fux, ay += dl * fuy, az += dl * fuz;
+      const F8 cross = dl * Suv, grow = one + dl * Suu;
+      fvx += cross * fux, fvy += cross * fuy, fvz += cross * fuz;
+      fux *= grow, fuy *= grow, fuz *= grow;
+    }
+    {
+      const F8 alpha = ih2 * ld8(T.ia[1]);
+      const F8 f2 = fvx * fvx + fvy * fvy + fvz * fvz;
+      const F8 dl = solve(alpha, -half * (f2 - one), alpha + Svv * f2, 1);
+      bx += dl * fvx, by += dl * fvy, bz += dl * fvz;
+      const F8 cross = dl * Suv, grow = one + dl * Svv;
+      fux += cross * fvx, fuy += cross * fvy, fuz += cross * fvz;
+      fvx *= grow, fvy *= grow, fvz *= grow;
+    }
+    {
+      const F8 alpha = ih2 * ld8(T.ia[2]);
+      const F8 uv = fux * fvx + fuy * fvy + fuz * fvz;
+      const F8 uu = fux * fux + fuy * fuy + fuz * fuz;
+      const F8 vv = fvx * fvx + fvy * fvy + fvz * fvz;
+      const F8 denom = alpha + 0.25f * (Suu * vv + 2.0f * Suv * uv + Svv * uu);
+      const F8 dl = half * solve(alpha, -half * uv, denom, 2);
+      ax += dl * fvx, ay += dl * fvy, az += dl * fvz;
+      bx += dl * fux, by += dl * fuy, bz += dl * fuz;
+    }
+    if (lambda)
+      for (int l = 0; l < 8; ++l)
+        if (T.k[l] >= 0)
+          for (int c = 0; c < 3; ++c) lambda[3 * T.k[l] + c] = lam[c][l];
+    for (int q = 0; q < 3; ++q) {
+      Lanes8& v = g[q];
+      v.X += v.W * (Du[q] * ax + Dv[q] * bx);
+      v.Y += v.W * (Du[q] * ay + Dv[q] * by);
+      v.Z += v.W * (Du[q] * az + Dv[q] * bz);
+      scatter8(x, T.v[q], v);
+    }
+  }
+}
+
+// project_rows in single precision (positions relative to the packing origin; a stencil read
+// relative to its own first vertex was measured no more accurate - the floats' resolution of
+// each position is the same either way - and spilled registers).
+void project_rows8(const RowPacksT<float>& rp, int b, int e, P4f* x, double ihbd, double* lambda) {
+  const F8 zero = splat8(0);
+  const float ihb = static_cast<float>(ihbd);
+  for (int p = b; p < e; ++p) {
+    const int k0 = rp.off[p], k1 = rp.off[p + 1];
+    F8 c0x = zero, c0y = zero, c0z = zero, c1x = zero, c1y = zero, c1z = zero, c2x = zero,
+       c2y = zero, c2z = zero;
+    for (int k = k0; k < k1; ++k) {
+      const Lanes8 g = gather8(x, rp.colv + 8 * k);
+      const float* val = rp.val + 24 * k;
+      const F8 v0 = ld8(val), v1 = ld8(val + 8), v2 = ld8(val + 16);
+      c0x += v0 * g.X, c0y += v0 * g.Y, c0z += v0 * g.Z;
+      c1x += v1 * g.X, c1y += v1 * g.Y, c1z += v1 * g.Z;
+      c2x += v2 * g.X, c2y += v2 * g.Y, c2z += v2 * g.Z;
+    }
+    const int32_t* blk = rp.blk + 8 * p;
+    F8 lam[9];
+    if (lambda) {
+      for (int j = 0; j < 9; ++j) {
+        lam[j] = zero;
+        for (int l = 0; l < 8; ++l)
+          if (blk[l] >= 0) lam[j][l] = static_cast<float>(lambda[9 * blk[l] + j]);
+      }
+      const F8 al0 = ihb * ld8(rp.ik + 24 * p), al1 = ihb * ld8(rp.ik + 24 * p + 8),
+               al2 = ihb * ld8(rp.ik + 24 * p + 16);
+      c0x += al0 * lam[0], c0y += al0 * lam[1], c0z += al0 * lam[2];
+      c1x += al1 * lam[3], c1y += al1 * lam[4], c1z += al1 * lam[5];
+      c2x += al2 * lam[6], c2y += al2 * lam[7], c2z += al2 * lam[8];
+    }
+    const float* A = rp.ai + 48 * p;
+    const F8 a00 = ld8(A), a01 = ld8(A + 8), a02 = ld8(A + 16), a11 = ld8(A + 24),
+             a12 = ld8(A + 32), a22 = ld8(A + 40);
+    const F8 d0x = -(a00 * c0x + a01 * c1x + a02 * c2x), d0y = -(a00 * c0y + a01 * c1y + a02 * c2y),
+             d0z = -(a00 * c0z + a01 * c1z + a02 * c2z);
+    const F8 d1x = -(a01 * c0x + a11 * c1x + a12 * c2x), d1y = -(a01 * c0y + a11 * c1y + a12 * c2y),
+             d1z = -(a01 * c0z + a11 * c1z + a12 * c2z);
+    const F8 d2x = -(a02 * c0x + a12 * c1x + a22 * c2x), d2y = -(a02 * c0y + a12 * c1y + a22 * c2y),
+             d2z = -(a02 * c0z + a12 * c1z + a22 * c2z);
+    if (lambda) {
+      const F8 d[9] = {d0x, d0y, d0z, d1x, d1y, d1z, d2x, d2y, d2z};
+      for (int l = 0; l < 8; ++l)
+        if (blk[l] >= 0)
+          for (int j = 0; j < 9; ++j) lambda[9 * blk[l] + j] = lam[j][l] + d[j][l];
+    }
+    for (int k = k0; k < k1; ++k) {
+      const int32_t* v = rp.colv + 8 * k;
+      Lanes8 g = gather8(x, v);
+      const float* val = rp.val + 24 * k;
+      const F8 v0 = ld8(val), v1 = ld8(val + 8), v2 = ld8(val + 16);
+      g.X += g.W * (v0 * d0x + v1 * d1x + v2 * d2x);
+      g.Y += g.W * (v0 * d0y + v1 * d1y + v2 * d2y);
+      g.Z += g.W * (v0 * d0z + v1 * d1z + v2 * d2z);
+      scatter8(x, v, g);
+    }
+  }
+}
+
+void pack8(const double* x, const double* w, const double* origin, P4f* p, int b, int e) {
+  for (int i = b; i < e; ++i) {
+    for (int c = 0; c < 3; ++c) p[i].c[c] = static_cast<float>(x[3 * i + c] - origin[c]);
+    p[i].c[3] = static_cast<float>(w[i]);
+  }
+}
+
+void unpack8(const P4f* p, const double* origin, double* x, int b, int e) {
+  for (int i = b; i < e; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double x0 = x[3 * i + c];
+      const float packed = static_cast<float>(x0 - origin[c]);  // what pack8 stored
+      x[3 * i + c] = x0 + (static_cast<double>(p[i].c[c]) - static_cast<double>(packed));
+    }
+}

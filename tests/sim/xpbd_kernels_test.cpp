@@ -1,6 +1,6 @@
-// XPBD's hot loops (sim/xpbd_kernels.hpp): the packed kernels (four elements per pack, one per
-// lane) do what projecting the elements one after the other does, the AVX2 build agrees with
-// the portable one, and a triangle projection does what the constraint says.
+// XPBD's hot loops (sim/xpbd_kernels.hpp): the packed kernels (four doubles or eight floats per
+// pack, one element per lane) do what projecting the elements one after the other does, the AVX2
+// build agrees with the portable one, and a triangle projection does what the constraint says.
 #include "sim/xpbd_kernels.hpp"
 
 #include <gtest/gtest.h>
@@ -29,9 +29,10 @@ struct Problem {
 };
 
 // Random but well-posed data: positions in the unit cube, some vertices fixed (w = 0), 203
-// triangles and 101 bending blocks of 3 to 7 vertices (counts not multiples of four: the last
-// pack is padded) over vertices no two elements share, compliances that keep every denominator
-// away from zero, and each block's inverse system matrix as the solver builds it.
+// triangles and 101 bending blocks of 3 to 7 vertices (counts not multiples of four or eight:
+// the last pack is padded) over vertices no two elements share, elements that ignore
+// translations (as real ones), compliances that keep every denominator away from zero, and each
+// block's inverse system matrix as the solver builds it.
 Problem make_problem(unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, 1), s(-5, 5);
@@ -58,16 +59,25 @@ Problem make_problem(unsigned seed) {
       T.ia[a] = 0.1 + u(rng);
     }
     for (double& d : T.D) d = s(rng);
+    T.D[0] = -T.D[2] - T.D[4];  // sum_k D_k = 0, as for every triangle: F ignores translations
+    T.D[1] = -T.D[3] - T.D[5];
     p.tris.push_back(T);
   }
   // One triangle with all its vertices fixed: the kernels must leave it (and its multipliers)
   // alone.
   for (int a = 0; a < 3; ++a) p.w[p.tris[5].v[a]] = 0;
   for (int r = 0; r < nblk; ++r) {
+    double mean[3] = {0, 0, 0};
     for (int i = 0; i < lens[r]; ++i) {
       p.colv.push_back(perm[next++]);
-      for (int a = 0; a < 3; ++a) p.val.push_back(s(rng));
+      for (int a = 0; a < 3; ++a) {
+        p.val.push_back(s(rng));
+        mean[a] += p.val.back() / lens[r];
+      }
     }
+    // Rows that annihilate constants (as the tensor bending's: P 1 = 0).
+    for (int i = 0; i < lens[r]; ++i)
+      for (int a = 0; a < 3; ++a) p.val[p.val.size() - 3 * (i + 1) + a] -= mean[a];
     p.off.push_back(static_cast<int>(p.colv.size()));
     for (int a = 0; a < 3; ++a) p.ik.push_back(0.1 + u(rng));
   }
@@ -242,6 +252,128 @@ TEST(XpbdKernels, SimdBuildAgreesWithThePortableOne) {
     for (int c = 0; c < 4; ++c) d = std::max(d, std::abs(a.xp[i].c[c] - b.xp[i].c[c]));
   std::printf("%s vs portable: positions differ by %.3e\n", fast.name, d);
   EXPECT_LT(d, 1e-12);
+}
+
+// The problem in single precision: positions moved to `offset` (metres away from the origin,
+// as a cloth on a dress form is) and packed relative to `origin` by pack8.
+struct Packed8 {
+  std::vector<double> x;  // the double state (3 per vertex) that unpack8 updates
+  std::vector<P4f> xp;
+  std::vector<TriPack8> tp;
+  RowPackData8 rp;
+};
+Packed8 pack_problem8(const Problem& p, const Kernels& K, const double* offset,
+                      const double* origin) {
+  Packed8 k;
+  k.x.resize(3 * p.n);
+  for (int i = 0; i < p.n; ++i)
+    for (int c = 0; c < 3; ++c) k.x[3 * i + c] = p.x[i][c] + offset[c];
+  k.xp.assign(p.n + 1, P4f{{0, 0, 0, 0}});
+  K.pack8(k.x.data(), p.w.data(), origin, k.xp.data(), 0, p.n);
+  pack_triangles<float, 8>(p.tris.data(), 0, static_cast<int>(p.tris.size()), p.n, k.tp);
+  const int nb = static_cast<int>(p.off.size()) - 1;
+  k.rp.append(p.off.data(), p.colv.data(), p.val.data(), p.ik.data(), 0, nb, p.n);
+  for (int r = 0; r < nb; ++r)
+    for (int m = 0; m < 6; ++m) k.rp.ai_of(r, m) = static_cast<float>(p.ai[6 * r + m]);
+  return k;
+}
+
+// The single-precision kernels (eight elements per pack, positions as floats relative to an
+// origin, the state kept in double by unpack8) do what the double reference does, to float
+// round-off, with the cloth a metre and more from the coordinate origin.
+TEST(XpbdKernels, SinglePrecisionPacksProjectLikeTheDoubleReference) {
+  const double offset[3] = {-0.7, 1.3, 0.45};  // a cloth at a dress form's chest
+  const double origin[3] = {-0.5, 1.6, 0.2};   // one of its vertices, not the centre
+  for (const Kernels* K : {&kernels(false), &kernels(true)})
+    for (bool keep : {false, true}) {
+      Problem ref = make_problem(7);
+      const Problem orig = ref;
+      Packed8 pk = pack_problem8(ref, *K, offset, origin);
+      EXPECT_EQ(pk.tp.size(), 26u);  // 203 triangles: 25 full packs and one of three
+      EXPECT_EQ(pk.rp.packs(), 13);  // 101 blocks: 12 full packs and one of five
+      std::vector<double> lt_ref(3 * ref.tris.size(), 0.0), lt = lt_ref;
+      std::vector<double> lr_ref(9 * (ref.off.size() - 1), 0.0), lr = lr_ref;
+      for (int it = 0; it < 3; ++it) {
+        reference_tris(ref, kIh2, keep ? lt_ref.data() : nullptr);
+        reference_rows(ref, kIhb, keep ? lr_ref.data() : nullptr);
+        K->pack8(pk.x.data(), ref.w.data(), origin, pk.xp.data(), 0, ref.n);
+        K->tris8(pk.tp.data(), 0, static_cast<int>(pk.tp.size()), pk.xp.data(), kIh2,
+                 keep ? lt.data() : nullptr);
+        K->rows8(pk.rp.view(), 0, pk.rp.packs(), pk.xp.data(), kIhb, keep ? lr.data() : nullptr);
+        K->unpack8(pk.xp.data(), origin, pk.x.data(), 0, ref.n);
+      }
+      double move = 0, d = 0;
+      for (int i = 0; i < ref.n; ++i) {
+        move = std::max(move, (ref.x[i] - orig.x[i]).norm());
+        for (int c = 0; c < 3; ++c)
+          d = std::max(d, std::abs(pk.x[3 * i + c] - offset[c] - ref.x[i][c]));
+      }
+      double dl = 0, lmax = 0;
+      for (size_t k = 0; k < lt.size(); ++k) {
+        dl = std::max(dl, std::abs(lt[k] - lt_ref[k]));
+        lmax = std::max(lmax, std::abs(lt_ref[k]));
+      }
+      for (size_t k = 0; k < lr.size(); ++k) {
+        dl = std::max(dl, std::abs(lr[k] - lr_ref[k]));
+        lmax = std::max(lmax, std::abs(lr_ref[k]));
+      }
+      std::printf(
+          "%s single-precision kernels (multipliers %s): positions moved up to %.3e, differ "
+          "from the double reference by %.3e; multipliers by %.3e of up to %.3e\n",
+          K->name, keep ? "kept" : "reset", move, d, dl, lmax);
+      EXPECT_GT(move, 1e-3);
+      // Float round-off (measured 1.6e-7 m): positions resolved to ~6e-8 m around the origin,
+      // the moves (up to 0.4 m) to ~1e-7 of themselves.
+      EXPECT_LT(d, 1e-6);
+      if (keep) {
+        EXPECT_LT(dl, 1e-6 * lmax);  // measured 1.2e-7
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(lt[3 * 5 + c], 0.0);  // the fixed triangle
+      }
+      for (int i = 0; i < ref.n; ++i) {
+        if (ref.w[i] != 0) continue;  // fixed vertices keep their double positions exactly
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(pk.x[3 * i + c], orig.x[i][c] + offset[c]);
+      }
+      for (int c = 0; c < 4; ++c) EXPECT_EQ(pk.xp[ref.n].c[c], 0.0f);  // the scratch vertex
+    }
+}
+
+// pack8 then unpack8 with nothing moved in between gives back every double bit for bit: the
+// float copy's resolution does not leak into the state.
+TEST(XpbdKernels, SinglePrecisionRoundTripKeepsTheDoublePositions) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-2, 2);
+  const int n = 1000;
+  std::vector<double> x(3 * n), w(n, 1.0), y;
+  for (double& v : x) v = u(rng);
+  y = x;
+  const double origin[3] = {0.1, 1.2, -0.3};
+  for (const Kernels* K : {&kernels(false), &kernels(true)}) {
+    std::vector<P4f> p(n);
+    K->pack8(y.data(), w.data(), origin, p.data(), 0, n);
+    K->unpack8(p.data(), origin, y.data(), 0, n);
+    for (int i = 0; i < 3 * n; ++i) ASSERT_EQ(y[i], x[i]) << K->name << " coordinate " << i;
+  }
+}
+
+TEST(XpbdKernels, SinglePrecisionSimdBuildAgreesWithThePortableOne) {
+  const Kernels& fast = kernels(true);
+  const Kernels& ref = kernels(false);
+  if (fast.tris8 == ref.tris8)
+    GTEST_SKIP() << "this CPU (or DRAPE_XPBD_SIMD=0) has only the portable kernels";
+  const Problem p = make_problem(11);
+  const double offset[3] = {0, 1.2, 0}, origin[3] = {0, 1, 0};
+  Packed8 a = pack_problem8(p, fast, offset, origin), b = pack_problem8(p, ref, offset, origin);
+  for (int it = 0; it < 3; ++it) {
+    fast.tris8(a.tp.data(), 0, static_cast<int>(a.tp.size()), a.xp.data(), kIh2, nullptr);
+    ref.tris8(b.tp.data(), 0, static_cast<int>(b.tp.size()), b.xp.data(), kIh2, nullptr);
+    fast.rows8(a.rp.view(), 0, a.rp.packs(), a.xp.data(), kIhb, nullptr);
+    ref.rows8(b.rp.view(), 0, b.rp.packs(), b.xp.data(), kIhb, nullptr);
+  }
+  double d = 0;
+  for (size_t i = 0; i < a.xp.size(); ++i)
+    for (int c = 0; c < 4; ++c) d = std::max(d, double(std::abs(a.xp[i].c[c] - b.xp[i].c[c])));
+  std::printf("%s vs portable, single precision: positions differ by %.3e\n", fast.name, d);
+  EXPECT_LT(d, 1e-6);  // float round-off (FMA contraction) only: measured 1.2e-7
 }
 
 // A unit right triangle (rest edges along u and v) stretched by 10 % along u, vertex 0 fixed:
