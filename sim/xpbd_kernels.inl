@@ -1,13 +1,23 @@
 // The body of XPBD's hot loops (sim/xpbd_kernels.hpp), included once per instruction set by
 // sim/xpbd_kernels.cpp (portable) and sim/xpbd_kernels_avx2.cpp (AVX2+FMA) inside a namespace
-// of their own. Values are GCC/Clang vector-extension vectors of four doubles, one element per
-// lane: the compiler maps one to an AVX register, or to two SSE2 registers.
+// of their own. Values are GCC/Clang vector-extension vectors, one element per lane: four
+// doubles or eight floats, which the compiler maps to one AVX register or to two SSE2 ones.
+// Each kernel is written once over a lane type (Dbl4, Flt8 below) and instantiated for both.
 
 #if defined(__GNUC__) && !defined(__clang__)
 // The helpers below take and return vectors by value; GCC notes that this ABI differs between
 // units with and without AVX. They are inlined and never called across units.
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
+// m ? a : b, lane by lane (m: a lane-wise comparison, all 0 or all 1 bits).
+template <class V, class M>
+inline V sel(M m, V a, V b) {
+  return reinterpret_cast<V>((reinterpret_cast<M>(a) & m) | (reinterpret_cast<M>(b) & ~m));
+}
+template <class V>
+struct LanesOf {
+  V X, Y, Z, W;
+};
 using D4 = double __attribute__((vector_size(32)));
 using M4 = long long __attribute__((vector_size(32)));  // a lane-wise comparison: all 0 or 1 bits
 
@@ -21,12 +31,6 @@ inline D4 ld(const P4& p) {  // 32-byte aligned
 }
 inline void st(P4& p, D4 v) {
   *reinterpret_cast<D4*>(p.c) = v;
-}
-inline D4 splat(double s) {
-  return D4{s, s, s, s};
-}
-inline D4 sel(M4 m, D4 a, D4 b) {  // m ? a : b, lane by lane
-  return reinterpret_cast<D4>((reinterpret_cast<M4>(a) & m) | (reinterpret_cast<M4>(b) & ~m));
 }
 
 // 4x4 transpose: rows r0..r3 in, columns out (its own inverse).
@@ -42,18 +46,16 @@ inline void transpose(D4 r0, D4 r1, D4 r2, D4 r3, D4& a, D4& b, D4& c, D4& d) {
 }
 
 // The four vertices v[0..3] (one per lane) as x, y, z and inverse mass w.
-struct Lanes {
-  D4 X, Y, Z, W;
-};
+using Lanes = LanesOf<D4>;
 #if defined(__AVX__)
-inline Lanes gather(const P4* x, const int32_t* v) {
+inline Lanes xpbd_gather(const P4* x, const int32_t* v) {
   Lanes g;
   transpose(ld(x[v[0]]), ld(x[v[1]]), ld(x[v[2]]), ld(x[v[3]]), g.X, g.Y, g.Z, g.W);
   return g;
 }
 #else
 // Without AVX a 256-bit shuffle is lowered through memory: element by element is faster.
-inline Lanes gather(const P4* x, const int32_t* v) {
+inline Lanes xpbd_gather(const P4* x, const int32_t* v) {
   const double *a = x[v[0]].c, *b = x[v[1]].c, *c = x[v[2]].c, *d = x[v[3]].c;
   return Lanes{D4{a[0], b[0], c[0], d[0]}, D4{a[1], b[1], c[1], d[1]}, D4{a[2], b[2], c[2], d[2]},
                D4{a[3], b[3], c[3], d[3]}};
@@ -61,7 +63,7 @@ inline Lanes gather(const P4* x, const int32_t* v) {
 #endif
 // Writes the lanes back. Lanes sharing a vertex (only the scratch vertex of padding, which no
 // projection moves) write the same value.
-inline void scatter(P4* x, const int32_t* v, const Lanes& g) {
+inline void xpbd_scatter(P4* x, const int32_t* v, const Lanes& g) {
 #if defined(__AVX__)
   D4 r0, r1, r2, r3;
   transpose(g.X, g.Y, g.Z, g.W, r0, r1, r2, r3);
@@ -79,166 +81,7 @@ inline void scatter(P4* x, const int32_t* v, const Lanes& g) {
 #endif
 }
 
-// The three strain constraints of a triangle (E_uu, E_vv, E_uv) are projected one after the
-// other as in classic XPBD, but in the space of F = (fu, fv): every gradient is
-// w_q (D_uq a + D_vq b) for vectors a, b, so each projection changes F by a closed form
-// (S_uu, S_vv, S_uv below) and the vertices are moved once, by the sum. Each lane is one
-// triangle; a lane whose denominator vanishes (all vertices fixed, padding) changes nothing.
-void project_tris(const TriPack* packs, int b, int e, P4* x, double ih2, double* lambda) {
-  const D4 zero = splat(0), one = splat(1), half = splat(0.5), tiny = splat(1e-20);
-  for (int p = b; p < e; ++p) {
-    const TriPack& T = packs[p];
-    Lanes g[3];
-    D4 Du[3], Dv[3];
-    for (int q = 0; q < 3; ++q) {
-      g[q] = gather(x, T.v[q]);
-      Du[q] = ld(T.D[2 * q]);
-      Dv[q] = ld(T.D[2 * q + 1]);
-    }
-    D4 fux = g[0].X * Du[0] + g[1].X * Du[1] + g[2].X * Du[2];
-    D4 fuy = g[0].Y * Du[0] + g[1].Y * Du[1] + g[2].Y * Du[2];
-    D4 fuz = g[0].Z * Du[0] + g[1].Z * Du[1] + g[2].Z * Du[2];
-    D4 fvx = g[0].X * Dv[0] + g[1].X * Dv[1] + g[2].X * Dv[2];
-    D4 fvy = g[0].Y * Dv[0] + g[1].Y * Dv[1] + g[2].Y * Dv[2];
-    D4 fvz = g[0].Z * Dv[0] + g[1].Z * Dv[1] + g[2].Z * Dv[2];
-    const D4 Suu = g[0].W * Du[0] * Du[0] + g[1].W * Du[1] * Du[1] + g[2].W * Du[2] * Du[2];
-    const D4 Svv = g[0].W * Dv[0] * Dv[0] + g[1].W * Dv[1] * Dv[1] + g[2].W * Dv[2] * Dv[2];
-    const D4 Suv = g[0].W * Du[0] * Dv[0] + g[1].W * Du[1] * Dv[1] + g[2].W * Du[2] * Dv[2];
-    const M4 live = (g[0].W + g[1].W + g[2].W) > zero;
-    D4 lam[3] = {zero, zero, zero};
-    if (lambda)
-      for (int l = 0; l < 4; ++l)
-        if (T.k[l] >= 0)
-          for (int c = 0; c < 3; ++c) lam[c][l] = lambda[3 * T.k[l] + c];
-    // dl = (num - alpha lam) / denom where the lane is live and denom is not ~0, else 0.
-    auto solve = [&](D4 alpha, D4 num, D4 denom, int c) {
-      const M4 ok = (denom >= tiny) & live;
-      const D4 dl = sel(ok, (num - alpha * lam[c]) / sel(ok, denom, one), zero);
-      lam[c] += dl;
-      return dl;
-    };
-    D4 ax = zero, ay = zero, az = zero, bx = zero, by = zero, bz = zero;
-    // E_uu = (|fu|^2 - 1) / 2 with gradient D_uq fu: a += dl fu, fv += dl S_uv fu,
-    // fu *= 1 + dl S_uu.
-    {
-      const D4 alpha = ih2 * ld(T.ia[0]);
-      const D4 f2 = fux * fux + fuy * fuy + fuz * fuz;
-      const D4 dl = solve(alpha, -half * (f2 - one), alpha + Suu * f2, 0);
-      ax += dl * fux, ay += dl * fuy, az += dl * fuz;
-      const D4 cross = dl * Suv, grow = one + dl * Suu;
-      fvx += cross * fux, fvy += cross * fuy, fvz += cross * fuz;
-      fux *= grow, fuy *= grow, fuz *= grow;
-    }
-    // E_vv = (|fv|^2 - 1) / 2 with gradient D_vq fv: the same with u and v swapped.
-    {
-      const D4 alpha = ih2 * ld(T.ia[1]);
-      const D4 f2 = fvx * fvx + fvy * fvy + fvz * fvz;
-      const D4 dl = solve(alpha, -half * (f2 - one), alpha + Svv * f2, 1);
-      bx += dl * fvx, by += dl * fvy, bz += dl * fvz;
-      const D4 cross = dl * Suv, grow = one + dl * Svv;
-      fux += cross * fvx, fuy += cross * fvy, fuz += cross * fvz;
-      fvx *= grow, fvy *= grow, fvz *= grow;
-    }
-    // E_uv = fu . fv / 2, gradient (D_uq fv + D_vq fu) / 2.
-    {
-      const D4 alpha = ih2 * ld(T.ia[2]);
-      const D4 uv = fux * fvx + fuy * fvy + fuz * fvz;
-      const D4 uu = fux * fux + fuy * fuy + fuz * fuz;
-      const D4 vv = fvx * fvx + fvy * fvy + fvz * fvz;
-      const D4 denom = alpha + 0.25 * (Suu * vv + 2.0 * Suv * uv + Svv * uu);
-      const D4 dl = half * solve(alpha, -half * uv, denom, 2);
-      ax += dl * fvx, ay += dl * fvy, az += dl * fvz;
-      bx += dl * fux, by += dl * fuy, bz += dl * fuz;
-    }
-    if (lambda)
-      for (int l = 0; l < 4; ++l)
-        if (T.k[l] >= 0)
-          for (int c = 0; c < 3; ++c) lambda[3 * T.k[l] + c] = lam[c][l];
-    for (int q = 0; q < 3; ++q) {
-      Lanes& v = g[q];
-      v.X += v.W * (Du[q] * ax + Dv[q] * bx);
-      v.Y += v.W * (Du[q] * ay + Dv[q] * by);
-      v.Z += v.W * (Du[q] * az + Dv[q] * bz);
-      scatter(x, T.v[q], v);
-    }
-  }
-}
-
-// Bending block (one per lane): C_a = sum_j v_aj x_j (a = 0, 1, 2); A dl = -C - alpha l with
-// A^-1 cached (all 0 for a lane that does nothing).
-void project_rows(const RowPacks& rp, int b, int e, P4* x, double ihb, double* lambda) {
-  const D4 zero = splat(0);
-  for (int p = b; p < e; ++p) {
-    // C_a = (cax, cay, caz): named values, not arrays, so that they stay in registers.
-    D4 c0x = zero, c0y = zero, c0z = zero, c1x = zero, c1y = zero, c1z = zero, c2x = zero,
-       c2y = zero, c2z = zero;
-    const int k0 = rp.off[p], k1 = rp.off[p + 1];
-    for (int k = k0; k < k1; ++k) {
-      const Lanes g = gather(x, rp.colv + 4 * k);
-      const double* val = rp.val + 12 * k;
-      const D4 v0 = ld(val), v1 = ld(val + 4), v2 = ld(val + 8);
-      c0x += v0 * g.X, c0y += v0 * g.Y, c0z += v0 * g.Z;
-      c1x += v1 * g.X, c1y += v1 * g.Y, c1z += v1 * g.Z;
-      c2x += v2 * g.X, c2y += v2 * g.Y, c2z += v2 * g.Z;
-    }
-    const int32_t* blk = rp.blk + 4 * p;
-    D4 lam[9];  // [3 a + c] (only with lambda)
-    if (lambda) {
-      for (int j = 0; j < 9; ++j) {
-        lam[j] = zero;
-        for (int l = 0; l < 4; ++l)
-          if (blk[l] >= 0) lam[j][l] = lambda[9 * blk[l] + j];
-      }
-      const D4 al0 = ihb * ld(rp.ik + 12 * p), al1 = ihb * ld(rp.ik + 12 * p + 4),
-               al2 = ihb * ld(rp.ik + 12 * p + 8);
-      c0x += al0 * lam[0], c0y += al0 * lam[1], c0z += al0 * lam[2];
-      c1x += al1 * lam[3], c1y += al1 * lam[4], c1z += al1 * lam[5];
-      c2x += al2 * lam[6], c2y += al2 * lam[7], c2z += al2 * lam[8];
-    }
-    // dl_a = -sum_b Ai_ab (C_b + alpha_b l_b).
-    const double* A = rp.ai + 24 * p;
-    const D4 a00 = ld(A), a01 = ld(A + 4), a02 = ld(A + 8), a11 = ld(A + 12), a12 = ld(A + 16),
-             a22 = ld(A + 20);
-    const D4 d0x = -(a00 * c0x + a01 * c1x + a02 * c2x), d0y = -(a00 * c0y + a01 * c1y + a02 * c2y),
-             d0z = -(a00 * c0z + a01 * c1z + a02 * c2z);
-    const D4 d1x = -(a01 * c0x + a11 * c1x + a12 * c2x), d1y = -(a01 * c0y + a11 * c1y + a12 * c2y),
-             d1z = -(a01 * c0z + a11 * c1z + a12 * c2z);
-    const D4 d2x = -(a02 * c0x + a12 * c1x + a22 * c2x), d2y = -(a02 * c0y + a12 * c1y + a22 * c2y),
-             d2z = -(a02 * c0z + a12 * c1z + a22 * c2z);
-    if (lambda) {
-      const D4 d[9] = {d0x, d0y, d0z, d1x, d1y, d1z, d2x, d2y, d2z};
-      for (int l = 0; l < 4; ++l)
-        if (blk[l] >= 0)
-          for (int j = 0; j < 9; ++j) lambda[9 * blk[l] + j] = lam[j][l] + d[j][l];
-    }
-    for (int k = k0; k < k1; ++k) {
-      const int32_t* v = rp.colv + 4 * k;
-      Lanes g = gather(x, v);
-      const double* val = rp.val + 12 * k;
-      const D4 v0 = ld(val), v1 = ld(val + 4), v2 = ld(val + 8);
-      g.X += g.W * (v0 * d0x + v1 * d1x + v2 * d2x);
-      g.Y += g.W * (v0 * d0y + v1 * d1y + v2 * d2y);
-      g.Z += g.W * (v0 * d0z + v1 * d1z + v2 * d2z);
-      scatter(x, v, g);
-    }
-  }
-}
-
-void pack(const double* x, const double* w, P4* p, int b, int e) {
-  for (int i = b; i < e; ++i) {
-    p[i].c[0] = x[3 * i];
-    p[i].c[1] = x[3 * i + 1];
-    p[i].c[2] = x[3 * i + 2];
-    p[i].c[3] = w[i];
-  }
-}
-
-void unpack(const P4* p, double* x, int b, int e) {
-  for (int i = b; i < e; ++i)
-    for (int c = 0; c < 3; ++c) x[3 * i + c] = p[i].c[c];
-}
-
-// ---- Single precision: eight elements per pack (XpbdOptions::single_precision) ----
+// Single precision: eight elements per pack (XpbdOptions::single_precision).
 using F8 = float __attribute__((vector_size(32)));
 using F4 = float __attribute__((vector_size(16)));
 using M8 = int __attribute__((vector_size(32)));
@@ -253,12 +96,6 @@ inline F4 ld4(const P4f& p) {  // 16-byte aligned
 }
 inline void st4(P4f& p, F4 v) {
   *reinterpret_cast<F4*>(p.c) = v;
-}
-inline F8 splat8(float s) {
-  return F8{s, s, s, s, s, s, s, s};
-}
-inline F8 sel8(M8 m, F8 a, F8 b) {  // m ? a : b, lane by lane
-  return reinterpret_cast<F8>((reinterpret_cast<M8>(a) & m) | (reinterpret_cast<M8>(b) & ~m));
 }
 
 // Four rows, each [vertex l | vertex l + 4] as (x, y, z, w | x, y, z, w), to the columns
@@ -275,9 +112,7 @@ inline void transpose8(F8 a, F8 b, F8 c, F8 d, F8& X, F8& Y, F8& Z, F8& W) {
   W = __builtin_shufflevector(t1, t3, 2, 3, 10, 11, 6, 7, 14, 15);
 }
 
-struct Lanes8 {
-  F8 X, Y, Z, W;
-};
+using Lanes8 = LanesOf<F8>;
 inline F8 join(F4 a, F4 b) {
   return __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7);
 }
@@ -303,142 +138,214 @@ inline void scatter8(P4f* x, const int32_t* v, const Lanes8& g) {
   st4(x[v[7]], __builtin_shufflevector(d, d, 4, 5, 6, 7));
 }
 
-// project_tris in single precision, F formed from the edges: (x1 - x0) D_1 + (x2 - x0) D_2
-// (D_0 = -D_1 - D_2).
-void project_tris8(const TriPack8* packs, int b, int e, P4f* x, double ih2d, double* lambda) {
-  const F8 zero = splat8(0), one = splat8(1), half = splat8(0.5f), tiny = splat8(1e-20f);
-  const float ih2 = static_cast<float>(ih2d);
+// The lane types: vector, scalar, lanes, padded position, packs, loads, gather and scatter.
+struct Dbl4 {
+  using V = D4;
+  using S = double;
+  static constexpr int L = 4;
+  using PX = P4;
+  using TriPackType = TriPack;
+  static V load(const double* p) { return ld(p); }
+  static Lanes gather(const P4* x, const int32_t* v) { return xpbd_gather(x, v); }
+  static void scatter(P4* x, const int32_t* v, const Lanes& g) { xpbd_scatter(x, v, g); }
+};
+struct Flt8 {
+  using V = F8;
+  using S = float;
+  static constexpr int L = 8;
+  using PX = P4f;
+  using TriPackType = TriPack8;
+  static V load(const float* p) { return ld8(p); }
+  static Lanes8 gather(const P4f* x, const int32_t* v) { return gather8(x, v); }
+  static void scatter(P4f* x, const int32_t* v, const Lanes8& g) { scatter8(x, v, g); }
+};
+
+// The three strain constraints of a triangle (E_uu, E_vv, E_uv) are projected one after the
+// other as in classic XPBD, but in the space of F = (fu, fv): every gradient is
+// w_q (D_uq a + D_vq b) for vectors a, b, so each projection changes F by a closed form
+// (S_uu, S_vv, S_uv below) and the vertices are moved once, by the sum. Each lane is one
+// triangle; a lane whose denominator vanishes (all vertices fixed, padding) changes nothing.
+// F is formed from the edges, (x1 - x0) D_1 + (x2 - x0) D_2 (D_0 = -D_1 - D_2).
+template <class T>
+void tris_impl(const typename T::TriPackType* packs, int b, int e, typename T::PX* x, double ih2d,
+               double* lambda) {
+  using V = typename T::V;
+  using S = typename T::S;
+  constexpr int L = T::L;
+  const V zero = V{} + S(0), one = zero + S(1), half = zero + S(0.5), tiny = zero + S(1e-20);
+  const S ih2 = static_cast<S>(ih2d);
   for (int p = b; p < e; ++p) {
-    const TriPack8& T = packs[p];
-    Lanes8 g[3];
-    F8 Du[3], Dv[3];
+    const auto& P = packs[p];
+    LanesOf<V> g[3];
+    V Du[3], Dv[3];
     for (int q = 0; q < 3; ++q) {
-      g[q] = gather8(x, T.v[q]);
-      Du[q] = ld8(T.D[2 * q]);
-      Dv[q] = ld8(T.D[2 * q + 1]);
+      g[q] = T::gather(x, P.v[q]);
+      Du[q] = T::load(P.D[2 * q]);
+      Dv[q] = T::load(P.D[2 * q + 1]);
     }
-    const F8 e1x = g[1].X - g[0].X, e1y = g[1].Y - g[0].Y, e1z = g[1].Z - g[0].Z;
-    const F8 e2x = g[2].X - g[0].X, e2y = g[2].Y - g[0].Y, e2z = g[2].Z - g[0].Z;
-    F8 fux = e1x * Du[1] + e2x * Du[2], fuy = e1y * Du[1] + e2y * Du[2],
-       fuz = e1z * Du[1] + e2z * Du[2];
-    F8 fvx = e1x * Dv[1] + e2x * Dv[2], fvy = e1y * Dv[1] + e2y * Dv[2],
-       fvz = e1z * Dv[1] + e2z * Dv[2];
-    const F8 Suu = g[0].W * Du[0] * Du[0] + g[1].W * Du[1] * Du[1] + g[2].W * Du[2] * Du[2];
-    const F8 Svv = g[0].W * Dv[0] * Dv[0] + g[1].W * Dv[1] * Dv[1] + g[2].W * Dv[2] * Dv[2];
-    const F8 Suv = g[0].W * Du[0] * Dv[0] + g[1].W * Du[1] * Dv[1] + g[2].W * Du[2] * Dv[2];
-    const M8 live = (g[0].W + g[1].W + g[2].W) > zero;
-    F8 lam[3] = {zero, zero, zero};
+    const V e1x = g[1].X - g[0].X, e1y = g[1].Y - g[0].Y, e1z = g[1].Z - g[0].Z;
+    const V e2x = g[2].X - g[0].X, e2y = g[2].Y - g[0].Y, e2z = g[2].Z - g[0].Z;
+    V fux = e1x * Du[1] + e2x * Du[2], fuy = e1y * Du[1] + e2y * Du[2],
+      fuz = e1z * Du[1] + e2z * Du[2];
+    V fvx = e1x * Dv[1] + e2x * Dv[2], fvy = e1y * Dv[1] + e2y * Dv[2],
+      fvz = e1z * Dv[1] + e2z * Dv[2];
+    const V Suu = g[0].W * Du[0] * Du[0] + g[1].W * Du[1] * Du[1] + g[2].W * Du[2] * Du[2];
+    const V Svv = g[0].W * Dv[0] * Dv[0] + g[1].W * Dv[1] * Dv[1] + g[2].W * Dv[2] * Dv[2];
+    const V Suv = g[0].W * Du[0] * Dv[0] + g[1].W * Du[1] * Dv[1] + g[2].W * Du[2] * Dv[2];
+    const auto live = (g[0].W + g[1].W + g[2].W) > zero;
+    V lam[3] = {zero, zero, zero};
     if (lambda)
-      for (int l = 0; l < 8; ++l)
-        if (T.k[l] >= 0)
-          for (int c = 0; c < 3; ++c) lam[c][l] = static_cast<float>(lambda[3 * T.k[l] + c]);
-    auto solve = [&](F8 alpha, F8 num, F8 denom, int c) {
-      const M8 ok = (denom >= tiny) & live;
-      const F8 dl = sel8(ok, (num - alpha * lam[c]) / sel8(ok, denom, one), zero);
+      for (int l = 0; l < L; ++l)
+        if (P.k[l] >= 0)
+          for (int c = 0; c < 3; ++c) lam[c][l] = static_cast<S>(lambda[3 * P.k[l] + c]);
+    // dl = (num - alpha lam) / denom where the lane is live and denom is not ~0, else 0.
+    auto solve = [&](V alpha, V num, V denom, int c) {
+      const auto ok = (denom >= tiny) & live;
+      const V dl = sel(ok, (num - alpha * lam[c]) / sel(ok, denom, one), zero);
       lam[c] += dl;
       return dl;
     };
-    F8 ax = zero, ay = zero, az = zero, bx = zero, by = zero, bz = zero;
+    V ax = zero, ay = zero, az = zero, bx = zero, by = zero, bz = zero;
+    // E_uu = (|fu|^2 - 1) / 2 with gradient D_uq fu: a += dl fu, fv += dl S_uv fu,
+    // fu *= 1 + dl S_uu.
     {
-      const F8 alpha = ih2 * ld8(T.ia[0]);
-      const F8 f2 = fux * fux + fuy * fuy + fuz * fuz;
-      const F8 dl = solve(alpha, -half * (f2 - one), alpha + Suu * f2, 0);
+      const V alpha = ih2 * T::load(P.ia[0]);
+      const V f2 = fux * fux + fuy * fuy + fuz * fuz;
+      const V dl = solve(alpha, -half * (f2 - one), alpha + Suu * f2, 0);
       ax += dl * fux, ay += dl * fuy, az += dl * fuz;
-      const F8 cross = dl * Suv, grow = one + dl * Suu;
+      const V cross = dl * Suv, grow = one + dl * Suu;
       fvx += cross * fux, fvy += cross * fuy, fvz += cross * fuz;
       fux *= grow, fuy *= grow, fuz *= grow;
     }
+    // E_vv = (|fv|^2 - 1) / 2 with gradient D_vq fv: the same with u and v swapped.
     {
-      const F8 alpha = ih2 * ld8(T.ia[1]);
-      const F8 f2 = fvx * fvx + fvy * fvy + fvz * fvz;
-      const F8 dl = solve(alpha, -half * (f2 - one), alpha + Svv * f2, 1);
+      const V alpha = ih2 * T::load(P.ia[1]);
+      const V f2 = fvx * fvx + fvy * fvy + fvz * fvz;
+      const V dl = solve(alpha, -half * (f2 - one), alpha + Svv * f2, 1);
       bx += dl * fvx, by += dl * fvy, bz += dl * fvz;
-      const F8 cross = dl * Suv, grow = one + dl * Svv;
+      const V cross = dl * Suv, grow = one + dl * Svv;
       fux += cross * fvx, fuy += cross * fvy, fuz += cross * fvz;
       fvx *= grow, fvy *= grow, fvz *= grow;
     }
+    // E_uv = fu . fv / 2, gradient (D_uq fv + D_vq fu) / 2.
     {
-      const F8 alpha = ih2 * ld8(T.ia[2]);
-      const F8 uv = fux * fvx + fuy * fvy + fuz * fvz;
-      const F8 uu = fux * fux + fuy * fuy + fuz * fuz;
-      const F8 vv = fvx * fvx + fvy * fvy + fvz * fvz;
-      const F8 denom = alpha + 0.25f * (Suu * vv + 2.0f * Suv * uv + Svv * uu);
-      const F8 dl = half * solve(alpha, -half * uv, denom, 2);
+      const V alpha = ih2 * T::load(P.ia[2]);
+      const V uv = fux * fvx + fuy * fvy + fuz * fvz;
+      const V uu = fux * fux + fuy * fuy + fuz * fuz;
+      const V vv = fvx * fvx + fvy * fvy + fvz * fvz;
+      const V denom = alpha + S(0.25) * (Suu * vv + S(2) * Suv * uv + Svv * uu);
+      const V dl = half * solve(alpha, -half * uv, denom, 2);
       ax += dl * fvx, ay += dl * fvy, az += dl * fvz;
       bx += dl * fux, by += dl * fuy, bz += dl * fuz;
     }
     if (lambda)
-      for (int l = 0; l < 8; ++l)
-        if (T.k[l] >= 0)
-          for (int c = 0; c < 3; ++c) lambda[3 * T.k[l] + c] = lam[c][l];
+      for (int l = 0; l < L; ++l)
+        if (P.k[l] >= 0)
+          for (int c = 0; c < 3; ++c) lambda[3 * P.k[l] + c] = lam[c][l];
     for (int q = 0; q < 3; ++q) {
-      Lanes8& v = g[q];
+      LanesOf<V>& v = g[q];
       v.X += v.W * (Du[q] * ax + Dv[q] * bx);
       v.Y += v.W * (Du[q] * ay + Dv[q] * by);
       v.Z += v.W * (Du[q] * az + Dv[q] * bz);
-      scatter8(x, T.v[q], v);
+      T::scatter(x, P.v[q], v);
     }
   }
 }
 
-// project_rows in single precision (positions relative to the packing origin; a stencil read
-// relative to its own first vertex was measured no more accurate - the floats' resolution of
-// each position is the same either way - and spilled registers).
-void project_rows8(const RowPacksT<float>& rp, int b, int e, P4f* x, double ihbd, double* lambda) {
-  const F8 zero = splat8(0);
-  const float ihb = static_cast<float>(ihbd);
+// Bending block (one per lane): C_a = sum_j v_aj x_j (a = 0, 1, 2); A dl = -C - alpha l with
+// A^-1 cached (all 0 for a lane that does nothing). In single precision the positions are
+// relative to the packing origin; reading a stencil relative to its own first vertex was
+// measured no more accurate (the floats' resolution of each position is the same either way)
+// and spilled registers.
+template <class T>
+void rows_impl(const RowPacksT<typename T::S>& rp, int b, int e, typename T::PX* x, double ihbd,
+               double* lambda) {
+  using V = typename T::V;
+  using S = typename T::S;
+  constexpr int L = T::L;
+  const V zero = V{} + S(0);
+  const S ihb = static_cast<S>(ihbd);
   for (int p = b; p < e; ++p) {
+    // C_a = (cax, cay, caz): named values, not arrays, so that they stay in registers.
+    V c0x = zero, c0y = zero, c0z = zero, c1x = zero, c1y = zero, c1z = zero, c2x = zero,
+      c2y = zero, c2z = zero;
     const int k0 = rp.off[p], k1 = rp.off[p + 1];
-    F8 c0x = zero, c0y = zero, c0z = zero, c1x = zero, c1y = zero, c1z = zero, c2x = zero,
-       c2y = zero, c2z = zero;
     for (int k = k0; k < k1; ++k) {
-      const Lanes8 g = gather8(x, rp.colv + 8 * k);
-      const float* val = rp.val + 24 * k;
-      const F8 v0 = ld8(val), v1 = ld8(val + 8), v2 = ld8(val + 16);
+      const auto g = T::gather(x, rp.colv + L * k);
+      const S* val = rp.val + 3 * L * k;
+      const V v0 = T::load(val), v1 = T::load(val + L), v2 = T::load(val + 2 * L);
       c0x += v0 * g.X, c0y += v0 * g.Y, c0z += v0 * g.Z;
       c1x += v1 * g.X, c1y += v1 * g.Y, c1z += v1 * g.Z;
       c2x += v2 * g.X, c2y += v2 * g.Y, c2z += v2 * g.Z;
     }
-    const int32_t* blk = rp.blk + 8 * p;
-    F8 lam[9];
+    const int32_t* blk = rp.blk + L * p;
+    V lam[9];  // [3 a + c] (only with lambda)
     if (lambda) {
       for (int j = 0; j < 9; ++j) {
         lam[j] = zero;
-        for (int l = 0; l < 8; ++l)
-          if (blk[l] >= 0) lam[j][l] = static_cast<float>(lambda[9 * blk[l] + j]);
+        for (int l = 0; l < L; ++l)
+          if (blk[l] >= 0) lam[j][l] = static_cast<S>(lambda[9 * blk[l] + j]);
       }
-      const F8 al0 = ihb * ld8(rp.ik + 24 * p), al1 = ihb * ld8(rp.ik + 24 * p + 8),
-               al2 = ihb * ld8(rp.ik + 24 * p + 16);
+      const S* ik = rp.ik + 3 * L * p;
+      const V al0 = ihb * T::load(ik), al1 = ihb * T::load(ik + L), al2 = ihb * T::load(ik + 2 * L);
       c0x += al0 * lam[0], c0y += al0 * lam[1], c0z += al0 * lam[2];
       c1x += al1 * lam[3], c1y += al1 * lam[4], c1z += al1 * lam[5];
       c2x += al2 * lam[6], c2y += al2 * lam[7], c2z += al2 * lam[8];
     }
-    const float* A = rp.ai + 48 * p;
-    const F8 a00 = ld8(A), a01 = ld8(A + 8), a02 = ld8(A + 16), a11 = ld8(A + 24),
-             a12 = ld8(A + 32), a22 = ld8(A + 40);
-    const F8 d0x = -(a00 * c0x + a01 * c1x + a02 * c2x), d0y = -(a00 * c0y + a01 * c1y + a02 * c2y),
-             d0z = -(a00 * c0z + a01 * c1z + a02 * c2z);
-    const F8 d1x = -(a01 * c0x + a11 * c1x + a12 * c2x), d1y = -(a01 * c0y + a11 * c1y + a12 * c2y),
-             d1z = -(a01 * c0z + a11 * c1z + a12 * c2z);
-    const F8 d2x = -(a02 * c0x + a12 * c1x + a22 * c2x), d2y = -(a02 * c0y + a12 * c1y + a22 * c2y),
-             d2z = -(a02 * c0z + a12 * c1z + a22 * c2z);
+    // dl_a = -sum_b Ai_ab (C_b + alpha_b l_b).
+    const S* A = rp.ai + 6 * L * p;
+    const V a00 = T::load(A), a01 = T::load(A + L), a02 = T::load(A + 2 * L),
+            a11 = T::load(A + 3 * L), a12 = T::load(A + 4 * L), a22 = T::load(A + 5 * L);
+    const V d0x = -(a00 * c0x + a01 * c1x + a02 * c2x), d0y = -(a00 * c0y + a01 * c1y + a02 * c2y),
+            d0z = -(a00 * c0z + a01 * c1z + a02 * c2z);
+    const V d1x = -(a01 * c0x + a11 * c1x + a12 * c2x), d1y = -(a01 * c0y + a11 * c1y + a12 * c2y),
+            d1z = -(a01 * c0z + a11 * c1z + a12 * c2z);
+    const V d2x = -(a02 * c0x + a12 * c1x + a22 * c2x), d2y = -(a02 * c0y + a12 * c1y + a22 * c2y),
+            d2z = -(a02 * c0z + a12 * c1z + a22 * c2z);
     if (lambda) {
-      const F8 d[9] = {d0x, d0y, d0z, d1x, d1y, d1z, d2x, d2y, d2z};
-      for (int l = 0; l < 8; ++l)
+      const V d[9] = {d0x, d0y, d0z, d1x, d1y, d1z, d2x, d2y, d2z};
+      for (int l = 0; l < L; ++l)
         if (blk[l] >= 0)
           for (int j = 0; j < 9; ++j) lambda[9 * blk[l] + j] = lam[j][l] + d[j][l];
     }
     for (int k = k0; k < k1; ++k) {
-      const int32_t* v = rp.colv + 8 * k;
-      Lanes8 g = gather8(x, v);
-      const float* val = rp.val + 24 * k;
-      const F8 v0 = ld8(val), v1 = ld8(val + 8), v2 = ld8(val + 16);
+      const int32_t* v = rp.colv + L * k;
+      auto g = T::gather(x, v);
+      const S* val = rp.val + 3 * L * k;
+      const V v0 = T::load(val), v1 = T::load(val + L), v2 = T::load(val + 2 * L);
       g.X += g.W * (v0 * d0x + v1 * d1x + v2 * d2x);
       g.Y += g.W * (v0 * d0y + v1 * d1y + v2 * d2y);
       g.Z += g.W * (v0 * d0z + v1 * d1z + v2 * d2z);
-      scatter8(x, v, g);
+      T::scatter(x, v, g);
     }
   }
+}
+
+void project_tris(const TriPack* packs, int b, int e, P4* x, double ih2, double* lambda) {
+  tris_impl<Dbl4>(packs, b, e, x, ih2, lambda);
+}
+void project_rows(const RowPacks& rp, int b, int e, P4* x, double ihb, double* lambda) {
+  rows_impl<Dbl4>(rp, b, e, x, ihb, lambda);
+}
+void project_tris8(const TriPack8* packs, int b, int e, P4f* x, double ih2, double* lambda) {
+  tris_impl<Flt8>(packs, b, e, x, ih2, lambda);
+}
+void project_rows8(const RowPacksT<float>& rp, int b, int e, P4f* x, double ihb, double* lambda) {
+  rows_impl<Flt8>(rp, b, e, x, ihb, lambda);
+}
+
+void pack(const double* x, const double* w, P4* p, int b, int e) {
+  for (int i = b; i < e; ++i) {
+    p[i].c[0] = x[3 * i];
+    p[i].c[1] = x[3 * i + 1];
+    p[i].c[2] = x[3 * i + 2];
+    p[i].c[3] = w[i];
+  }
+}
+
+void unpack(const P4* p, double* x, int b, int e) {
+  for (int i = b; i < e; ++i)
+    for (int c = 0; c < 3; ++c) x[3 * i + c] = p[i].c[c];
 }
 
 void pack8(const double* x, const double* w, const double* origin, P4f* p, int b, int e) {
