@@ -68,8 +68,8 @@ void XpbdSolver::cook(const Cloth& cloth) {
   tri_col_ = colour_sorted(n, static_cast<int>(tris_.size()), 3,
                            tris_.empty() ? nullptr : tris_[0].v, sizeof(Tri), order);
   apply_order(tris_, order);
-  // Packs of four triangles of one colour (sim/xpbd_kernels.hpp); padding lanes use the
-  // scratch vertex n.
+  // Packs of four (double) or eight (single precision) triangles of one colour
+  // (sim/xpbd_kernels.hpp); padding lanes use the scratch vertex n.
   cooked_f32_ = opt_.single_precision;
   tri_packs_.clear();
   tri_packs8_.clear();
@@ -84,7 +84,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
       tpack_col_.push_back(static_cast<int>(tri_packs_.size()));
     }
   }
-  // (Items of the parallel loops: vertices, packs of four elements, hinges, springs.)
+  // (Items of the parallel loops: vertices, packs of elements, hinges, springs.)
   pool_->set_min_parallel(static_cast<int>(tris_.size()) < opt_.min_parallel_triangles
                               ? std::numeric_limits<int>::max()
                               : 64);
@@ -198,6 +198,8 @@ void XpbdSolver::cook(const Cloth& cloth) {
   // + the scratch vertex of padding lanes
   xp_.assign(cooked_f32_ ? 0 : n + 1, xpbd::P4{{0, 0, 0, 0}});
   xp8_.assign(cooked_f32_ ? n + 1 : 0, xpbd::P4f{{0, 0, 0, 0}});
+  tri_anchor8_.assign(48 * tri_packs8_.size(), 0.0f);
+  row_anchor8_.assign(72 * static_cast<size_t>(row_packs8_.packs()), 0.0f);
   w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
   // Connected pieces (union-find over the elements' vertices).
   std::vector<int> parent(n);
@@ -575,14 +577,24 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   xpbd::P4f* xp8 = xp8_.data();
   const xpbd::RowPacksT<float> rp8 = row_packs8_.view();
   auto project_tris8 = [&](int b, int e, int) {
-    K.tris8(tri_packs8_.data(), b, e, xp8, ih2, lam_tri);
+    K.tris8(tri_packs8_.data(), tri_anchor8_.data(), b, e, xp8, ih2, lam_tri);
   };
-  auto project_rows8 = [&](int b, int e, int) { K.rows8(rp8, b, e, xp8, ihb, lam_row); };
-  // The packed positions' origin: the cloth's first vertex at the frame's start (a float then
-  // resolves every vertex of a cloth a metre or two across to ~1e-7 m or better).
-  if (n > 0)
-    for (int c = 0; c < 3; ++c) origin_[c] = x[0][c];
+  auto project_rows8 = [&](int b, int e, int) {
+    K.rows8(rp8, row_anchor8_.data(), b, e, xp8, ihb, lam_row);
+  };
   const bool padded = !tris_.empty() || row_off_.size() > 1;  // (the springs model has neither)
+  if (cooked_f32_ && padded) {
+    // Single precision: the anchors are the positions at the frame's start; the elements' terms
+    // at the anchors are summed in double once per frame (xpbd_kernels.hpp, Kernels::tris8).
+    const double* xd = reinterpret_cast<const double*>(x.data());
+    anchors_.assign(xd, xd + 3 * n);
+    pool_->parallel_for(static_cast<int>(tri_packs8_.size()), [&](int b, int e, int) {
+      xpbd::anchor_triangles(tri_packs8_.data(), b, e, anchors_.data(), tri_anchor8_.data());
+    });
+    pool_->parallel_for(row_packs8_.packs(), [&](int b, int e, int) {
+      xpbd::anchor_rows(rp8, b, e, anchors_.data(), row_anchor8_.data());
+    });
+  }
   auto project_hinges = [&](int b, int e, int) {
     for (int k = b; k < e; ++k) {
       const Hinge& H = hinges_[k];
@@ -751,12 +763,12 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     for (int it = 0; it < opt_.iterations; ++it) {
       if (padded && cooked_f32_) {
         pool_->parallel_for(n, [&](int b, int e, int) {
-          K.pack8(reinterpret_cast<const double*>(x.data()), w, origin_, xp8, b, e);
+          K.pack8(reinterpret_cast<const double*>(x.data()), w, anchors_.data(), xp8, b, e);
         });
         by_colour(tpack8_col_, project_tris8);
         if (s % be == be - 1 || s == ns - 1) by_colour(rpack8_col_, project_rows8);
         pool_->parallel_for(n, [&](int b, int e, int) {
-          K.unpack8(xp8, origin_, reinterpret_cast<double*>(x.data()), b, e);
+          K.unpack8(xp8, anchors_.data(), reinterpret_cast<double*>(x.data()), b, e);
         });
       } else if (padded) {
         pool_->parallel_for(n, [&](int b, int e, int) {

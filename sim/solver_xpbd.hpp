@@ -71,9 +71,9 @@ struct XpbdOptions {
   // XPBD (1) stays the default.
   int bending_every = 1;
   // Triangles and bending blocks projected in single precision, eight per pack (AVX: one
-  // register), on positions taken relative to a vertex of the cloth (xpbd_kernels.hpp, P4f);
-  // the state stays double and receives the kernels' moves. false: the double kernels, four per
-  // pack. Measured in docs/solvers.md section 3o.
+  // register), on the positions' displacements from their place at the frame's start
+  // (xpbd_kernels.hpp, P4f); the state stays double and receives the kernels' moves. false: the
+  // double kernels, four per pack. Measured in docs/solvers.md section 3o.
   bool single_precision = true;
   bool freeze = false;
   double freeze_speed = 1e-3;  // m/s
@@ -197,14 +197,16 @@ class XpbdSolver : public Solver {
   std::vector<Hinge> hinges_;
   std::vector<Spring> springs_;
   std::vector<int> tri_col_, hinge_col_, spring_col_;  // colour offsets into the arrays
-  // The triangles in packs of four of one colour (xpbd_kernels.hpp), colour offsets in packs.
+  // The triangles in packs of four doubles of one colour (xpbd_kernels.hpp), colour offsets in
+  // packs (the eight-float packs of single precision: below).
   std::vector<xpbd::TriPack> tri_packs_;
   std::vector<int> tpack_col_;
   // The energy's tensor bending as linear vector constraints (ClothEnergy bending rows), CSR in
   // colour order: row r is sum_k row_val_[k] x[row_col_[k]], inverse stiffness row_ik_[r].
   std::vector<int> row_off_, row_colv_, row_cols_;
   std::vector<double> row_val_, row_ik_;
-  // The same blocks in packs of four of one colour (xpbd_kernels.hpp), colour offsets in packs.
+  // The same blocks in packs of four doubles of one colour (xpbd_kernels.hpp), colour offsets in
+  // packs (or eight floats: row_packs8_).
   // Per block the packs hold the inverse of its 3x3 system matrix A = sum_j w_j v_j v_j^T +
   // alpha/h^2 (upper triangle, 6 entries; all zero when A is singular). A depends only on the
   // inverse masses and the substep, so it is rebuilt only when one of them changes (a piece
@@ -221,17 +223,19 @@ class XpbdSolver : public Solver {
   std::vector<Vec3> lambda_hinge_, xt_;
   // Positions padded to four doubles (the fourth: inverse mass) for the triangle and bending
   // kernels (xpbd_kernels.hpp), packed before and unpacked after them in every iteration; one
-  // more, the scratch vertex (w = 0), for the packs' padding lanes.
+  // more, the scratch vertex (w = 0), for the packs' padding lanes. (xp8_: the same in floats.)
   std::vector<xpbd::P4> xp_;
   // The single-precision forms (XpbdOptions::single_precision; only those of the precision the
-  // solver was cooked for are filled) and the origin of the packed positions.
+  // solver was cooked for are filled), the anchors (positions at the frame's start) and the
+  // elements' terms at the anchors (xpbd_kernels.hpp, Kernels::tris8).
   bool cooked_f32_ = false;
   std::vector<xpbd::TriPack8> tri_packs8_;
   std::vector<int> tpack8_col_;
   xpbd::RowPackData8 row_packs8_;
   std::vector<int> rpack8_col_;
   std::vector<xpbd::P4f> xp8_;
-  double origin_[3] = {0, 0, 0};
+  std::vector<double> anchors_;
+  std::vector<float> tri_anchor8_, row_anchor8_;
   const xpbd::Kernels* kern_ = &xpbd::kernels();
   double h_prev_ = 0;
   std::vector<double> w_;  // inverse mass of each vertex, 0 when not free or frozen

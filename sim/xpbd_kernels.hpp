@@ -5,7 +5,7 @@
 // Two precisions: four doubles per pack, positions padded to four doubles (P4) with the inverse
 // mass in the fourth lane (a 4x4 transpose of four vertices gives the lanes' x, y, z and w); or
 // (the solver's default, XpbdOptions::single_precision) eight floats per pack on 16-byte P4f
-// positions relative to an origin near the cloth, the state itself staying double.
+// displacements from double anchors, the state itself staying double.
 // The same source (sim/xpbd_kernels.inl) is compiled twice: portable (x86-64 baseline: SSE2, or
 // any other target) and, on x86-64, with AVX2+FMA; kernels() picks the AVX2 build at run time
 // when the CPU has it. Results of the two differ by round-off only (FMA contraction).
@@ -23,8 +23,8 @@ namespace drape::sim::xpbd {
 struct alignas(32) P4 {
   double c[4];
 };
-// The single-precision form (XpbdOptions::single_precision): 16 bytes, the position relative to
-// an origin near the cloth (pack8), so that a float resolves it to ~3e-8 m.
+// The single-precision form (XpbdOptions::single_precision): 16 bytes, the displacement from an
+// anchor position (pack8) and the inverse mass.
 struct alignas(16) P4f {
   float c[4];
 };
@@ -110,18 +110,26 @@ struct Kernels {
   // Positions (3 doubles per vertex) and inverse masses to and from the padded form, [b, e).
   void (*pack)(const double* x, const double* w, P4* p, int b, int e);
   void (*unpack)(const P4* p, double* x, int b, int e);
-  // The same in single precision, eight elements per pack, on positions relative to an origin
-  // near the cloth; so the elements must not change under a translation (sum_k D_k = 0, used by
-  // the triangle kernel, which forms F from the edges; bending rows that annihilate constants,
-  // as ClothEnergy's: P 1 = 0). pack8 stores float(x - origin); unpack8 adds to x
-  // the change of each float since pack8 (x += p - float(x - origin), in double), so a vertex the
-  // kernels did not move keeps its double position exactly, and the kernels' moves land to float
-  // round-off.
-  void (*tris8)(const TriPack8* packs, int b, int e, P4f* x, double ih2, double* lambda);
-  void (*rows8)(const RowPacksT<float>& rp, int b, int e, P4f* x, double ihb, double* lambda);
-  void (*pack8)(const double* x, const double* w, const double* origin, P4f* p, int b, int e);
-  void (*unpack8)(const P4f* p, const double* origin, double* x, int b, int e);
+  // The same in single precision, eight elements per pack, on each position's displacement from
+  // a double anchor a (the positions at the frame's start): p = float(x - a), a few mm at most,
+  // resolved to ~1e-9 m. What the anchors contribute is summed once per frame in double
+  // (anchor_triangles, anchor_rows: fa = each triangle's F at the anchors, 48 floats per pack;
+  // ca = each bending block's C at the anchors, 72 floats per pack), so the kernels add only
+  // displacements: F = F(a) + (d1 - d0) D_1 + (d2 - d0) D_2, C = C(a) + sum_j v_j d_j.
+  // unpack8 adds to x the change of each float since pack8 (x += p - float(x - a), in double),
+  // so a vertex the kernels did not move keeps its double bits.
+  void (*tris8)(const TriPack8* packs, const float* fa, int b, int e, P4f* x, double ih2,
+                double* lambda);
+  void (*rows8)(const RowPacksT<float>& rp, const float* ca, int b, int e, P4f* x, double ihb,
+                double* lambda);
+  void (*pack8)(const double* x, const double* w, const double* a, P4f* p, int b, int e);
+  void (*unpack8)(const P4f* p, const double* a, double* x, int b, int e);
 };
+
+// The anchor terms of the single-precision kernels for packs [b, e) (see Kernels::tris8), summed
+// in double from the anchors a (3 per vertex) and the packs' own float coefficients.
+void anchor_triangles(const TriPack8* packs, int b, int e, const double* a, float* fa);
+void anchor_rows(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca);
 
 // The fastest build this CPU runs; simd = false: the portable one (tests compare the two).
 // DRAPE_XPBD_SIMD=0 in the environment forces the portable build.

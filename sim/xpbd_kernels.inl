@@ -140,6 +140,7 @@ inline void scatter8(P4f* x, const int32_t* v, const Lanes8& g) {
 
 // The lane types: vector, scalar, lanes, padded position, packs, loads, gather and scatter.
 struct Dbl4 {
+  static constexpr bool kAnchored = false;  // absolute positions
   using V = D4;
   using S = double;
   static constexpr int L = 4;
@@ -150,6 +151,7 @@ struct Dbl4 {
   static void scatter(P4* x, const int32_t* v, const Lanes& g) { xpbd_scatter(x, v, g); }
 };
 struct Flt8 {
+  static constexpr bool kAnchored = true;  // displacements from anchors (Kernels::tris8)
   using V = F8;
   using S = float;
   static constexpr int L = 8;
@@ -165,10 +167,11 @@ struct Flt8 {
 // w_q (D_uq a + D_vq b) for vectors a, b, so each projection changes F by a closed form
 // (S_uu, S_vv, S_uv below) and the vertices are moved once, by the sum. Each lane is one
 // triangle; a lane whose denominator vanishes (all vertices fixed, padding) changes nothing.
-// F is formed from the edges, (x1 - x0) D_1 + (x2 - x0) D_2 (D_0 = -D_1 - D_2).
+// F is formed from the edges, (x1 - x0) D_1 + (x2 - x0) D_2 (D_0 = -D_1 - D_2); in single
+// precision from the displacements' edges plus F at the anchors.
 template <class T>
-void tris_impl(const typename T::TriPackType* packs, int b, int e, typename T::PX* x, double ih2d,
-               double* lambda) {
+void tris_impl(const typename T::TriPackType* packs, const typename T::S* fa, int b, int e,
+               typename T::PX* x, double ih2d, double* lambda) {
   using V = typename T::V;
   using S = typename T::S;
   constexpr int L = T::L;
@@ -189,6 +192,11 @@ void tris_impl(const typename T::TriPackType* packs, int b, int e, typename T::P
       fuz = e1z * Du[1] + e2z * Du[2];
     V fvx = e1x * Dv[1] + e2x * Dv[2], fvy = e1y * Dv[1] + e2y * Dv[2],
       fvz = e1z * Dv[1] + e2z * Dv[2];
+    if constexpr (T::kAnchored) {  // + F at the anchors
+      const S* A = fa + 6 * L * p;
+      fux += T::load(A), fuy += T::load(A + L), fuz += T::load(A + 2 * L);
+      fvx += T::load(A + 3 * L), fvy += T::load(A + 4 * L), fvz += T::load(A + 5 * L);
+    }
     const V Suu = g[0].W * Du[0] * Du[0] + g[1].W * Du[1] * Du[1] + g[2].W * Du[2] * Du[2];
     const V Svv = g[0].W * Dv[0] * Dv[0] + g[1].W * Dv[1] * Dv[1] + g[2].W * Dv[2] * Dv[2];
     const V Suv = g[0].W * Du[0] * Dv[0] + g[1].W * Du[1] * Dv[1] + g[2].W * Du[2] * Dv[2];
@@ -253,13 +261,11 @@ void tris_impl(const typename T::TriPackType* packs, int b, int e, typename T::P
 }
 
 // Bending block (one per lane): C_a = sum_j v_aj x_j (a = 0, 1, 2); A dl = -C - alpha l with
-// A^-1 cached (all 0 for a lane that does nothing). In single precision the positions are
-// relative to the packing origin; reading a stencil relative to its own first vertex was
-// measured no more accurate (the floats' resolution of each position is the same either way)
-// and spilled registers.
+// A^-1 cached (all 0 for a lane that does nothing). In single precision C starts from its value
+// at the anchors and sums the displacements.
 template <class T>
-void rows_impl(const RowPacksT<typename T::S>& rp, int b, int e, typename T::PX* x, double ihbd,
-               double* lambda) {
+void rows_impl(const RowPacksT<typename T::S>& rp, const typename T::S* ca, int b, int e,
+               typename T::PX* x, double ihbd, double* lambda) {
   using V = typename T::V;
   using S = typename T::S;
   constexpr int L = T::L;
@@ -269,6 +275,12 @@ void rows_impl(const RowPacksT<typename T::S>& rp, int b, int e, typename T::PX*
     // C_a = (cax, cay, caz): named values, not arrays, so that they stay in registers.
     V c0x = zero, c0y = zero, c0z = zero, c1x = zero, c1y = zero, c1z = zero, c2x = zero,
       c2y = zero, c2z = zero;
+    if constexpr (T::kAnchored) {  // C at the anchors
+      const S* A = ca + 9 * L * p;
+      c0x = T::load(A), c0y = T::load(A + L), c0z = T::load(A + 2 * L);
+      c1x = T::load(A + 3 * L), c1y = T::load(A + 4 * L), c1z = T::load(A + 5 * L);
+      c2x = T::load(A + 6 * L), c2y = T::load(A + 7 * L), c2z = T::load(A + 8 * L);
+    }
     const int k0 = rp.off[p], k1 = rp.off[p + 1];
     for (int k = k0; k < k1; ++k) {
       const auto g = T::gather(x, rp.colv + L * k);
@@ -322,16 +334,18 @@ void rows_impl(const RowPacksT<typename T::S>& rp, int b, int e, typename T::PX*
 }
 
 void project_tris(const TriPack* packs, int b, int e, P4* x, double ih2, double* lambda) {
-  tris_impl<Dbl4>(packs, b, e, x, ih2, lambda);
+  tris_impl<Dbl4>(packs, nullptr, b, e, x, ih2, lambda);
 }
 void project_rows(const RowPacks& rp, int b, int e, P4* x, double ihb, double* lambda) {
-  rows_impl<Dbl4>(rp, b, e, x, ihb, lambda);
+  rows_impl<Dbl4>(rp, nullptr, b, e, x, ihb, lambda);
 }
-void project_tris8(const TriPack8* packs, int b, int e, P4f* x, double ih2, double* lambda) {
-  tris_impl<Flt8>(packs, b, e, x, ih2, lambda);
+void project_tris8(const TriPack8* packs, const float* fa, int b, int e, P4f* x, double ih2,
+                   double* lambda) {
+  tris_impl<Flt8>(packs, fa, b, e, x, ih2, lambda);
 }
-void project_rows8(const RowPacksT<float>& rp, int b, int e, P4f* x, double ihb, double* lambda) {
-  rows_impl<Flt8>(rp, b, e, x, ihb, lambda);
+void project_rows8(const RowPacksT<float>& rp, const float* ca, int b, int e, P4f* x, double ihb,
+                   double* lambda) {
+  rows_impl<Flt8>(rp, ca, b, e, x, ihb, lambda);
 }
 
 void pack(const double* x, const double* w, P4* p, int b, int e) {
@@ -348,18 +362,18 @@ void unpack(const P4* p, double* x, int b, int e) {
     for (int c = 0; c < 3; ++c) x[3 * i + c] = p[i].c[c];
 }
 
-void pack8(const double* x, const double* w, const double* origin, P4f* p, int b, int e) {
+void pack8(const double* x, const double* w, const double* a, P4f* p, int b, int e) {
   for (int i = b; i < e; ++i) {
-    for (int c = 0; c < 3; ++c) p[i].c[c] = static_cast<float>(x[3 * i + c] - origin[c]);
+    for (int c = 0; c < 3; ++c) p[i].c[c] = static_cast<float>(x[3 * i + c] - a[3 * i + c]);
     p[i].c[3] = static_cast<float>(w[i]);
   }
 }
 
-void unpack8(const P4f* p, const double* origin, double* x, int b, int e) {
+void unpack8(const P4f* p, const double* a, double* x, int b, int e) {
   for (int i = b; i < e; ++i)
     for (int c = 0; c < 3; ++c) {
       const double x0 = x[3 * i + c];
-      const float packed = static_cast<float>(x0 - origin[c]);  // what pack8 stored
+      const float packed = static_cast<float>(x0 - a[3 * i + c]);  // what pack8 stored
       x[3 * i + c] = x0 + (static_cast<double>(p[i].c[c]) - static_cast<double>(packed));
     }
 }
