@@ -198,6 +198,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
   // + the scratch vertex of padding lanes
   xp_.assign(cooked_f32_ ? 0 : n + 1, xpbd::P4{{0, 0, 0, 0}});
   xp8_.assign(cooked_f32_ ? n + 1 : 0, xpbd::P4f{{0, 0, 0, 0}});
+  anchors_.clear();  // renewed at the next step
   tri_anchor8_.assign(48 * tri_packs8_.size(), 0.0f);
   row_anchor8_.assign(72 * static_cast<size_t>(row_packs8_.packs()), 0.0f);
   w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
@@ -584,16 +585,27 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   };
   const bool padded = !tris_.empty() || row_off_.size() > 1;  // (the springs model has neither)
   if (cooked_f32_ && padded) {
-    // Single precision: the anchors are the positions at the frame's start; the elements' terms
-    // at the anchors are summed in double once per frame (xpbd_kernels.hpp, Kernels::tris8).
+    // Single precision: the anchors are the positions at the start of a frame, renewed once a
+    // vertex is more than anchor_reach from its anchor (or after a cook); the elements' terms
+    // at the anchors are summed in double then (xpbd_kernels.hpp, Kernels::tris8). A float
+    // resolves a displacement of 2 cm to 2e-9 m; a cloth at rest keeps its anchors.
     const double* xd = reinterpret_cast<const double*>(x.data());
-    anchors_.assign(xd, xd + 3 * n);
-    pool_->parallel_for(static_cast<int>(tri_packs8_.size()), [&](int b, int e, int) {
-      xpbd::anchor_triangles(tri_packs8_.data(), b, e, anchors_.data(), tri_anchor8_.data());
-    });
-    pool_->parallel_for(row_packs8_.packs(), [&](int b, int e, int) {
-      xpbd::anchor_rows(rp8, b, e, anchors_.data(), row_anchor8_.data());
-    });
+    bool renew = anchors_.size() != static_cast<size_t>(3 * n);
+    const double reach2 = kAnchorReach * kAnchorReach;
+    for (int i = 0; i < n && !renew; ++i)
+      renew =
+          (x[i] - Vec3(anchors_[3 * i], anchors_[3 * i + 1], anchors_[3 * i + 2])).squaredNorm() >
+          reach2;
+    if (renew) {
+      anchors_.assign(xd, xd + 3 * n);
+      pool_->parallel_for(static_cast<int>(tri_packs8_.size()), [&](int b, int e, int) {
+        K.anchor_triangles(tri_packs8_.data(), b, e, anchors_.data(), tri_anchor8_.data());
+      });
+      pool_->parallel_for(row_packs8_.packs(), [&](int b, int e, int) {
+        K.anchor_rows(rp8, b, e, anchors_.data(), row_anchor8_.data());
+      });
+      ++anchor_renewals_;
+    }
   }
   auto project_hinges = [&](int b, int e, int) {
     for (int k = b; k < e; ++k) {

@@ -153,6 +153,8 @@ class XpbdSolver : public Solver {
   XpbdOptions& options() { return opt_; }
   int frozen_count() const { return frozen_count_; }
   int contact_detections() const { return detections_; }
+  // Single precision: how many times the anchors were renewed (XpbdOptions::single_precision).
+  long anchor_renewals() const { return anchor_renewals_; }
   // Largest inertia scale of any piece (1: nothing settling; XpbdOptions::settle).
   double settle_scale() const;
   // Self-collision pairs found at the last detection (scenes with self_collision on).
@@ -236,6 +238,8 @@ class XpbdSolver : public Solver {
   std::vector<xpbd::P4f> xp8_;
   std::vector<double> anchors_;
   std::vector<float> tri_anchor8_, row_anchor8_;
+  static constexpr double kAnchorReach = 0.02;  // m
+  long anchor_renewals_ = 0;
   const xpbd::Kernels* kern_ = &xpbd::kernels();
   double h_prev_ = 0;
   std::vector<double> w_;  // inverse mass of each vertex, 0 when not free or frozen

@@ -10,8 +10,9 @@ namespace drape::sim::xpbd {
 
 namespace portable {
 #include "sim/xpbd_kernels.inl"
-const Kernels kKernels{"portable",     &project_tris,  &project_rows, &pack,   &unpack,
-                       &project_tris8, &project_rows8, &pack8,        &unpack8};
+const Kernels kKernels{"portable", &project_tris,     &project_rows,  &pack,
+                       &unpack,    &project_tris8,    &project_rows8, &pack8,
+                       &unpack8,   &anchor_triangles, &anchor_rows};
 }  // namespace portable
 
 template <class T, int L>
@@ -78,39 +79,6 @@ void RowPackDataT<T, L>::append(const int* boff, const int* bcol, const double* 
 }
 template struct RowPackDataT<double, 4>;
 template struct RowPackDataT<float, 8>;
-
-void anchor_triangles(const TriPack8* packs, int b, int e, const double* a, float* fa) {
-  for (int p = b; p < e; ++p) {
-    const TriPack8& T = packs[p];
-    float* out = fa + 48 * p;
-    for (int l = 0; l < 8; ++l) {
-      const double* a0 = a + 3 * T.v[0][l];
-      const double* a1 = a + 3 * T.v[1][l];
-      const double* a2 = a + 3 * T.v[2][l];
-      for (int c = 0; c < 3; ++c) {
-        const double e1 = a1[c] - a0[c], e2 = a2[c] - a0[c];
-        out[8 * c + l] = static_cast<float>(e1 * T.D[2][l] + e2 * T.D[4][l]);
-        out[8 * (3 + c) + l] = static_cast<float>(e1 * T.D[3][l] + e2 * T.D[5][l]);
-      }
-    }
-  }
-}
-
-void anchor_rows(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca) {
-  for (int p = b; p < e; ++p) {
-    double c[9][8] = {};
-    for (int k = rp.off[p]; k < rp.off[p + 1]; ++k)
-      for (int l = 0; l < 8; ++l) {
-        const double* x = a + 3 * rp.colv[8 * k + l];
-        for (int r = 0; r < 3; ++r) {
-          const double v = rp.val[24 * k + 8 * r + l];
-          for (int d = 0; d < 3; ++d) c[3 * r + d][l] += v * x[d];
-        }
-      }
-    for (int j = 0; j < 9; ++j)
-      for (int l = 0; l < 8; ++l) ca[72 * p + 8 * j + l] = static_cast<float>(c[j][l]);
-  }
-}
 
 #if defined(DRAPE_XPBD_AVX2)
 namespace avx2 {

@@ -377,3 +377,39 @@ void unpack8(const P4f* p, const double* a, double* x, int b, int e) {
       x[3 * i + c] = x0 + (static_cast<double>(p[i].c[c]) - static_cast<double>(packed));
     }
 }
+
+void anchor_triangles(const TriPack8* packs, int b, int e, const double* a, float* fa) {
+  for (int p = b; p < e; ++p) {
+    const TriPack8& T = packs[p];
+    double e1[3][8], e2[3][8];
+    for (int l = 0; l < 8; ++l)
+      for (int c = 0; c < 3; ++c) {
+        const double a0 = a[3 * T.v[0][l] + c];
+        e1[c][l] = a[3 * T.v[1][l] + c] - a0;
+        e2[c][l] = a[3 * T.v[2][l] + c] - a0;
+      }
+    float* out = fa + 48 * p;
+    for (int c = 0; c < 3; ++c)
+      for (int l = 0; l < 8; ++l) {
+        out[8 * c + l] = static_cast<float>(e1[c][l] * T.D[2][l] + e2[c][l] * T.D[4][l]);
+        out[8 * (3 + c) + l] = static_cast<float>(e1[c][l] * T.D[3][l] + e2[c][l] * T.D[5][l]);
+      }
+  }
+}
+
+void anchor_rows(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca) {
+  for (int p = b; p < e; ++p) {
+    double c[9][8] = {};
+    for (int k = rp.off[p]; k < rp.off[p + 1]; ++k) {
+      double ax[3][8];  // the lanes' anchors, then 8 lanes at a time (vectorised)
+      for (int l = 0; l < 8; ++l)
+        for (int d = 0; d < 3; ++d) ax[d][l] = a[3 * rp.colv[8 * k + l] + d];
+      for (int r = 0; r < 3; ++r)
+        for (int d = 0; d < 3; ++d)
+          for (int l = 0; l < 8; ++l)
+            c[3 * r + d][l] += static_cast<double>(rp.val[24 * k + 8 * r + l]) * ax[d][l];
+    }
+    for (int j = 0; j < 9; ++j)
+      for (int l = 0; l < 8; ++l) ca[72 * p + 8 * j + l] = static_cast<float>(c[j][l]);
+  }
+}

@@ -281,8 +281,8 @@ Packed8 pack_problem8(const Problem& p, const Kernels& K, const double* offset) 
     for (int m = 0; m < 6; ++m) k.rp.ai_of(r, m) = static_cast<float>(p.ai[6 * r + m]);
   k.fa.resize(48 * k.tp.size());
   k.ca.resize(72 * static_cast<size_t>(k.rp.packs()));
-  anchor_triangles(k.tp.data(), 0, static_cast<int>(k.tp.size()), k.a.data(), k.fa.data());
-  anchor_rows(k.rp.view(), 0, k.rp.packs(), k.a.data(), k.ca.data());
+  K.anchor_triangles(k.tp.data(), 0, static_cast<int>(k.tp.size()), k.a.data(), k.fa.data());
+  K.anchor_rows(k.rp.view(), 0, k.rp.packs(), k.a.data(), k.ca.data());
   return k;
 }
 
