@@ -111,13 +111,15 @@ struct Kernels {
   void (*pack)(const double* x, const double* w, P4* p, int b, int e);
   void (*unpack)(const P4* p, double* x, int b, int e);
   // The same in single precision, eight elements per pack, on each position's displacement from
-  // a double anchor a (the positions at the frame's start): p = float(x - a), a few mm at most,
-  // resolved to ~1e-9 m. What the anchors contribute is summed once per frame in double
+  // a double anchor a: p = float(x - a). (XpbdSolver takes the positions at a frame's start as
+  // anchors and renews them once a vertex is 2 cm from its own, so a float resolves p to
+  // <= 2e-9 m.) What the anchors contribute is summed in double when they are set
   // (anchor_triangles, anchor_rows: fa = each triangle's F at the anchors, 48 floats per pack;
   // ca = each bending block's C at the anchors, 72 floats per pack), so the kernels add only
-  // displacements: F = F(a) + (d1 - d0) D_1 + (d2 - d0) D_2, C = C(a) + sum_j v_j d_j.
-  // unpack8 adds to x the change of each float since pack8 (x += p - float(x - a), in double),
-  // so a vertex the kernels did not move keeps its double bits.
+  // displacements: F = F(a) + (d1 - d0) D_1 + (d2 - d0) D_2 (a triangle's D_k sum to 0),
+  // C = C(a) + sum_j v_j d_j. unpack8 adds to x the change of each float since pack8
+  // (x += p - float(x - a), in double), so a vertex the kernels did not move keeps its double
+  // bits.
   void (*tris8)(const TriPack8* packs, const float* fa, int b, int e, P4f* x, double ih2,
                 double* lambda);
   void (*rows8)(const RowPacksT<float>& rp, const float* ca, int b, int e, P4f* x, double ihb,
