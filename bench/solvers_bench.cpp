@@ -450,8 +450,9 @@ int probe(int argc, char** argv) {
     std::printf("\n");
   }
   if (auto* xp = xpbd_of(s.get())) {
-    std::printf("xpbd: %.2f contact detections per frame\n",
-                double(xp->contact_detections()) / frames);
+    std::printf("xpbd: %.2f contact detections per frame, %ld anchor renewals in %d frames%s\n",
+                double(xp->contact_detections()) / frames, xp->anchor_renewals(), frames,
+                xp->options().single_precision ? "" : " (double precision)");
     if (xp->options().coarse_factor > 0) {
       const CoarseStats& c = xp->last_coarse();
       std::printf(
