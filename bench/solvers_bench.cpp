@@ -798,35 +798,52 @@ void thread_rows(int max_res) {
   // same result), wall and CPU ms per frame at 128^2 and 256^2, with XPBD's kernels in single
   // precision (the default) and in double, side by side. The study's other rows are CPU time of
   // one thread (the machine is shared); this is what one frame takes on this 2-core machine.
+  // The host's speed drifts by tens of % within minutes: at 128^2 the four configurations run
+  // interleaved in three rounds and each row is the median of its three (256^2: one round).
   std::ofstream tc("out/bench/solvers_threads.csv");
-  tc << "scene,solver,resolution,substeps,threads,precision,wall_ms_per_frame,cpu_ms_per_frame\n";
+  tc << "scene,solver,resolution,substeps,threads,precision,runs,wall_ms_per_frame,"
+        "cpu_ms_per_frame\n";
   for (int res : {128, 256}) {
     if (res > max_res) continue;
-    double wall_of[2][2] = {{0, 0}, {0, 0}};  // [double][threads - 1]
+    const int rounds = res <= 128 ? 3 : 1;
+    std::vector<double> wall_runs[2][2], cpu_runs[2][2];  // [double][threads - 1]
+    for (int round = 0; round < rounds; ++round)
+      for (int dbl : {0, 1})
+        for (int threads : {1, 2}) {
+          StudyScene sc = make_scene("form", res);
+          SolverConfig cfg;
+          cfg.substeps = 10;
+          cfg.threads = threads;
+          cfg.air_damping = sc.air_damping;
+          auto s = make_solver("default", cfg);
+          if (auto* xp = xpbd_of(s->get())) xp->options().single_precision = !dbl;
+          const int frames = static_cast<int>(std::lround(sc.duration * 90));
+          const double c0 = cpu_ms();
+          const auto w0 = std::chrono::steady_clock::now();
+          for (int f = 0; f < frames; ++f) (*s)->step(sc.cloth, sc.objects, 1.0 / 90);
+          wall_runs[dbl][threads - 1].push_back(
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0)
+                  .count() /
+              frames);
+          cpu_runs[dbl][threads - 1].push_back((cpu_ms() - c0) / frames);
+        }
+    auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
+    double wall_of[2][2];
     for (int dbl : {0, 1})
       for (int threads : {1, 2}) {
-        StudyScene sc = make_scene("form", res);
-        SolverConfig cfg;
-        cfg.substeps = 10;
-        cfg.threads = threads;
-        cfg.air_damping = sc.air_damping;
-        auto s = make_solver("default", cfg);
-        if (auto* xp = xpbd_of(s->get())) xp->options().single_precision = !dbl;
-        const int frames = static_cast<int>(std::lround(sc.duration * 90));
-        const double c0 = cpu_ms();
-        const auto w0 = std::chrono::steady_clock::now();
-        for (int f = 0; f < frames; ++f) (*s)->step(sc.cloth, sc.objects, 1.0 / 90);
-        const double wall =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0)
-                .count() /
-            frames;
-        const double cpu = (cpu_ms() - c0) / frames;
-        const char* prec = dbl ? "double" : "single";
+        const double wall = median(wall_runs[dbl][threads - 1]);
+        const double cpu = median(cpu_runs[dbl][threads - 1]);
         wall_of[dbl][threads - 1] = wall;
-        std::printf("threads  %4d %s 10x1 %s, %d thread%s: %8.3f ms/frame wall, %8.3f ms CPU\n",
-                    res, kDefaultSolver, prec, threads, threads > 1 ? "s" : "", wall, cpu);
+        const char* prec = dbl ? "double" : "single";
+        std::printf(
+            "threads  %4d %s 10x1 %s, %d thread%s: %8.3f ms/frame wall, %8.3f ms CPU (median "
+            "of %d)\n",
+            res, kDefaultSolver, prec, threads, threads > 1 ? "s" : "", wall, cpu, rounds);
         tc << "form," << kDefaultSolver << "," << res << ",10," << threads << "," << prec << ","
-           << wall << "," << cpu << std::endl;
+           << rounds << "," << wall << "," << cpu << std::endl;
       }
     std::printf("    ratio double / single precision = %.2fx (1 thread), %.2fx (2 threads)\n",
                 wall_of[1][0] / wall_of[0][0], wall_of[1][1] / wall_of[0][1]);
