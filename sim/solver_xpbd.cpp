@@ -590,7 +590,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     // at the anchors are summed in double then (xpbd_kernels.hpp, Kernels::tris8). A float
     // resolves a displacement of 2 cm to 2e-9 m; a cloth at rest keeps its anchors.
     const double* xd = reinterpret_cast<const double*>(x.data());
-    bool renew = anchors_.size() != static_cast<size_t>(3 * n);
+    bool renew = anchors_.size() != static_cast<size_t>(3 * (n + 1));
     const double reach2 = kAnchorReach * kAnchorReach;
     for (int i = 0; i < n && !renew; ++i)
       renew =
@@ -598,6 +598,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
           reach2;
     if (renew) {
       anchors_.assign(xd, xd + 3 * n);
+      anchors_.resize(3 * (n + 1), 0.0);  // the scratch vertex of padding lanes (its P4f is 0)
       pool_->parallel_for(static_cast<int>(tri_packs8_.size()), [&](int b, int e, int) {
         K.anchor_triangles(tri_packs8_.data(), b, e, anchors_.data(), tri_anchor8_.data());
       });

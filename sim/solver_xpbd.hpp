@@ -236,7 +236,7 @@ class XpbdSolver : public Solver {
   xpbd::RowPackData8 row_packs8_;
   std::vector<int> rpack8_col_;
   std::vector<xpbd::P4f> xp8_;
-  std::vector<double> anchors_;
+  std::vector<double> anchors_;  // 3 per vertex, and the scratch vertex's (0)
   std::vector<float> tri_anchor8_, row_anchor8_;
   static constexpr double kAnchorReach = 0.02;  // m
   long anchor_renewals_ = 0;

@@ -126,8 +126,8 @@ struct Kernels {
                 double* lambda);
   void (*pack8)(const double* x, const double* w, const double* a, P4f* p, int b, int e);
   void (*unpack8)(const P4f* p, const double* a, double* x, int b, int e);
-  // The anchor terms for packs [b, e), summed in double from the anchors a (3 per vertex) and
-  // the packs' own float coefficients.
+  // The anchor terms for packs [b, e), summed in double from the anchors a (3 per vertex,
+  // including the scratch vertex of padding lanes) and the packs' own float coefficients.
   void (*anchor_triangles)(const TriPack8* packs, int b, int e, const double* a, float* fa);
   void (*anchor_rows)(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca);
 };
