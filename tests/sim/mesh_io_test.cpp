@@ -219,6 +219,39 @@ TEST(MeshIo, PlyHeaderWithoutEndHeaderIsAnErrorNotAHang) {
 
 // A PLY element count larger than the file (fuzz_mesh: assimp tried to allocate 57 GB, seed
 // fuzz/corpus/mesh/regress_ply_huge_count) is rejected before assimp.
+// An ASCII PLY body whose numbers do not line up with its header (fuzz_mesh: one number too many
+// on a vertex line; assimp 5.2 then requested ~18 GB before failing, seed
+// fuzz/corpus/mesh/regress_ply_ascii_misaligned) is a clear error naming the element and entry,
+// before assimp reads it; so is a body with numbers left over.
+TEST(MeshIo, PlyAsciiBodyThatDoesNotMatchItsHeaderIsAnError) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string shifted = head + "0 0 0 5\n1 0 0\n0 1 0\n3 0 1 2\n";
+  std::string err = drape::sim::ply_load_error(shifted, "shifted.ply", true);
+  EXPECT_NE(err.find("shifted.ply"), std::string::npos) << err;
+  // (The vertices take "0 0 0", "5 1 0", "0 0 1"; the face a list of 0; six numbers are left.)
+  EXPECT_NE(err.find("PLY body: more numbers than the header declares"), std::string::npos) << err;
+  err = drape::sim::ply_load_error(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1\n", "short.ply", true);
+  EXPECT_NE(err.find("element \"face\" entry 0 of 1: its list of 3 numbers is cut short"),
+            std::string::npos)
+      << err;
+  err = drape::sim::ply_load_error(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n7\n", "extra.ply", true);
+  EXPECT_NE(err.find("more numbers than the header declares"), std::string::npos) << err;
+  err = drape::sim::ply_load_error(head + "0 0 0\n1 0 0\n0 x 0\n3 0 1 2\n", "nan.ply", true);
+  EXPECT_NE(err.find("element \"vertex\" entry 2 of 3: \"x\" is not a number"), std::string::npos)
+      << err;
+  drape::sim::expect_ply_loads(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "ok.ply", 1);
+  // The fuzzer's file itself, from the corpus: rejected quickly, without the allocation.
+  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/fuzz/corpus/mesh/regress_ply_ascii_misaligned",
+                   std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 1000u);
+  auto r = drape::sim::load_mesh_from_memory(bytes.data() + 1, bytes.size() - 1, "ply", "fz.ply");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("PLY body"), std::string::npos) << r.error();
+}
+
 TEST(MeshIo, PlyElementCountBeyondTheFileIsAnError) {
   const std::string ply =
       "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
