@@ -586,7 +586,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   const bool padded = !tris_.empty() || row_off_.size() > 1;  // (the springs model has neither)
   if (cooked_f32_ && padded) {
     // Single precision: the anchors are the positions at the start of a frame, renewed once a
-    // vertex is more than anchor_reach from its anchor (or after a cook); the elements' terms
+    // vertex is more than kAnchorReach from its anchor (or after a cook); the elements' terms
     // at the anchors are summed in double then (xpbd_kernels.hpp, Kernels::tris8). A float
     // resolves a displacement of 2 cm to 2e-9 m; a cloth at rest keeps its anchors.
     const double* xd = reinterpret_cast<const double*>(x.data());
