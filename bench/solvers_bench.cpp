@@ -450,9 +450,13 @@ int probe(int argc, char** argv) {
     std::printf("\n");
   }
   if (auto* xp = xpbd_of(s.get())) {
-    std::printf("xpbd: %.2f contact detections per frame, %ld anchor renewals in %d frames%s\n",
-                double(xp->contact_detections()) / frames, xp->anchor_renewals(), frames,
-                xp->options().single_precision ? "" : " (double precision)");
+    const bool f32 = xp->options().single_precision;
+    std::printf(
+        "xpbd: %.2f contact detections per frame, %ld anchor renewals in %d frames%s; kernels %s "
+        "(%d triangles, %d bending blocks per pack)\n",
+        double(xp->contact_detections()) / frames, xp->anchor_renewals(), frames,
+        f32 ? "" : " (double precision)", xp->kernels().name, f32 ? xp->kernels().tri_lanes : 4,
+        f32 ? xp->kernels().row_lanes : 4);
     if (xp->options().coarse_factor > 0) {
       const CoarseStats& c = xp->last_coarse();
       std::printf(

@@ -155,6 +155,8 @@ class XpbdSolver : public Solver {
   int contact_detections() const { return detections_; }
   // Single precision: how many times the anchors were renewed (XpbdOptions::single_precision).
   long anchor_renewals() const { return anchor_renewals_; }
+  // The build of the hot loops in use (xpbd_kernels.hpp: portable, AVX2 or AVX-512).
+  const xpbd::Kernels& kernels() const { return *kern_; }
   // Largest inertia scale of any piece (1: nothing settling; XpbdOptions::settle).
   double settle_scale() const;
   // Self-collision pairs found at the last detection (scenes with self_collision on).
@@ -230,12 +232,22 @@ class XpbdSolver : public Solver {
   // The single-precision forms (XpbdOptions::single_precision; only those of the precision the
   // solver was cooked for are filled), the anchors (positions at the frame's start) and the
   // elements' terms at the anchors (xpbd_kernels.hpp, Kernels::tris8).
+  // Packs of eight floats, or of sixteen when the kernels' build prefers it (AVX-512:
+  // Kernels::tri_lanes, row_lanes, cooked into tlanes_, rlanes_); the colour offsets count the
+  // packs in use.
   bool cooked_f32_ = false;
+  int tlanes_ = 8, rlanes_ = 8;
   std::vector<xpbd::TriPack8> tri_packs8_;
+  std::vector<xpbd::TriPack16> tri_packs16_;
   std::vector<int> tpack8_col_;
   xpbd::RowPackData8 row_packs8_;
+  xpbd::RowPackData16 row_packs16_;
   std::vector<int> rpack8_col_;
   std::vector<xpbd::P4f> xp8_;
+  int float_tri_packs() const {
+    return static_cast<int>(tlanes_ == 16 ? tri_packs16_.size() : tri_packs8_.size());
+  }
+  int float_row_packs() const { return rlanes_ == 16 ? row_packs16_.packs() : row_packs8_.packs(); }
   std::vector<double> anchors_;  // 3 per vertex, and the scratch vertex's (0)
   std::vector<float> tri_anchor8_, row_anchor8_;
   static constexpr double kAnchorReach = 0.02;  // m

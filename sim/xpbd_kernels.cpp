@@ -10,9 +10,7 @@ namespace drape::sim::xpbd {
 
 namespace portable {
 #include "sim/xpbd_kernels.inl"
-const Kernels kKernels{"portable", &project_tris,     &project_rows,  &pack,
-                       &unpack,    &project_tris8,    &project_rows8, &pack8,
-                       &unpack8,   &anchor_triangles, &anchor_rows};
+const Kernels kKernels = make_kernels("portable", 8, 8);
 }  // namespace portable
 
 template <class T, int L>
@@ -32,6 +30,7 @@ void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriP
 }
 template void pack_triangles<double, 4>(const Tri*, int, int, int, std::vector<TriPack>&);
 template void pack_triangles<float, 8>(const Tri*, int, int, int, std::vector<TriPack8>&);
+template void pack_triangles<float, 16>(const Tri*, int, int, int, std::vector<TriPack16>&);
 
 template <class T, int L>
 void RowPackDataT<T, L>::clear() {
@@ -79,26 +78,50 @@ void RowPackDataT<T, L>::append(const int* boff, const int* bcol, const double* 
 }
 template struct RowPackDataT<double, 4>;
 template struct RowPackDataT<float, 8>;
+template struct RowPackDataT<float, 16>;
 
 #if defined(DRAPE_XPBD_AVX2)
 namespace avx2 {
 extern const Kernels kKernels;
 }
+namespace avx512 {
+extern const Kernels kKernels;
+}
+
+namespace {
+// The SIMD builds this CPU runs, narrowest first (DRAPE_XPBD_SIMD=0: none; =avx2: not AVX-512).
+std::vector<const Kernels*> simd_builds() {
+  std::vector<const Kernels*> out;
+  const char* env = std::getenv("DRAPE_XPBD_SIMD");
+  if (env && std::strcmp(env, "0") == 0) return out;
+  __builtin_cpu_init();
+  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) return out;
+  out.push_back(&avx2::kKernels);
+  if (env && std::strcmp(env, "avx2") == 0) return out;
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+      __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw"))
+    out.push_back(&avx512::kKernels);
+  return out;
+}
+}  // namespace
 #endif
 
 const Kernels& kernels(bool simd) {
 #if defined(DRAPE_XPBD_AVX2)
-  static const bool use = [] {
-    const char* env = std::getenv("DRAPE_XPBD_SIMD");
-    if (env && std::strcmp(env, "0") == 0) return false;
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  }();
-  if (simd && use) return avx2::kKernels;
+  static const std::vector<const Kernels*> builds = simd_builds();
+  if (simd && !builds.empty()) return *builds.back();
 #else
   (void)simd;
 #endif
   return portable::kKernels;
+}
+
+std::vector<const Kernels*> all_kernels() {
+  std::vector<const Kernels*> out{&portable::kKernels};
+#if defined(DRAPE_XPBD_AVX2)
+  for (const Kernels* k : simd_builds()) out.push_back(k);
+#endif
+  return out;
 }
 
 }  // namespace drape::sim::xpbd

@@ -6,9 +6,11 @@
 // mass in the fourth lane (a 4x4 transpose of four vertices gives the lanes' x, y, z and w); or
 // (the solver's default, XpbdOptions::single_precision) eight floats per pack on 16-byte P4f
 // displacements from double anchors, the state itself staying double.
-// The same source (sim/xpbd_kernels.inl) is compiled twice: portable (x86-64 baseline: SSE2, or
-// any other target) and, on x86-64, with AVX2+FMA; kernels() picks the AVX2 build at run time
-// when the CPU has it. Results of the two differ by round-off only (FMA contraction).
+// The same source (sim/xpbd_kernels.inl) is compiled three times: portable (x86-64 baseline:
+// SSE2, or any other target) and, on x86-64, with AVX2+FMA and with AVX-512 (F, VL, DQ, BW);
+// kernels() picks the widest build the CPU has at run time. Results differ by round-off only
+// (FMA contraction). In single precision the AVX-512 build packs sixteen elements, the others
+// eight (Kernels::float_lanes).
 // No Eigen here: an inline Eigen function instantiated in the AVX2 unit could be the copy the
 // linker keeps for the whole program.
 #pragma once
@@ -48,6 +50,7 @@ struct alignas(32) TriPackT {
 };
 using TriPack = TriPackT<double, 4>;
 using TriPack8 = TriPackT<float, 8>;
+using TriPack16 = TriPackT<float, 16>;
 
 // Appends triangles [b, e) (one colour) as packs of L; padding lanes use vertex `scratch`
 // (an extra P4 whose inverse mass is 0).
@@ -98,9 +101,17 @@ struct RowPackDataT {
 };
 using RowPackData = RowPackDataT<double, 4>;
 using RowPackData8 = RowPackDataT<float, 8>;
+using RowPackData16 = RowPackDataT<float, 16>;
 
 struct Kernels {
-  const char* name;  // "avx2" or "portable"
+  const char* name;  // "avx512", "avx2" or "portable"
+  // The single-precision pack widths this build runs fastest, for triangles and for bending
+  // blocks: 16 or 8. Every build has the kernels of both widths (tris8/rows8, tris16/rows16),
+  // so that builds can be compared. The AVX-512 build packs triangles in sixteens (1.3-1.4x the
+  // eight-lane kernel, measured) and bending blocks in eights: a block gathers and scatters ~10
+  // vertices for ~20 multiply-adds, and on a CPU whose 512-bit operations share two ports the
+  // sixteen-lane gathers cost more than they save (measured 1.1x slower at 128^2).
+  int tri_lanes, row_lanes;
   // Projects triangle packs [b, e) once (Gauss-Seidel within a triangle: E_uu, E_vv, E_uv one
   // after the other). lambda: the triangles' multipliers (3 per triangle index), or null when
   // they are reset every substep.
@@ -130,10 +141,20 @@ struct Kernels {
   // including the scratch vertex of padding lanes) and the packs' own float coefficients.
   void (*anchor_triangles)(const TriPack8* packs, int b, int e, const double* a, float* fa);
   void (*anchor_rows)(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca);
+  // The same, sixteen elements per pack (96 and 144 anchor floats per pack).
+  void (*tris16)(const TriPack16* packs, const float* fa, int b, int e, P4f* x, double ih2,
+                 double* lambda);
+  void (*rows16)(const RowPacksT<float>& rp, const float* ca, int b, int e, P4f* x, double ihb,
+                 double* lambda);
+  void (*anchor_triangles16)(const TriPack16* packs, int b, int e, const double* a, float* fa);
+  void (*anchor_rows16)(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca);
 };
 
-// The fastest build this CPU runs; simd = false: the portable one (tests compare the two).
-// DRAPE_XPBD_SIMD=0 in the environment forces the portable build.
+// The fastest build this CPU runs (AVX-512, then AVX2+FMA); simd = false: the portable one
+// (tests compare them). DRAPE_XPBD_SIMD=0 in the environment forces the portable build,
+// DRAPE_XPBD_SIMD=avx2 the AVX2 one (when the CPU has it).
 const Kernels& kernels(bool simd = true);
+// Every build this CPU runs, the portable one first.
+std::vector<const Kernels*> all_kernels();
 
 }  // namespace drape::sim::xpbd

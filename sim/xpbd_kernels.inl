@@ -2,7 +2,8 @@
 // sim/xpbd_kernels.cpp (portable) and sim/xpbd_kernels_avx2.cpp (AVX2+FMA) inside a namespace
 // of their own. Values are GCC/Clang vector-extension vectors, one element per lane: four
 // doubles or eight floats, which the compiler maps to one AVX register or to two SSE2 ones.
-// Each kernel is written once over a lane type (Dbl4, Flt8 below) and instantiated for both.
+// Each kernel is written once over a lane type (Dbl4, Flt8, Flt16 below) and instantiated for
+// each.
 
 #if defined(__GNUC__) && !defined(__clang__)
 // The helpers below take and return vectors by value; GCC notes that this ABI differs between
@@ -138,6 +139,87 @@ inline void scatter8(P4f* x, const int32_t* v, const Lanes8& g) {
   st4(x[v[7]], __builtin_shufflevector(d, d, 4, 5, 6, 7));
 }
 
+// Sixteen floats per pack (the AVX-512 build's width; the other builds compile the same code,
+// which GCC lowers to two AVX or four SSE registers per vector).
+using F16 = float __attribute__((vector_size(64)));
+// GCC does not inline the sixteen-lane gather and scatter on its own (they are long): a call
+// spills every accumulator of the bending kernel.
+#define XPBD_INLINE inline __attribute__((always_inline))
+
+XPBD_INLINE F16 ld16(const float* p) {
+  F16 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+// transpose8 on four 128-bit quarters: rows [v_l | v_l+4 | v_l+8 | v_l+12] to X = (x0 .. x15),
+// Y, Z, W (its own inverse).
+XPBD_INLINE void transpose16(F16 a, F16 b, F16 c, F16 d, F16& X, F16& Y, F16& Z, F16& W) {
+  const F16 t0 =
+      __builtin_shufflevector(a, b, 0, 16, 1, 17, 4, 20, 5, 21, 8, 24, 9, 25, 12, 28, 13, 29);
+  const F16 t1 =
+      __builtin_shufflevector(a, b, 2, 18, 3, 19, 6, 22, 7, 23, 10, 26, 11, 27, 14, 30, 15, 31);
+  const F16 t2 =
+      __builtin_shufflevector(c, d, 0, 16, 1, 17, 4, 20, 5, 21, 8, 24, 9, 25, 12, 28, 13, 29);
+  const F16 t3 =
+      __builtin_shufflevector(c, d, 2, 18, 3, 19, 6, 22, 7, 23, 10, 26, 11, 27, 14, 30, 15, 31);
+  X = __builtin_shufflevector(t0, t2, 0, 1, 16, 17, 4, 5, 20, 21, 8, 9, 24, 25, 12, 13, 28, 29);
+  Y = __builtin_shufflevector(t0, t2, 2, 3, 18, 19, 6, 7, 22, 23, 10, 11, 26, 27, 14, 15, 30, 31);
+  Z = __builtin_shufflevector(t1, t3, 0, 1, 16, 17, 4, 5, 20, 21, 8, 9, 24, 25, 12, 13, 28, 29);
+  W = __builtin_shufflevector(t1, t3, 2, 3, 18, 19, 6, 7, 22, 23, 10, 11, 26, 27, 14, 15, 30, 31);
+}
+using Lanes16 = LanesOf<F16>;
+XPBD_INLINE F16 join4(F4 a, F4 b, F4 c, F4 d) {
+  return __builtin_shufflevector(join(a, b), join(c, d), 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12,
+                                 13, 14, 15);
+}
+#if defined(__AVX512F__)
+// Four vertices into the four quarters of one register: a load and three inserts from memory
+// (which, unlike a shuffle of registers, do not need the shuffle port).
+XPBD_INLINE F16 load4x4(const P4f& a, const P4f& b, const P4f& c, const P4f& d) {
+  __m512 r = _mm512_zextps128_ps512(_mm_load_ps(a.c));
+  r = _mm512_insertf32x4(r, _mm_load_ps(b.c), 1);
+  r = _mm512_insertf32x4(r, _mm_load_ps(c.c), 2);
+  r = _mm512_insertf32x4(r, _mm_load_ps(d.c), 3);
+  return reinterpret_cast<F16>(r);
+}
+#else
+XPBD_INLINE F16 load4x4(const P4f& a, const P4f& b, const P4f& c, const P4f& d) {
+  return join4(ld4(a), ld4(b), ld4(c), ld4(d));
+}
+#endif
+XPBD_INLINE Lanes16 gather16(const P4f* x, const int32_t* v) {
+  Lanes16 g;
+  transpose16(load4x4(x[v[0]], x[v[4]], x[v[8]], x[v[12]]),
+              load4x4(x[v[1]], x[v[5]], x[v[9]], x[v[13]]),
+              load4x4(x[v[2]], x[v[6]], x[v[10]], x[v[14]]),
+              load4x4(x[v[3]], x[v[7]], x[v[11]], x[v[15]]), g.X, g.Y, g.Z, g.W);
+  return g;
+}
+// Quarter q of a (four floats).
+template <int q>
+XPBD_INLINE F4 quarter(F16 a) {
+  return __builtin_shufflevector(a, a, 4 * q, 4 * q + 1, 4 * q + 2, 4 * q + 3);
+}
+// As scatter8: lanes sharing a vertex (only padding's scratch vertex) write the same value.
+XPBD_INLINE void scatter16(P4f* x, const int32_t* v, const Lanes16& g) {
+  F16 r[4];
+  transpose16(g.X, g.Y, g.Z, g.W, r[0], r[1], r[2], r[3]);
+  for (int l = 0; l < 4; ++l) {
+#if defined(__AVX512F__)
+    const __m512 q = reinterpret_cast<__m512>(r[l]);
+    _mm_store_ps(x[v[l]].c, _mm512_castps512_ps128(q));
+    _mm_store_ps(x[v[l + 4]].c, _mm512_extractf32x4_ps(q, 1));
+    _mm_store_ps(x[v[l + 8]].c, _mm512_extractf32x4_ps(q, 2));
+    _mm_store_ps(x[v[l + 12]].c, _mm512_extractf32x4_ps(q, 3));
+#else
+    st4(x[v[l]], quarter<0>(r[l]));
+    st4(x[v[l + 4]], quarter<1>(r[l]));
+    st4(x[v[l + 8]], quarter<2>(r[l]));
+    st4(x[v[l + 12]], quarter<3>(r[l]));
+#endif
+  }
+}
+
 // The lane types: vector, scalar, lanes, padded position, packs, loads, gather and scatter.
 struct Dbl4 {
   static constexpr bool kAnchored = false;  // absolute positions
@@ -160,6 +242,19 @@ struct Flt8 {
   static V load(const float* p) { return ld8(p); }
   static Lanes8 gather(const P4f* x, const int32_t* v) { return gather8(x, v); }
   static void scatter(P4f* x, const int32_t* v, const Lanes8& g) { scatter8(x, v, g); }
+};
+struct Flt16 {
+  static constexpr bool kAnchored = true;
+  using V = F16;
+  using S = float;
+  static constexpr int L = 16;
+  using PX = P4f;
+  using TriPackType = TriPack16;
+  XPBD_INLINE static V load(const float* p) { return ld16(p); }
+  XPBD_INLINE static Lanes16 gather(const P4f* x, const int32_t* v) { return gather16(x, v); }
+  XPBD_INLINE static void scatter(P4f* x, const int32_t* v, const Lanes16& g) {
+    scatter16(x, v, g);
+  }
 };
 
 // The three strain constraints of a triangle (E_uu, E_vv, E_uv) are projected one after the
@@ -347,6 +442,14 @@ void project_rows8(const RowPacksT<float>& rp, const float* ca, int b, int e, P4
                    double* lambda) {
   rows_impl<Flt8>(rp, ca, b, e, x, ihb, lambda);
 }
+void project_tris16(const TriPack16* packs, const float* fa, int b, int e, P4f* x, double ih2,
+                    double* lambda) {
+  tris_impl<Flt16>(packs, fa, b, e, x, ih2, lambda);
+}
+void project_rows16(const RowPacksT<float>& rp, const float* ca, int b, int e, P4f* x, double ihb,
+                    double* lambda) {
+  rows_impl<Flt16>(rp, ca, b, e, x, ihb, lambda);
+}
 
 void pack(const double* x, const double* w, P4* p, int b, int e) {
   for (int i = b; i < e; ++i) {
@@ -378,38 +481,63 @@ void unpack8(const P4f* p, const double* a, double* x, int b, int e) {
     }
 }
 
-void anchor_triangles(const TriPack8* packs, int b, int e, const double* a, float* fa) {
+template <int L>
+void anchor_triangles_impl(const TriPackT<float, L>* packs, int b, int e, const double* a,
+                           float* fa) {
   for (int p = b; p < e; ++p) {
-    const TriPack8& T = packs[p];
-    double e1[3][8], e2[3][8];
-    for (int l = 0; l < 8; ++l)
+    const TriPackT<float, L>& T = packs[p];
+    double e1[3][L], e2[3][L];
+    for (int l = 0; l < L; ++l)
       for (int c = 0; c < 3; ++c) {
         const double a0 = a[3 * T.v[0][l] + c];
         e1[c][l] = a[3 * T.v[1][l] + c] - a0;
         e2[c][l] = a[3 * T.v[2][l] + c] - a0;
       }
-    float* out = fa + 48 * p;
+    float* out = fa + 6 * L * p;
     for (int c = 0; c < 3; ++c)
-      for (int l = 0; l < 8; ++l) {
-        out[8 * c + l] = static_cast<float>(e1[c][l] * T.D[2][l] + e2[c][l] * T.D[4][l]);
-        out[8 * (3 + c) + l] = static_cast<float>(e1[c][l] * T.D[3][l] + e2[c][l] * T.D[5][l]);
+      for (int l = 0; l < L; ++l) {
+        out[L * c + l] = static_cast<float>(e1[c][l] * T.D[2][l] + e2[c][l] * T.D[4][l]);
+        out[L * (3 + c) + l] = static_cast<float>(e1[c][l] * T.D[3][l] + e2[c][l] * T.D[5][l]);
       }
   }
 }
 
-void anchor_rows(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca) {
+template <int L>
+void anchor_rows_impl(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca) {
   for (int p = b; p < e; ++p) {
-    double c[9][8] = {};
+    double c[9][L] = {};
     for (int k = rp.off[p]; k < rp.off[p + 1]; ++k) {
-      double ax[3][8];  // the lanes' anchors, then 8 lanes at a time (vectorised)
-      for (int l = 0; l < 8; ++l)
-        for (int d = 0; d < 3; ++d) ax[d][l] = a[3 * rp.colv[8 * k + l] + d];
+      double ax[3][L];  // the lanes' anchors, then L lanes at a time (vectorised)
+      for (int l = 0; l < L; ++l)
+        for (int d = 0; d < 3; ++d) ax[d][l] = a[3 * rp.colv[L * k + l] + d];
       for (int r = 0; r < 3; ++r)
         for (int d = 0; d < 3; ++d)
-          for (int l = 0; l < 8; ++l)
-            c[3 * r + d][l] += static_cast<double>(rp.val[24 * k + 8 * r + l]) * ax[d][l];
+          for (int l = 0; l < L; ++l)
+            c[3 * r + d][l] += static_cast<double>(rp.val[3 * L * k + L * r + l]) * ax[d][l];
     }
     for (int j = 0; j < 9; ++j)
-      for (int l = 0; l < 8; ++l) ca[72 * p + 8 * j + l] = static_cast<float>(c[j][l]);
+      for (int l = 0; l < L; ++l) ca[9 * L * p + L * j + l] = static_cast<float>(c[j][l]);
   }
+}
+
+void anchor_triangles(const TriPack8* packs, int b, int e, const double* a, float* fa) {
+  anchor_triangles_impl<8>(packs, b, e, a, fa);
+}
+void anchor_rows(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca) {
+  anchor_rows_impl<8>(rp, b, e, a, ca);
+}
+void anchor_triangles16(const TriPack16* packs, int b, int e, const double* a, float* fa) {
+  anchor_triangles_impl<16>(packs, b, e, a, fa);
+}
+void anchor_rows16(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca) {
+  anchor_rows_impl<16>(rp, b, e, a, ca);
+}
+
+// This build's kernels, named, with its preferred single-precision widths.
+constexpr Kernels make_kernels(const char* name, int tri_lanes, int row_lanes) {
+  return Kernels{name,           tri_lanes,       row_lanes,       &project_tris,
+                 &project_rows,  &pack,           &unpack,         &project_tris8,
+                 &project_rows8, &pack8,          &unpack8,        &anchor_triangles,
+                 &anchor_rows,   &project_tris16, &project_rows16, &anchor_triangles16,
+                 &anchor_rows16};
 }

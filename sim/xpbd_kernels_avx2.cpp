@@ -8,8 +8,6 @@
 namespace drape::sim::xpbd::avx2 {
 #include "sim/xpbd_kernels.inl"
 extern const Kernels kKernels;
-const Kernels kKernels{"avx2",   &project_tris,     &project_rows,  &pack,
-                       &unpack,  &project_tris8,    &project_rows8, &pack8,
-                       &unpack8, &anchor_triangles, &anchor_rows};
+const Kernels kKernels = make_kernels("avx2", 8, 8);
 }  // namespace drape::sim::xpbd::avx2
 #endif

@@ -1,6 +1,7 @@
-// XPBD's hot loops (sim/xpbd_kernels.hpp): the packed kernels (four doubles or eight floats per
-// pack, one element per lane) do what projecting the elements one after the other does, the AVX2
-// build agrees with the portable one, and a triangle projection does what the constraint says.
+// XPBD's hot loops (sim/xpbd_kernels.hpp): the packed kernels (four doubles, or eight or sixteen
+// floats per pack, one element per lane) do what projecting the elements one after the other
+// does, the SIMD builds (AVX2, AVX-512) agree with the portable one, and a triangle projection
+// does what the constraint says.
 #include "sim/xpbd_kernels.hpp"
 
 #include <gtest/gtest.h>
@@ -190,7 +191,7 @@ double max_diff(const std::vector<P4>& a, const std::vector<Eigen::Vector3d>& b)
 }
 
 TEST(XpbdKernels, PacksProjectLikeOneElementAfterTheOther) {
-  for (const Kernels* K : {&kernels(false), &kernels(true)})
+  for (const Kernels* K : all_kernels())
     for (bool keep : {false, true}) {
       Problem ref = make_problem(7);
       const Problem orig = ref;
@@ -234,39 +235,56 @@ TEST(XpbdKernels, PacksProjectLikeOneElementAfterTheOther) {
 }
 
 TEST(XpbdKernels, SimdBuildAgreesWithThePortableOne) {
-  const Kernels& fast = kernels(true);
-  const Kernels& ref = kernels(false);
-  EXPECT_STREQ(ref.name, "portable");
-  if (fast.tris == ref.tris)
+  const std::vector<const Kernels*> builds = all_kernels();
+  if (builds.size() < 2)
     GTEST_SKIP() << "this CPU (or DRAPE_XPBD_SIMD=0) has only the portable kernels";
+  const Kernels& ref = *builds[0];
   const Problem p = make_problem(11);
-  Packed a = pack_problem(p), b = pack_problem(p);
-  for (int it = 0; it < 3; ++it) {
-    fast.tris(a.tp.data(), 0, static_cast<int>(a.tp.size()), a.xp.data(), kIh2, nullptr);
-    ref.tris(b.tp.data(), 0, static_cast<int>(b.tp.size()), b.xp.data(), kIh2, nullptr);
-    fast.rows(a.rp.view(), 0, a.rp.packs(), a.xp.data(), kIhb, nullptr);
-    ref.rows(b.rp.view(), 0, b.rp.packs(), b.xp.data(), kIhb, nullptr);
+  for (size_t k = 1; k < builds.size(); ++k) {
+    const Kernels& fast = *builds[k];
+    Packed a = pack_problem(p), b = pack_problem(p);
+    for (int it = 0; it < 3; ++it) {
+      fast.tris(a.tp.data(), 0, static_cast<int>(a.tp.size()), a.xp.data(), kIh2, nullptr);
+      ref.tris(b.tp.data(), 0, static_cast<int>(b.tp.size()), b.xp.data(), kIh2, nullptr);
+      fast.rows(a.rp.view(), 0, a.rp.packs(), a.xp.data(), kIhb, nullptr);
+      ref.rows(b.rp.view(), 0, b.rp.packs(), b.xp.data(), kIhb, nullptr);
+    }
+    double d = 0;
+    for (size_t i = 0; i < a.xp.size(); ++i)
+      for (int c = 0; c < 4; ++c) d = std::max(d, std::abs(a.xp[i].c[c] - b.xp[i].c[c]));
+    std::printf("%s vs portable: positions differ by %.3e\n", fast.name, d);
+    EXPECT_LT(d, 1e-12);
   }
-  double d = 0;
-  for (size_t i = 0; i < a.xp.size(); ++i)
-    for (int c = 0; c < 4; ++c) d = std::max(d, std::abs(a.xp[i].c[c] - b.xp[i].c[c]));
-  std::printf("%s vs portable: positions differ by %.3e\n", fast.name, d);
-  EXPECT_LT(d, 1e-12);
 }
 
 // The problem in single precision: positions moved to `offset` (metres away from the origin,
 // as a cloth on a dress form is), anchored at the positions they start from (as at a frame's
 // start), with the elements' terms at the anchors.
-struct Packed8 {
+template <int L>
+struct PackedF {
   std::vector<double> x;  // the double state (3 per vertex) that unpack8 updates
   std::vector<double> a;  // the anchors
   std::vector<P4f> xp;
-  std::vector<TriPack8> tp;
-  RowPackData8 rp;
+  std::vector<TriPackT<float, L>> tp;
+  RowPackDataT<float, L> rp;
   std::vector<float> fa, ca;
+  // The kernels of this width.
+  void tris(const Kernels& K, double* lambda) {
+    if constexpr (L == 16)
+      K.tris16(tp.data(), fa.data(), 0, static_cast<int>(tp.size()), xp.data(), kIh2, lambda);
+    else
+      K.tris8(tp.data(), fa.data(), 0, static_cast<int>(tp.size()), xp.data(), kIh2, lambda);
+  }
+  void rows(const Kernels& K, double* lambda) {
+    if constexpr (L == 16)
+      K.rows16(rp.view(), ca.data(), 0, rp.packs(), xp.data(), kIhb, lambda);
+    else
+      K.rows8(rp.view(), ca.data(), 0, rp.packs(), xp.data(), kIhb, lambda);
+  }
 };
-Packed8 pack_problem8(const Problem& p, const Kernels& K, const double* offset) {
-  Packed8 k;
+template <int L>
+PackedF<L> pack_problem_f(const Problem& p, const Kernels& K, const double* offset) {
+  PackedF<L> k;
   k.x.resize(3 * p.n);
   for (int i = 0; i < p.n; ++i)
     for (int c = 0; c < 3; ++c) k.x[3 * i + c] = p.x[i][c] + offset[c];
@@ -274,40 +292,47 @@ Packed8 pack_problem8(const Problem& p, const Kernels& K, const double* offset) 
   k.a.resize(3 * (p.n + 1), 0.0);  // the scratch vertex's anchor
   k.xp.assign(p.n + 1, P4f{{0, 0, 0, 0}});
   K.pack8(k.x.data(), p.w.data(), k.a.data(), k.xp.data(), 0, p.n);
-  pack_triangles<float, 8>(p.tris.data(), 0, static_cast<int>(p.tris.size()), p.n, k.tp);
+  pack_triangles<float, L>(p.tris.data(), 0, static_cast<int>(p.tris.size()), p.n, k.tp);
   const int nb = static_cast<int>(p.off.size()) - 1;
   k.rp.append(p.off.data(), p.colv.data(), p.val.data(), p.ik.data(), 0, nb, p.n);
   for (int r = 0; r < nb; ++r)
     for (int m = 0; m < 6; ++m) k.rp.ai_of(r, m) = static_cast<float>(p.ai[6 * r + m]);
-  k.fa.resize(48 * k.tp.size());
-  k.ca.resize(72 * static_cast<size_t>(k.rp.packs()));
-  K.anchor_triangles(k.tp.data(), 0, static_cast<int>(k.tp.size()), k.a.data(), k.fa.data());
-  K.anchor_rows(k.rp.view(), 0, k.rp.packs(), k.a.data(), k.ca.data());
+  k.fa.resize(6 * L * k.tp.size());
+  k.ca.resize(9 * L * static_cast<size_t>(k.rp.packs()));
+  if constexpr (L == 16) {
+    K.anchor_triangles16(k.tp.data(), 0, static_cast<int>(k.tp.size()), k.a.data(), k.fa.data());
+    K.anchor_rows16(k.rp.view(), 0, k.rp.packs(), k.a.data(), k.ca.data());
+  } else {
+    K.anchor_triangles(k.tp.data(), 0, static_cast<int>(k.tp.size()), k.a.data(), k.fa.data());
+    K.anchor_rows(k.rp.view(), 0, k.rp.packs(), k.a.data(), k.ca.data());
+  }
   return k;
 }
 
-// The single-precision kernels (eight elements per pack, floats for the displacements from the
-// anchors, the state kept in double by unpack8) do what the double reference does, to float
-// round-off of the displacements, with the cloth a metre and more from the coordinate origin.
-TEST(XpbdKernels, SinglePrecisionPacksProjectLikeTheDoubleReference) {
+// The single-precision kernels (eight or sixteen elements per pack, floats for the displacements
+// from the anchors, the state kept in double by unpack8) do what the double reference does, to
+// float round-off of the displacements, with the cloth a metre and more from the coordinate
+// origin; every build, both widths.
+template <int L>
+void check_single_precision_against_double() {
   const double offset[3] = {-0.7, 1.3, 0.45};  // a cloth at a dress form's chest
-  for (const Kernels* K : {&kernels(false), &kernels(true)})
+  for (const Kernels* K : all_kernels())
     for (bool keep : {false, true}) {
       Problem ref = make_problem(7);
       const Problem orig = ref;
-      Packed8 pk = pack_problem8(ref, *K, offset);
-      EXPECT_EQ(pk.tp.size(), 26u);  // 203 triangles: 25 full packs and one of three
-      EXPECT_EQ(pk.rp.packs(), 13);  // 101 blocks: 12 full packs and one of five
+      PackedF<L> pk = pack_problem_f<L>(ref, *K, offset);
+      // 203 triangles: 25 full packs of eight and one of three (12 of sixteen and one of
+      // eleven); 101 blocks: 12 full packs and one of five (6 and one of five).
+      EXPECT_EQ(pk.tp.size(), L == 8 ? 26u : 13u);
+      EXPECT_EQ(pk.rp.packs(), L == 8 ? 13 : 7);
       std::vector<double> lt_ref(3 * ref.tris.size(), 0.0), lt = lt_ref;
       std::vector<double> lr_ref(9 * (ref.off.size() - 1), 0.0), lr = lr_ref;
       for (int it = 0; it < 3; ++it) {
         reference_tris(ref, kIh2, keep ? lt_ref.data() : nullptr);
         reference_rows(ref, kIhb, keep ? lr_ref.data() : nullptr);
         K->pack8(pk.x.data(), ref.w.data(), pk.a.data(), pk.xp.data(), 0, ref.n);
-        K->tris8(pk.tp.data(), pk.fa.data(), 0, static_cast<int>(pk.tp.size()), pk.xp.data(), kIh2,
-                 keep ? lt.data() : nullptr);
-        K->rows8(pk.rp.view(), pk.ca.data(), 0, pk.rp.packs(), pk.xp.data(), kIhb,
-                 keep ? lr.data() : nullptr);
+        pk.tris(*K, keep ? lt.data() : nullptr);
+        pk.rows(*K, keep ? lr.data() : nullptr);
         K->unpack8(pk.xp.data(), pk.a.data(), pk.x.data(), 0, ref.n);
       }
       double move = 0, d = 0;
@@ -326,9 +351,9 @@ TEST(XpbdKernels, SinglePrecisionPacksProjectLikeTheDoubleReference) {
         lmax = std::max(lmax, std::abs(lr_ref[k]));
       }
       std::printf(
-          "%s single-precision kernels (multipliers %s): positions moved up to %.3e, differ "
-          "from the double reference by %.3e; multipliers by %.3e of up to %.3e\n",
-          K->name, keep ? "kept" : "reset", move, d, dl, lmax);
+          "%s single-precision kernels, %d lanes (multipliers %s): positions moved up to %.3e, "
+          "differ from the double reference by %.3e; multipliers by %.3e of up to %.3e\n",
+          K->name, L, keep ? "kept" : "reset", move, d, dl, lmax);
       EXPECT_GT(move, 1e-3);
       // Float round-off of the displacements (measured 3.8e-8 m; the moves here reach 0.4 m,
       // a frame's on a cloth a few mm).
@@ -344,6 +369,41 @@ TEST(XpbdKernels, SinglePrecisionPacksProjectLikeTheDoubleReference) {
       for (int c = 0; c < 4; ++c) EXPECT_EQ(pk.xp[ref.n].c[c], 0.0f);  // the scratch vertex
     }
 }
+TEST(XpbdKernels, SinglePrecisionPacksProjectLikeTheDoubleReference) {
+  check_single_precision_against_double<8>();
+}
+TEST(XpbdKernels, SixteenLanePacksProjectLikeTheDoubleReference) {
+  check_single_precision_against_double<16>();
+}
+
+// The two widths run the same arithmetic lane by lane: sixteen-lane packs move the vertices as
+// eight-lane packs of the same elements do, in every build.
+TEST(XpbdKernels, SixteenLanePacksAgreeWithEightLanePacks) {
+  const Problem p = make_problem(5);
+  const double offset[3] = {0.3, 1.1, -0.2};
+  for (const Kernels* K : all_kernels()) {
+    PackedF<8> a = pack_problem_f<8>(p, *K, offset);
+    PackedF<16> b = pack_problem_f<16>(p, *K, offset);
+    double dfa = 0;  // the anchor terms, element by element
+    for (size_t t = 0; t < p.tris.size(); ++t)
+      for (int j = 0; j < 6; ++j)
+        dfa = std::max(dfa, double(std::abs(a.fa[48 * (t / 8) + 8 * j + t % 8] -
+                                            b.fa[96 * (t / 16) + 16 * j + t % 16])));
+    EXPECT_EQ(dfa, 0.0) << K->name;
+    for (int it = 0; it < 3; ++it) {
+      a.tris(*K, nullptr);
+      b.tris(*K, nullptr);
+      a.rows(*K, nullptr);
+      b.rows(*K, nullptr);
+    }
+    double d = 0;
+    for (size_t i = 0; i < a.xp.size(); ++i)
+      for (int c = 0; c < 4; ++c) d = std::max(d, double(std::abs(a.xp[i].c[c] - b.xp[i].c[c])));
+    std::printf("%s: sixteen-lane packs vs eight-lane packs: positions differ by %.3e\n", K->name,
+                d);
+    EXPECT_LT(d, 3e-7);  // float round-off at most (FMA contraction may differ by width)
+  }
+}
 
 // pack8 then unpack8 with nothing moved in between gives back every double bit for bit: the
 // float copy's resolution does not leak into the state.
@@ -356,7 +416,7 @@ TEST(XpbdKernels, SinglePrecisionRoundTripKeepsTheDoublePositions) {
   y = x;
   std::vector<double> a(3 * n);  // anchors: up to 5 mm away
   for (int i = 0; i < 3 * n; ++i) a[i] = x[i] + 0.005 * std::sin(i);
-  for (const Kernels* K : {&kernels(false), &kernels(true)}) {
+  for (const Kernels* K : all_kernels()) {
     std::vector<P4f> p(n);
     K->pack8(y.data(), w.data(), a.data(), p.data(), 0, n);
     K->unpack8(p.data(), a.data(), y.data(), 0, n);
@@ -365,26 +425,38 @@ TEST(XpbdKernels, SinglePrecisionRoundTripKeepsTheDoublePositions) {
 }
 
 TEST(XpbdKernels, SinglePrecisionSimdBuildAgreesWithThePortableOne) {
-  const Kernels& fast = kernels(true);
-  const Kernels& ref = kernels(false);
-  if (fast.tris8 == ref.tris8)
+  const std::vector<const Kernels*> builds = all_kernels();
+  if (builds.size() < 2)
     GTEST_SKIP() << "this CPU (or DRAPE_XPBD_SIMD=0) has only the portable kernels";
+  const Kernels& ref = *builds[0];
   const Problem p = make_problem(11);
   const double offset[3] = {0, 1.2, 0};
-  Packed8 a = pack_problem8(p, fast, offset), b = pack_problem8(p, ref, offset);
-  for (int it = 0; it < 3; ++it) {
-    fast.tris8(a.tp.data(), a.fa.data(), 0, static_cast<int>(a.tp.size()), a.xp.data(), kIh2,
-               nullptr);
-    ref.tris8(b.tp.data(), b.fa.data(), 0, static_cast<int>(b.tp.size()), b.xp.data(), kIh2,
-              nullptr);
-    fast.rows8(a.rp.view(), a.ca.data(), 0, a.rp.packs(), a.xp.data(), kIhb, nullptr);
-    ref.rows8(b.rp.view(), b.ca.data(), 0, b.rp.packs(), b.xp.data(), kIhb, nullptr);
+  for (size_t k = 1; k < builds.size(); ++k) {
+    const Kernels& fast = *builds[k];
+    PackedF<8> a = pack_problem_f<8>(p, fast, offset), b = pack_problem_f<8>(p, ref, offset);
+    PackedF<16> a16 = pack_problem_f<16>(p, fast, offset), b16 = pack_problem_f<16>(p, ref, offset);
+    for (int it = 0; it < 3; ++it) {
+      a.tris(fast, nullptr);
+      b.tris(ref, nullptr);
+      a.rows(fast, nullptr);
+      b.rows(ref, nullptr);
+      a16.tris(fast, nullptr);
+      b16.tris(ref, nullptr);
+      a16.rows(fast, nullptr);
+      b16.rows(ref, nullptr);
+    }
+    double d = 0, d16 = 0;
+    for (size_t i = 0; i < a.xp.size(); ++i)
+      for (int c = 0; c < 4; ++c) {
+        d = std::max(d, double(std::abs(a.xp[i].c[c] - b.xp[i].c[c])));
+        d16 = std::max(d16, double(std::abs(a16.xp[i].c[c] - b16.xp[i].c[c])));
+      }
+    std::printf(
+        "%s vs portable, single precision: positions differ by %.3e (8 lanes), %.3e (16 lanes)\n",
+        fast.name, d, d16);
+    EXPECT_LT(d, 3e-7);  // float round-off (FMA contraction) only: measured 3.0e-8
+    EXPECT_LT(d16, 3e-7);
   }
-  double d = 0;
-  for (size_t i = 0; i < a.xp.size(); ++i)
-    for (int c = 0; c < 4; ++c) d = std::max(d, double(std::abs(a.xp[i].c[c] - b.xp[i].c[c])));
-  std::printf("%s vs portable, single precision: positions differ by %.3e\n", fast.name, d);
-  EXPECT_LT(d, 3e-7);  // float round-off (FMA contraction) only: measured 3.0e-8
 }
 
 // A unit right triangle (rest edges along u and v) stretched by 10 % along u, vertex 0 fixed:
@@ -392,7 +464,7 @@ TEST(XpbdKernels, SinglePrecisionSimdBuildAgreesWithThePortableOne) {
 // S_uu = 1 (only vertex 1 carries fu), so fu scales by 1 + dl with dl = -0.105 / 1.21 exactly;
 // E_vv and E_uv are 0 and stay so.
 TEST(XpbdKernels, OneProjectionRemovesTheStretchOfATriangle) {
-  for (const Kernels* k : {&kernels(false), &kernels(true)}) {
+  for (const Kernels* k : all_kernels()) {
     // Vertices 0..2 (w = 0, 1, 1) and the scratch vertex 3 of the three padding lanes.
     std::vector<P4> x{P4{{0, 0, 0, 0}}, P4{{1.1, 0, 0, 1}}, P4{{0, 1, 0, 1}}, P4{{0, 0, 0, 0}}};
     Tri T{};
