@@ -1,5 +1,6 @@
 // XPBD's hot loops built for AVX2+FMA (sim/xpbd_kernels.hpp); compiled with -mavx2 -mfma on
 // x86-64 only (sim/CMakeLists.txt) and called only when the CPU reports both.
+#include <algorithm>
 #include <cstring>
 
 #include "sim/xpbd_kernels.hpp"
