@@ -205,7 +205,6 @@ void XpbdSolver::cook(const Cloth& cloth) {
   lambda_tri_.assign(3 * tris_.size(), 0.0);
   lambda_hinge_.assign(hinges_.size(), Vec3::Zero());
   lambda_spring_.assign(springs_.size(), 0.0);
-  xt_.resize(n);
   // + the scratch vertex of padding lanes
   xp_.assign(cooked_f32_ ? 0 : n + 1, xpbd::P4{{0, 0, 0, 0}});
   xp8_.assign(cooked_f32_ ? n + 1 : 0, xpbd::P4f{{0, 0, 0, 0}});
@@ -213,6 +212,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
   tri_anchor8_.assign(static_cast<size_t>(6 * tlanes_) * float_tri_packs(), 0.0f);
   row_anchor8_.assign(static_cast<size_t>(9 * rlanes_) * float_row_packs(), 0.0f);
   w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
+  w0_.assign(n, -1.0);
   // Connected pieces (union-find over the elements' vertices).
   std::vector<int> parent(n);
   for (int i = 0; i < n; ++i) parent[i] = i;
@@ -516,30 +516,45 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   } else {
     std::fill(piece_scale_.begin(), piece_scale_.end(), 1.0);
   }
+  // w = the unscaled inverse mass (w0: 0 when not free or frozen) / the piece's settling scale.
+  // A change of w0 (a pin, a release, a piece falling asleep or waking) needs the bending blocks'
+  // sums over their stencils again; a change of scale alone does not (below).
   auto set_w = [&] {
     for (int i = 0; i < n; ++i) {
-      const double wi = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen)
-                            ? S.inv_mass[i] / piece_scale_[piece_of_[i]]
-                            : 0.0;
+      const double w0 = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
+      const double wi = w0 > 0 ? w0 / piece_scale_[piece_of_[i]] : 0.0;
       if (wi != w_[i]) w_changed_ = true;
+      if (w0 != w0_[i]) w0_changed_ = true;
       w_[i] = wi;
+      w0_[i] = w0;
     }
   };
-  // The bending blocks' inverse system matrices (in row_packs_), for the current w and h.
+  // The bending blocks' inverse system matrices (in row_packs_), for the current w and h:
+  // A = sum_j w_j v_j v_j^T + alpha / (be h^2). A block's stencil lies in one piece, so
+  // w_j = w0_j / scale and A = B / scale + alpha with B = sum_j w0_j v_j v_j^T, kept per block
+  // (row_b_) and summed again only when w0 changed.
   auto build_row_inverses = [&](int b, int e, int) {
     for (int r = b; r < e; ++r) {
-      double A[6] = {0, 0, 0, 0, 0, 0};  // 00 01 02 11 12 22
-      for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
-        const double wj = w_[row_colv_[k]];
-        if (wj == 0) continue;
-        const double* v = &row_val_[3 * k];
-        A[0] += wj * v[0] * v[0];
-        A[1] += wj * v[0] * v[1];
-        A[2] += wj * v[0] * v[2];
-        A[3] += wj * v[1] * v[1];
-        A[4] += wj * v[1] * v[2];
-        A[5] += wj * v[2] * v[2];
+      double* B = &row_b_[6 * r];  // 00 01 02 11 12 22
+      if (w0_changed_) {
+        for (int m = 0; m < 6; ++m) B[m] = 0;
+        for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
+          const double wj = w0_[row_colv_[k]];
+          if (wj == 0) continue;
+          const double* v = &row_val_[3 * k];
+          B[0] += wj * v[0] * v[0];
+          B[1] += wj * v[0] * v[1];
+          B[2] += wj * v[0] * v[2];
+          B[3] += wj * v[1] * v[1];
+          B[4] += wj * v[1] * v[2];
+          B[5] += wj * v[2] * v[2];
+        }
       }
+      const double is = row_off_[r + 1] > row_off_[r]
+                            ? 1.0 / piece_scale_[piece_of_[row_colv_[row_off_[r]]]]
+                            : 1.0;
+      double A[6];
+      for (int m = 0; m < 6; ++m) A[m] = B[m] * is;
       double ai[6] = {0, 0, 0, 0, 0, 0};
       auto store = [&] {
         for (int m = 0; m < 6; ++m) {
@@ -770,16 +785,26 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       w_dirty_ = false;
     }
     if (!row_ik_.empty() && (w_changed_ || ihb != row_ai_h_)) {
+      row_b_.resize(row_ik_.size() * 2);  // 6 per block (3 rows)
       pool_->parallel_for(static_cast<int>(row_ik_.size() / 3), build_row_inverses);
       row_ai_h_ = ihb;
       w_changed_ = false;
+      w0_changed_ = false;
     }
+    // The substep's start positions go straight to x_prev (the velocity update reads them there,
+    // and they are what x_prev holds after the step). Gravity alone is written out here (the same
+    // arithmetic as ClothEnergy::external_force); the pressure toward the form goes through it.
+    const EnergyOptions& eo = energy_.options();
+    const bool gravity_only = !(eo.pressure > 0 && scene.form);
     pool_->parallel_for(n, [&](int b, int e, int) {
       for (int i = b; i < e; ++i) {
-        xt_[i] = x[i];
-        if (w[i] > 0)
-          x[i] += h * S.v[i] + (h * h / (piece_scale_[piece_of_[i]] * S.mass[i])) *
-                                   energy_.external_force(i, x[i], S.mass[i]);
+        S.x_prev[i] = x[i];
+        if (!(w[i] > 0)) continue;
+        const double m = S.mass[i];
+        const Vec3 f = !gravity_only ? energy_.external_force(i, x[i], m)
+                       : eo.gravity  ? Vec3(m * eo.g)
+                                     : Vec3::Zero();
+        x[i] += h * S.v[i] + (h * h / (piece_scale_[piece_of_[i]] * m)) * f;
       }
     });
     if (warm) {
@@ -821,15 +846,15 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       // (Hinges exist only without bending rows: the order of the two does not matter.)
       by_colour(hinge_col_, project_hinges);
       by_colour(spring_col_, project_springs);
-      energy_.project_contacts(x, &xt_, scene.friction);
+      energy_.project_contacts(x, &S.x_prev, scene.friction);
       if (scene.self_collision) self_.project(cloth, x, w, scene.offset);
       ++st.iterations;
     }
     pool_->parallel_for(n, [&](int b, int e, int) {
       for (int i = b; i < e; ++i) {
-        S.x_prev[i] = xt_[i];
         if (w[i] > 0)
-          S.v[i] = (piece_scale_[piece_of_[i]] > 1.0 ? damp_settle : damp) * (x[i] - xt_[i]) / h;
+          S.v[i] =
+              (piece_scale_[piece_of_[i]] > 1.0 ? damp_settle : damp) * (x[i] - S.x_prev[i]) / h;
         else if (S.flags[i] & kFlagFrozen)
           S.v[i].setZero();
       }

@@ -219,12 +219,16 @@ class XpbdSolver : public Solver {
   std::vector<int> rpack_col_;
   double row_ai_h_ = -1;  // the 1/(be h^2) the cached inverses were built for
   bool w_changed_ = true;
+  // The inverse masses without the settling scale (w0_) and whether they changed since the
+  // bending blocks' sums row_b_ (6 per block: sum_j w0_j v_j v_j^T) were taken.
+  std::vector<double> w0_, row_b_;
+  bool w0_changed_ = true;
   // The inverse masses w_ must be recomputed (each frame's start; a piece's settling scale
   // changed or a piece fell asleep within the frame); otherwise they are kept between substeps.
   bool w_dirty_ = true;
   std::vector<Vec3> lambda_row_;
   std::vector<double> lambda_tri_, lambda_spring_;
-  std::vector<Vec3> lambda_hinge_, xt_;
+  std::vector<Vec3> lambda_hinge_;
   // Positions padded to four doubles (the fourth: inverse mass) for the triangle and bending
   // kernels (xpbd_kernels.hpp), packed before and unpacked after them in every iteration; one
   // more, the scratch vertex (w = 0), for the packs' padding lanes. (xp8_: the same in floats.)
