@@ -746,13 +746,15 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   const double damp = std::exp(-opt_.damping * h);
   const double damp_settle = std::exp(-opt_.settle_damping * h);
   const double margin = energy_.options().contact_margin;
+  const double moved_lim = 0.25 * margin * margin;  // (half the margin)^2
   for (int s = 0; s < ns; ++s) {
     if (s == 0 && contacts_fresh_) st.max_penetration = fresh_penetration_;
     bool detect = s == 0 ? !contacts_fresh_ : true;
     if (s > 0 && opt_.reuse_contacts) {
-      const double lim = 0.25 * margin * margin;
+      // Some vertex more than half the margin from where contacts were last detected (tested
+      // per vertex in the previous substep's velocity loop, on the pool).
       detect = false;
-      for (int i = 0; i < n && !detect; ++i) detect = (x[i] - x_det_[i]).squaredNorm() > lim;
+      for (char m : moved_part_) detect = detect || m;
     }
     if (detect) {
       const auto t0 = std::chrono::steady_clock::now();
@@ -850,7 +852,9 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       if (scene.self_collision) self_.project(cloth, x, w, scene.offset);
       ++st.iterations;
     }
-    pool_->parallel_for(n, [&](int b, int e, int) {
+    const bool test_moved = opt_.reuse_contacts && s + 1 < ns;
+    moved_part_.assign(pool_->size(), 0);
+    pool_->parallel_for(n, [&](int b, int e, int wk) {
       for (int i = b; i < e; ++i) {
         if (w[i] > 0)
           S.v[i] =
@@ -858,6 +862,12 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         else if (S.flags[i] & kFlagFrozen)
           S.v[i].setZero();
       }
+      if (test_moved && !moved_part_[wk])
+        for (int i = b; i < e; ++i)
+          if ((x[i] - x_det_[i]).squaredNorm() > moved_lim) {
+            moved_part_[wk] = 1;
+            break;
+          }
     });
     if (opt_.settle || opt_.freeze) {
       // Per piece, once per substep: the largest free-vertex speed (settling may start when

@@ -222,6 +222,9 @@ class XpbdSolver : public Solver {
   // The inverse masses without the settling scale (w0_) and whether they changed since the
   // bending blocks' sums row_b_ (6 per block: sum_j w0_j v_j v_j^T) were taken.
   std::vector<double> w0_, row_b_;
+  // Per pool thread: a vertex it updated in the substep moved more than half the contact margin
+  // since the last detection (XpbdOptions::reuse_contacts).
+  std::vector<char> moved_part_;
   bool w0_changed_ = true;
   // The inverse masses w_ must be recomputed (each frame's start; a piece's settling scale
   // changed or a piece fell asleep within the frame); otherwise they are kept between substeps.
