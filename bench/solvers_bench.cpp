@@ -366,6 +366,7 @@ int probe(int argc, char** argv) {
           static_cast<int>(env_num("XPBD_FINISH_CYCLES", xp->options().finisher.cycles));
       xp->options().finish_thread = env_num("XPBD_FINISH_THREAD", 1) > 0;
       xp->options().single_precision = env_num("XPBD_F32", 1) > 0;
+      if (const char* k = std::getenv("XPBD_KERNELS")) xp->options().kernels = k;
     }
   }
   sc.objects.friction = env_num("PROBE_FRICTION", sc.objects.friction);
@@ -800,19 +801,30 @@ void sleep_rows(int sres) {
 void thread_rows(int max_res) {
   // Both cores: the default solver 10x1 on the form scene with 1 and 2 threads (colour-parallel,
   // same result), wall and CPU ms per frame at 128^2 and 256^2, with XPBD's kernels in single
-  // precision (the default) and in double, side by side. The study's other rows are CPU time of
-  // one thread (the machine is shared); this is what one frame takes on this 2-core machine.
-  // The host's speed drifts by tens of % within minutes: at 128^2 the four configurations run
-  // interleaved in three rounds and each row is the median of its three (256^2: one round).
+  // precision (the default) and in double, side by side; on a CPU with AVX-512 also the single
+  // precision kernels of the AVX2 build (what a CPU without AVX-512 runs). The study's other rows
+  // are CPU time of one thread (the machine is shared); this is what one frame takes on this
+  // 2-core machine. The host's speed drifts by tens of % within minutes: at 128^2 the
+  // configurations run interleaved in three rounds and each row is the median of its three
+  // (256^2: one round).
   std::ofstream tc("out/bench/solvers_threads.csv");
-  tc << "scene,solver,resolution,substeps,threads,precision,runs,wall_ms_per_frame,"
+  tc << "scene,solver,resolution,substeps,threads,precision,kernels,runs,wall_ms_per_frame,"
         "cpu_ms_per_frame\n";
+  struct Config {
+    bool dbl;
+    std::string kernels;  // XpbdOptions::kernels ("": the fastest build)
+  };
+  std::vector<Config> configs{{false, ""}};
+  if (std::string(xpbd::kernels().name) == "avx512") configs.push_back({false, "avx2"});
+  configs.push_back({true, ""});
+  const int nc = static_cast<int>(configs.size());
   for (int res : {128, 256}) {
     if (res > max_res) continue;
     const int rounds = res <= 128 ? 3 : 1;
-    std::vector<double> wall_runs[2][2], cpu_runs[2][2];  // [double][threads - 1]
+    std::vector<std::vector<double>> wall_runs(2 * nc), cpu_runs(2 * nc);  // [2 c + threads - 1]
+    std::vector<std::string> used(nc);
     for (int round = 0; round < rounds; ++round)
-      for (int dbl : {0, 1})
+      for (int c = 0; c < nc; ++c)
         for (int threads : {1, 2}) {
           StudyScene sc = make_scene("form", res);
           SolverConfig cfg;
@@ -820,37 +832,47 @@ void thread_rows(int max_res) {
           cfg.threads = threads;
           cfg.air_damping = sc.air_damping;
           auto s = make_solver("default", cfg);
-          if (auto* xp = xpbd_of(s->get())) xp->options().single_precision = !dbl;
+          if (auto* xp = xpbd_of(s->get())) {
+            xp->options().single_precision = !configs[c].dbl;
+            xp->options().kernels = configs[c].kernels;
+          }
           const int frames = static_cast<int>(std::lround(sc.duration * 90));
           const double c0 = cpu_ms();
           const auto w0 = std::chrono::steady_clock::now();
           for (int f = 0; f < frames; ++f) (*s)->step(sc.cloth, sc.objects, 1.0 / 90);
-          wall_runs[dbl][threads - 1].push_back(
+          wall_runs[2 * c + threads - 1].push_back(
               std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0)
                   .count() /
               frames);
-          cpu_runs[dbl][threads - 1].push_back((cpu_ms() - c0) / frames);
+          cpu_runs[2 * c + threads - 1].push_back((cpu_ms() - c0) / frames);
+          if (auto* xp = xpbd_of(s->get())) used[c] = xp->kernels().name;
         }
     auto median = [](std::vector<double> v) {
       std::sort(v.begin(), v.end());
       return v[v.size() / 2];
     };
-    double wall_of[2][2];
-    for (int dbl : {0, 1})
+    std::vector<double> wall_of(2 * nc);
+    for (int c = 0; c < nc; ++c)
       for (int threads : {1, 2}) {
-        const double wall = median(wall_runs[dbl][threads - 1]);
-        const double cpu = median(cpu_runs[dbl][threads - 1]);
-        wall_of[dbl][threads - 1] = wall;
-        const char* prec = dbl ? "double" : "single";
+        const double wall = median(wall_runs[2 * c + threads - 1]);
+        const double cpu = median(cpu_runs[2 * c + threads - 1]);
+        wall_of[2 * c + threads - 1] = wall;
+        const char* prec = configs[c].dbl ? "double" : "single";
         std::printf(
-            "threads  %4d %s 10x1 %s, %d thread%s: %8.3f ms/frame wall, %8.3f ms CPU (median "
-            "of %d)\n",
-            res, kDefaultSolver, prec, threads, threads > 1 ? "s" : "", wall, cpu, rounds);
+            "threads  %4d %s 10x1 %s (%s), %d thread%s: %8.3f ms/frame wall, %8.3f ms CPU "
+            "(median of %d)\n",
+            res, kDefaultSolver, prec, used[c].c_str(), threads, threads > 1 ? "s" : "", wall, cpu,
+            rounds);
         tc << "form," << kDefaultSolver << "," << res << ",10," << threads << "," << prec << ","
-           << rounds << "," << wall << "," << cpu << std::endl;
+           << used[c] << "," << rounds << "," << wall << "," << cpu << std::endl;
       }
+    const int d = nc - 1;  // the double row
     std::printf("    ratio double / single precision = %.2fx (1 thread), %.2fx (2 threads)\n",
-                wall_of[1][0] / wall_of[0][0], wall_of[1][1] / wall_of[0][1]);
+                wall_of[2 * d] / wall_of[0], wall_of[2 * d + 1] / wall_of[1]);
+    if (nc == 3)
+      std::printf(
+          "    ratio avx2 / avx512 kernels (single) = %.2fx (1 thread), %.2fx (2 threads)\n",
+          wall_of[2] / wall_of[0], wall_of[3] / wall_of[1]);
   }
 }
 

@@ -71,6 +71,10 @@ void XpbdSolver::cook(const Cloth& cloth) {
   // Packs of four (double) or eight (single precision) triangles of one colour
   // (sim/xpbd_kernels.hpp); padding lanes use the scratch vertex n.
   cooked_f32_ = opt_.single_precision;
+  cooked_kernels_ = opt_.kernels;
+  kern_ = &xpbd::kernels();
+  for (const xpbd::Kernels* k : xpbd::all_kernels())
+    if (opt_.kernels == k->name) kern_ = k;
   tlanes_ = kern_->tri_lanes;
   rlanes_ = kern_->row_lanes;
   tri_packs_.clear();
@@ -474,7 +478,9 @@ double XpbdSolver::settle_scale() const {
 
 StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   StepStats st;
-  if (!energy_.up_to_date(cloth) || opt_.single_precision != cooked_f32_) cook(cloth);
+  if (!energy_.up_to_date(cloth) || opt_.single_precision != cooked_f32_ ||
+      opt_.kernels != cooked_kernels_)
+    cook(cloth);
   w_dirty_ = true;  // pins, releases, wakes and finishes happen between frames
   energy_.set_form(&scene);
   auto& S = cloth.state;

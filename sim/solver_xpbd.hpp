@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "sim/coarse_correction.hpp"
@@ -75,6 +76,10 @@ struct XpbdOptions {
   // (xpbd_kernels.hpp, P4f); the state stays double and receives the kernels' moves. false: the
   // double kernels, four per pack. Measured in docs/solvers.md section 3o.
   bool single_precision = true;
+  // The build of the hot loops by name ("portable", "avx2", "avx512"; xpbd_kernels.hpp), or
+  // empty: the fastest this CPU runs. A name the CPU does not run is ignored. For benchmarks
+  // that compare builds in one process.
+  std::string kernels;
   bool freeze = false;
   double freeze_speed = 1e-3;  // m/s
   int freeze_steps = 30;
@@ -243,6 +248,7 @@ class XpbdSolver : public Solver {
   // Kernels::tri_lanes, row_lanes, cooked into tlanes_, rlanes_); the colour offsets count the
   // packs in use.
   bool cooked_f32_ = false;
+  std::string cooked_kernels_;  // XpbdOptions::kernels when cooked
   int tlanes_ = 8, rlanes_ = 8;
   std::vector<xpbd::TriPack8> tri_packs8_;
   std::vector<xpbd::TriPack16> tri_packs16_;
