@@ -9,8 +9,8 @@
 // The same source (sim/xpbd_kernels.inl) is compiled three times: portable (x86-64 baseline:
 // SSE2, or any other target) and, on x86-64, with AVX2+FMA and with AVX-512 (F, VL, DQ, BW);
 // kernels() picks the widest build the CPU has at run time. Results differ by round-off only
-// (FMA contraction). In single precision the AVX-512 build packs sixteen elements, the others
-// eight (Kernels::float_lanes).
+// (FMA contraction). In single precision the AVX-512 build packs sixteen triangles, the others
+// eight (Kernels::tri_lanes; bending blocks: eight in every build, Kernels::row_lanes).
 // No Eigen here: an inline Eigen function instantiated in the AVX2 unit could be the copy the
 // linker keeps for the whole program.
 #pragma once
