@@ -457,7 +457,7 @@ int probe(int argc, char** argv) {
         "(%d triangles, %d bending blocks per pack)\n",
         double(xp->contact_detections()) / frames, xp->anchor_renewals(), frames,
         f32 ? "" : " (double precision)", xp->kernels().name, f32 ? xp->kernels().tri_lanes : 4,
-        f32 ? xp->kernels().row_lanes : 4);
+        f32 ? 8 : 4);
     if (xp->options().coarse_factor > 0) {
       const CoarseStats& c = xp->last_coarse();
       std::printf(

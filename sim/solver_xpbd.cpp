@@ -76,7 +76,6 @@ void XpbdSolver::cook(const Cloth& cloth) {
   for (const xpbd::Kernels* k : xpbd::all_kernels())
     if (opt_.kernels == k->name) kern_ = k;
   tlanes_ = kern_->tri_lanes;
-  rlanes_ = kern_->row_lanes;
   tri_packs_.clear();
   tri_packs8_.clear();
   tri_packs16_.clear();
@@ -162,15 +161,10 @@ void XpbdSolver::cook(const Cloth& cloth) {
     lambda_row_.assign(row_ik_.size(), Vec3::Zero());
     row_packs_.clear();
     row_packs8_.clear();
-    row_packs16_.clear();
     rpack_col_.assign(1, 0);
     rpack8_col_.assign(1, 0);
     for (size_t c = 0; c + 1 < row_cols_.size(); ++c) {
-      if (cooked_f32_ && rlanes_ == 16) {
-        row_packs16_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
-                            row_cols_[c], row_cols_[c + 1], n);
-        rpack8_col_.push_back(row_packs16_.packs());
-      } else if (cooked_f32_) {
+      if (cooked_f32_) {
         row_packs8_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
                            row_cols_[c], row_cols_[c + 1], n);
         rpack8_col_.push_back(row_packs8_.packs());
@@ -214,7 +208,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
   xp8_.assign(cooked_f32_ ? n + 1 : 0, xpbd::P4f{{0, 0, 0, 0}});
   anchors_.clear();  // renewed at the next step
   tri_anchor8_.assign(static_cast<size_t>(6 * tlanes_) * float_tri_packs(), 0.0f);
-  row_anchor8_.assign(static_cast<size_t>(9 * rlanes_) * float_row_packs(), 0.0f);
+  row_anchor8_.assign(72 * static_cast<size_t>(row_packs8_.packs()), 0.0f);
   w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
   w0_.assign(n, -1.0);
   // Connected pieces (union-find over the elements' vertices).
@@ -564,9 +558,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       double ai[6] = {0, 0, 0, 0, 0, 0};
       auto store = [&] {
         for (int m = 0; m < 6; ++m) {
-          if (cooked_f32_ && rlanes_ == 16)
-            row_packs16_.ai_of(r, m) = static_cast<float>(ai[m]);
-          else if (cooked_f32_)
+          if (cooked_f32_)
             row_packs8_.ai_of(r, m) = static_cast<float>(ai[m]);
           else
             row_packs_.ai_of(r, m) = ai[m];
@@ -610,8 +602,8 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   const xpbd::RowPacks rp = row_packs_.view();
   auto project_tris = [&](int b, int e, int) { K.tris(tri_packs_.data(), b, e, xp, ih2, lam_tri); };
   xpbd::P4f* xp8 = xp8_.data();
-  const bool wide_t = tlanes_ == 16, wide_r = rlanes_ == 16;
-  const xpbd::RowPacksT<float> rp8 = wide_r ? row_packs16_.view() : row_packs8_.view();
+  const bool wide_t = tlanes_ == 16;
+  const xpbd::RowPacksT<float> rp8 = row_packs8_.view();
   auto project_tris8 = [&](int b, int e, int) {
     if (wide_t)
       K.tris16(tri_packs16_.data(), tri_anchor8_.data(), b, e, xp8, ih2, lam_tri);
@@ -619,10 +611,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       K.tris8(tri_packs8_.data(), tri_anchor8_.data(), b, e, xp8, ih2, lam_tri);
   };
   auto project_rows8 = [&](int b, int e, int) {
-    if (wide_r)
-      K.rows16(rp8, row_anchor8_.data(), b, e, xp8, ihb, lam_row);
-    else
-      K.rows8(rp8, row_anchor8_.data(), b, e, xp8, ihb, lam_row);
+    K.rows8(rp8, row_anchor8_.data(), b, e, xp8, ihb, lam_row);
   };
   const bool padded = !tris_.empty() || row_off_.size() > 1;  // (the springs model has neither)
   if (cooked_f32_ && padded) {
@@ -646,11 +635,8 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         else
           K.anchor_triangles(tri_packs8_.data(), b, e, anchors_.data(), tri_anchor8_.data());
       });
-      pool_->parallel_for(float_row_packs(), [&](int b, int e, int) {
-        if (wide_r)
-          K.anchor_rows16(rp8, b, e, anchors_.data(), row_anchor8_.data());
-        else
-          K.anchor_rows(rp8, b, e, anchors_.data(), row_anchor8_.data());
+      pool_->parallel_for(row_packs8_.packs(), [&](int b, int e, int) {
+        K.anchor_rows(rp8, b, e, anchors_.data(), row_anchor8_.data());
       });
       ++anchor_renewals_;
     }

@@ -244,23 +244,21 @@ class XpbdSolver : public Solver {
   // The single-precision forms (XpbdOptions::single_precision; only those of the precision the
   // solver was cooked for are filled), the anchors (positions at the frame's start) and the
   // elements' terms at the anchors (xpbd_kernels.hpp, Kernels::tris8).
-  // Packs of eight floats, or of sixteen when the kernels' build prefers it (AVX-512:
-  // Kernels::tri_lanes, row_lanes, cooked into tlanes_, rlanes_); the colour offsets count the
-  // packs in use.
+  // Triangles in packs of eight floats, or of sixteen when the kernels' build prefers it
+  // (AVX-512: Kernels::tri_lanes, cooked into tlanes_; the colour offsets count the packs in
+  // use); bending blocks in packs of eight (sixteen measured slower, xpbd_kernels.hpp).
   bool cooked_f32_ = false;
   std::string cooked_kernels_;  // XpbdOptions::kernels when cooked
-  int tlanes_ = 8, rlanes_ = 8;
+  int tlanes_ = 8;
   std::vector<xpbd::TriPack8> tri_packs8_;
   std::vector<xpbd::TriPack16> tri_packs16_;
   std::vector<int> tpack8_col_;
   xpbd::RowPackData8 row_packs8_;
-  xpbd::RowPackData16 row_packs16_;
   std::vector<int> rpack8_col_;
   std::vector<xpbd::P4f> xp8_;
   int float_tri_packs() const {
     return static_cast<int>(tlanes_ == 16 ? tri_packs16_.size() : tri_packs8_.size());
   }
-  int float_row_packs() const { return rlanes_ == 16 ? row_packs16_.packs() : row_packs8_.packs(); }
   std::vector<double> anchors_;  // 3 per vertex, and the scratch vertex's (0)
   std::vector<float> tri_anchor8_, row_anchor8_;
   static constexpr double kAnchorReach = 0.02;  // m

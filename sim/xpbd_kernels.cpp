@@ -10,7 +10,7 @@ namespace drape::sim::xpbd {
 
 namespace portable {
 #include "sim/xpbd_kernels.inl"
-const Kernels kKernels = make_kernels("portable", 8, 8);
+const Kernels kKernels = make_kernels("portable", 8);
 }  // namespace portable
 
 template <class T, int L>

@@ -10,7 +10,7 @@
 // SSE2, or any other target) and, on x86-64, with AVX2+FMA and with AVX-512 (F, VL, DQ, BW);
 // kernels() picks the widest build the CPU has at run time. Results differ by round-off only
 // (FMA contraction). In single precision the AVX-512 build packs sixteen triangles, the others
-// eight (Kernels::tri_lanes; bending blocks: eight in every build, Kernels::row_lanes).
+// eight (Kernels::tri_lanes); bending blocks are packed eight per pack in every build.
 // No Eigen here: an inline Eigen function instantiated in the AVX2 unit could be the copy the
 // linker keeps for the whole program.
 #pragma once
@@ -105,13 +105,13 @@ using RowPackData16 = RowPackDataT<float, 16>;
 
 struct Kernels {
   const char* name;  // "avx512", "avx2" or "portable"
-  // The single-precision pack widths this build runs fastest, for triangles and for bending
-  // blocks: 16 or 8. Every build has the kernels of both widths (tris8/rows8, tris16/rows16),
-  // so that builds can be compared. The AVX-512 build packs triangles in sixteens (1.3-1.4x the
-  // eight-lane kernel, measured) and bending blocks in eights: a block gathers and scatters ~10
-  // vertices for ~20 multiply-adds, and on a CPU whose 512-bit operations share two ports the
-  // sixteen-lane gathers cost more than they save (measured 1.1x slower at 128^2).
-  int tri_lanes, row_lanes;
+  // The single-precision triangle pack width this build runs fastest: 16 (AVX-512, 1.4x the
+  // eight-lane kernel at 128^2, measured) or 8. Every build has the kernels of both widths
+  // (tris8/rows8, tris16/rows16), so that builds and widths can be compared. Bending blocks are
+  // packed in eights by every build: a block gathers and scatters ~10 vertices for ~20
+  // multiply-adds, and the sixteen-lane kernel measured 1.1x slower at 128^2 (docs/solvers.md
+  // section 3p); rows16 stays for that comparison.
+  int tri_lanes;
   // Projects triangle packs [b, e) once (Gauss-Seidel within a triangle: E_uu, E_vv, E_uv one
   // after the other). lambda: the triangles' multipliers (3 per triangle index), or null when
   // they are reset every substep.

@@ -533,11 +533,22 @@ void anchor_rows16(const RowPacksT<float>& rp, int b, int e, const double* a, fl
   anchor_rows_impl<16>(rp, b, e, a, ca);
 }
 
-// This build's kernels, named, with its preferred single-precision widths.
-constexpr Kernels make_kernels(const char* name, int tri_lanes, int row_lanes) {
-  return Kernels{name,           tri_lanes,       row_lanes,       &project_tris,
-                 &project_rows,  &pack,           &unpack,         &project_tris8,
-                 &project_rows8, &pack8,          &unpack8,        &anchor_triangles,
-                 &anchor_rows,   &project_tris16, &project_rows16, &anchor_triangles16,
+// This build's kernels, named, with its preferred single-precision triangle pack width.
+constexpr Kernels make_kernels(const char* name, int tri_lanes) {
+  return Kernels{name,
+                 tri_lanes,
+                 &project_tris,
+                 &project_rows,
+                 &pack,
+                 &unpack,
+                 &project_tris8,
+                 &project_rows8,
+                 &pack8,
+                 &unpack8,
+                 &anchor_triangles,
+                 &anchor_rows,
+                 &project_tris16,
+                 &project_rows16,
+                 &anchor_triangles16,
                  &anchor_rows16};
 }

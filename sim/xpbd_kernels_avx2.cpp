@@ -9,6 +9,6 @@
 namespace drape::sim::xpbd::avx2 {
 #include "sim/xpbd_kernels.inl"
 extern const Kernels kKernels;
-const Kernels kKernels = make_kernels("avx2", 8, 8);
+const Kernels kKernels = make_kernels("avx2", 8);
 }  // namespace drape::sim::xpbd::avx2
 #endif

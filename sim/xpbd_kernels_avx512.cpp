@@ -18,6 +18,6 @@
 namespace drape::sim::xpbd::avx512 {
 #include "sim/xpbd_kernels.inl"
 extern const Kernels kKernels;
-const Kernels kKernels = make_kernels("avx512", 16, 8);
+const Kernels kKernels = make_kernels("avx512", 16);
 }  // namespace drape::sim::xpbd::avx512
 #endif

@@ -10,8 +10,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numeric>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace drape::sim::xpbd {
@@ -234,11 +236,40 @@ TEST(XpbdKernels, PacksProjectLikeOneElementAfterTheOther) {
     }
 }
 
+// kernels() returns the last (widest) of all_kernels(), which starts with the portable build;
+// DRAPE_XPBD_SIMD=0 leaves only that one, DRAPE_XPBD_SIMD=avx2 stops below AVX-512 (ctest runs
+// this test with both too: simd_off.*, simd_avx2.*).
+TEST(XpbdKernels, TheFastestBuildTheCpuRunsIsChosen) {
+  const std::vector<const Kernels*> builds = all_kernels();
+  ASSERT_FALSE(builds.empty());
+  EXPECT_STREQ(builds.front()->name, "portable");
+  EXPECT_EQ(builds.front(), &kernels(false));
+  EXPECT_EQ(builds.back(), &kernels(true));
+  const char* env = std::getenv("DRAPE_XPBD_SIMD");
+  const std::string cap = env ? env : "";
+  if (cap == "0") {
+    EXPECT_EQ(builds.size(), 1u);
+  }
+  for (size_t k = 1; k < builds.size(); ++k) {
+    EXPECT_STRNE(builds[k]->name, builds[k - 1]->name);
+    if (cap == "avx2") {
+      EXPECT_STREQ(builds[k]->name, "avx2");
+    }
+  }
+  // Triangle widths: sixteen only from the AVX-512 build.
+  for (const Kernels* K : builds)
+    EXPECT_EQ(K->tri_lanes, std::string(K->name) == "avx512" ? 16 : 8) << K->name;
+  std::printf("builds this CPU runs:");
+  for (const Kernels* K : builds) std::printf(" %s", K->name);
+  std::printf("; chosen: %s\n", kernels(true).name);
+}
+
 TEST(XpbdKernels, SimdBuildAgreesWithThePortableOne) {
   const std::vector<const Kernels*> builds = all_kernels();
-  if (builds.size() < 2)
-    GTEST_SKIP() << "this CPU (or DRAPE_XPBD_SIMD=0) has only the portable kernels";
+  // (With only the portable build, on a CPU without AVX2 or with DRAPE_XPBD_SIMD=0, there is
+  // nothing to compare: TheFastestBuildTheCpuRunsIsChosen checks that case.)
   const Kernels& ref = *builds[0];
+  EXPECT_EQ(&ref, &kernels(false));
   const Problem p = make_problem(11);
   for (size_t k = 1; k < builds.size(); ++k) {
     const Kernels& fast = *builds[k];
@@ -426,9 +457,10 @@ TEST(XpbdKernels, SinglePrecisionRoundTripKeepsTheDoublePositions) {
 
 TEST(XpbdKernels, SinglePrecisionSimdBuildAgreesWithThePortableOne) {
   const std::vector<const Kernels*> builds = all_kernels();
-  if (builds.size() < 2)
-    GTEST_SKIP() << "this CPU (or DRAPE_XPBD_SIMD=0) has only the portable kernels";
+  // (With only the portable build, on a CPU without AVX2 or with DRAPE_XPBD_SIMD=0, there is
+  // nothing to compare: TheFastestBuildTheCpuRunsIsChosen checks that case.)
   const Kernels& ref = *builds[0];
+  EXPECT_EQ(&ref, &kernels(false));
   const Problem p = make_problem(11);
   const double offset[3] = {0, 1.2, 0};
   for (size_t k = 1; k < builds.size(); ++k) {
