@@ -900,9 +900,28 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
   const double reach = off + opt_.contact_margin;
   // Cloth bounds: objects whose bounds do not touch them are skipped entirely.
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max()), hi = -lo;
-  for (int i = 0; i < n; ++i) {
-    lo = lo.cwiseMin(x[i]);
-    hi = hi.cwiseMax(x[i]);
+  const bool par = pool && pool->size() > 1;
+  if (par) {
+    bounds_part_.assign(2 * pool->size(), lo);
+    for (int w = 0; w < pool->size(); ++w) bounds_part_[2 * w + 1] = hi;
+    pool->parallel_for(n, [&](int b, int e, int w) {
+      Vec3 l = bounds_part_[2 * w], h = bounds_part_[2 * w + 1];
+      for (int i = b; i < e; ++i) {
+        l = l.cwiseMin(x[i]);
+        h = h.cwiseMax(x[i]);
+      }
+      bounds_part_[2 * w] = l;
+      bounds_part_[2 * w + 1] = h;
+    });
+    for (int w = 0; w < pool->size(); ++w) {
+      lo = lo.cwiseMin(bounds_part_[2 * w]);
+      hi = hi.cwiseMax(bounds_part_[2 * w + 1]);
+    }
+  } else {
+    for (int i = 0; i < n; ++i) {
+      lo = lo.cwiseMin(x[i]);
+      hi = hi.cwiseMax(x[i]);
+    }
   }
   lo.array() -= reach;
   hi.array() += reach;
@@ -982,31 +1001,64 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
     }
   };
   double deepest = 0;
-  if (pool && pool->size() > 1) {
+  if (par) {
+    // Tested in blocks (counting each block's contacts), then listed in vertex order: each
+    // block's contacts start after those of the blocks before it.
+    constexpr int kContactBlock = 256;
+    const int nb = (n + kContactBlock - 1) / kContactBlock;
     deepest_part_.assign(pool->size(), 0.0);
-    pool->parallel_for(n, [&](int b, int e, int w) { test(b, e, deepest_part_[w]); });
+    block_contacts_.assign(nb + 1, 0);
+    pool->parallel_for(nb, [&](int b, int e, int w) {
+      for (int k = b; k < e; ++k) {
+        const int vb = k * kContactBlock, ve = std::min(n, vb + kContactBlock);
+        test(vb, ve, deepest_part_[w]);
+        int c = 0;
+        for (int i = vb; i < ve; ++i) c += candidate_[i].vertex >= 0;
+        block_contacts_[k + 1] = c;
+      }
+    });
     for (double d : deepest_part_) deepest = std::max(deepest, d);
+    for (int k = 0; k < nb; ++k) block_contacts_[k + 1] += block_contacts_[k];
+    contacts_.resize(block_contacts_[nb]);
+    pool->parallel_for(nb, [&](int b, int e, int) {
+      for (int k = b; k < e; ++k) {
+        int c = block_contacts_[k];
+        for (int i = k * kContactBlock; i < std::min(n, (k + 1) * kContactBlock); ++i)
+          if (candidate_[i].vertex >= 0) {
+            contact_index_[i] = c;
+            contacts_[c++] = candidate_[i];
+          }
+      }
+    });
   } else {
     test(0, n, deepest);
+    for (int i = 0; i < n; ++i)
+      if (candidate_[i].vertex >= 0) {
+        contact_index_[i] = static_cast<int>(contacts_.size());
+        contacts_.push_back(candidate_[i]);
+      }
   }
-  for (int i = 0; i < n; ++i)
-    if (candidate_[i].vertex >= 0) {
-      contact_index_[i] = static_cast<int>(contacts_.size());
-      contacts_.push_back(candidate_[i]);
-    }
   return deepest;
 }
 
+namespace {
+void project_contact(const Contact& c, Vec3& xi, const std::vector<Vec3>* start, double mu) {
+  const double d = c.n.dot(xi - c.p);
+  if (d >= 0) return;
+  xi -= d * c.n;
+  if (start && mu > 0) coulomb_position_friction(xi, (*start)[c.vertex], c.n, -d, mu);
+}
+}  // namespace
+
 void ClothEnergy::project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start,
                                    double mu) const {
-  const bool friction = start && mu > 0;
-  for (const auto& c : contacts_) {
-    Vec3& xi = x[c.vertex];
-    const double d = c.n.dot(xi - c.p);
-    if (d >= 0) continue;
-    xi -= d * c.n;
-    if (friction) coulomb_position_friction(xi, (*start)[c.vertex], c.n, -d, mu);
-  }
+  for (const auto& c : contacts_) project_contact(c, x[c.vertex], start, mu);
+}
+
+void ClothEnergy::project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start, double mu,
+                                   int b, int e) const {
+  for (int i = b; i < e; ++i)
+    if (contact_index_[i] >= 0) project_contact(contacts_[contact_index_[i]], x[i], start, mu);
 }
 
 void ClothEnergy::set_friction(double mu, double eps, const std::vector<Vec3>& anchor) {

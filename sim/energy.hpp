@@ -210,6 +210,9 @@ class ClothEnergy {
   // the normal correction (static), else shortened by that much (kinetic).
   void project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start = nullptr,
                         double mu = 0) const;
+  // The same for the contacts of vertices [b, e) only (a contact moves its own vertex alone).
+  void project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start, double mu, int b,
+                        int e) const;
 
   // --- friction for the energy-based solvers (Newton, VBD, the static solve) -----------------
   // Coulomb friction as IPC's lagged dissipation potential: over the vertices with a contact,
@@ -277,6 +280,8 @@ class ClothEnergy {
   std::vector<int> contact_index_;
   std::vector<Contact> candidate_;    // per vertex, the deepest candidate (vertex -1: none)
   std::vector<double> deepest_part_;  // per pool worker
+  std::vector<Vec3> bounds_part_;     // per pool worker: lower and upper corner
+  std::vector<int> block_contacts_;   // per block of kContactBlock vertices: contacts before it
   double k_contact_ = 1e3;
   int culled_ = 0;
   // friction (set_friction)

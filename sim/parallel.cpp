@@ -108,11 +108,10 @@ ThreadPool::~ThreadPool() {
 // 16-31): the caller and even-numbered workers take chunks from the front, odd-numbered ones
 // from the back, so with two threads each keeps to the same part of the range (the same part
 // of the mesh) from one call to the next instead of trading cache lines.
-void ThreadPool::run(int n, Thunk thunk, void* ctx) {
+void ThreadPool::run(int n, Thunk thunk, void* ctx, int chunks) {
   thunk_ = thunk;
   ctx_ = ctx;
   n_ = n;
-  const int chunks = std::min(n, threads_ * 4);
   chunks_.store(chunks, std::memory_order_relaxed);
   done_.store(0, std::memory_order_relaxed);
   const uint64_t gen = generation_.load(std::memory_order_relaxed) + 1;
@@ -122,6 +121,19 @@ void ThreadPool::run(int n, Thunk thunk, void* ctx) {
   work(gen, 0);
   for (int spin = 0; done_.load(std::memory_order_acquire) != chunks; ++spin)
     if (spin > 64) std::this_thread::yield();
+}
+
+// Chunk k's start: each half of the range is split in chunks that halve toward the middle
+// (1/2, 1/4, ... of the half, the last two equal), so that the threads, taking chunks from
+// opposite ends, meet on small ones.
+int ThreadPool::chunk_start(int k) const {
+  const int m = chunks_.load(std::memory_order_relaxed);
+  const int64_t n = n_;
+  if (m < 4 || m % 2) return static_cast<int>(n * k / m);
+  const int c = m / 2;
+  const int64_t h1 = n / 2, h2 = n - h1;
+  if (k <= c) return static_cast<int>(k == c ? h1 : h1 - (h1 >> k));
+  return static_cast<int>(n - h2 + (h2 >> (m - k)));
 }
 
 void ThreadPool::work(uint64_t gen, int w) {
@@ -139,9 +151,7 @@ void ThreadPool::work(uint64_t gen, int w) {
       claimed = from_back ? cur - (uint64_t{1} << 16) : cur + 1;
     } while (!next_.compare_exchange_weak(cur, claimed, std::memory_order_acq_rel));
     // Claimed chunk k of this generation: the caller waits for it, so the task is valid.
-    const int64_t m = chunks_.load(std::memory_order_relaxed);
-    const int b = static_cast<int>(static_cast<int64_t>(n_) * k / m);
-    const int e = static_cast<int>(static_cast<int64_t>(n_) * (k + 1) / m);
+    const int b = chunk_start(k), e = chunk_start(k + 1);
     if (b < e) thunk_(ctx_, b, e, w);
     done_.fetch_add(1, std::memory_order_acq_rel);
   }

@@ -3,6 +3,7 @@
 // without allocating per call.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <thread>
@@ -45,7 +46,22 @@ class ThreadPool {
       fn(0, n, 0);
       return;
     }
-    run(n, &invoke<std::remove_reference_t<Fn>>, &fn);
+    run(n, &invoke<std::remove_reference_t<Fn>>, &fn, std::min(n, threads_ * 4));
+  }
+  // Runs fn(slot, worker) once for each slot in [0, size()), every slot claimed by one thread
+  // (the caller takes slot 0 first; a worker that arrives late may find its slot taken by the
+  // caller, which then runs it after its own). fn may wait for another slot only if it can take
+  // that slot's work over when nobody has claimed it (XpbdSolver's sweep does). No allocation.
+  template <class Fn>
+  void parallel_slots(Fn&& fn) {
+    auto body = [&fn](int b, int e, int w) {
+      for (int k = b; k < e; ++k) fn(k, w);
+    };
+    if (threads_ == 1) {
+      body(0, 1, 0);
+      return;
+    }
+    run(threads_, &invoke<decltype(body)>, &body, threads_);
   }
   // Times a worker went to sleep after spinning idle (parallel.cpp, kSpinBeforeSleep).
   long idle_sleeps() const { return idle_sleeps_.load(std::memory_order_relaxed); }
@@ -58,7 +74,8 @@ class ThreadPool {
   static void invoke(void* f, int b, int e, int w) {
     (*static_cast<Fn*>(f))(b, e, w);
   }
-  void run(int n, Thunk thunk, void* ctx);
+  void run(int n, Thunk thunk, void* ctx, int chunks);
+  int chunk_start(int k) const;
   void work(uint64_t generation, int w);
   void worker_main(int w);
 

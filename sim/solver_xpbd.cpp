@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <thread>
 
 namespace drape::sim {
 
@@ -16,6 +17,9 @@ XpbdSolver::XpbdSolver(XpbdOptions opt)
 XpbdSolver::~XpbdSolver() = default;
 
 namespace {
+
+// A bending coefficient this small against its block's largest is a cancelled zero (cook()).
+constexpr double kZeroCoefficient = 1e-9;
 
 // Sorts elements by colour: returns the colour offsets and fills `order`.
 std::vector<int> colour_sorted(int n, int count, int k, const int32_t* verts, size_t stride,
@@ -94,6 +98,8 @@ void XpbdSolver::cook(const Cloth& cloth) {
     }
   }
   // (Items of the parallel loops: vertices, packs of elements, hinges, springs.)
+  sweep_parallel_ =
+      pool_->size() >= 2 && static_cast<int>(tris_.size()) >= opt_.min_parallel_triangles;
   pool_->set_min_parallel(static_cast<int>(tris_.size()) < opt_.min_parallel_triangles
                               ? std::numeric_limits<int>::max()
                               : 64);
@@ -132,6 +138,26 @@ void XpbdSolver::cook(const Cloth& cloth) {
         }
         bcol.push_back(static_cast<int>(ent[i][0]));
         for (int a = 0; a < 3; ++a) bval.push_back(ent[i][1 + a]);
+      }
+      // Columns whose three coefficients are round-off of an exact zero (a cancellation: on a
+      // regular grid one in five, ~1e-11 of the block's largest coefficient) are left out; the
+      // block's rows keep their other coefficients bit for bit.
+      {
+        const int b0 = boff.back(), b1 = static_cast<int>(bcol.size());
+        double big = 0;
+        for (int e = 3 * b0; e < 3 * b1; ++e) big = std::max(big, std::abs(bval[e]));
+        int out = b0;
+        for (int e = b0; e < b1; ++e) {
+          if (std::abs(bval[3 * e]) <= kZeroCoefficient * big &&
+              std::abs(bval[3 * e + 1]) <= kZeroCoefficient * big &&
+              std::abs(bval[3 * e + 2]) <= kZeroCoefficient * big)
+            continue;
+          bcol[out] = bcol[e];
+          for (int a = 0; a < 3; ++a) bval[3 * out + a] = bval[3 * e + a];
+          ++out;
+        }
+        bcol.resize(out);
+        bval.resize(3 * out);
       }
       boff.push_back(static_cast<int>(bcol.size()));
       for (int a = 0; a < 3; ++a) {
@@ -203,12 +229,46 @@ void XpbdSolver::cook(const Cloth& cloth) {
   lambda_tri_.assign(3 * tris_.size(), 0.0);
   lambda_hinge_.assign(hinges_.size(), Vec3::Zero());
   lambda_spring_.assign(springs_.size(), 0.0);
-  // + the scratch vertex of padding lanes
-  xp_.assign(cooked_f32_ ? 0 : n + 1, xpbd::P4{{0, 0, 0, 0}});
-  xp8_.assign(cooked_f32_ ? n + 1 : 0, xpbd::P4f{{0, 0, 0, 0}});
+  // Padding lanes and entries use scratch vertices (inverse mass 0: they read and write back
+  // zeros), one per share of a colour's packs (scratch_slot()), so that two threads never touch
+  // the same one: n + t for the packs of share t.
+  scratch_slots_ = std::max(2, pool_->size());
+  {
+    const int S = scratch_slots_;
+    auto fix_tris = [&](auto& packs, const std::vector<int>& col) {
+      for (size_t c = 0; c + 1 < col.size(); ++c)
+        for (int p = col[c]; p < col[c + 1]; ++p) {
+          const int t = scratch_slot(p - col[c], col[c + 1] - col[c]);
+          for (auto& vq : packs[p].v)
+            for (auto& v : vq)
+              if (v == n) v = n + t;
+        }
+    };
+    auto fix_rows = [&](auto& rp, const std::vector<int>& col, int L) {
+      for (size_t c = 0; c + 1 < col.size(); ++c)
+        for (int p = col[c]; p < col[c + 1]; ++p) {
+          const int t = scratch_slot(p - col[c], col[c + 1] - col[c]);
+          for (int k = L * rp.off[p]; k < L * rp.off[p + 1]; ++k)
+            if (rp.colv[k] == n) rp.colv[k] = n + t;
+        }
+    };
+    if (!cooked_f32_) {
+      fix_tris(tri_packs_, tpack_col_);
+      fix_rows(row_packs_, rpack_col_, 4);
+    } else {
+      if (tlanes_ == 16)
+        fix_tris(tri_packs16_, tpack8_col_);
+      else
+        fix_tris(tri_packs8_, tpack8_col_);
+      fix_rows(row_packs8_, rpack8_col_, 8);
+    }
+    xp_.assign(cooked_f32_ ? 0 : n + S, xpbd::P4{{0, 0, 0, 0}});
+    xp8_.assign(cooked_f32_ ? n + S : 0, xpbd::P4f{{0, 0, 0, 0}});
+  }
   anchors_.clear();  // renewed at the next step
   tri_anchor8_.assign(static_cast<size_t>(6 * tlanes_) * float_tri_packs(), 0.0f);
   row_anchor8_.assign(72 * static_cast<size_t>(row_packs8_.packs()), 0.0f);
+  build_sweep(n);
   w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
   w0_.assign(n, -1.0);
   // Connected pieces (union-find over the elements' vertices).
@@ -243,6 +303,83 @@ void XpbdSolver::cook(const Cloth& cloth) {
   piece_full_.assign(num_pieces_, 0);
   piece_coarse_.assign(num_pieces_, 0);
   piece_finish_.assign(num_pieces_, 0);
+}
+
+double XpbdSolver::cooked_bending_energy(const std::vector<Vec3>& x) const {
+  double e = 0;
+  for (size_t r = 0; r + 1 < row_off_.size(); ++r) {
+    Vec3 V[3] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+    for (int k = row_off_[r]; k < row_off_[r + 1]; ++k)
+      for (int a = 0; a < 3; ++a) V[a] += row_val_[3 * k + a] * x[row_colv_[k]];
+    for (int a = 0; a < 3; ++a)
+      if (row_ik_[3 * r + a] > 0) e += 0.5 * V[a].squaredNorm() / row_ik_[3 * r + a];
+  }
+  return e;
+}
+
+void XpbdSolver::build_sweep(int n) {
+  sweep_.clear();
+  const bool padded = !tris_.empty() || row_off_.size() > 1;
+  if (!cooked_f32_ || !padded) return;
+  const int blocks = (n + kSweepBlock - 1) / kSweepBlock;
+  auto add = [&](int kind, int b, int e) {
+    sweep_.push_back(SweepPhase{kind, b, e, (e - b) / 2, {0, 0}});
+  };
+  add(kSweepPack, 0, blocks);
+  for (size_t c = 0; c + 1 < tpack8_col_.size(); ++c)
+    add(kSweepTris, tpack8_col_[c], tpack8_col_[c + 1]);
+  for (size_t c = 0; c + 1 < rpack8_col_.size(); ++c)
+    add(kSweepRows, rpack8_col_[c], rpack8_col_[c + 1]);
+  add(kSweepUnpack, 0, blocks);
+  // The vertices of item i of a phase (the scratch vertex n of padding lanes left out: lanes
+  // only write back what they read there).
+  auto for_vertices = [&](const SweepPhase& P, int i, auto&& fn) {
+    switch (P.kind) {
+      case kSweepPack:
+      case kSweepUnpack:
+        for (int v = i * kSweepBlock; v < std::min(n, (i + 1) * kSweepBlock); ++v) fn(v);
+        break;
+      case kSweepTris:
+        for (int q = 0; q < 3; ++q)
+          for (int l = 0; l < tlanes_; ++l) {
+            const int v = tlanes_ == 16 ? tri_packs16_[i].v[q][l] : tri_packs8_[i].v[q][l];
+            if (v < n) fn(v);
+          }
+        break;
+      default:
+        for (int k = row_packs8_.off[i]; k < row_packs8_.off[i + 1]; ++k)
+          for (int l = 0; l < 8; ++l) {
+            const int v = row_packs8_.colv[8 * k + l];
+            if (v < n) fn(v);
+          }
+    }
+  };
+  std::vector<int> mark(n, -1);
+  for (size_t p = 0; p < sweep_.size(); ++p) {
+    SweepPhase& P = sweep_[p];
+    const int cnt[2] = {P.half, P.e - P.b - P.half};
+    if (p == 0) {  // (the sweep starts after a barrier)
+      P.safe[0] = cnt[0];
+      P.safe[1] = cnt[1];
+      continue;
+    }
+    const SweepPhase& Q = sweep_[p - 1];
+    for (int t = 0; t < 2; ++t) {
+      // The vertices of the other slot's half of the previous phase ...
+      const int stamp = static_cast<int>(2 * p + t);
+      const int ob = t == 0 ? Q.b + Q.half : Q.b, oe = t == 0 ? Q.e : Q.b + Q.half;
+      for (int i = ob; i < oe; ++i) for_vertices(Q, i, [&](int v) { mark[v] = stamp; });
+      // ... and this slot's items from its outer end up to the first one touching them.
+      int safe = 0;
+      for (; safe < cnt[t]; ++safe) {
+        const int i = t == 0 ? P.b + safe : P.e - 1 - safe;
+        bool hit = false;
+        for_vertices(P, i, [&](int v) { hit = hit || mark[v] == stamp; });
+        if (hit) break;
+      }
+      P.safe[t] = safe;
+    }
+  }
 }
 
 bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
@@ -310,12 +447,16 @@ void XpbdSolver::snap_to_contacts(Cloth& cloth) {
   const double lim = opt_.contact_snap_depth;
   if (lim <= 0) return;
   auto& S = cloth.state;
-  for (const Contact& c : energy_.contacts()) {
-    const int i = c.vertex;
-    if (!cloth.is_free(i) || (S.flags[i] & kFlagFrozen)) continue;
-    const double d = c.n.dot(S.x[i] - c.p);
-    if (d < 0 && d > -lim) S.x[i] -= d * c.n;
-  }
+  const auto& cs = energy_.contacts();
+  pool_->parallel_for(static_cast<int>(cs.size()), [&](int b, int e, int) {
+    for (int k = b; k < e; ++k) {
+      const Contact& c = cs[k];
+      const int i = c.vertex;
+      if (!cloth.is_free(i) || (S.flags[i] & kFlagFrozen)) continue;
+      const double d = c.n.dot(S.x[i] - c.p);
+      if (d < 0 && d > -lim) S.x[i] -= d * c.n;
+    }
+  });
 }
 
 void XpbdSolver::unsettle(int piece) {
@@ -620,7 +761,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     // at the anchors are summed in double then (xpbd_kernels.hpp, Kernels::tris8). A float
     // resolves a displacement of 2 cm to 2e-9 m; a cloth at rest keeps its anchors.
     const double* xd = reinterpret_cast<const double*>(x.data());
-    bool renew = anchors_.size() != static_cast<size_t>(3 * (n + 1));
+    bool renew = anchors_.size() != static_cast<size_t>(3 * (n + scratch_slots_));
     const double reach2 = kAnchorReach * kAnchorReach;
     for (int i = 0; i < n && !renew; ++i)
       renew =
@@ -628,7 +769,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
           reach2;
     if (renew) {
       anchors_.assign(xd, xd + 3 * n);
-      anchors_.resize(3 * (n + 1), 0.0);  // the scratch vertex of padding lanes (its P4f is 0)
+      anchors_.resize(3 * (n + scratch_slots_), 0.0);  // the scratch vertices (their P4f: 0)
       pool_->parallel_for(float_tri_packs(), [&](int b, int e, int) {
         if (wide_t)
           K.anchor_triangles16(tri_packs16_.data(), b, e, anchors_.data(), tri_anchor8_.data());
@@ -693,6 +834,23 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       pool_->parallel_for(cnt, [&](int lo, int hi, int wk) { fn(b + lo, b + hi, wk); });
     }
   };
+  // Packs (triangles, bending blocks): each thread runs its own share of a colour's packs, whose
+  // padding uses that share's scratch vertex.
+  auto by_colour_packs = [&](const std::vector<int>& off, auto& fn) {
+    const int S = scratch_slots_;
+    for (size_t c = 0; c + 1 < off.size(); ++c) {
+      const int b = off[c], cnt = off[c + 1] - off[c];
+      auto share = [&](int t, int wk) {
+        const int lo = b + static_cast<int>(int64_t{cnt} * t / S);
+        const int hi = b + static_cast<int>(int64_t{cnt} * (t + 1) / S);
+        if (lo < hi) fn(lo, hi, wk);
+      };
+      if (sweep_parallel_ && pool_->size() == S)
+        pool_->parallel_slots(share);
+      else
+        for (int t = 0; t < S; ++t) share(t, 0);
+    }
+  };
 
   // Warm start: apply the (scaled) multipliers of the previous substep as displacements.
   auto warm_tris = [&](int b, int e, int) {
@@ -740,6 +898,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   const double margin = energy_.options().contact_margin;
   const double moved_lim = 0.25 * margin * margin;  // (half the margin)^2
   for (int s = 0; s < ns; ++s) {
+    bool copy_det = false;
     if (s == 0 && contacts_fresh_) st.max_penetration = fresh_penetration_;
     bool detect = s == 0 ? !contacts_fresh_ : true;
     if (s > 0 && opt_.reuse_contacts) {
@@ -767,7 +926,8 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         }
       }
       snap_to_contacts(cloth);
-      x_det_ = x;
+      x_det_.resize(n);
+      copy_det = true;  // x_det_ = x, in the prediction loop below
       ++detections_;
       st.collision_ms +=
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -790,7 +950,8 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     // arithmetic as ClothEnergy::external_force); the pressure toward the form goes through it.
     const EnergyOptions& eo = energy_.options();
     const bool gravity_only = !(eo.pressure > 0 && scene.form);
-    pool_->parallel_for(n, [&](int b, int e, int) {
+    auto predict = [&](int b, int e) {
+      if (copy_det) std::copy(x.begin() + b, x.begin() + e, x_det_.begin() + b);
       for (int i = b; i < e; ++i) {
         S.x_prev[i] = x[i];
         if (!(w[i] > 0)) continue;
@@ -800,7 +961,150 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
                                      : Vec3::Zero();
         x[i] += h * S.v[i] + (h * h / (piece_scale_[piece_of_[i]] * m)) * f;
       }
-    });
+    };
+    // The whole substep in one sweep (SweepPhase: the prediction with the packing, the elements,
+    // the unpacking with the contacts, velocities and motion sums) where it applies: single
+    // precision, one iteration, no warm start, no self-collision, bending in this substep.
+    const bool fused = padded && cooked_f32_ && !sweep_.empty() && pool_->size() <= 2 &&
+                       opt_.iterations == 1 && !warm && !scene.self_collision && hinges_.empty() &&
+                       springs_.empty() && (s % be == be - 1 || s == ns - 1);
+    const bool test_moved = opt_.reuse_contacts && s + 1 < ns;
+    moved_part_.assign(pool_->size(), 0);
+    // Velocities from the substep's motion; the contact-reuse test (some vertex more than half
+    // the margin from where contacts were last detected, per thread).
+    auto velocities = [&](int b, int e, int wk) {
+      for (int i = b; i < e; ++i) {
+        if (w[i] > 0)
+          S.v[i] =
+              (piece_scale_[piece_of_[i]] > 1.0 ? damp_settle : damp) * (x[i] - S.x_prev[i]) / h;
+        else if (S.flags[i] & kFlagFrozen)
+          S.v[i].setZero();
+      }
+      if (test_moved && !moved_part_[wk])
+        for (int i = b; i < e; ++i)
+          if ((x[i] - x_det_[i]).squaredNorm() > moved_lim) {
+            moved_part_[wk] = 1;
+            break;
+          }
+    };
+    // Per sweep vertex block k: the pieces' motion sums over its free vertices (PieceMotion),
+    // one run per stretch of vertices of one piece.
+    const double slow2 = opt_.settle_speed * opt_.settle_speed;
+    if (fused && (opt_.settle || opt_.freeze))
+      block_motion_.resize((n + kSweepBlock - 1) / kSweepBlock);
+    auto block_motion = [&](int k, int b, int e) {
+      auto& runs = block_motion_[k];
+      runs.clear();
+      for (int i = b; i < e; ++i) {
+        if (!(w[i] > 0)) continue;
+        if (runs.empty() || runs.back().first != piece_of_[i]) runs.push_back({piece_of_[i], {}});
+        PieceMotion& acc = runs.back().second;
+        const double v2 = S.v[i].squaredNorm(), m = S.mass[i];
+        acc.max_v2 = std::max(acc.max_v2, v2);
+        acc.mv2 += m * v2;
+        acc.mv2_capped += m * std::min(v2, slow2);
+        acc.m += m;
+      }
+    };
+    // The element sweep (SweepPhase): items [b, e) of phase P.
+    auto sweep_items = [&](const SweepPhase& P, int b, int e, int slot) {
+      if (b >= e) return;
+      switch (P.kind) {
+        case kSweepPack:
+          for (int k = b; k < e; ++k) {
+            const int vb = k * kSweepBlock, ve = std::min(n, vb + kSweepBlock);
+            predict(vb, ve);
+            K.pack8(reinterpret_cast<const double*>(x.data()), w, anchors_.data(), xp8, vb, ve);
+          }
+          break;
+        case kSweepTris:
+          project_tris8(b, e, 0);
+          break;
+        case kSweepRows:
+          project_rows8(b, e, 0);
+          break;
+        default:
+          for (int k = b; k < e; ++k) {
+            const int vb = k * kSweepBlock, ve = std::min(n, vb + kSweepBlock);
+            K.unpack8(xp8, anchors_.data(), reinterpret_cast<double*>(x.data()), vb, ve);
+            energy_.project_contacts(x, &S.x_prev, scene.friction, vb, ve);
+            velocities(vb, ve, slot);
+            if (opt_.settle || opt_.freeze) block_motion(k, vb, ve);
+          }
+      }
+    };
+    auto sweep = [&] {
+      const int np = static_cast<int>(sweep_.size());
+      if (!sweep_parallel_) {
+        for (const SweepPhase& P : sweep_) sweep_items(P, P.b, P.e, 0);
+        return;
+      }
+      ++sweeps_;
+      sweep_done_[0].store(0, std::memory_order_relaxed);
+      sweep_done_[1].store(0, std::memory_order_relaxed);
+      sweep_owner_.store(-1, std::memory_order_relaxed);
+      int phase[2] = {0, 0}, stage[2] = {0, 0};  // where each slot is
+      bool taken_over = false;
+      // Runs slot t until it is done, or (wait = false) until it would wait for the other slot.
+      // With wait, slot 0 takes slot 1 over when nobody has claimed it (a worker not scheduled).
+      auto run_slot = [&](int t, bool wait) {
+        const int o = 1 - t;
+        auto ready = [&](int q) {
+          if (q <= 0 || sweep_done_[o].load(std::memory_order_acquire) >= q) return true;
+          if (!wait) return false;
+          for (int spin = 0;; ++spin) {
+            if (sweep_done_[o].load(std::memory_order_acquire) >= q) return true;
+            if (t == 0) {
+              int nobody = -1;
+              if (sweep_owner_.load(std::memory_order_relaxed) == -1 &&
+                  sweep_owner_.compare_exchange_strong(nobody, 0, std::memory_order_acq_rel)) {
+                taken_over = true;
+                return false;
+              }
+            }
+            if (spin > 256) std::this_thread::yield();
+          }
+        };
+        while (phase[t] < np) {
+          const SweepPhase& P = sweep_[phase[t]];
+          const int mb = P.b + P.half;  // slot 1's first item
+          if (stage[t] == 0) {
+            if (!ready(phase[t] - 1)) return;
+            if (t == 0)
+              sweep_items(P, P.b, P.b + P.safe[0], t);
+            else
+              sweep_items(P, P.e - P.safe[1], P.e, t);
+            stage[t] = 1;
+          }
+          const int rb = t == 0 ? P.b + P.safe[0] : mb, re = t == 0 ? mb : P.e - P.safe[1];
+          if (rb < re) {
+            if (!ready(phase[t])) return;
+            sweep_items(P, rb, re, t);
+          }
+          stage[t] = 0;
+          sweep_done_[t].store(++phase[t], std::memory_order_release);
+        }
+      };
+      pool_->parallel_slots([&](int slot, int wk) {
+        if (slot == 1) {
+          int nobody = -1;
+          if ((opt_.sweep_worker || wk == 0) &&
+              sweep_owner_.compare_exchange_strong(nobody, wk, std::memory_order_acq_rel))
+            run_slot(1, true);
+          return;
+        }
+        if (slot != 0) return;
+        run_slot(0, true);
+        if (!taken_over) return;
+        // Both slots on this thread: alternate, each up to where it needs the other.
+        while (phase[0] < np || phase[1] < np) {
+          run_slot(1, false);
+          run_slot(0, false);
+        }
+        ++sweep_takeovers_;
+      });
+    };
+    if (!fused) pool_->parallel_for(n, [&](int b, int e, int) { predict(b, e); });
     if (warm) {
       const double f = opt_.warm_start * (h_prev_ > 0 ? (h / h_prev_) * (h / h_prev_) : 0.0);
       for (double& l : lambda_tri_) l *= f;
@@ -818,13 +1122,17 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       std::fill(lambda_row_.begin(), lambda_row_.end(), Vec3::Zero());
       std::fill(lambda_spring_.begin(), lambda_spring_.end(), 0.0);
     }
-    for (int it = 0; it < opt_.iterations; ++it) {
+    for (int it = 0; it < opt_.iterations && fused; ++it) {
+      sweep();
+      ++st.iterations;
+    }
+    for (int it = 0; it < opt_.iterations && !fused; ++it) {
       if (padded && cooked_f32_) {
         pool_->parallel_for(n, [&](int b, int e, int) {
           K.pack8(reinterpret_cast<const double*>(x.data()), w, anchors_.data(), xp8, b, e);
         });
-        by_colour(tpack8_col_, project_tris8);
-        if (s % be == be - 1 || s == ns - 1) by_colour(rpack8_col_, project_rows8);
+        by_colour_packs(tpack8_col_, project_tris8);
+        if (s % be == be - 1 || s == ns - 1) by_colour_packs(rpack8_col_, project_rows8);
         pool_->parallel_for(n, [&](int b, int e, int) {
           K.unpack8(xp8, anchors_.data(), reinterpret_cast<double*>(x.data()), b, e);
         });
@@ -832,8 +1140,8 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         pool_->parallel_for(n, [&](int b, int e, int) {
           K.pack(reinterpret_cast<const double*>(x.data()), w, xp, b, e);
         });
-        by_colour(tpack_col_, project_tris);
-        if (s % be == be - 1 || s == ns - 1) by_colour(rpack_col_, project_rows);
+        by_colour_packs(tpack_col_, project_tris);
+        if (s % be == be - 1 || s == ns - 1) by_colour_packs(rpack_col_, project_rows);
         pool_->parallel_for(
             n, [&](int b, int e, int) { K.unpack(xp, reinterpret_cast<double*>(x.data()), b, e); });
       }
@@ -844,23 +1152,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       if (scene.self_collision) self_.project(cloth, x, w, scene.offset);
       ++st.iterations;
     }
-    const bool test_moved = opt_.reuse_contacts && s + 1 < ns;
-    moved_part_.assign(pool_->size(), 0);
-    pool_->parallel_for(n, [&](int b, int e, int wk) {
-      for (int i = b; i < e; ++i) {
-        if (w[i] > 0)
-          S.v[i] =
-              (piece_scale_[piece_of_[i]] > 1.0 ? damp_settle : damp) * (x[i] - S.x_prev[i]) / h;
-        else if (S.flags[i] & kFlagFrozen)
-          S.v[i].setZero();
-      }
-      if (test_moved && !moved_part_[wk])
-        for (int i = b; i < e; ++i)
-          if ((x[i] - x_det_[i]).squaredNorm() > moved_lim) {
-            moved_part_[wk] = 1;
-            break;
-          }
-    });
+    if (!fused) pool_->parallel_for(n, [&](int b, int e, int wk) { velocities(b, e, wk); });
     if (opt_.settle || opt_.freeze) {
       // Per piece, once per substep: the largest free-vertex speed (settling may start when
       // all are below settle_speed; a piece is awake while one is above freeze_speed) and the
@@ -872,7 +1164,6 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       // is released (~0.1-0.2 m/s RMS at 128^2, where the drape rises by up to ~80 mm in about
       // a second).
       std::fill(motion_.begin(), motion_.end(), PieceMotion{});
-      const double slow2 = opt_.settle_speed * opt_.settle_speed;
       // Summed in registers over each run of vertices of one piece (a piece's vertices are
       // mostly contiguous), not through memory vertex by vertex.
       int cur = -1;
@@ -885,20 +1176,30 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         pm.mv2_capped += acc.mv2_capped;
         pm.m += acc.m;
       };
-      for (int i = 0; i < n; ++i) {
-        if (!(w[i] > 0)) continue;
-        if (piece_of_[i] != cur) {
-          flush();
-          cur = piece_of_[i];
-          acc = PieceMotion{};
+      if (fused) {
+        // The sweep's sums per vertex block, added in block order.
+        for (const auto& runs : block_motion_)
+          for (const auto& [piece, pm] : runs) {
+            cur = piece;
+            acc = pm;
+            flush();
+          }
+      } else {
+        for (int i = 0; i < n; ++i) {
+          if (!(w[i] > 0)) continue;
+          if (piece_of_[i] != cur) {
+            flush();
+            cur = piece_of_[i];
+            acc = PieceMotion{};
+          }
+          const double v2 = S.v[i].squaredNorm(), m = S.mass[i];
+          acc.max_v2 = std::max(acc.max_v2, v2);
+          acc.mv2 += m * v2;
+          acc.mv2_capped += m * std::min(v2, slow2);
+          acc.m += m;
         }
-        const double v2 = S.v[i].squaredNorm(), m = S.mass[i];
-        acc.max_v2 = std::max(acc.max_v2, v2);
-        acc.mv2 += m * v2;
-        acc.mv2_capped += m * std::min(v2, slow2);
-        acc.m += m;
+        flush();
       }
-      flush();
     }
     if (opt_.settle) {
       const double exit2 = opt_.settle_exit_speed * opt_.settle_exit_speed;

@@ -8,6 +8,7 @@
 // of one colour share no vertex), and each colour is projected on the thread pool.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -34,6 +35,9 @@ struct XpbdOptions {
   // too little work to share (measured, form 10x1 on this 2-core VM: 32^2 1.49 ms per frame on
   // one thread, 1.83 on two; 64^2 6.2 vs 4.7 ms wall).
   int min_parallel_triangles = 4000;
+  // Tests only: false keeps the pool's worker from taking its part of the element sweep (as if
+  // it were never scheduled), so that the caller takes it over (XpbdSolver::SweepPhase).
+  bool sweep_worker = true;
   // Warm start (0..1): each substep starts from the previous substep's multipliers scaled by
   // this factor (and by (h / h_prev)^2), applying their displacement w grad C lambda with the
   // prediction. 0 (default) is classic XPBD: multipliers reset every substep, whose fixed point
@@ -160,6 +164,15 @@ class XpbdSolver : public Solver {
   int contact_detections() const { return detections_; }
   // Single precision: how many times the anchors were renewed (XpbdOptions::single_precision).
   long anchor_renewals() const { return anchor_renewals_; }
+  // Element sweeps run on two threads, and those in which the caller ran both halves itself
+  // (the worker had not claimed its half when the caller needed it).
+  long sweeps() const { return sweeps_; }
+  // The bending energy of positions x as the cooked blocks state it (1/2 sum_r |V_r x|^2 k_r;
+  // tensor bending, after a step), and their stencil entries (columns whose three coefficients
+  // are cancelled zeros are left out, cook()).
+  double cooked_bending_energy(const std::vector<Vec3>& x) const;
+  int bending_entries() const { return static_cast<int>(row_colv_.size()); }
+  long sweep_takeovers() const { return sweep_takeovers_; }
   // The build of the hot loops in use (xpbd_kernels.hpp: portable, AVX2 or AVX-512).
   const xpbd::Kernels& kernels() const { return *kern_; }
   // Largest inertia scale of any piece (1: nothing settling; XpbdOptions::settle).
@@ -259,6 +272,41 @@ class XpbdSolver : public Solver {
   int float_tri_packs() const {
     return static_cast<int>(tlanes_ == 16 ? tri_packs16_.size() : tri_packs8_.size());
   }
+  // The single-precision element sweep of a substep (pack, the triangle colours, the bending
+  // colours, unpack) as phases that two threads run without a barrier between them: in each
+  // phase slot 0 runs the first half of the items (vertex blocks or packs, which are in mesh
+  // order) and slot 1 the second; a slot runs the items of its half that share no vertex with
+  // the other slot's half of the previous phase (safe, counted from the outer end: slot 0 from
+  // the front, slot 1 from the back) without waiting, and waits for the other slot to finish
+  // the previous phase only before the rest (near the middle). No slot starts a phase before the
+  // other has finished the one before the previous. Every item thus sees what it would see after
+  // a barrier between the phases: the results are those of the phases run one after the other,
+  // bit for bit. Built by build_sweep() in cook(); run by sweep() (step()).
+  struct SweepPhase {
+    int kind;     // kSweepPack, kSweepTris, kSweepRows, kSweepUnpack
+    int b, e;     // items: vertex blocks (kSweepBlock vertices) or packs
+    int half;     // slot 0: [b, b + half), slot 1: [b + half, e)
+    int safe[2];  // slot 0: [b, b + safe[0]); slot 1: [e - safe[1], e)
+  };
+  enum { kSweepPack, kSweepTris, kSweepRows, kSweepUnpack };
+  static constexpr int kSweepBlock = 256;
+  std::vector<SweepPhase> sweep_;
+  void build_sweep(int n);
+  std::atomic<int> sweep_done_[2] = {};  // phases a slot has finished
+  std::atomic<int> sweep_owner_{-1};     // the thread running slot 1 (-1: nobody yet)
+  long sweeps_ = 0, sweep_takeovers_ = 0;
+  bool sweep_parallel_ = false;  // two threads (else one runs the phases one after the other)
+  // Scratch vertices of padding (n, n + 1, ...): one per share of a colour's packs, the share of
+  // the pack at position pos of cnt being the t with cnt t / S <= pos < cnt (t + 1) / S; with two
+  // the sweep's halves.
+  int scratch_slots_ = 2;
+  int scratch_slot(int pos, int cnt) const {
+    int t = 0;
+    while (t + 1 < scratch_slots_ &&
+           static_cast<int>(int64_t{cnt} * (t + 1) / scratch_slots_) <= pos)
+      ++t;
+    return t;
+  }
   std::vector<double> anchors_;  // 3 per vertex, and the scratch vertex's (0)
   std::vector<float> tri_anchor8_, row_anchor8_;
   static constexpr double kAnchorReach = 0.02;  // m
@@ -276,6 +324,8 @@ class XpbdSolver : public Solver {
     double max_v2 = 0, mv2 = 0, mv2_capped = 0, m = 0;
   };
   std::vector<PieceMotion> motion_;
+  // The sweep's motion sums per vertex block: (piece, sums) per run of one piece's vertices.
+  std::vector<std::vector<std::pair<int, PieceMotion>>> block_motion_;
   std::vector<int> piece_full_;      // settling: substeps at the full scale
   std::vector<uint8_t> fixed_prev_;  // settling: vertex was fixed at the last step
   void unsettle(int piece);

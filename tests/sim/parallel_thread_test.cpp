@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <thread>
 #include <vector>
@@ -32,6 +33,42 @@ TEST(ThreadPool, RunsEveryIndexExactlyOnce) {
         });
         for (int i = 0; i < n; ++i) ASSERT_EQ(hits[i].load(), 1) << threads << " " << n << " " << i;
       }
+    }
+  }
+}
+
+// Each half of the range is cut in chunks that halve toward the middle (1/2, 1/4, 1/8, 1/8 of
+// the half with two threads), so that the threads, working from the two ends, meet on small
+// ones: whoever finishes first waits for at most a sixteenth of the loop, not an eighth.
+TEST(ThreadPool, ChunksHalveTowardTheMiddleOfTheRange) {
+  ThreadPool pool(2);
+  pool.set_min_parallel(0);
+  std::vector<std::pair<int, int>> got;
+  std::mutex m;
+  pool.parallel_for(4096, [&](int b, int e, int) {
+    std::lock_guard<std::mutex> lock(m);
+    got.push_back({b, e});
+  });
+  std::sort(got.begin(), got.end());
+  const std::vector<std::pair<int, int>> want{{0, 1024},    {1024, 1536}, {1536, 1792},
+                                              {1792, 2048}, {2048, 2304}, {2304, 2560},
+                                              {2560, 3072}, {3072, 4096}};
+  EXPECT_EQ(got, want);
+}
+
+// parallel_slots: every slot once, each on one thread.
+TEST(ThreadPool, RunsEverySlotExactlyOnce) {
+  for (int threads : {1, 2, 3}) {
+    ThreadPool pool(threads);
+    for (int rep = 0; rep < 200; ++rep) {
+      std::vector<std::atomic<int>> hits(threads);
+      for (auto& h : hits) h.store(0);
+      pool.parallel_slots([&](int slot, int w) {
+        EXPECT_GE(w, 0);
+        EXPECT_LT(w, threads);
+        hits[slot].fetch_add(1);
+      });
+      for (int k = 0; k < threads; ++k) ASSERT_EQ(hits[k].load(), 1) << threads << " " << k;
     }
   }
 }
