@@ -347,6 +347,7 @@ int probe(int argc, char** argv) {
       xp->options().warm_start = env_num("XPBD_WARM", xp->options().warm_start);
       xp->options().reuse_contacts = env_num("XPBD_REUSE", 1) > 0;
       xp->options().bending_every = static_cast<int>(env_num("XPBD_BEND_EVERY", 1));
+      xp->options().retest_contacts = env_num("XPBD_RETEST", 1) > 0;
       xp->options().settle = env_num("XPBD_SETTLE", 1) > 0;
       xp->options().freeze = env_num("XPBD_FREEZE", 0) > 0;
       xp->options().settle_mass_scale = env_num("XPBD_SETTLE_SCALE", 64);
@@ -456,11 +457,11 @@ int probe(int argc, char** argv) {
   if (auto* xp = xpbd_of(s.get())) {
     const bool f32 = xp->options().single_precision;
     std::printf(
-        "xpbd: %.2f contact detections per frame, %ld anchor renewals in %d frames%s; kernels %s "
-        "(%d triangles, %d bending blocks per pack)\n",
-        double(xp->contact_detections()) / frames, xp->anchor_renewals(), frames,
-        f32 ? "" : " (double precision)", xp->kernels().name, f32 ? xp->kernels().tri_lanes : 4,
-        f32 ? 8 : 4);
+        "xpbd: %.2f contact detections and %.0f vertices tested again per frame, %ld anchor "
+        "renewals in %d frames%s; kernels %s (%d triangles, %d bending blocks per pack)\n",
+        double(xp->contact_detections()) / frames, double(xp->contact_retests()) / frames,
+        xp->anchor_renewals(), frames, f32 ? "" : " (double precision)", xp->kernels().name,
+        f32 ? xp->kernels().tri_lanes : 4, f32 ? 8 : 4);
     if (xp->options().coarse_factor > 0) {
       const CoarseStats& c = xp->last_coarse();
       std::printf(

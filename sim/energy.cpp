@@ -891,13 +891,115 @@ void ClothEnergy::clear_contacts() {
   contacts_.clear();
 }
 
-double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scene,
-                                    ThreadPool* pool) {
-  clear_contacts();
+double ClothEnergy::test_vertex(const Cloth& cloth, const SceneObjects& scene, int i, bool floor,
+                                bool form_on) {
   const auto& x = cloth.state.x;
-  const int n = cloth.num_vertices();
   const double off = scene.offset;
   const double reach = off + opt_.contact_margin;
+  double deepest = 0;
+  auto consider = [&](double dist, const Vec3& nrm, const Vec3& surf) {
+    if (dist >= reach) return;
+    const double pen = off - dist;
+    deepest = std::max(deepest, pen);
+    const Vec3 p = surf + off * nrm;
+    Contact& c = candidate_[i];
+    if (c.vertex < 0 || nrm.dot(x[i] - p) < c.n.dot(x[i] - c.p)) c = {i, nrm, p};
+  };
+  candidate_[i].vertex = -1;
+  const uint8_t fl = cloth.state.flags[i];
+  if (fl & (kFlagKinematic | kFlagNoCollide | kFlagPinned | kFlagPinched)) return 0;
+  const Vec3& p = x[i];
+  if (floor) consider(p.y(), Vec3(0, 1, 0), Vec3(p.x(), 0, p.z()));
+  for (const auto& s : scene.spheres) {
+    const Vec3 d = p - s.centre;
+    const double dn = d.norm();
+    if (dn - s.radius >= reach || dn < 1e-12) continue;
+    const Vec3 nrm = d / dn;
+    consider(dn - s.radius, nrm, s.centre + s.radius * nrm);
+  }
+  for (const auto& h : scene.hands) {
+    if (!h.tracked || !h.collides) continue;
+    const Vec3 ab = h.tip - h.position;
+    const double L2 = ab.squaredNorm();
+    const double t = L2 > 0 ? std::clamp((p - h.position).dot(ab) / L2, 0.0, 1.0) : 0.0;
+    const Vec3 c = h.position + t * ab;
+    const Vec3 d = p - c;
+    const double dn = d.norm();
+    if (dn - h.radius >= reach || dn < 1e-12) continue;
+    consider(dn - h.radius, d / dn, c + h.radius * d / dn);
+  }
+  for (const auto& pl : scene.plates) {
+    const Vec3 d = p - pl.centre;
+    if (std::abs(d.x()) > pl.half_x || std::abs(d.z()) > pl.half_z) continue;
+    if (d.y() < -pl.thickness) continue;  // below the plate: untouched
+    consider(d.y(), Vec3(0, 1, 0), Vec3(p.x(), pl.centre.y(), p.z()));
+  }
+  for (const auto& b : scene.boxes) {
+    const Vec3 d = p - b.centre;
+    const Vec3 q = d.cwiseAbs() - b.half;
+    if (q.maxCoeff() >= reach) continue;
+    if ((q.array() > 0).count() > 1) continue;  // near an edge/corner outside: skip
+    int ax = 0;
+    q.maxCoeff(&ax);
+    Vec3 nrm = Vec3::Zero();
+    nrm[ax] = d[ax] >= 0 ? 1 : -1;
+    Vec3 surf = p;
+    surf[ax] = b.centre[ax] + nrm[ax] * b.half[ax];
+    consider(q[ax], nrm, surf);
+  }
+  if (form_on) {
+    Vec3 nrm;  // (+inf outside the form's height range)
+    const double sd = scene.form->normal_distance_within(p, reach, &nrm);
+    if (sd < reach) consider(sd, nrm, p - sd * nrm);
+  }
+  return deepest;
+}
+
+double ClothEnergy::retest_contact(const Cloth& cloth, const SceneObjects& scene, int i) {
+  return test_vertex(cloth, scene, i, scene.floor, scene.form != nullptr);
+}
+
+void ClothEnergy::list_contacts(int n, ThreadPool* pool) {
+  clear_contacts();
+  if (pool && pool->size() > 1) {
+    // Each block's contacts start after those of the blocks before it.
+    constexpr int kContactBlock = 256;
+    const int nb = (n + kContactBlock - 1) / kContactBlock;
+    block_contacts_.assign(nb + 1, 0);
+    pool->parallel_for(nb, [&](int b, int e, int) {
+      for (int k = b; k < e; ++k) {
+        int c = 0;
+        for (int i = k * kContactBlock; i < std::min(n, (k + 1) * kContactBlock); ++i)
+          c += candidate_[i].vertex >= 0;
+        block_contacts_[k + 1] = c;
+      }
+    });
+    for (int k = 0; k < nb; ++k) block_contacts_[k + 1] += block_contacts_[k];
+    contacts_.resize(block_contacts_[nb]);
+    pool->parallel_for(nb, [&](int b, int e, int) {
+      for (int k = b; k < e; ++k) {
+        int c = block_contacts_[k];
+        for (int i = k * kContactBlock; i < std::min(n, (k + 1) * kContactBlock); ++i)
+          if (candidate_[i].vertex >= 0) {
+            contact_index_[i] = c;
+            contacts_[c++] = candidate_[i];
+          }
+      }
+    });
+    return;
+  }
+  for (int i = 0; i < n; ++i)
+    if (candidate_[i].vertex >= 0) {
+      contact_index_[i] = static_cast<int>(contacts_.size());
+      contacts_.push_back(candidate_[i]);
+    }
+}
+
+double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scene,
+                                    ThreadPool* pool) {
+  const auto& x = cloth.state.x;
+  const int n = cloth.num_vertices();
+  const double reach = scene.offset + opt_.contact_margin;
   // Cloth bounds: objects whose bounds do not touch them are skipped entirely.
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max()), hi = -lo;
   const bool par = pool && pool->size() > 1;
@@ -932,112 +1034,28 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
     return t;
   };
   culled_ = 0;
-  // Per vertex, the deepest candidate (into candidate_[i]; vertex -1: none yet).
+  // Per vertex, the deepest candidate (into candidate_[i]; vertex -1: none).
   candidate_.resize(n);
-  auto consider = [&](int i, double dist, const Vec3& nrm, const Vec3& surf, double& deepest) {
-    if (dist >= reach) return;
-    const double pen = off - dist;
-    deepest = std::max(deepest, pen);
-    const Vec3 p = surf + off * nrm;
-    Contact& c = candidate_[i];
-    if (c.vertex < 0 || nrm.dot(x[i] - p) < c.n.dot(x[i] - c.p)) c = {i, nrm, p};
-  };
   const bool floor = scene.floor && touches(Vec3(-1e9, -1, -1e9), Vec3(1e9, 0, 1e9));
   bool form_on = false;
   if (scene.form) {
     const DressForm& f = *scene.form;
     form_on = touches(Vec3(-1, f.min_y(), -1), Vec3(1, f.max_y(), 1));
   }
-  auto test = [&](int b, int e, double& deepest) {
-    for (int i = b; i < e; ++i) {
-      candidate_[i].vertex = -1;
-      const uint8_t fl = cloth.state.flags[i];
-      if (fl & (kFlagKinematic | kFlagNoCollide | kFlagPinned | kFlagPinched)) continue;
-      const Vec3& p = x[i];
-      if (floor) consider(i, p.y(), Vec3(0, 1, 0), Vec3(p.x(), 0, p.z()), deepest);
-      for (const auto& s : scene.spheres) {
-        const Vec3 d = p - s.centre;
-        const double dn = d.norm();
-        if (dn - s.radius >= reach || dn < 1e-12) continue;
-        const Vec3 nrm = d / dn;
-        consider(i, dn - s.radius, nrm, s.centre + s.radius * nrm, deepest);
-      }
-      for (const auto& h : scene.hands) {
-        if (!h.tracked || !h.collides) continue;
-        const Vec3 ab = h.tip - h.position;
-        const double L2 = ab.squaredNorm();
-        const double t = L2 > 0 ? std::clamp((p - h.position).dot(ab) / L2, 0.0, 1.0) : 0.0;
-        const Vec3 c = h.position + t * ab;
-        const Vec3 d = p - c;
-        const double dn = d.norm();
-        if (dn - h.radius >= reach || dn < 1e-12) continue;
-        consider(i, dn - h.radius, d / dn, c + h.radius * d / dn, deepest);
-      }
-      for (const auto& pl : scene.plates) {
-        const Vec3 d = p - pl.centre;
-        if (std::abs(d.x()) > pl.half_x || std::abs(d.z()) > pl.half_z) continue;
-        if (d.y() < -pl.thickness) continue;  // below the plate: untouched
-        consider(i, d.y(), Vec3(0, 1, 0), Vec3(p.x(), pl.centre.y(), p.z()), deepest);
-      }
-      for (const auto& b : scene.boxes) {
-        const Vec3 d = p - b.centre;
-        const Vec3 q = d.cwiseAbs() - b.half;
-        if (q.maxCoeff() >= reach) continue;
-        if ((q.array() > 0).count() > 1) continue;  // near an edge/corner outside: skip
-        int ax = 0;
-        q.maxCoeff(&ax);
-        Vec3 nrm = Vec3::Zero();
-        nrm[ax] = d[ax] >= 0 ? 1 : -1;
-        Vec3 surf = p;
-        surf[ax] = b.centre[ax] + nrm[ax] * b.half[ax];
-        consider(i, q[ax], nrm, surf, deepest);
-      }
-      if (form_on) {
-        Vec3 nrm;  // (+inf outside the form's height range)
-        const double sd = scene.form->normal_distance_within(p, reach, &nrm);
-        if (!(sd < reach)) continue;
-        consider(i, sd, nrm, p - sd * nrm, deepest);
-      }
-    }
-  };
   double deepest = 0;
   if (par) {
-    // Tested in blocks (counting each block's contacts), then listed in vertex order: each
-    // block's contacts start after those of the blocks before it.
-    constexpr int kContactBlock = 256;
-    const int nb = (n + kContactBlock - 1) / kContactBlock;
     deepest_part_.assign(pool->size(), 0.0);
-    block_contacts_.assign(nb + 1, 0);
-    pool->parallel_for(nb, [&](int b, int e, int w) {
-      for (int k = b; k < e; ++k) {
-        const int vb = k * kContactBlock, ve = std::min(n, vb + kContactBlock);
-        test(vb, ve, deepest_part_[w]);
-        int c = 0;
-        for (int i = vb; i < ve; ++i) c += candidate_[i].vertex >= 0;
-        block_contacts_[k + 1] = c;
-      }
+    pool->parallel_for(n, [&](int b, int e, int w) {
+      double d = deepest_part_[w];
+      for (int i = b; i < e; ++i) d = std::max(d, test_vertex(cloth, scene, i, floor, form_on));
+      deepest_part_[w] = d;
     });
     for (double d : deepest_part_) deepest = std::max(deepest, d);
-    for (int k = 0; k < nb; ++k) block_contacts_[k + 1] += block_contacts_[k];
-    contacts_.resize(block_contacts_[nb]);
-    pool->parallel_for(nb, [&](int b, int e, int) {
-      for (int k = b; k < e; ++k) {
-        int c = block_contacts_[k];
-        for (int i = k * kContactBlock; i < std::min(n, (k + 1) * kContactBlock); ++i)
-          if (candidate_[i].vertex >= 0) {
-            contact_index_[i] = c;
-            contacts_[c++] = candidate_[i];
-          }
-      }
-    });
   } else {
-    test(0, n, deepest);
     for (int i = 0; i < n; ++i)
-      if (candidate_[i].vertex >= 0) {
-        contact_index_[i] = static_cast<int>(contacts_.size());
-        contacts_.push_back(candidate_[i]);
-      }
+      deepest = std::max(deepest, test_vertex(cloth, scene, i, floor, form_on));
   }
+  list_contacts(n, pool);
   return deepest;
 }
 
@@ -1053,6 +1071,12 @@ void project_contact(const Contact& c, Vec3& xi, const std::vector<Vec3>* start,
 void ClothEnergy::project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start,
                                    double mu) const {
   for (const auto& c : contacts_) project_contact(c, x[c.vertex], start, mu);
+}
+
+void ClothEnergy::project_tested_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start,
+                                          double mu, int b, int e) const {
+  for (int i = b; i < e; ++i)
+    if (candidate_[i].vertex >= 0) project_contact(candidate_[i], x[i], start, mu);
 }
 
 void ClothEnergy::project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start, double mu,

@@ -198,6 +198,18 @@ class ClothEnergy {
   // deepest penetration (m). Reuses internal storage. With a pool the vertices are tested in
   // parallel and the contacts then listed in vertex order (the same list as without).
   double detect_contacts(const Cloth& cloth, const SceneObjects& scene, ThreadPool* pool = nullptr);
+  // Between detections (after one, with the same cloth and objects): vertex i tested again alone,
+  // as detect_contacts tests it (without its culling of objects by the cloth's bounds, which only
+  // skips objects out of reach); returns its penetration (as detect_contacts). Its contact
+  // changes in contacts() once list_contacts() lists the tested candidates (safe to call for
+  // different vertices on several threads).
+  double retest_contact(const Cloth& cloth, const SceneObjects& scene, int i);
+  void list_contacts(int num_vertices, ThreadPool* pool = nullptr);
+  // project_contacts over vertices [b, e) with their contacts as last tested (listed or not).
+  void project_tested_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start, double mu,
+                               int b, int e) const;
+  // Vertex i's contact as last tested (vertex -1: none), listed or not yet.
+  const Contact& tested_contact(int i) const { return candidate_[i]; }
   void clear_contacts();
   double contact_stiffness() const { return k_contact_; }
   void set_contact_stiffness(double k) { k_contact_ = k; }
@@ -278,7 +290,11 @@ class ClothEnergy {
   // contacts
   std::vector<Contact> contacts_;
   std::vector<int> contact_index_;
-  std::vector<Contact> candidate_;    // per vertex, the deepest candidate (vertex -1: none)
+  std::vector<Contact> candidate_;  // per vertex, the deepest candidate (vertex -1: none)
+  // Tests vertex i against the scene's objects (the floor and the form only when on): its
+  // deepest candidate into candidate_[i]; returns its deepest penetration (0: none).
+  double test_vertex(const Cloth& cloth, const SceneObjects& scene, int i, bool floor,
+                     bool form_on);
   std::vector<double> deepest_part_;  // per pool worker
   std::vector<Vec3> bounds_part_;     // per pool worker: lower and upper corner
   std::vector<int> block_contacts_;   // per block of kContactBlock vertices: contacts before it

@@ -968,8 +968,39 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     const bool fused = padded && cooked_f32_ && !sweep_.empty() && pool_->size() <= 2 &&
                        opt_.iterations == 1 && !warm && !scene.self_collision && hinges_.empty() &&
                        springs_.empty() && (s % be == be - 1 || s == ns - 1);
-    const bool test_moved = opt_.reuse_contacts && s + 1 < ns;
+    // With contacts reused, the sweep tests again each vertex that moved more than half the
+    // margin since its own last test (a detection of all vertices happens only at a frame's
+    // start); otherwise such a vertex makes the next substep detect all of them again.
+    const bool retest = fused && opt_.reuse_contacts && opt_.retest_contacts && s + 1 < ns;
+    const bool test_moved = opt_.reuse_contacts && s + 1 < ns && !retest;
     moved_part_.assign(pool_->size(), 0);
+    if (retest) {
+      retest_part_.assign(2, RetestPart{});
+      unsettle_mark_.assign(2 * static_cast<size_t>(num_pieces_), 0);
+    }
+    const bool settle_check = opt_.settle && settle_scale() > 1.0;
+    // Vertices [b, e) that moved more than half the margin since their last test: tested again
+    // as contact detection tests them; then as after a detection, a settling piece pushed more
+    // than 1 mm into a fresh plane ends its settling (unsettle_mark_), a vertex up to
+    // contact_snap_depth inside it is put on it, and the test's position is kept (x_det_).
+    auto retest_moved = [&](int b, int e, int slot) {
+      RetestPart& rp = retest_part_[slot];
+      for (int i = b; i < e; ++i) {
+        if (!((x[i] - x_det_[i]).squaredNorm() > moved_lim)) continue;
+        rp.deepest = std::max(rp.deepest, energy_.retest_contact(cloth, scene, i));
+        ++rp.count;
+        const Contact& c = energy_.tested_contact(i);
+        if (c.vertex >= 0) {
+          const double d = c.n.dot(x[i] - c.p);
+          if (settle_check && d < -1e-3 && piece_scale_[piece_of_[i]] > 1.0)
+            unsettle_mark_[static_cast<size_t>(slot) * num_pieces_ + piece_of_[i]] = 1;
+          if (opt_.contact_snap_depth > 0 && d < 0 && d > -opt_.contact_snap_depth &&
+              cloth.is_free(i) && !(S.flags[i] & kFlagFrozen))
+            x[i] -= d * c.n;
+        }
+        x_det_[i] = x[i];
+      }
+    };
     // Velocities from the substep's motion; the contact-reuse test (some vertex more than half
     // the margin from where contacts were last detected, per thread).
     auto velocities = [&](int b, int e, int wk) {
@@ -1027,9 +1058,10 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
           for (int k = b; k < e; ++k) {
             const int vb = k * kSweepBlock, ve = std::min(n, vb + kSweepBlock);
             K.unpack8(xp8, anchors_.data(), reinterpret_cast<double*>(x.data()), vb, ve);
-            energy_.project_contacts(x, &S.x_prev, scene.friction, vb, ve);
+            energy_.project_tested_contacts(x, &S.x_prev, scene.friction, vb, ve);
             velocities(vb, ve, slot);
             if (opt_.settle || opt_.freeze) block_motion(k, vb, ve);
+            if (retest) retest_moved(vb, ve, slot);
           }
       }
     };
@@ -1125,6 +1157,14 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     for (int it = 0; it < opt_.iterations && fused; ++it) {
       sweep();
       ++st.iterations;
+    }
+    if (retest && retest_part_[0].count + retest_part_[1].count > 0) {
+      contacts_unlisted_ = true;  // (listed after the last substep)
+      contact_retests_ += retest_part_[0].count + retest_part_[1].count;
+      st.max_penetration =
+          std::max({st.max_penetration, retest_part_[0].deepest, retest_part_[1].deepest});
+      for (int p = 0; p < num_pieces_; ++p)
+        if (unsettle_mark_[p] || unsettle_mark_[static_cast<size_t>(num_pieces_) + p]) unsettle(p);
     }
     for (int it = 0; it < opt_.iterations && !fused; ++it) {
       if (padded && cooked_f32_) {
@@ -1261,6 +1301,10 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     }
     S.time += h;
     ++st.substeps;
+  }
+  if (contacts_unlisted_) {
+    energy_.list_contacts(n, pool_.get());
+    contacts_unlisted_ = false;
   }
   return st;
 }

@@ -38,6 +38,10 @@ struct XpbdOptions {
   // Tests only: false keeps the pool's worker from taking its part of the element sweep (as if
   // it were never scheduled), so that the caller takes it over (XpbdSolver::SweepPhase).
   bool sweep_worker = true;
+  // With reuse_contacts, in the element sweep: each vertex that moved more than half the margin
+  // since its own last contact test is tested again there, instead of all vertices being tested
+  // again in the next substep (the frame's first substep still tests all).
+  bool retest_contacts = true;
   // Warm start (0..1): each substep starts from the previous substep's multipliers scaled by
   // this factor (and by (h / h_prev)^2), applying their displacement w grad C lambda with the
   // prediction. 0 (default) is classic XPBD: multipliers reset every substep, whose fixed point
@@ -167,6 +171,10 @@ class XpbdSolver : public Solver {
   // Element sweeps run on two threads, and those in which the caller ran both halves itself
   // (the worker had not claimed its half when the caller needed it).
   long sweeps() const { return sweeps_; }
+  // Vertices tested again for contact in the sweep (XpbdOptions::retest_contacts).
+  long contact_retests() const { return contact_retests_; }
+  // The energy as the solver cooked it (its contacts: those of the last step).
+  const ClothEnergy& energy() const { return energy_; }
   // The bending energy of positions x as the cooked blocks state it (1/2 sum_r |V_r x|^2 k_r;
   // tensor bending, after a step), and their stencil entries (columns whose three coefficients
   // are cancelled zeros are left out, cook()).
@@ -294,7 +302,18 @@ class XpbdSolver : public Solver {
   void build_sweep(int n);
   std::atomic<int> sweep_done_[2] = {};  // phases a slot has finished
   std::atomic<int> sweep_owner_{-1};     // the thread running slot 1 (-1: nobody yet)
-  long sweeps_ = 0, sweep_takeovers_ = 0;
+  long sweeps_ = 0, sweep_takeovers_ = 0, contact_retests_ = 0;
+  // Per sweep slot: vertices tested again for contact and their deepest penetration; pieces a
+  // test ends the settling of (slot * pieces + piece).
+  struct RetestPart {
+    long count = 0;
+    double deepest = 0;
+  };
+  std::vector<RetestPart> retest_part_;
+  // Contacts tested again in the sweep and not yet in the energy's contact list (the sweep
+  // projects the tested ones, ClothEnergy::project_tested_contacts): listed at the step's end.
+  bool contacts_unlisted_ = false;
+  std::vector<char> unsettle_mark_;
   bool sweep_parallel_ = false;  // two threads (else one runs the phases one after the other)
   // Scratch vertices of padding (n, n + 1, ...): one per share of a colour's packs, the share of
   // the pack at position pos of cnt being the t with cnt t / S <= pos < cnt (t + 1) / S; with two
