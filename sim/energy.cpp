@@ -904,8 +904,10 @@ double ClothEnergy::test_vertex(const Cloth& cloth, const SceneObjects& scene, i
     const Vec3 p = surf + off * nrm;
     Contact& c = candidate_[i];
     if (c.vertex < 0 || nrm.dot(x[i] - p) < c.n.dot(x[i] - c.p)) c = {i, nrm, p};
+    has_candidate_[i] = 1;
   };
   candidate_[i].vertex = -1;
+  has_candidate_[i] = 0;
   const uint8_t fl = cloth.state.flags[i];
   if (fl & (kFlagKinematic | kFlagNoCollide | kFlagPinned | kFlagPinched)) return 0;
   const Vec3& p = x[i];
@@ -970,7 +972,7 @@ void ClothEnergy::list_contacts(int n, ThreadPool* pool) {
       for (int k = b; k < e; ++k) {
         int c = 0;
         for (int i = k * kContactBlock; i < std::min(n, (k + 1) * kContactBlock); ++i)
-          c += candidate_[i].vertex >= 0;
+          c += has_candidate_[i];
         block_contacts_[k + 1] = c;
       }
     });
@@ -980,7 +982,7 @@ void ClothEnergy::list_contacts(int n, ThreadPool* pool) {
       for (int k = b; k < e; ++k) {
         int c = block_contacts_[k];
         for (int i = k * kContactBlock; i < std::min(n, (k + 1) * kContactBlock); ++i)
-          if (candidate_[i].vertex >= 0) {
+          if (has_candidate_[i]) {
             contact_index_[i] = c;
             contacts_[c++] = candidate_[i];
           }
@@ -1036,6 +1038,7 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
   culled_ = 0;
   // Per vertex, the deepest candidate (into candidate_[i]; vertex -1: none).
   candidate_.resize(n);
+  has_candidate_.resize(n);
   const bool floor = scene.floor && touches(Vec3(-1e9, -1, -1e9), Vec3(1e9, 0, 1e9));
   bool form_on = false;
   if (scene.form) {
@@ -1076,7 +1079,7 @@ void ClothEnergy::project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>
 void ClothEnergy::project_tested_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start,
                                           double mu, int b, int e) const {
   for (int i = b; i < e; ++i)
-    if (candidate_[i].vertex >= 0) project_contact(candidate_[i], x[i], start, mu);
+    if (has_candidate_[i]) project_contact(candidate_[i], x[i], start, mu);
 }
 
 void ClothEnergy::project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start, double mu,

@@ -290,7 +290,8 @@ class ClothEnergy {
   // contacts
   std::vector<Contact> contacts_;
   std::vector<int> contact_index_;
-  std::vector<Contact> candidate_;  // per vertex, the deepest candidate (vertex -1: none)
+  std::vector<Contact> candidate_;      // per vertex, the deepest candidate (vertex -1: none)
+  std::vector<uint8_t> has_candidate_;  // per vertex: candidate_[i].vertex >= 0 (a byte to scan)
   // Tests vertex i against the scene's objects (the floor and the form only when on): its
   // deepest candidate into candidate_[i]; returns its deepest penetration (0: none).
   double test_vertex(const Cloth& cloth, const SceneObjects& scene, int i, bool floor,
