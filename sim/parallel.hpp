@@ -36,7 +36,8 @@ class ThreadPool {
   ThreadPool& operator=(const ThreadPool&) = delete;
   int size() const { return threads_; }
 
-  // Runs fn(begin, end, worker) over [0, n) split in up to 4 size() contiguous chunks claimed
+  // Runs fn(begin, end, worker) over [0, n) split in up to 4 size() contiguous chunks (halving
+  // in size toward the middle of the range: parallel.cpp, chunk_start) claimed
   // by whichever thread is free (the caller included; fn may be called several times per
   // thread, `worker` is the calling thread's index); returns when all are done. fn must be
   // callable as void(int, int, int). No allocation.

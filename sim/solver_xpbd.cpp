@@ -331,8 +331,8 @@ void XpbdSolver::build_sweep(int n) {
   for (size_t c = 0; c + 1 < rpack8_col_.size(); ++c)
     add(kSweepRows, rpack8_col_[c], rpack8_col_[c + 1]);
   add(kSweepUnpack, 0, blocks);
-  // The vertices of item i of a phase (the scratch vertex n of padding lanes left out: lanes
-  // only write back what they read there).
+  // The vertices of item i of a phase (the scratch vertices n, n + 1 of padding lanes left out:
+  // each half of a phase's packs has its own).
   auto for_vertices = [&](const SweepPhase& P, int i, auto&& fn) {
     switch (P.kind) {
       case kSweepPack:
@@ -970,8 +970,11 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
                        springs_.empty() && (s % be == be - 1 || s == ns - 1);
     // With contacts reused, the sweep tests again each vertex that moved more than half the
     // margin since its own last test (a detection of all vertices happens only at a frame's
-    // start); otherwise such a vertex makes the next substep detect all of them again.
-    const bool retest = fused && opt_.reuse_contacts && opt_.retest_contacts && s + 1 < ns;
+    // start); otherwise such a vertex makes the next substep detect all of them again. (Only
+    // when every substep runs the sweep, bending_every = 1: a substep outside it projects the
+    // energy's contact list, which lists the tested contacts only at the step's end.)
+    const bool retest =
+        fused && be == 1 && opt_.reuse_contacts && opt_.retest_contacts && s + 1 < ns;
     const bool test_moved = opt_.reuse_contacts && s + 1 < ns && !retest;
     moved_part_.assign(pool_->size(), 0);
     if (retest) {
