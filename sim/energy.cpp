@@ -1082,12 +1082,6 @@ void ClothEnergy::project_tested_contacts(std::vector<Vec3>& x, const std::vecto
     if (has_candidate_[i]) project_contact(candidate_[i], x[i], start, mu);
 }
 
-void ClothEnergy::project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start, double mu,
-                                   int b, int e) const {
-  for (int i = b; i < e; ++i)
-    if (contact_index_[i] >= 0) project_contact(contacts_[contact_index_[i]], x[i], start, mu);
-}
-
 void ClothEnergy::set_friction(double mu, double eps, const std::vector<Vec3>& anchor) {
   friction_mu_ = mu;
   friction_eps_ = eps;

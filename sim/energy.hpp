@@ -222,9 +222,6 @@ class ClothEnergy {
   // the normal correction (static), else shortened by that much (kinetic).
   void project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start = nullptr,
                         double mu = 0) const;
-  // The same for the contacts of vertices [b, e) only (a contact moves its own vertex alone).
-  void project_contacts(std::vector<Vec3>& x, const std::vector<Vec3>* start, double mu, int b,
-                        int e) const;
 
   // --- friction for the energy-based solvers (Newton, VBD, the static solve) -----------------
   // Coulomb friction as IPC's lagged dissipation potential: over the vertices with a contact,
