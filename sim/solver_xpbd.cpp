@@ -20,6 +20,12 @@ namespace {
 
 // A bending coefficient this small against its block's largest is a cancelled zero (cook()).
 constexpr double kZeroCoefficient = 1e-9;
+// A settling piece with a vertex deeper than this inside a fresh contact plane was pushed (a
+// hand, a moved form): its settling ends. (Not 0.1 mm as for waking a sleeping piece: a
+// settling piece still slides, and a plane re-found on a curved form after half a margin of
+// sliding can sit ~0.1 mm off; measured at 128^2, it ended settling over and over and the
+// drape never came to rest.)
+constexpr double kUnsettleDepth = 1e-3;
 
 // Sorts elements by colour: returns the colour offsets and fills `order`.
 std::vector<int> colour_sorted(int n, int count, int k, const int32_t* verts, size_t stride,
@@ -72,8 +78,11 @@ void XpbdSolver::cook(const Cloth& cloth) {
   tri_col_ = colour_sorted(n, static_cast<int>(tris_.size()), 3,
                            tris_.empty() ? nullptr : tris_[0].v, sizeof(Tri), order);
   apply_order(tris_, order);
-  // Packs of four (double) or eight (single precision) triangles of one colour
-  // (sim/xpbd_kernels.hpp); padding lanes use the scratch vertex n.
+  // Packs of four (double) or eight or sixteen (single precision) triangles of one colour
+  // (sim/xpbd_kernels.hpp); padding lanes use the scratch vertices n, n + 1, ...: one per share
+  // of a colour's packs, the shares the threads run (by_colour_packs, the sweep's halves).
+  scratch_slots_ = std::max(2, pool_->size());
+  const int S = scratch_slots_;
   cooked_f32_ = opt_.single_precision;
   cooked_kernels_ = opt_.kernels;
   kern_ = &xpbd::kernels();
@@ -87,13 +96,14 @@ void XpbdSolver::cook(const Cloth& cloth) {
   tpack8_col_.assign(1, 0);
   for (size_t c = 0; c + 1 < tri_col_.size(); ++c) {
     if (cooked_f32_ && tlanes_ == 16) {
-      xpbd::pack_triangles<float, 16>(tris_.data(), tri_col_[c], tri_col_[c + 1], n, tri_packs16_);
+      xpbd::pack_triangles<float, 16>(tris_.data(), tri_col_[c], tri_col_[c + 1], n, tri_packs16_,
+                                      S);
       tpack8_col_.push_back(static_cast<int>(tri_packs16_.size()));
     } else if (cooked_f32_) {
-      xpbd::pack_triangles<float, 8>(tris_.data(), tri_col_[c], tri_col_[c + 1], n, tri_packs8_);
+      xpbd::pack_triangles<float, 8>(tris_.data(), tri_col_[c], tri_col_[c + 1], n, tri_packs8_, S);
       tpack8_col_.push_back(static_cast<int>(tri_packs8_.size()));
     } else {
-      xpbd::pack_triangles(tris_.data(), tri_col_[c], tri_col_[c + 1], n, tri_packs_);
+      xpbd::pack_triangles(tris_.data(), tri_col_[c], tri_col_[c + 1], n, tri_packs_, S);
       tpack_col_.push_back(static_cast<int>(tri_packs_.size()));
     }
   }
@@ -192,11 +202,11 @@ void XpbdSolver::cook(const Cloth& cloth) {
     for (size_t c = 0; c + 1 < row_cols_.size(); ++c) {
       if (cooked_f32_) {
         row_packs8_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
-                           row_cols_[c], row_cols_[c + 1], n);
+                           row_cols_[c], row_cols_[c + 1], n, S);
         rpack8_col_.push_back(row_packs8_.packs());
       } else {
         row_packs_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
-                          row_cols_[c], row_cols_[c + 1], n);
+                          row_cols_[c], row_cols_[c + 1], n, S);
         rpack_col_.push_back(row_packs_.packs());
       }
     }
@@ -229,42 +239,9 @@ void XpbdSolver::cook(const Cloth& cloth) {
   lambda_tri_.assign(3 * tris_.size(), 0.0);
   lambda_hinge_.assign(hinges_.size(), Vec3::Zero());
   lambda_spring_.assign(springs_.size(), 0.0);
-  // Padding lanes and entries use scratch vertices (inverse mass 0: they read and write back
-  // zeros), one per share of a colour's packs (scratch_slot()), so that two threads never touch
-  // the same one: n + t for the packs of share t.
-  scratch_slots_ = std::max(2, pool_->size());
-  {
-    const int S = scratch_slots_;
-    auto fix_tris = [&](auto& packs, const std::vector<int>& col) {
-      for (size_t c = 0; c + 1 < col.size(); ++c)
-        for (int p = col[c]; p < col[c + 1]; ++p) {
-          const int t = scratch_slot(p - col[c], col[c + 1] - col[c]);
-          for (auto& vq : packs[p].v)
-            for (auto& v : vq)
-              if (v == n) v = n + t;
-        }
-    };
-    auto fix_rows = [&](auto& rp, const std::vector<int>& col, int L) {
-      for (size_t c = 0; c + 1 < col.size(); ++c)
-        for (int p = col[c]; p < col[c + 1]; ++p) {
-          const int t = scratch_slot(p - col[c], col[c + 1] - col[c]);
-          for (int k = L * rp.off[p]; k < L * rp.off[p + 1]; ++k)
-            if (rp.colv[k] == n) rp.colv[k] = n + t;
-        }
-    };
-    if (!cooked_f32_) {
-      fix_tris(tri_packs_, tpack_col_);
-      fix_rows(row_packs_, rpack_col_, 4);
-    } else {
-      if (tlanes_ == 16)
-        fix_tris(tri_packs16_, tpack8_col_);
-      else
-        fix_tris(tri_packs8_, tpack8_col_);
-      fix_rows(row_packs8_, rpack8_col_, 8);
-    }
-    xp_.assign(cooked_f32_ ? 0 : n + S, xpbd::P4{{0, 0, 0, 0}});
-    xp8_.assign(cooked_f32_ ? n + S : 0, xpbd::P4f{{0, 0, 0, 0}});
-  }
+  // + the scratch vertices of padding, one per share of a colour's packs (xpbd::share_begin)
+  xp_.assign(cooked_f32_ ? 0 : n + S, xpbd::P4{{0, 0, 0, 0}});
+  xp8_.assign(cooked_f32_ ? n + S : 0, xpbd::P4f{{0, 0, 0, 0}});
   anchors_.clear();  // renewed at the next step
   tri_anchor8_.assign(static_cast<size_t>(6 * tlanes_) * float_tri_packs(), 0.0f);
   row_anchor8_.assign(72 * static_cast<size_t>(row_packs8_.packs()), 0.0f);
@@ -323,7 +300,7 @@ void XpbdSolver::build_sweep(int n) {
   if (!cooked_f32_ || !padded) return;
   const int blocks = (n + kSweepBlock - 1) / kSweepBlock;
   auto add = [&](int kind, int b, int e) {
-    sweep_.push_back(SweepPhase{kind, b, e, (e - b) / 2, {0, 0}});
+    sweep_.push_back(SweepPhase{kind, b, e, xpbd::share_begin(e - b, 1, 2), {0, 0}});
   };
   add(kSweepPack, 0, blocks);
   for (size_t c = 0; c + 1 < tpack8_col_.size(); ++c)
@@ -444,19 +421,20 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
 }
 
 void XpbdSolver::snap_to_contacts(Cloth& cloth) {
-  const double lim = opt_.contact_snap_depth;
-  if (lim <= 0) return;
-  auto& S = cloth.state;
+  if (opt_.contact_snap_depth <= 0) return;
   const auto& cs = energy_.contacts();
   pool_->parallel_for(static_cast<int>(cs.size()), [&](int b, int e, int) {
-    for (int k = b; k < e; ++k) {
-      const Contact& c = cs[k];
-      const int i = c.vertex;
-      if (!cloth.is_free(i) || (S.flags[i] & kFlagFrozen)) continue;
-      const double d = c.n.dot(S.x[i] - c.p);
-      if (d < 0 && d > -lim) S.x[i] -= d * c.n;
-    }
+    for (int k = b; k < e; ++k) snap_onto(cloth, cs[k]);
   });
+}
+
+void XpbdSolver::snap_onto(Cloth& cloth, const Contact& c) const {
+  const int i = c.vertex;
+  const double lim = opt_.contact_snap_depth;
+  auto& S = cloth.state;
+  if (lim <= 0 || !cloth.is_free(i) || (S.flags[i] & kFlagFrozen)) return;
+  const double d = c.n.dot(S.x[i] - c.p);
+  if (d < 0 && d > -lim) S.x[i] -= d * c.n;
 }
 
 void XpbdSolver::unsettle(int piece) {
@@ -841,8 +819,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     for (size_t c = 0; c + 1 < off.size(); ++c) {
       const int b = off[c], cnt = off[c + 1] - off[c];
       auto share = [&](int t, int wk) {
-        const int lo = b + static_cast<int>(int64_t{cnt} * t / S);
-        const int hi = b + static_cast<int>(int64_t{cnt} * (t + 1) / S);
+        const int lo = b + xpbd::share_begin(cnt, t, S), hi = b + xpbd::share_begin(cnt, t + 1, S);
         if (lo < hi) fn(lo, hi, wk);
       };
       if (sweep_parallel_ && pool_->size() == S)
@@ -913,15 +890,11 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
           std::max(st.max_penetration, energy_.detect_contacts(cloth, scene, pool_.get()));
       if (scene.self_collision) self_.detect(cloth, x, scene.offset, margin);
       if (opt_.settle && settle_scale() > 1.0) {
-        // Something pushed into a settling piece (a hand, a moved form): a vertex deeper than
-        // 1 mm inside a fresh contact plane. (Not 0.1 mm as for waking a sleeping piece: a
-        // settling piece still slides, and a plane re-found on a curved form after half a
-        // margin of sliding can sit ~0.1 mm off; measured at 128^2, it ended settling over and
-        // over and the drape never came to rest.)
+        // Something pushed into a settling piece (kUnsettleDepth).
         for (int i = 0; i < n; ++i) {
           const int ci = energy_.contact_of(i);
           if (ci >= 0 && piece_scale_[piece_of_[i]] > 1.0 &&
-              energy_.contacts()[ci].n.dot(x[i] - energy_.contacts()[ci].p) < -1e-3)
+              energy_.contacts()[ci].n.dot(x[i] - energy_.contacts()[ci].p) < -kUnsettleDepth)
             unsettle(piece_of_[i]);
         }
       }
@@ -984,7 +957,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     const bool settle_check = opt_.settle && settle_scale() > 1.0;
     // Vertices [b, e) that moved more than half the margin since their last test: tested again
     // as contact detection tests them; then as after a detection, a settling piece pushed more
-    // than 1 mm into a fresh plane ends its settling (unsettle_mark_), a vertex up to
+    // than kUnsettleDepth into a fresh plane ends its settling (unsettle_mark_), a vertex up to
     // contact_snap_depth inside it is put on it, and the test's position is kept (x_det_).
     auto retest_moved = [&](int b, int e, int slot) {
       RetestPart& rp = retest_part_[slot];
@@ -994,12 +967,10 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         ++rp.count;
         const Contact& c = energy_.tested_contact(i);
         if (c.vertex >= 0) {
-          const double d = c.n.dot(x[i] - c.p);
-          if (settle_check && d < -1e-3 && piece_scale_[piece_of_[i]] > 1.0)
+          if (settle_check && c.n.dot(x[i] - c.p) < -kUnsettleDepth &&
+              piece_scale_[piece_of_[i]] > 1.0)
             unsettle_mark_[static_cast<size_t>(slot) * num_pieces_ + piece_of_[i]] = 1;
-          if (opt_.contact_snap_depth > 0 && d < 0 && d > -opt_.contact_snap_depth &&
-              cloth.is_free(i) && !(S.flags[i] & kFlagFrozen))
-            x[i] -= d * c.n;
+          snap_onto(cloth, c);
         }
         x_det_[i] = x[i];
       }

@@ -5,7 +5,8 @@
 // models one per hinge (sum K_k x_k, compliance 1/w); each spring a distance constraint;
 // contacts are projected.
 // The element data are cooked once per topology into flat arrays sorted by colour (elements
-// of one colour share no vertex), and each colour is projected on the thread pool.
+// of one colour share no vertex); a substep runs on the thread pool as one element sweep
+// (SweepPhase) or, in the configurations the sweep does not serve, one pool call per colour.
 #pragma once
 
 #include <atomic>
@@ -171,6 +172,7 @@ class XpbdSolver : public Solver {
   // Element sweeps run on two threads, and those in which the caller ran both halves itself
   // (the worker had not claimed its half when the caller needed it).
   long sweeps() const { return sweeps_; }
+  long sweep_takeovers() const { return sweep_takeovers_; }
   // Vertices tested again for contact in the sweep (XpbdOptions::retest_contacts).
   long contact_retests() const { return contact_retests_; }
   // The energy as the solver cooked it (its contacts: those of the last step).
@@ -180,7 +182,6 @@ class XpbdSolver : public Solver {
   // are cancelled zeros are left out, cook()).
   double cooked_bending_energy(const std::vector<Vec3>& x) const;
   int bending_entries() const { return static_cast<int>(row_colv_.size()); }
-  long sweep_takeovers() const { return sweep_takeovers_; }
   // The build of the hot loops in use (xpbd_kernels.hpp: portable, AVX2 or AVX-512).
   const xpbd::Kernels& kernels() const { return *kern_; }
   // Largest inertia scale of any piece (1: nothing settling; XpbdOptions::settle).
@@ -259,8 +260,9 @@ class XpbdSolver : public Solver {
   std::vector<double> lambda_tri_, lambda_spring_;
   std::vector<Vec3> lambda_hinge_;
   // Positions padded to four doubles (the fourth: inverse mass) for the triangle and bending
-  // kernels (xpbd_kernels.hpp), packed before and unpacked after them in every iteration; one
-  // more, the scratch vertex (w = 0), for the packs' padding lanes. (xp8_: the same in floats.)
+  // kernels (xpbd_kernels.hpp), packed before and unpacked after them in every iteration; then
+  // the scratch vertices (w = 0) of the packs' padding (scratch_slots_). (xp8_: the same in
+  // floats.)
   std::vector<xpbd::P4> xp_;
   // The single-precision forms (XpbdOptions::single_precision; only those of the precision the
   // solver was cooked for are filled), the anchors (positions at the frame's start) and the
@@ -315,18 +317,10 @@ class XpbdSolver : public Solver {
   bool contacts_unlisted_ = false;
   std::vector<char> unsettle_mark_;
   bool sweep_parallel_ = false;  // two threads (else one runs the phases one after the other)
-  // Scratch vertices of padding (n, n + 1, ...): one per share of a colour's packs, the share of
-  // the pack at position pos of cnt being the t with cnt t / S <= pos < cnt (t + 1) / S; with two
-  // the sweep's halves.
+  // Shares of a colour's packs, each with its scratch vertex of padding (xpbd::share_begin: n,
+  // n + 1, ...); with two, the sweep's halves.
   int scratch_slots_ = 2;
-  int scratch_slot(int pos, int cnt) const {
-    int t = 0;
-    while (t + 1 < scratch_slots_ &&
-           static_cast<int>(int64_t{cnt} * (t + 1) / scratch_slots_) <= pos)
-      ++t;
-    return t;
-  }
-  std::vector<double> anchors_;  // 3 per vertex, and the scratch vertex's (0)
+  std::vector<double> anchors_;  // 3 per vertex, and the scratch vertices' (0)
   std::vector<float> tri_anchor8_, row_anchor8_;
   static constexpr double kAnchorReach = 0.02;  // m
   long anchor_renewals_ = 0;
@@ -351,6 +345,8 @@ class XpbdSolver : public Solver {
   // Moves simulated vertices lying up to contact_snap_depth inside a fresh contact plane onto
   // it (position only; see XpbdOptions::contact_snap_depth).
   void snap_to_contacts(Cloth& cloth);
+  // The same for one contact's vertex.
+  void snap_onto(Cloth& cloth, const Contact& c) const;
   int num_pieces_ = 0, frozen_count_ = 0;
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
   std::vector<Vec3> x_det_;      // positions at the last contact detection

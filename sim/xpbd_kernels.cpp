@@ -14,13 +14,16 @@ const Kernels kKernels = make_kernels("portable", 8);
 }  // namespace portable
 
 template <class T, int L>
-void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPackT<T, L>>& out) {
+void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPackT<T, L>>& out,
+                    int shares) {
+  const int cnt = (e - b + L - 1) / L;
   for (int k0 = b; k0 < e; k0 += L) {
     TriPackT<T, L> P{};  // padding lanes: coefficients 0
+    const int pad = scratch + share_of((k0 - b) / L, cnt, shares);
     for (int l = 0; l < L; ++l) {
       const int k = k0 + l;
       P.k[l] = k < e ? k : -1;
-      for (int q = 0; q < 3; ++q) P.v[q][l] = k < e ? tris[k].v[q] : scratch;
+      for (int q = 0; q < 3; ++q) P.v[q][l] = k < e ? tris[k].v[q] : pad;
       if (k >= e) continue;
       for (int j = 0; j < 6; ++j) P.D[j][l] = static_cast<T>(tris[k].D[j]);
       for (int a = 0; a < 3; ++a) P.ia[a][l] = static_cast<T>(tris[k].ia[a]);
@@ -28,9 +31,9 @@ void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriP
     out.push_back(P);
   }
 }
-template void pack_triangles<double, 4>(const Tri*, int, int, int, std::vector<TriPack>&);
-template void pack_triangles<float, 8>(const Tri*, int, int, int, std::vector<TriPack8>&);
-template void pack_triangles<float, 16>(const Tri*, int, int, int, std::vector<TriPack16>&);
+template void pack_triangles<double, 4>(const Tri*, int, int, int, std::vector<TriPack>&, int);
+template void pack_triangles<float, 8>(const Tri*, int, int, int, std::vector<TriPack8>&, int);
+template void pack_triangles<float, 16>(const Tri*, int, int, int, std::vector<TriPack16>&, int);
 
 template <class T, int L>
 void RowPackDataT<T, L>::clear() {
@@ -45,18 +48,20 @@ void RowPackDataT<T, L>::clear() {
 
 template <class T, int L>
 void RowPackDataT<T, L>::append(const int* boff, const int* bcol, const double* bval,
-                                const double* bik, int b, int e, int scratch) {
+                                const double* bik, int b, int e, int scratch, int shares) {
   if (static_cast<int>(slot.size()) < e) slot.resize(e, -1);
+  const int cnt = (e - b + L - 1) / L;
   for (int r0 = b; r0 < e; r0 += L) {
     const int p = packs();
     const int lanes = std::min(L, e - r0);
+    const int pad = scratch + share_of((r0 - b) / L, cnt, shares);
     int len = 0;
     for (int l = 0; l < lanes; ++l) len = std::max(len, boff[r0 + l + 1] - boff[r0 + l]);
     for (int i = 0; i < len; ++i) {
       for (int l = 0; l < L; ++l) {
         const int r = r0 + l;
         const bool real = l < lanes && i < boff[r + 1] - boff[r];
-        colv.push_back(real ? bcol[boff[r] + i] : scratch);
+        colv.push_back(real ? bcol[boff[r] + i] : pad);
       }
       for (int a = 0; a < 3; ++a)
         for (int l = 0; l < L; ++l) {

@@ -52,12 +52,28 @@ using TriPack = TriPackT<double, 4>;
 using TriPack8 = TriPackT<float, 8>;
 using TriPack16 = TriPackT<float, 16>;
 
-// Appends triangles [b, e) (one colour) as packs of L; padding lanes use vertex `scratch`
-// (an extra P4 whose inverse mass is 0).
+// A colour's cnt packs in S shares, one per thread that runs them: share t is
+// [share_begin(cnt, t, S), share_begin(cnt, t + 1, S)). Padding in share t uses the scratch
+// vertex scratch + t (extra positions whose inverse mass is 0), so that two threads never read
+// and write back the same one.
+inline int share_begin(int cnt, int t, int shares) {
+  return static_cast<int>(int64_t{cnt} * t / shares);
+}
+// The share of the pack at position pos of cnt.
+inline int share_of(int pos, int cnt, int shares) {
+  int t = 0;
+  while (t + 1 < shares && share_begin(cnt, t + 1, shares) <= pos) ++t;
+  return t;
+}
+
+// Appends triangles [b, e) (one colour) as packs of L; padding lanes use the scratch vertex of
+// their pack's share (share_begin).
 template <class T, int L>
-void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPackT<T, L>>& out);
-inline void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPack>& out) {
-  pack_triangles<double, 4>(tris, b, e, scratch, out);
+void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPackT<T, L>>& out,
+                    int shares = 1);
+inline void pack_triangles(const Tri* tris, int b, int e, int scratch, std::vector<TriPack>& out,
+                           int shares = 1) {
+  pack_triangles<double, 4>(tris, b, e, scratch, out, shares);
 }
 
 // Tensor-bending blocks (three linear vector constraints sharing one stencil each; see
@@ -87,8 +103,9 @@ struct RowPackDataT {
   void clear();
   // Appends blocks [b, e) (one colour) of the CSR (boff, bcol, bval: 3 per entry; bik: 3 per
   // block).
+  // Padding uses the scratch vertex of the pack's share (share_begin).
   void append(const int* boff, const int* bcol, const double* bval, const double* bik, int b, int e,
-              int scratch);
+              int scratch, int shares = 1);
   int packs() const { return static_cast<int>(off.size()) - 1; }
   // The inverse system matrix entry m of a block.
   T& ai_of(int block, int m) {
