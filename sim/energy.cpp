@@ -48,7 +48,7 @@ void lump_masses(Cloth& cloth) {
   }
 }
 
-void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
+void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt, ThreadPool* pool) {
   opt_ = opt;
   num_vertices_ = cloth.num_vertices();
   built_version_ = cloth.topology_version;
@@ -93,18 +93,28 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
     }
     // Hinges: interior edges shared by exactly two triangles.
     if (opt_.bending) {
-      std::map<std::pair<int, int>, std::pair<int, int>> edge_tris;  // edge -> (tri, opposite)
+      // Edges seen so far, listed at their lower vertex (a vertex has a handful: a walk of its
+      // list is cheaper than a map's lookup — 8 ms at 128^2 with std::map). An edge keeps the
+      // first triangle that met it (tri, opposite vertex) until a hinge is made of it (tri -1).
+      struct EdgeSeen {
+        int hi, tri, opp, next;
+      };
+      std::vector<int> edge_head(num_vertices_, -1);
+      std::vector<EdgeSeen> edges_seen;
+      edges_seen.reserve(3 * tri_v_.size());
       for (int ti = 0; ti < static_cast<int>(tri_v_.size()); ++ti) {
         const auto& t = tri_v_[ti];
         for (int k = 0; k < 3; ++k) {
           int a = t[k], b = t[(k + 1) % 3], o = t[(k + 2) % 3];
-          auto key = std::make_pair(std::min(a, b), std::max(a, b));
-          auto it = edge_tris.find(key);
-          if (it == edge_tris.end()) {
-            edge_tris.emplace(key, std::make_pair(ti, o));
-          } else if (it->second.first >= 0) {
-            const int oa = it->second.second;
-            const int e0 = key.first, e1 = key.second;
+          const int e0 = std::min(a, b), e1 = std::max(a, b);
+          int found = edge_head[e0];
+          while (found >= 0 && edges_seen[found].hi != e1) found = edges_seen[found].next;
+          if (found < 0) {
+            edges_seen.push_back({e1, ti, o, edge_head[e0]});
+            edge_head[e0] = static_cast<int>(edges_seen.size()) - 1;
+          } else if (edges_seen[found].tri >= 0) {
+            EdgeSeen& seen = edges_seen[found];
+            const int oa = seen.opp;
             const Vec2 d = M[e1] - M[e0];
             const double len = d.norm();
             if (len < 1e-12) continue;
@@ -126,7 +136,7 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
               return opt_.rigid_boundary_hinges && !cloth.is_free(tv[0]) && !cloth.is_free(tv[1]) &&
                      !cloth.is_free(tv[2]);
             };
-            const int t1 = it->second.first;
+            const int t1 = seen.tri;
             double area = (rigid(t1) ? 0.0 : tri_area_[t1]) + (rigid(ti) ? 0.0 : tri_area_[ti]);
             if (area <= 0) area = tri_area_[t1] + tri_area_[ti];
             // In-plane normal of the edge (direction of curvature the hinge resists).
@@ -136,13 +146,13 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt) {
             hinge_k_.push_back(K);
             hinge_w_.push_back(B * len * len / area);
             hinge_t_.push_back({t1, ti});
-            it->second.first = -1;  // a third triangle on this edge makes no further hinge
+            seen.tri = -1;  // a third triangle on this edge makes no further hinge
           }
         }
       }
     }
     if (opt_.bending && opt_.bending_model == EnergyOptions::Bending::kTensor)
-      build_tensor_bending(cloth);
+      build_tensor_bending(cloth, pool);
   } else {
     // The study's 8-neighbour springs: structural springs along grid rows/columns and both
     // diagonals of every cell (grid panels), else along triangle edges.
@@ -214,62 +224,145 @@ struct Csr {
   int rows() const { return static_cast<int>(off.size()) - 1; }
 };
 
-// C = A diag(s) B (s optional, over A's columns = B's rows); B has `ncols` columns. Rows of C
-// sorted by column, exact zeros kept (the pattern is what VBD's colouring needs).
-void spgemm(const Csr& A, const Csr& B, int ncols, Csr& C, const std::vector<double>* s) {
-  std::vector<double> acc(ncols, 0.0);
-  std::vector<int> mark(ncols, -1), touched;
-  C.reset(A.rows());
-  // Reserve the product's upper bound (sum of the B rows each A entry selects): the output is
-  // ~1M entries at 128^2, and growing it by push_back copied it ~20 times.
-  size_t bound = 0;
-  for (int r : A.col) bound += static_cast<size_t>(B.off[r + 1] - B.off[r]);
-  C.col.reserve(bound);
-  C.val.reserve(bound);
-  for (int i = 0; i < A.rows(); ++i) {
-    touched.clear();
-    for (int ka = A.off[i]; ka < A.off[i + 1]; ++ka) {
-      const int r = A.col[ka];
-      const double a = A.val[ka] * (s ? (*s)[r] : 1.0);
-      for (int kb = B.off[r]; kb < B.off[r + 1]; ++kb) {
-        const int j = B.col[kb];
-        if (mark[j] != i) {
-          mark[j] = i;
-          acc[j] = 0.0;
-          touched.push_back(j);
-        }
-        acc[j] += a * B.val[kb];
-      }
-    }
-    std::sort(touched.begin(), touched.end());
-    for (int j : touched) C.push(j, acc[j]);
-    C.end_row();
+// Rows [0, rows) of a matrix built in parts: part k (one per pool slot, or one without a pool)
+// gets rows [lo, hi) and writes them, in order, into its own Csr with fill(lo, hi, part); the
+// parts are then joined into C. Each row is computed as without parts: the same result.
+template <class Fill>
+void by_row_parts(int rows, ThreadPool* pool, Csr& C, Fill&& fill) {
+  const int parts = pool && rows >= 4096 ? pool->size() : 1;
+  if (parts == 1) {
+    C.reset(rows);
+    fill(0, rows, C);
+    return;
+  }
+  std::vector<Csr> part(parts);
+  pool->parallel_slots([&](int k, int) {
+    const int lo = static_cast<int>(static_cast<int64_t>(rows) * k / parts);
+    const int hi = static_cast<int>(static_cast<int64_t>(rows) * (k + 1) / parts);
+    part[k].reset(hi - lo);
+    fill(lo, hi, part[k]);
+  });
+  C = std::move(part[0]);
+  for (int k = 1; k < parts; ++k) {
+    const int base = static_cast<int>(C.col.size());
+    for (size_t r = 1; r < part[k].off.size(); ++r) C.off.push_back(base + part[k].off[r]);
+    C.col.insert(C.col.end(), part[k].col.begin(), part[k].col.end());
+    C.val.insert(C.val.end(), part[k].val.begin(), part[k].val.end());
   }
 }
 
-// C = A + B (same row count).
-void spadd(const Csr& A, const Csr& B, int ncols, Csr& C) {
-  C.reset(A.rows());
-  C.col.reserve(A.col.size() + B.col.size());
-  C.val.reserve(A.col.size() + B.col.size());
-  std::vector<double> acc(ncols, 0.0);
-  std::vector<int> mark(ncols, -1), touched;
-  for (int i = 0; i < A.rows(); ++i) {
-    touched.clear();
-    for (const Csr* M : {&A, &B})
-      for (int k = M->off[i]; k < M->off[i + 1]; ++k) {
-        const int j = M->col[k];
-        if (mark[j] != i) {
-          mark[j] = i;
-          acc[j] = 0.0;
-          touched.push_back(j);
+// C = A diag(s) B (s optional, over A's columns = B's rows); B has `ncols` columns. Rows of C
+// sorted by column, exact zeros kept (the pattern is what VBD's colouring needs).
+void spgemm(const Csr& A, const Csr& B, int ncols, Csr& C, const std::vector<double>* s,
+            ThreadPool* pool = nullptr) {
+  by_row_parts(A.rows(), pool, C, [&](int lo, int hi, Csr& out) {
+    std::vector<double> acc(ncols, 0.0);
+    std::vector<int> mark(ncols, -1), touched;
+    // Reserve the product's upper bound (sum of the B rows each A entry selects): the output is
+    // ~1M entries at 128^2, and growing it by push_back copied it ~20 times.
+    size_t bound = 0;
+    for (int k = A.off[lo]; k < A.off[hi]; ++k)
+      bound += static_cast<size_t>(B.off[A.col[k] + 1] - B.off[A.col[k]]);
+    out.col.reserve(bound);
+    out.val.reserve(bound);
+    for (int i = lo; i < hi; ++i) {
+      touched.clear();
+      touched.clear();
+      for (int ka = A.off[i]; ka < A.off[i + 1]; ++ka) {
+        const int r = A.col[ka];
+        const double a = A.val[ka] * (s ? (*s)[r] : 1.0);
+        for (int kb = B.off[r]; kb < B.off[r + 1]; ++kb) {
+          const int j = B.col[kb];
+          if (mark[j] != i) {
+            mark[j] = i;
+            acc[j] = 0.0;
+            touched.push_back(j);
+          }
+          acc[j] += a * B.val[kb];
         }
-        acc[j] += M->val[k];
       }
-    std::sort(touched.begin(), touched.end());
-    for (int j : touched) C.push(j, acc[j]);
-    C.end_row();
-  }
+      std::sort(touched.begin(), touched.end());
+      for (int j : touched) out.push(j, acc[j]);
+      out.end_row();
+    }
+  });
+}
+
+// C = A + B (same row count).
+void spadd(const Csr& A, const Csr& B, int ncols, Csr& C, ThreadPool* pool = nullptr) {
+  by_row_parts(A.rows(), pool, C, [&](int lo, int hi, Csr& out) {
+    const size_t bound = static_cast<size_t>(A.off[hi] - A.off[lo] + B.off[hi] - B.off[lo]);
+    out.col.reserve(bound);
+    out.val.reserve(bound);
+    std::vector<double> acc(ncols, 0.0);
+    std::vector<int> mark(ncols, -1), touched;
+    for (int i = lo; i < hi; ++i) {
+      touched.clear();
+      for (const Csr* M : {&A, &B})
+        for (int k = M->off[i]; k < M->off[i + 1]; ++k) {
+          const int j = M->col[k];
+          if (mark[j] != i) {
+            mark[j] = i;
+            acc[j] = 0.0;
+            touched.push_back(j);
+          }
+          acc[j] += M->val[k];
+        }
+      std::sort(touched.begin(), touched.end());
+      for (int j : touched) out.push(j, acc[j]);
+      out.end_row();
+    }
+  });
+}
+
+// Gk = (Gl + W Gd) Km, row by row with the arithmetic (its order included) of spgemm(W, Gd) ->
+// WG, spadd(Gl, WG) -> Gs, spgemm(Gs, Km) -> Gk: the same values without the two intermediate
+// matrices (at 128^2 ~17 MB, whose filling was mostly page faults). Gd, Gl: nh columns; Km: n.
+void blend_rows(const Csr& Gl, const Csr& W, const Csr& Gd, const Csr& Km, int nh, int n, Csr& Gk,
+                ThreadPool* pool) {
+  by_row_parts(Gl.rows(), pool, Gk, [&](int lo, int hi, Csr& out) {
+    std::vector<double> a1(nh, 0.0), a2(nh, 0.0), a3(n, 0.0);
+    std::vector<int> m1(nh, -1), m2(nh, -1), m3(n, -1), t1, t2, t3;
+    size_t bound = 0;  // (an upper bound of the output, as in spgemm)
+    for (int k = Gl.off[lo]; k < Gl.off[hi]; ++k)
+      bound += static_cast<size_t>(Km.off[Gl.col[k] + 1] - Km.off[Gl.col[k]]);
+    for (int k = W.off[lo]; k < W.off[hi]; ++k)
+      bound += 4 * static_cast<size_t>(Gd.off[W.col[k] + 1] - Gd.off[W.col[k]]);
+    out.col.reserve(bound);
+    out.val.reserve(bound);
+    auto add = [](std::vector<double>& acc, std::vector<int>& mark, std::vector<int>& touched,
+                  int row, int j, double v) {
+      if (mark[j] != row) {
+        mark[j] = row;
+        acc[j] = 0.0;
+        touched.push_back(j);
+      }
+      acc[j] += v;
+    };
+    for (int i = lo; i < hi; ++i) {
+      t1.clear();
+      t2.clear();
+      t3.clear();
+      for (int ka = W.off[i]; ka < W.off[i + 1]; ++ka) {
+        const int r = W.col[ka];
+        const double a = W.val[ka];
+        for (int kb = Gd.off[r]; kb < Gd.off[r + 1]; ++kb)
+          add(a1, m1, t1, i, Gd.col[kb], a * Gd.val[kb]);
+      }
+      std::sort(t1.begin(), t1.end());
+      for (int k = Gl.off[i]; k < Gl.off[i + 1]; ++k) add(a2, m2, t2, i, Gl.col[k], Gl.val[k]);
+      for (int j : t1) add(a2, m2, t2, i, j, a1[j]);
+      std::sort(t2.begin(), t2.end());
+      for (int j : t2) {
+        const double a = a2[j];
+        for (int kb = Km.off[j]; kb < Km.off[j + 1]; ++kb)
+          add(a3, m3, t3, i, Km.col[kb], a * Km.val[kb]);
+      }
+      std::sort(t3.begin(), t3.end());
+      for (int j : t3) out.push(j, a3[j]);
+      out.end_row();
+    }
+  });
 }
 
 void transpose(const Csr& A, int ncols, Csr& T) {
@@ -298,7 +391,7 @@ void transpose(const Csr& A, int ncols, Csr& T) {
 // angles are replaced by the linear hinge vectors s_e = sum_k K_ek x_k (|s_e| ~ theta_e), so
 // E = 1/2 sum_t sum_ij C_t,ij s_i . s_j = 1/2 x^T (P (x) I3) x, P = sum_t K_t^T C_t K_t.
 
-void ClothEnergy::build_tensor_bending(const Cloth& cloth) {
+void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   const auto& M = cloth.topo.material;
   const FabricParams& fab = cloth.fabric;
   const double bu = std::max(fab.bending_weft, 0.0), bv = std::max(fab.bending_warp, 0.0);
@@ -359,12 +452,12 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth) {
   // known angles: a free edge resists no curvature on its own).
   // Divergence form: S_t = 1/A_t sum_e beta_e |e| theta_e n_e n_e^T (the distributional Hessian
   // of the piecewise-linear surface, beta = 1/2; 1 next to a rigid triangle).
-  Csr Gloc, Gdiv;  // rows 3t + c, columns hinges (the same pattern)
-  Gloc.reset(3 * nt);
-  Gdiv.reset(3 * nt);
-  for (int t = 0; t < nt; ++t) {
-    const int k = tri_nh_[t];
-    if (k > 0) {
+  // The local estimators first (a 3x3 eigensolve per triangle: ~10 ms at 128^2), on the pool.
+  std::vector<Eigen::Matrix3d> mloc(nt);
+  auto local = [&](int t0, int t1) {
+    for (int t = t0; t < t1; ++t) {
+      const int k = tri_nh_[t];
+      if (k == 0) continue;
       Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
       Eigen::Matrix3d Lt = Eigen::Matrix3d::Zero();
       for (int a = 0; a < k; ++a) Lt.row(a) = L[th[t][a]].transpose();
@@ -378,7 +471,29 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth) {
       for (int c = 0; c < 3; ++c) evi[c] = ev[c] > 1e-12 * ev.cwiseAbs().maxCoeff() ? 1 / ev[c] : 0;
       const Eigen::Matrix3d Gi =
           es.eigenvectors() * evi.asDiagonal() * es.eigenvectors().transpose();
-      const Eigen::Matrix3d Mloc = dinv.asDiagonal() * Lt.transpose() * Gi;  // S = Mloc theta
+      mloc[t] = dinv.asDiagonal() * Lt.transpose() * Gi;  // S = Mloc theta
+    }
+  };
+  if (pool && nt >= 4096) {
+    const int parts = pool->size();
+    pool->parallel_slots([&](int k, int) {
+      local(static_cast<int>(static_cast<int64_t>(nt) * k / parts),
+            static_cast<int>(static_cast<int64_t>(nt) * (k + 1) / parts));
+    });
+  } else {
+    local(0, nt);
+  }
+  Csr Gloc, Gdiv;  // rows 3t + c, columns hinges (the same pattern)
+  Gloc.reset(3 * nt);
+  Gdiv.reset(3 * nt);
+  for (Csr* G : {&Gloc, &Gdiv}) {
+    G->col.reserve(9 * static_cast<size_t>(nt));
+    G->val.reserve(9 * static_cast<size_t>(nt));
+  }
+  for (int t = 0; t < nt; ++t) {
+    const int k = tri_nh_[t];
+    if (k > 0) {
+      const Eigen::Matrix3d& Mloc = mloc[t];
       for (int c = 0; c < 3; ++c) {
         for (int a = 0; a < k; ++a) {
           const int h = th[t][a];
@@ -394,7 +509,15 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth) {
       for (int c = 0; c < 3; ++c) Gloc.end_row(), Gdiv.end_row();
     }
   }
-  Csr Gs;
+  // Km: hinge -> its 4 vertices with weights K (S rows over vertices: Gk = Gs Km).
+  Csr Km;
+  Km.reset(nh);
+  for (int h = 0; h < nh; ++h) {
+    for (int k = 0; k < 4; ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
+    Km.end_row();
+  }
+  Csr Gs, Gk, GkT, P;
+  bool fused = false;  // Gk made from the blend's parts directly (blend_rows)
   const auto est = opt_.curvature_estimator;
   if (est == EnergyOptions::Curvature::kLocal) {
     Gs = Gloc;
@@ -409,6 +532,8 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth) {
     Csr W, Gdl = Gdiv;
     for (size_t k = 0; k < Gdl.val.size(); ++k) Gdl.val[k] -= Gloc.val[k];
     W.reset(3 * nt);
+    W.col.reserve(12 * static_cast<size_t>(nt));
+    W.val.reserve(12 * static_cast<size_t>(nt));
     for (int t = 0; t < nt; ++t)
       for (int c = 0; c < 3; ++c) {
         if (tri_nh_[t] > 0) {
@@ -422,25 +547,22 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth) {
         }
         W.end_row();
       }
-    Csr WG;
-    spgemm(W, Gdl, nh, WG, nullptr);
-    for (int pass = 1; pass < opt_.curvature_smoothing; ++pass) {
-      Csr next;
-      spgemm(W, WG, nh, next, nullptr);
-      WG = std::move(next);
+    if (opt_.curvature_smoothing <= 1) {
+      blend_rows(Gloc, W, Gdl, Km, nh, n, Gk, pool);
+      fused = true;
+    } else {
+      Csr WG;
+      spgemm(W, Gdl, nh, WG, nullptr, pool);
+      for (int pass = 1; pass < opt_.curvature_smoothing; ++pass) {
+        Csr next;
+        spgemm(W, WG, nh, next, nullptr, pool);
+        WG = std::move(next);
+      }
+      spadd(Gloc, WG, nh, Gs, pool);
     }
-    spadd(Gloc, WG, nh, Gs);
   }
-  // S rows over vertices Gk = Gs Km (Km: hinge -> its 4 vertices with weights K), and
-  // P = Gk^T (A D) Gk.
-  Csr Km;
-  Km.reset(nh);
-  for (int h = 0; h < nh; ++h) {
-    for (int k = 0; k < 4; ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
-    Km.end_row();
-  }
-  Csr Gk, GkT, P;
-  spgemm(Gs, Km, n, Gk, nullptr);
+  // S rows over vertices Gk = Gs Km, and P = Gk^T (A D) Gk.
+  if (!fused) spgemm(Gs, Km, n, Gk, nullptr, pool);
   tensor_ = true;
   if (!opt_.bending_matrix) {
     tri_S_off_ = std::move(Gk.off);
@@ -452,7 +574,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth) {
   std::vector<double> ad(3 * nt);
   for (int t = 0; t < nt; ++t)
     for (int c = 0; c < 3; ++c) ad[3 * t + c] = tri_area_[t] * bend_D_[c];
-  spgemm(GkT, Gk, n, P, &ad);
+  spgemm(GkT, Gk, n, P, &ad, pool);
   // CSR with the diagonal always present.
   bend_off_.assign(n + 1, 0);
   bend_diag_.assign(n, 0.0);

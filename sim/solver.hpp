@@ -8,6 +8,8 @@
 
 namespace drape::sim {
 
+class ThreadPool;  // sim/parallel.hpp
+
 struct StepStats {
   int substeps = 0;
   int iterations = 0;          // total over substeps
@@ -25,6 +27,8 @@ class Solver {
   // Advances the cloth by one frame of length dt (substepping internally as configured),
   // against the scene's objects. Must not allocate per step once warmed up for a topology.
   virtual StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) = 0;
+  // The solver's worker threads, for work around its steps (the watchdog's checks), or null.
+  virtual ThreadPool* pool() { return nullptr; }
 };
 
 }  // namespace drape::sim

@@ -16,7 +16,7 @@ VbdSolver::VbdSolver(VbdOptions opt)
 VbdSolver::~VbdSolver() = default;
 
 void VbdSolver::cook(const Cloth& cloth) {
-  energy_.build(cloth, opt_.energy);
+  energy_.build(cloth, opt_.energy, pool_.get());
   energy_.vertex_neighbours(nbr_off_, nbrs_);
   num_colours_ = greedy_colouring(nbr_off_, nbrs_, colour_of_, colour_off_, colour_items_);
   const int n = cloth.num_vertices();

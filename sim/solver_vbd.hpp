@@ -59,6 +59,7 @@ class VbdSolver : public Solver {
   ~VbdSolver() override;
   std::string name() const override { return "vbd"; }
   StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) override;
+  ThreadPool* pool() override { return pool_.get(); }
   VbdOptions& options() { return opt_; }
   const ClothEnergy& energy() const { return energy_; }
   int num_colours() const { return num_colours_; }

@@ -164,6 +164,7 @@ class XpbdSolver : public Solver {
   ~XpbdSolver() override;
   std::string name() const override { return "xpbd"; }
   StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) override;
+  ThreadPool* pool() override { return pool_.get(); }
   XpbdOptions& options() { return opt_; }
   int frozen_count() const { return frozen_count_; }
   int contact_detections() const { return detections_; }

@@ -1,6 +1,10 @@
 #include "sim/watchdog.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+
+#include "sim/parallel.hpp"
 
 namespace drape::sim {
 
@@ -14,34 +18,75 @@ bool cloth_finite(const Cloth& cloth) {
 WatchdogSolver::WatchdogSolver(std::unique_ptr<Solver> inner, WatchdogOptions opt)
     : inner_(std::move(inner)), opt_(opt) {}
 
-namespace {
-double kinetic(const Cloth& c) {
+template <class Fn>
+void WatchdogSolver::by_parts(int n, Fn&& fn) {
+  ThreadPool* pool = inner_->pool();
+  const int np = pool && n >= 4096 ? pool->size() : 1;
+  parts_.assign(np, Part{});
+  auto run = [&](int k, int) {
+    fn(static_cast<int>(static_cast<int64_t>(n) * k / np),
+       static_cast<int>(static_cast<int64_t>(n) * (k + 1) / np), parts_[k]);
+  };
+  if (np == 1)
+    run(0, 0);
+  else
+    pool->parallel_slots(run);
+}
+
+double WatchdogSolver::kinetic(const Cloth& cloth) {
+  const auto& S = cloth.state;
+  by_parts(static_cast<int>(S.v.size()), [&](int b, int e, Part& p) {
+    for (int i = b; i < e; ++i) p.ke += 0.5 * S.mass[i] * S.v[i].squaredNorm();
+  });
   double ke = 0;
-  for (size_t i = 0; i < c.state.v.size(); ++i)
-    ke += 0.5 * c.state.mass[i] * c.state.v[i].squaredNorm();
+  for (const Part& p : parts_) ke += p.ke;
   return ke;
 }
-}  // namespace
 
-bool WatchdogSolver::healthy(const Cloth& cloth, double ke_before) const {
+bool WatchdogSolver::healthy(const Cloth& cloth, double ke_before) {
   const auto& S = cloth.state;
-  double mass = 0;
-  for (size_t i = 0; i < S.x.size(); ++i) {
-    if (!S.x[i].allFinite() || !S.v[i].allFinite()) return false;
-    if (S.v[i].squaredNorm() > opt_.max_speed * opt_.max_speed) return false;
-    if (S.x[i].squaredNorm() > opt_.max_extent * opt_.max_extent) return false;
-    mass += S.mass[i];
+  const double v2max = opt_.max_speed * opt_.max_speed, x2max = opt_.max_extent * opt_.max_extent;
+  by_parts(static_cast<int>(S.x.size()), [&](int b, int e, Part& p) {
+    for (int i = b; i < e; ++i) {
+      if (!S.x[i].allFinite() || !S.v[i].allFinite() || S.v[i].squaredNorm() > v2max ||
+          S.x[i].squaredNorm() > x2max) {
+        p.ok = false;
+        return;
+      }
+      p.mass += S.mass[i];
+      p.ke += 0.5 * S.mass[i] * S.v[i].squaredNorm();
+    }
+  });
+  double mass = 0, ke = 0;
+  for (const Part& p : parts_) {
+    if (!p.ok) return false;
+    mass += p.mass;
+    ke += p.ke;
   }
   // Scale: the kinetic energy of the whole cloth at 1 m/s.
-  const double ke = kinetic(cloth);
   return ke <= opt_.max_kinetic_growth * (ke_before + 0.5 * mass * 1.0);
 }
 
-void WatchdogSolver::save(const Cloth& cloth) {
-  x_ = cloth.state.x;  // same sizes after warm-up: no allocation
-  xp_ = cloth.state.x_prev;
-  v_ = cloth.state.v;
-  time_ = cloth.state.time;
+double WatchdogSolver::save(const Cloth& cloth) {
+  const auto& S = cloth.state;
+  const int n = static_cast<int>(S.x.size());
+  x_.resize(n);  // same sizes after warm-up: no allocation
+  xp_.resize(S.x_prev.size());
+  v_.resize(S.v.size());
+  time_ = S.time;
+  by_parts(n, [&](int b, int e, Part& p) {
+    std::copy(S.x.begin() + b, S.x.begin() + e, x_.begin() + b);
+    if (S.x_prev.size() == S.x.size())
+      std::copy(S.x_prev.begin() + b, S.x_prev.begin() + e, xp_.begin() + b);
+    for (int i = b; i < e; ++i) {
+      v_[i] = S.v[i];
+      p.ke += 0.5 * S.mass[i] * S.v[i].squaredNorm();
+    }
+  });
+  if (S.x_prev.size() != S.x.size()) xp_ = S.x_prev;
+  double ke = 0;
+  for (const Part& p : parts_) ke += p.ke;
+  return ke;
 }
 
 void WatchdogSolver::restore(Cloth& cloth) const {
@@ -54,8 +99,7 @@ void WatchdogSolver::restore(Cloth& cloth) const {
 }
 
 StepStats WatchdogSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
-  save(cloth);
-  const double ke0 = kinetic(cloth);
+  const double ke0 = save(cloth);
   StepStats st = inner_->step(cloth, scene, dt);
   if (healthy(cloth, ke0)) return st;
   st.diverged = true;

@@ -24,17 +24,31 @@ class WatchdogSolver : public Solver {
   WatchdogSolver(std::unique_ptr<Solver> inner, WatchdogOptions opt = {});
   std::string name() const override { return inner_->name(); }
   StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) override;
+  ThreadPool* pool() override { return inner_->pool(); }
   Solver& inner() { return *inner_; }
   int total_rollbacks() const { return total_rollbacks_; }
 
  private:
-  bool healthy(const Cloth& cloth, double ke_before) const;
-  void save(const Cloth& cloth);
+  // Per part of the vertices (one per thread of the inner solver's pool): the sums of a pass.
+  struct Part {
+    bool ok = true;
+    double mass = 0, ke = 0;
+  };
+  // Runs fn(begin, end, part) over the vertices in parts, on the inner solver's pool if it has
+  // one; the parts' sums in part order (the same sums on any thread).
+  template <class Fn>
+  void by_parts(int n, Fn&& fn);
+  // The state saved (x, x_prev, v, time); returns its kinetic energy.
+  double save(const Cloth& cloth);
+  double kinetic(const Cloth& cloth);
+  // Finite, not too fast, within bounds, and no blow-up of the kinetic energy.
+  bool healthy(const Cloth& cloth, double ke_before);
   void restore(Cloth& cloth) const;
 
   std::unique_ptr<Solver> inner_;
   WatchdogOptions opt_;
   std::vector<Vec3> x_, xp_, v_;
+  std::vector<Part> parts_;
   double time_ = 0;
   int total_rollbacks_ = 0;
 };
