@@ -751,7 +751,9 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     // Single precision: the anchors are the positions at the start of a frame, renewed once a
     // vertex is more than kAnchorReach from its anchor (or after a cook); the elements' terms
     // at the anchors are summed in double then (xpbd_kernels.hpp, Kernels::tris8). A float
-    // resolves a displacement of 2 cm to 2e-9 m; a cloth at rest keeps its anchors.
+    // resolves a displacement of 5 cm to 3.7e-9 m; a cloth at rest keeps its anchors. (At 2 cm
+    // the falling 128^2 drape renewed them 75 times in 270 frames, 3 % of its time; at 5 cm 30,
+    // and its error at rest the same to 5 um.)
     const double* xd = reinterpret_cast<const double*>(x.data());
     bool renew = anchors_.size() != static_cast<size_t>(3 * (n + scratch_slots_));
     const double reach2 = kAnchorReach * kAnchorReach;

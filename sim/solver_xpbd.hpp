@@ -323,7 +323,7 @@ class XpbdSolver : public Solver {
   int scratch_slots_ = 2;
   std::vector<double> anchors_;  // 3 per vertex, and the scratch vertices' (0)
   std::vector<float> tri_anchor8_, row_anchor8_;
-  static constexpr double kAnchorReach = 0.02;  // m
+  static constexpr double kAnchorReach = 0.05;  // m (a float resolves 3.7e-9 m there)
   long anchor_renewals_ = 0;
   const xpbd::Kernels* kern_ = &xpbd::kernels();
   double h_prev_ = 0;

@@ -140,8 +140,8 @@ struct Kernels {
   void (*unpack)(const P4* p, double* x, int b, int e);
   // The same in single precision, eight elements per pack, on each position's displacement from
   // a double anchor a: p = float(x - a). (XpbdSolver takes the positions at a frame's start as
-  // anchors and renews them once a vertex is 2 cm from its own, so a float resolves p to
-  // <= 2e-9 m.) What the anchors contribute is summed in double when they are set
+  // anchors and renews them once a vertex is 5 cm from its own, so a float resolves p to
+  // <= 3.7e-9 m.) What the anchors contribute is summed in double when they are set
   // (anchor_triangles, anchor_rows: fa = each triangle's F at the anchors, 48 floats per pack;
   // ca = each bending block's C at the anchors, 72 floats per pack), so the kernels add only
   // displacements: F = F(a) + (d1 - d0) D_1 + (d2 - d0) D_2 (a triangle's D_k sum to 0),
