@@ -60,6 +60,8 @@ DressForm::DressForm(double y0, double dy, std::vector<Vec2> centres, std::vecto
     for (int j = 0; j + 1 < num_sections_; ++j)
       max_gradient_[j] = std::max({own[std::max(j - 1, 0)], own[j], own[j + 1]});
   }
+  max_gradient_all_ =
+      max_gradient_.empty() ? 1.0 : *std::max_element(max_gradient_.begin(), max_gradient_.end());
   // The samples' slopes, once (each contact test interpolates four of them).
   slopes_.resize(radii_.size());
   centre_slopes_.resize(num_sections_);

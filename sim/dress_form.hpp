@@ -111,6 +111,11 @@ class DressForm {
 
   double min_y() const { return y0_; }
   double max_y() const { return y0_ + dy_ * (num_sections_ - 1); }
+  // A bound on |grad F| over the whole form within reach of its surface (F = rho - r, the
+  // radial excess; per section in normal_distance_within): a point where
+  // normal_distance_within(p) = d >= 0 is at least d / max_gradient() - s from every point
+  // where it is below s (within the height range).
+  double max_gradient() const { return max_gradient_all_; }
   const FormLandmarks& landmarks() const { return landmarks_; }
 
   // Continuous surface: bilinear in (height, angle) between the four nearest samples
@@ -161,6 +166,7 @@ class DressForm {
   // Per cell between sections j and j + 1: an upper bound of |grad F| within it (its radial
   // slopes in height and angle and its centre's drift; normal_distance_within).
   std::vector<double> max_gradient_;
+  double max_gradient_all_ = 1.0;
   // Radius at angle th and centre between sections j and j + 1 at fraction t (located once by
   // the callers: radius_at, centre_at, push_outside, signed_distance).
   double radius_in(int j, double t, double th) const;

@@ -1014,7 +1014,7 @@ void ClothEnergy::clear_contacts() {
 }
 
 double ClothEnergy::test_vertex(const Cloth& cloth, const SceneObjects& scene, int i, bool floor,
-                                bool form_on) {
+                                bool form_on, double culled_clear) {
   const auto& x = cloth.state.x;
   const double off = scene.offset;
   const double reach = off + opt_.contact_margin;
@@ -1030,13 +1030,21 @@ double ClothEnergy::test_vertex(const Cloth& cloth, const SceneObjects& scene, i
   };
   candidate_[i].vertex = -1;
   has_candidate_[i] = 0;
+  clearance2_[i] = 0;
   const uint8_t fl = cloth.state.flags[i];
   if (fl & (kFlagKinematic | kFlagNoCollide | kFlagPinned | kFlagPinched)) return 0;
   const Vec3& p = x[i];
-  if (floor) consider(p.y(), Vec3(0, 1, 0), Vec3(p.x(), 0, p.z()));
+  // The clearance: per object a lower bound on the distance from p to where the object's test
+  // below would find a contact (each a distance to a set, or a bound with its gradient).
+  double clear = culled_clear;
+  if (floor) {
+    consider(p.y(), Vec3(0, 1, 0), Vec3(p.x(), 0, p.z()));
+    clear = std::min(clear, p.y() - reach);
+  }
   for (const auto& s : scene.spheres) {
     const Vec3 d = p - s.centre;
     const double dn = d.norm();
+    clear = std::min(clear, dn - s.radius - reach);
     if (dn - s.radius >= reach || dn < 1e-12) continue;
     const Vec3 nrm = d / dn;
     consider(dn - s.radius, nrm, s.centre + s.radius * nrm);
@@ -1049,11 +1057,15 @@ double ClothEnergy::test_vertex(const Cloth& cloth, const SceneObjects& scene, i
     const Vec3 c = h.position + t * ab;
     const Vec3 d = p - c;
     const double dn = d.norm();
+    clear = std::min(clear, dn - h.radius - reach);
     if (dn - h.radius >= reach || dn < 1e-12) continue;
     consider(dn - h.radius, d / dn, c + h.radius * d / dn);
   }
   for (const auto& pl : scene.plates) {
     const Vec3 d = p - pl.centre;
+    // (A contact needs |dx| <= half_x, |dz| <= half_z, -thickness <= dy < reach.)
+    clear = std::min(clear, std::max({std::abs(d.x()) - pl.half_x, std::abs(d.z()) - pl.half_z,
+                                      d.y() - reach, -pl.thickness - d.y()}));
     if (std::abs(d.x()) > pl.half_x || std::abs(d.z()) > pl.half_z) continue;
     if (d.y() < -pl.thickness) continue;  // below the plate: untouched
     consider(d.y(), Vec3(0, 1, 0), Vec3(p.x(), pl.centre.y(), p.z()));
@@ -1061,6 +1073,7 @@ double ClothEnergy::test_vertex(const Cloth& cloth, const SceneObjects& scene, i
   for (const auto& b : scene.boxes) {
     const Vec3 d = p - b.centre;
     const Vec3 q = d.cwiseAbs() - b.half;
+    clear = std::min(clear, q.maxCoeff() - reach);
     if (q.maxCoeff() >= reach) continue;
     if ((q.array() > 0).count() > 1) continue;  // near an edge/corner outside: skip
     int ax = 0;
@@ -1072,15 +1085,25 @@ double ClothEnergy::test_vertex(const Cloth& cloth, const SceneObjects& scene, i
     consider(q[ax], nrm, surf);
   }
   if (form_on) {
+    const DressForm& form = *scene.form;
     Vec3 nrm;  // (+inf outside the form's height range)
-    const double sd = scene.form->normal_distance_within(p, reach, &nrm);
+    const double sd = form.normal_distance_within(p, reach, &nrm);
     if (sd < reach) consider(sd, nrm, p - sd * nrm);
+    // Outside the height range: at least the way into it; inside: DressForm::max_gradient().
+    if (sd == std::numeric_limits<double>::infinity())
+      clear = std::min(clear, std::max(form.min_y() - p.y(), p.y() - form.max_y()));
+    else
+      clear = std::min(clear, sd / form.max_gradient() - reach);
   }
+  // Stored squared as a float, rounded down (a retest earlier than needed is harmless).
+  if (has_candidate_[i] == 0 && clear > 0)
+    clearance2_[i] = static_cast<float>(clear * clear * (1 - 1e-6));
   return deepest;
 }
 
 double ClothEnergy::retest_contact(const Cloth& cloth, const SceneObjects& scene, int i) {
-  return test_vertex(cloth, scene, i, scene.floor, scene.form != nullptr);
+  return test_vertex(cloth, scene, i, scene.floor, scene.form != nullptr,
+                     std::numeric_limits<double>::infinity());
 }
 
 void ClothEnergy::list_contacts(int n, ThreadPool* pool) {
@@ -1151,16 +1174,23 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
   }
   lo.array() -= reach;
   hi.array() += reach;
+  // An object culled is at least the gap between its bounds and the cloth's (grown by reach)
+  // from where a test would find a contact: every vertex's clearance is at most that.
+  double culled_clear = std::numeric_limits<double>::infinity();
   auto touches = [&](const Vec3& olo, const Vec3& ohi) {
     if (!opt_.cull_by_bounds) return true;
     const bool t = (olo.array() <= hi.array()).all() && (ohi.array() >= lo.array()).all();
-    if (!t) ++culled_;
+    if (!t) {
+      ++culled_;
+      culled_clear = std::min(culled_clear, std::max((olo - hi).maxCoeff(), (lo - ohi).maxCoeff()));
+    }
     return t;
   };
   culled_ = 0;
   // Per vertex, the deepest candidate (into candidate_[i]; vertex -1: none).
   candidate_.resize(n);
   has_candidate_.resize(n);
+  clearance2_.resize(n);
   const bool floor = scene.floor && touches(Vec3(-1e9, -1, -1e9), Vec3(1e9, 0, 1e9));
   bool form_on = false;
   if (scene.form) {
@@ -1172,13 +1202,14 @@ double ClothEnergy::detect_contacts(const Cloth& cloth, const SceneObjects& scen
     deepest_part_.assign(pool->size(), 0.0);
     pool->parallel_for(n, [&](int b, int e, int w) {
       double d = deepest_part_[w];
-      for (int i = b; i < e; ++i) d = std::max(d, test_vertex(cloth, scene, i, floor, form_on));
+      for (int i = b; i < e; ++i)
+        d = std::max(d, test_vertex(cloth, scene, i, floor, form_on, culled_clear));
       deepest_part_[w] = d;
     });
     for (double d : deepest_part_) deepest = std::max(deepest, d);
   } else {
     for (int i = 0; i < n; ++i)
-      deepest = std::max(deepest, test_vertex(cloth, scene, i, floor, form_on));
+      deepest = std::max(deepest, test_vertex(cloth, scene, i, floor, form_on, culled_clear));
   }
   list_contacts(n, pool);
   return deepest;

@@ -211,6 +211,9 @@ class ClothEnergy {
                                int b, int e) const;
   // Vertex i's contact as last tested (vertex -1: none), listed or not yet.
   const Contact& tested_contact(int i) const { return candidate_[i]; }
+  // The square of how far vertex i can move from where it was last tested without coming within
+  // reach of any object (a lower bound; 0 with a contact): until then a test again finds nothing.
+  double clearance2(int i) const { return clearance2_[i]; }
   void clear_contacts();
   double contact_stiffness() const { return k_contact_; }
   void set_contact_stiffness(double k) { k_contact_ = k; }
@@ -290,10 +293,13 @@ class ClothEnergy {
   std::vector<int> contact_index_;
   std::vector<Contact> candidate_;      // per vertex, the deepest candidate (vertex -1: none)
   std::vector<uint8_t> has_candidate_;  // per vertex: candidate_[i].vertex >= 0 (a byte to scan)
+  std::vector<float> clearance2_;       // per vertex: clearance2()
   // Tests vertex i against the scene's objects (the floor and the form only when on): its
-  // deepest candidate into candidate_[i]; returns its deepest penetration (0: none).
-  double test_vertex(const Cloth& cloth, const SceneObjects& scene, int i, bool floor,
-                     bool form_on);
+  // deepest candidate into candidate_[i] and its clearance into clearance2_[i] (at most
+  // culled_clear, the clearance from the objects detect_contacts culled); returns its deepest
+  // penetration (0: none).
+  double test_vertex(const Cloth& cloth, const SceneObjects& scene, int i, bool floor, bool form_on,
+                     double culled_clear);
   std::vector<double> deepest_part_;  // per pool worker
   std::vector<Vec3> bounds_part_;     // per pool worker: lower and upper corner
   std::vector<int> block_contacts_;   // per block of kContactBlock vertices: contacts before it

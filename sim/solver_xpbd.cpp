@@ -971,14 +971,16 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       unsettle_mark_.assign(2 * static_cast<size_t>(num_pieces_), 0);
     }
     const bool settle_check = opt_.settle && settle_scale() > 1.0;
-    // Vertices [b, e) that moved more than half the margin since their last test: tested again
-    // as contact detection tests them; then as after a detection, a settling piece pushed more
-    // than kUnsettleDepth into a fresh plane ends its settling (unsettle_mark_), a vertex up to
-    // contact_snap_depth inside it is put on it, and the test's position is kept (x_det_).
+    // Vertices [b, e) that moved more than half the margin since their last test, and more than
+    // their clearance then (ClothEnergy::clearance2: short of it a test finds nothing): tested
+    // again as contact detection tests them; then as after a detection, a settling piece pushed
+    // more than kUnsettleDepth into a fresh plane ends its settling (unsettle_mark_), a vertex up
+    // to contact_snap_depth inside it is put on it, and the test's position is kept (x_det_).
     auto retest_moved = [&](int b, int e, int slot) {
       RetestPart& rp = retest_part_[slot];
       for (int i = b; i < e; ++i) {
-        if (!((x[i] - x_det_[i]).squaredNorm() > moved_lim)) continue;
+        const double moved2 = (x[i] - x_det_[i]).squaredNorm();
+        if (!(moved2 > moved_lim) || !(moved2 > energy_.clearance2(i))) continue;
         rp.deepest = std::max(rp.deepest, energy_.retest_contact(cloth, scene, i));
         ++rp.count;
         const Contact& c = energy_.tested_contact(i);
@@ -1003,7 +1005,8 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       }
       if (test_moved && !moved_part_[wk])
         for (int i = b; i < e; ++i)
-          if ((x[i] - x_det_[i]).squaredNorm() > moved_lim) {
+          if (const double m2 = (x[i] - x_det_[i]).squaredNorm();
+              m2 > moved_lim && m2 > energy_.clearance2(i)) {
             moved_part_[wk] = 1;
             break;
           }

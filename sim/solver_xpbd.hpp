@@ -350,7 +350,7 @@ class XpbdSolver : public Solver {
   void snap_onto(Cloth& cloth, const Contact& c) const;
   int num_pieces_ = 0, frozen_count_ = 0;
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
-  std::vector<Vec3> x_det_;      // positions at the last contact detection
+  std::vector<Vec3> x_det_;      // each vertex's position at its last contact test
   SelfCollision self_;
   // Coarse correction of settled pieces (XpbdOptions::coarse_factor).
   std::unique_ptr<CoarseCorrection> coarse_;
