@@ -294,6 +294,10 @@ void XpbdSolver::cook(const Cloth& cloth) {
   piece_full_.assign(num_pieces_, 0);
   piece_coarse_.assign(num_pieces_, 0);
   piece_finish_.assign(num_pieces_, 0);
+  block_one_piece_.assign((n + kSweepBlock - 1) / kSweepBlock, 1);
+  for (int i = 0; i < n; ++i)
+    if (piece_of_[i] != piece_of_[i / kSweepBlock * kSweepBlock])
+      block_one_piece_[i / kSweepBlock] = 0;
 }
 
 double XpbdSolver::cooked_bending_energy(const std::vector<Vec3>& x) const {
@@ -951,6 +955,19 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         x[i] += h * S.v[i] + (h * h / (piece_scale_[piece_of_[i]] * m)) * f;
       }
     };
+    // The same for sweep vertex block k = [b, e): the kernels' loop when it is of one piece and
+    // gravity the only force.
+    const Vec3 gk = eo.gravity ? eo.g : Vec3::Zero();
+    auto block_predict = [&](int k, int b, int e) {
+      if (!gravity_only || !block_one_piece_[k]) {
+        predict(b, e);
+        return;
+      }
+      if (copy_det) std::copy(x.begin() + b, x.begin() + e, x_det_.begin() + b);
+      K.predict(reinterpret_cast<double*>(x.data()), reinterpret_cast<double*>(S.x_prev.data()),
+                reinterpret_cast<const double*>(S.v.data()), w, S.mass.data(),
+                piece_scale_[piece_of_[b]], h, gk.data(), b, e);
+    };
     // The whole substep in one sweep (SweepPhase: the prediction with the packing, the elements,
     // the unpacking with the contacts, velocities and motion sums) where it applies: single
     // precision, one iteration, no warm start, no self-collision, bending in this substep.
@@ -993,8 +1010,18 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         x_det_[i] = x[i];
       }
     };
-    // Velocities from the substep's motion; the contact-reuse test (some vertex more than half
-    // the margin from where contacts were last detected, per thread).
+    // The contact-reuse test (some vertex of [b, e) more than half the margin, and more than its
+    // clearance, from where it was last tested: moved_part_, per thread).
+    auto test_moved_part = [&](int b, int e, int wk) {
+      if (test_moved && !moved_part_[wk])
+        for (int i = b; i < e; ++i)
+          if (const double m2 = (x[i] - x_det_[i]).squaredNorm();
+              m2 > moved_lim && m2 > energy_.clearance2(i)) {
+            moved_part_[wk] = 1;
+            break;
+          }
+    };
+    // Velocities from the substep's motion, and the contact-reuse test.
     auto velocities = [&](int b, int e, int wk) {
       for (int i = b; i < e; ++i) {
         if (w[i] > 0)
@@ -1003,13 +1030,19 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         else if (S.flags[i] & kFlagFrozen)
           S.v[i].setZero();
       }
-      if (test_moved && !moved_part_[wk])
-        for (int i = b; i < e; ++i)
-          if (const double m2 = (x[i] - x_det_[i]).squaredNorm();
-              m2 > moved_lim && m2 > energy_.clearance2(i)) {
-            moved_part_[wk] = 1;
-            break;
-          }
+      test_moved_part(b, e, wk);
+    };
+    // The same for sweep vertex block k = [b, e): the kernels' loop when it is of one piece.
+    auto block_velocities = [&](int k, int b, int e, int wk) {
+      if (!block_one_piece_[k]) {
+        velocities(b, e, wk);
+        return;
+      }
+      K.velocities(reinterpret_cast<const double*>(x.data()),
+                   reinterpret_cast<const double*>(S.x_prev.data()),
+                   reinterpret_cast<double*>(S.v.data()), w, S.flags.data(), kFlagFrozen,
+                   piece_scale_[piece_of_[b]] > 1.0 ? damp_settle : damp, h, b, e);
+      test_moved_part(b, e, wk);
     };
     // Per sweep vertex block k: the pieces' motion sums over its free vertices (PieceMotion),
     // one run per stretch of vertices of one piece.
@@ -1037,7 +1070,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
         case kSweepPack:
           for (int k = b; k < e; ++k) {
             const int vb = k * kSweepBlock, ve = std::min(n, vb + kSweepBlock);
-            predict(vb, ve);
+            block_predict(k, vb, ve);
             K.pack8(reinterpret_cast<const double*>(x.data()), w, anchors_.data(), xp8, vb, ve);
           }
           break;
@@ -1052,7 +1085,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
             const int vb = k * kSweepBlock, ve = std::min(n, vb + kSweepBlock);
             K.unpack8(xp8, anchors_.data(), reinterpret_cast<double*>(x.data()), vb, ve);
             energy_.project_tested_contacts(x, &S.x_prev, scene.friction, vb, ve);
-            velocities(vb, ve, slot);
+            block_velocities(k, vb, ve, slot);
             if (opt_.settle || opt_.freeze) block_motion(k, vb, ve);
             if (retest) retest_moved(vb, ve, slot);
           }

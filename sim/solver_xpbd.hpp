@@ -340,6 +340,8 @@ class XpbdSolver : public Solver {
   std::vector<PieceMotion> motion_;
   // The sweep's motion sums per vertex block: (piece, sums) per run of one piece's vertices.
   std::vector<std::vector<std::pair<int, PieceMotion>>> block_motion_;
+  // Per sweep vertex block: its vertices all of one piece (the per-vertex kernels then run it).
+  std::vector<uint8_t> block_one_piece_;
   std::vector<int> piece_full_;      // settling: substeps at the full scale
   std::vector<uint8_t> fixed_prev_;  // settling: vertex was fixed at the last step
   void unsettle(int piece);

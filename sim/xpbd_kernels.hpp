@@ -154,6 +154,14 @@ struct Kernels {
                 double* lambda);
   void (*pack8)(const double* x, const double* w, const double* a, P4f* p, int b, int e);
   void (*unpack8)(const P4f* p, const double* a, double* x, int b, int e);
+  // XpbdSolver's per-vertex steps of a substep for vertices [b, e) of one piece (settling scale
+  // `scale`), written as its own loops are (the same arithmetic, bit for bit) so that they
+  // vectorise: the prediction, x_prev = x and, where w > 0, x += h v + (h^2 / (scale m)) (m g);
+  // the velocities, v = (damp (x - x_prev)) / h where w > 0, 0 where frozen (flags & frozen).
+  void (*predict)(double* x, double* x_prev, const double* v, const double* w, const double* mass,
+                  double scale, double h, const double* g, int b, int e);
+  void (*velocities)(const double* x, const double* x_prev, double* v, const double* w,
+                     const uint8_t* flags, uint8_t frozen, double damp, double h, int b, int e);
   // The anchor terms for packs [b, e), summed in double from the anchors a (3 per vertex,
   // including the scratch vertex of padding lanes) and the packs' own float coefficients.
   void (*anchor_triangles)(const TriPack8* packs, int b, int e, const double* a, float* fa);

@@ -472,6 +472,42 @@ void pack8(const double* x, const double* w, const double* a, P4f* p, int b, int
   }
 }
 
+// The solver's per-vertex steps (Kernels::predict, Kernels::velocities), without contraction
+// into fused multiply-adds: the solver's own loops, built for any x86-64, have none, and a block
+// must come out the same whichever of the two runs it.
+#if defined(__GNUC__) && !defined(__clang__)
+#define DRAPE_NO_CONTRACT __attribute__((optimize("fp-contract=off")))
+#else
+#define DRAPE_NO_CONTRACT
+#endif
+DRAPE_NO_CONTRACT void predict(double* x, double* x_prev, const double* v, const double* w,
+                               const double* mass, double scale, double h, const double* g, int b,
+                               int e) {
+  for (int i = b; i < e; ++i) {
+    const double m = mass[i];
+    const double c = h * h / (scale * m);
+    const bool free = w[i] > 0;
+    for (int k = 0; k < 3; ++k) {
+      const double x0 = x[3 * i + k];
+      x_prev[3 * i + k] = x0;
+      const double x1 = x0 + (h * v[3 * i + k] + c * (m * g[k]));
+      x[3 * i + k] = free ? x1 : x0;
+    }
+  }
+}
+
+DRAPE_NO_CONTRACT void velocities(const double* x, const double* x_prev, double* v, const double* w,
+                                  const uint8_t* flags, uint8_t frozen, double damp, double h,
+                                  int b, int e) {
+  for (int i = b; i < e; ++i) {
+    const bool free = w[i] > 0, still = (flags[i] & frozen) != 0;
+    for (int k = 0; k < 3; ++k) {
+      const double vk = damp * (x[3 * i + k] - x_prev[3 * i + k]) / h;
+      v[3 * i + k] = free ? vk : still ? 0.0 : v[3 * i + k];
+    }
+  }
+}
+
 void unpack8(const P4f* p, const double* a, double* x, int b, int e) {
   for (int i = b; i < e; ++i)
     for (int c = 0; c < 3; ++c) {
@@ -545,6 +581,8 @@ constexpr Kernels make_kernels(const char* name, int tri_lanes) {
                  &project_rows8,
                  &pack8,
                  &unpack8,
+                 &predict,
+                 &velocities,
                  &anchor_triangles,
                  &anchor_rows,
                  &project_tris16,
