@@ -1052,6 +1052,13 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     auto block_motion = [&](int k, int b, int e) {
       auto& runs = block_motion_[k];
       runs.clear();
+      if (block_one_piece_[k]) {
+        double sums[4];
+        if (K.motion(reinterpret_cast<const double*>(S.v.data()), w, S.mass.data(), slow2, b, e,
+                     sums) > 0)
+          runs.push_back({piece_of_[b], PieceMotion{sums[0], sums[1], sums[2], sums[3]}});
+        return;
+      }
       for (int i = b; i < e; ++i) {
         if (!(w[i] > 0)) continue;
         if (runs.empty() || runs.back().first != piece_of_[i]) runs.push_back({piece_of_[i], {}});

@@ -162,6 +162,10 @@ struct Kernels {
                   double scale, double h, const double* g, int b, int e);
   void (*velocities)(const double* x, const double* x_prev, double* v, const double* w,
                      const uint8_t* flags, uint8_t frozen, double damp, double h, int b, int e);
+  // The motion sums over the free vertices (w > 0) of [b, e), in vertex order, v2 = |v|^2:
+  // out = {max v2, sum m v2, sum m min(v2, slow2), sum m}; returns how many are free.
+  int (*motion)(const double* v, const double* w, const double* mass, double slow2, int b, int e,
+                double* out);
   // The anchor terms for packs [b, e), summed in double from the anchors a (3 per vertex,
   // including the scratch vertex of padding lanes) and the packs' own float coefficients.
   void (*anchor_triangles)(const TriPack8* packs, int b, int e, const double* a, float* fa);

@@ -508,6 +508,28 @@ DRAPE_NO_CONTRACT void velocities(const double* x, const double* x_prev, double*
   }
 }
 
+DRAPE_NO_CONTRACT int motion(const double* v, const double* w, const double* mass, double slow2,
+                             int b, int e, double* out) {
+  double mx = 0, mv2 = 0, capped = 0, ms = 0;
+  int free = 0;
+  for (int i = b; i < e; ++i) {
+    const bool f = w[i] > 0;
+    const double vx = v[3 * i], vy = v[3 * i + 1], vz = v[3 * i + 2];
+    const double v2 = vx * vx + vy * vy + vz * vz, m = mass[i];
+    // (Adding 0 for a vertex not free leaves each sum as it was.)
+    mx = std::max(mx, f ? v2 : 0.0);
+    mv2 += f ? m * v2 : 0.0;
+    capped += f ? m * std::min(v2, slow2) : 0.0;
+    ms += f ? m : 0.0;
+    free += f;
+  }
+  out[0] = mx;
+  out[1] = mv2;
+  out[2] = capped;
+  out[3] = ms;
+  return free;
+}
+
 void unpack8(const P4f* p, const double* a, double* x, int b, int e) {
   for (int i = b; i < e; ++i)
     for (int c = 0; c < 3; ++c) {
@@ -583,6 +605,7 @@ constexpr Kernels make_kernels(const char* name, int tri_lanes) {
                  &unpack8,
                  &predict,
                  &velocities,
+                 &motion,
                  &anchor_triangles,
                  &anchor_rows,
                  &project_tris16,

@@ -524,10 +524,10 @@ TEST(XpbdKernels, OneProjectionRemovesTheStretchOfATriangle) {
   }
 }
 
-// The solver's per-vertex steps (Kernels::predict, Kernels::velocities) in every build give what
+// The solver's per-vertex steps (Kernels::predict, velocities, motion) in every build give what
 // the solver's own loops give (written below as they are in solver_xpbd.cpp, with Eigen
 // vectors), bit for bit: free, fixed (w = 0) and frozen vertices, settling scale 3.
-TEST(XpbdKernels, PredictionAndVelocitiesAreTheSolversOwnBitForBit) {
+TEST(XpbdKernels, PredictionVelocitiesAndMotionSumsAreTheSolversOwnBitForBit) {
   using Vec3 = Eigen::Vector3d;
   const int n = 203;  // not a multiple of any vector width
   std::mt19937 rng(11);
@@ -577,6 +577,22 @@ TEST(XpbdKernels, PredictionAndVelocitiesAreTheSolversOwnBitForBit) {
     int vel_same = 0;
     for (int i = 0; i < n; ++i) vel_same += vk[i] == vr[i];
     EXPECT_EQ(vel_same, n) << K->name;
+    // The motion sums, as the solver's loop sums them (Eigen's squaredNorm).
+    const double slow2 = 0.25;
+    double ref[4] = {0, 0, 0, 0};
+    int free = 0;
+    for (int i = 0; i < n; ++i) {
+      if (!(w[i] > 0)) continue;
+      ++free;
+      const double v2 = vr[i].squaredNorm(), m = mass[i];
+      ref[0] = std::max(ref[0], v2);
+      ref[1] += m * v2;
+      ref[2] += m * std::min(v2, slow2);
+      ref[3] += m;
+    }
+    double sums[4];
+    EXPECT_EQ(K->motion(vk[0].data(), w.data(), mass.data(), slow2, 0, n, sums), free) << K->name;
+    for (int j = 0; j < 4; ++j) EXPECT_EQ(sums[j], ref[j]) << K->name << " sum " << j;
   }
 }
 
