@@ -1026,7 +1026,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
       for (int i = b; i < e; ++i) {
         if (w[i] > 0)
           S.v[i] =
-              (piece_scale_[piece_of_[i]] > 1.0 ? damp_settle : damp) * (x[i] - S.x_prev[i]) / h;
+              ((piece_scale_[piece_of_[i]] > 1.0 ? damp_settle : damp) / h) * (x[i] - S.x_prev[i]);
         else if (S.flags[i] & kFlagFrozen)
           S.v[i].setZero();
       }

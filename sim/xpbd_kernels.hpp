@@ -157,7 +157,7 @@ struct Kernels {
   // XpbdSolver's per-vertex steps of a substep for vertices [b, e) of one piece (settling scale
   // `scale`), written as its own loops are (the same arithmetic, bit for bit) so that they
   // vectorise: the prediction, x_prev = x and, where w > 0, x += h v + (h^2 / (scale m)) (m g);
-  // the velocities, v = (damp (x - x_prev)) / h where w > 0, 0 where frozen (flags & frozen).
+  // the velocities, v = (damp / h) (x - x_prev) where w > 0, 0 where frozen (flags & frozen).
   void (*predict)(double* x, double* x_prev, const double* v, const double* w, const double* mass,
                   double scale, double h, const double* g, int b, int e);
   void (*velocities)(const double* x, const double* x_prev, double* v, const double* w,

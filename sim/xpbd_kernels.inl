@@ -499,10 +499,11 @@ DRAPE_NO_CONTRACT void predict(double* x, double* x_prev, const double* v, const
 DRAPE_NO_CONTRACT void velocities(const double* x, const double* x_prev, double* v, const double* w,
                                   const uint8_t* flags, uint8_t frozen, double damp, double h,
                                   int b, int e) {
+  const double dh = damp / h;  // (a division per block, not three per vertex)
   for (int i = b; i < e; ++i) {
     const bool free = w[i] > 0, still = (flags[i] & frozen) != 0;
     for (int k = 0; k < 3; ++k) {
-      const double vk = damp * (x[3 * i + k] - x_prev[3 * i + k]) / h;
+      const double vk = dh * (x[3 * i + k] - x_prev[3 * i + k]);
       v[3 * i + k] = free ? vk : still ? 0.0 : v[3 * i + k];
     }
   }

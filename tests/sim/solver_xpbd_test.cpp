@@ -272,12 +272,13 @@ TEST(Xpbd, ContactReuseKeepsTheDrapeAndSkipsDetections) {
   EXPECT_LT(moved.retests + 270L * 32 * 32, static_cast<long>(reused.detections) * 32 * 32);
 }
 
-// Bending projected every second substep (an option): stable, and within 1 mm of the error of
-// bending every substep (16^2, 20 substeps, the drape 6 s in and coming to rest; at 32^2 the two
-// are equal, docs/solvers.md). Measured every substep / every 2nd: 1.36 / 0.69 mm with the
-// AVX-512 and AVX2 kernels, 1.59 / 1.06 mm with the portable ones. (3 s in, still moving, the
-// earlier version of this test: 1.5-3.9 mm, and the order of the two changed with round-off —
-// FMA contraction, the anchors' reach — by more than the two modes differ.)
+// Bending projected every second substep (an option): stable, and its drape (16^2, 20 substeps,
+// 6 s in, coming to rest) within 3 mm RMS of its nearest equilibrium, as bending every substep's
+// is. Not closer than a fixed margin to that one's: the 16^2 drape ends in one of several
+// frictional equilibria, chosen by round-off (FMA contraction in the kernels' builds, the
+// anchors' reach, the velocity's division) — measured this way over the builds and such
+// variants: every substep 0.40-1.59 mm, every 2nd 0.69-2.09 mm (3 s in: 1.5-3.9 mm, the order of
+// the two changing from one variant to the next; 10 s in: 0.14-1.17 and 0.22-1.50 mm).
 TEST(Xpbd, BendingEverySecondSubstepKeepsTheDrape) {
   XpbdOptions o;
   o.substeps = 20;
@@ -289,7 +290,8 @@ TEST(Xpbd, BendingEverySecondSubstepKeepsTheDrape) {
   o.bending_every = 2;
   const DrapeEnd two = form_drape_end(o, "bending every 2nd substep", 16, 540);
   EXPECT_GT(two.min_sd, two.offset - 5e-4);
-  EXPECT_LT(two.err, one.err + 1e-3);
+  EXPECT_LT(one.err, 3e-3);
+  EXPECT_LT(two.err, 3e-3);
   // Asked to test moved vertices one by one, it does not (the substeps without bending project
   // the energy's contact list): the same drape, the list complete.
   o.retest_contacts = true;

@@ -561,7 +561,7 @@ TEST(XpbdKernels, PredictionVelocitiesAndMotionSumsAreTheSolversOwnBitForBit) {
   const std::vector<Vec3> moved = xr;
   for (int i = 0; i < n; ++i) {
     if (w[i] > 0)
-      vr[i] = damp * (xr[i] - xpr[i]) / h;
+      vr[i] = (damp / h) * (xr[i] - xpr[i]);
     else if (flags[i] & kFrozen)
       vr[i].setZero();
   }
