@@ -910,11 +910,11 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
           std::max(st.max_penetration, energy_.detect_contacts(cloth, scene, pool_.get()));
       if (scene.self_collision) self_.detect(cloth, x, scene.offset, margin);
       if (opt_.settle && settle_scale() > 1.0) {
-        // Something pushed into a settling piece (kUnsettleDepth).
-        for (int i = 0; i < n; ++i) {
-          const int ci = energy_.contact_of(i);
-          if (ci >= 0 && piece_scale_[piece_of_[i]] > 1.0 &&
-              energy_.contacts()[ci].n.dot(x[i] - energy_.contacts()[ci].p) < -kUnsettleDepth)
+        // Something pushed into a settling piece (kUnsettleDepth). (The contacts are listed in
+        // vertex order.)
+        for (const Contact& c : energy_.contacts()) {
+          const int i = c.vertex;
+          if (piece_scale_[piece_of_[i]] > 1.0 && c.n.dot(x[i] - c.p) < -kUnsettleDepth)
             unsettle(piece_of_[i]);
         }
       }
