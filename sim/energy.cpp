@@ -267,7 +267,6 @@ void spgemm(const Csr& A, const Csr& B, int ncols, Csr& C, const std::vector<dou
     out.val.reserve(bound);
     for (int i = lo; i < hi; ++i) {
       touched.clear();
-      touched.clear();
       for (int ka = A.off[i]; ka < A.off[i + 1]; ++ka) {
         const int r = A.col[ka];
         const double a = A.val[ka] * (s ? (*s)[r] : 1.0);
