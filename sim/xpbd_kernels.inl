@@ -472,7 +472,7 @@ void pack8(const double* x, const double* w, const double* a, P4f* p, int b, int
   }
 }
 
-// The solver's per-vertex steps (Kernels::predict, Kernels::velocities), without contraction
+// The solver's per-vertex steps (Kernels::predict, velocities, motion), without contraction
 // into fused multiply-adds: the solver's own loops, built for any x86-64, have none, and a block
 // must come out the same whichever of the two runs it.
 #if defined(__GNUC__) && !defined(__clang__)
