@@ -236,9 +236,7 @@ void by_row_parts(int rows, ThreadPool* pool, Csr& C, Fill&& fill) {
     return;
   }
   std::vector<Csr> part(parts);
-  pool->parallel_slots([&](int k, int) {
-    const int lo = static_cast<int>(static_cast<int64_t>(rows) * k / parts);
-    const int hi = static_cast<int>(static_cast<int64_t>(rows) * (k + 1) / parts);
+  pool->parallel_parts(rows, [&](int lo, int hi, int k) {
     part[k].reset(hi - lo);
     fill(lo, hi, part[k]);
   });
@@ -474,11 +472,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
     }
   };
   if (pool && nt >= 4096) {
-    const int parts = pool->size();
-    pool->parallel_slots([&](int k, int) {
-      local(static_cast<int>(static_cast<int64_t>(nt) * k / parts),
-            static_cast<int>(static_cast<int64_t>(nt) * (k + 1) / parts));
-    });
+    pool->parallel_parts(nt, [&](int b, int e, int) { local(b, e); });
   } else {
     local(0, nt);
   }
@@ -1135,7 +1129,7 @@ void ClothEnergy::list_contacts(int n, ThreadPool* pool) {
     return;
   }
   for (int i = 0; i < n; ++i)
-    if (candidate_[i].vertex >= 0) {
+    if (has_candidate_[i]) {
       contact_index_[i] = static_cast<int>(contacts_.size());
       contacts_.push_back(candidate_[i]);
     }

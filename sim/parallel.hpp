@@ -27,6 +27,12 @@ int colour_elements(int num_vertices, const std::vector<int>& elem_offsets,
                     const std::vector<int>& elem_verts, std::vector<int>& order,
                     std::vector<int>& colour_offsets);
 
+// The first item of part k when n items are split in `parts` equal contiguous parts: part k is
+// [part_begin(n, k, parts), part_begin(n, k + 1, parts)).
+inline int part_begin(int n, int k, int parts) {
+  return static_cast<int>(int64_t{n} * k / parts);
+}
+
 class ThreadPool {
  public:
   // threads = total workers including the caller (>= 1).
@@ -63,6 +69,14 @@ class ThreadPool {
       return;
     }
     run(threads_, &invoke<decltype(body)>, &body, threads_);
+  }
+  // Runs fn(begin, end, part) once for each of size() equal parts of [0, n) (part_begin), one
+  // part per slot (parallel_slots): a part's results can be joined in part order, the same on
+  // any thread.
+  template <class Fn>
+  void parallel_parts(int n, Fn&& fn) {
+    parallel_slots(
+        [&](int k, int) { fn(part_begin(n, k, threads_), part_begin(n, k + 1, threads_), k); });
   }
   // Times a worker went to sleep after spinning idle (parallel.cpp, kSpinBeforeSleep).
   long idle_sleeps() const { return idle_sleeps_.load(std::memory_order_relaxed); }

@@ -993,11 +993,14 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     // again as contact detection tests them; then as after a detection, a settling piece pushed
     // more than kUnsettleDepth into a fresh plane ends its settling (unsettle_mark_), a vertex up
     // to contact_snap_depth inside it is put on it, and the test's position is kept (x_det_).
+    auto moved_beyond = [&](int i) {
+      const double m2 = (x[i] - x_det_[i]).squaredNorm();
+      return m2 > moved_lim && m2 > energy_.clearance2(i);
+    };
     auto retest_moved = [&](int b, int e, int slot) {
       RetestPart& rp = retest_part_[slot];
       for (int i = b; i < e; ++i) {
-        const double moved2 = (x[i] - x_det_[i]).squaredNorm();
-        if (!(moved2 > moved_lim) || !(moved2 > energy_.clearance2(i))) continue;
+        if (!moved_beyond(i)) continue;
         rp.deepest = std::max(rp.deepest, energy_.retest_contact(cloth, scene, i));
         ++rp.count;
         const Contact& c = energy_.tested_contact(i);
@@ -1015,8 +1018,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
     auto test_moved_part = [&](int b, int e, int wk) {
       if (test_moved && !moved_part_[wk])
         for (int i = b; i < e; ++i)
-          if (const double m2 = (x[i] - x_det_[i]).squaredNorm();
-              m2 > moved_lim && m2 > energy_.clearance2(i)) {
+          if (moved_beyond(i)) {
             moved_part_[wk] = 1;
             break;
           }

@@ -40,8 +40,9 @@ struct XpbdOptions {
   // it were never scheduled), so that the caller takes it over (XpbdSolver::SweepPhase).
   bool sweep_worker = true;
   // With reuse_contacts, in the element sweep: each vertex that moved more than half the margin
-  // since its own last contact test is tested again there, instead of all vertices being tested
-  // again in the next substep (the frame's first substep still tests all).
+  // and its clearance (ClothEnergy::clearance2) since its own last contact test is tested again
+  // there, instead of all vertices being tested again in the next substep (the frame's first
+  // substep still tests all).
   bool retest_contacts = true;
   // Warm start (0..1): each substep starts from the previous substep's multipliers scaled by
   // this factor (and by (h / h_prev)^2), applying their displacement w grad C lambda with the

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 
 #include "sim/parallel.hpp"
 
@@ -23,14 +22,10 @@ void WatchdogSolver::by_parts(int n, Fn&& fn) {
   ThreadPool* pool = inner_->pool();
   const int np = pool && n >= 4096 ? pool->size() : 1;
   parts_.assign(np, Part{});
-  auto run = [&](int k, int) {
-    fn(static_cast<int>(static_cast<int64_t>(n) * k / np),
-       static_cast<int>(static_cast<int64_t>(n) * (k + 1) / np), parts_[k]);
-  };
   if (np == 1)
-    run(0, 0);
+    fn(0, n, parts_[0]);
   else
-    pool->parallel_slots(run);
+    pool->parallel_parts(n, [&](int b, int e, int k) { fn(b, e, parts_[k]); });
 }
 
 double WatchdogSolver::kinetic(const Cloth& cloth) {

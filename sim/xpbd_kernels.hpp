@@ -18,6 +18,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "sim/parallel.hpp"
+
 namespace drape::sim::xpbd {
 
 // A vertex position padded to 32 bytes; the fourth lane is the vertex's inverse mass (0: fixed
@@ -57,7 +59,7 @@ using TriPack16 = TriPackT<float, 16>;
 // vertex scratch + t (extra positions whose inverse mass is 0), so that two threads never read
 // and write back the same one.
 inline int share_begin(int cnt, int t, int shares) {
-  return static_cast<int>(int64_t{cnt} * t / shares);
+  return part_begin(cnt, t, shares);
 }
 // The share of the pack at position pos of cnt.
 inline int share_of(int pos, int cnt, int shares) {
