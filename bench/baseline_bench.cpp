@@ -13,9 +13,9 @@
 #include <map>
 #include <random>
 
-#include "sim/dress_form.hpp"
-#include "sim/drop_scene.hpp"
-#include "sim/verlet_solver.hpp"
+#include "sim/form/dress_form.hpp"
+#include "sim/solvers/verlet_solver.hpp"
+#include "sim/testbeds/drop_testbed.hpp"
 
 namespace {
 
@@ -52,8 +52,9 @@ std::shared_ptr<const DressForm> form_9ar() {
   return f;
 }
 
-// The standard drop scene (sim/drop_scene.hpp, the same as tests/sim/drop_test.cpp): the panel
-// held at its top edge above the bust, released horizontal, swinging down against the form.
+// The standard drop scene (sim/testbeds/drop_testbed.hpp, the same as
+// tests/sim/testbeds/drop_testbed_test.cpp): the panel held at its top edge above the bust,
+// released horizontal, swinging down against the form.
 Cloth front_panel(int n) {
   return make_front_drop(form_9ar(), n, kPanel).cloth;
 }
@@ -104,7 +105,7 @@ void BM_FormCollision(benchmark::State& state) {
   // The panel laid around the front of the form (about +-75 degrees, from the hinge height
   // down), alternate vertices 2 mm inside and 2 mm outside the offset shell: half in contact.
   const DressForm& f = *scene.form;
-  DropScene d = make_front_drop(form_9ar(), n, kPanel);
+  DropTestbed d = make_front_drop(form_9ar(), n, kPanel);
   for (int i = 0; i < c.num_vertices(); ++i) {
     const Vec2& m = c.topo.material[i];
     const double y = d.hinge_y - 0.9 * (kPanel - m.y());

@@ -13,7 +13,7 @@
 #include <memory>
 #include <utility>
 
-#include "sim/scenes.hpp"
+#include "sim/testbeds/testbed.hpp"
 
 namespace drape::bench {
 
@@ -51,7 +51,7 @@ PeerRow run_bullet_sheet(int res, int substeps, int iterations, const PeerOption
   row.dt = h;
   row.iterations = iterations;
 
-  sim::StudyScene sc = sim::make_hanging_sheet(res);
+  sim::Testbed sc = sim::make_hanging_sheet(res);
   const sim::Cloth& cloth = sc.cloth;
   const int n = cloth.num_vertices();
   const auto& fab = cloth.fabric;

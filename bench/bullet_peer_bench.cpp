@@ -4,8 +4,8 @@
 // study itself (solvers_bench) writes the solver=bullet rows; this driver is for the matching.
 // Usage: bullet_peer_bench [--res N] [--check-rms MM] [--scale S] [--fixed K] [--bending] [--kdp D]
 //                          [--runs SUBSTEPSxITER,...] [--ours SOLVER:SUBSTEPSxITER,...]
-// --ours runs our solvers (sim/solver_factory.hpp) on the same scene in the same process, timed
-// the same way, for a side-by-side at equal error (CPU time = process CPU, both threads).
+// --ours runs our solvers (sim/solvers/solver_factory.hpp) on the same scene in the same process,
+// timed the same way, for a side-by-side at equal error (CPU time = process CPU, both threads).
 // Exit code 1 when a run is unstable or a position is not finite (the peer's check).
 #include <algorithm>
 #include <chrono>
@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "bench/bullet_peer.hpp"
-#include "sim/scenes.hpp"
-#include "sim/solver_factory.hpp"
-#include "sim/solver_newton.hpp"
+#include "sim/solvers/solver_factory.hpp"
+#include "sim/solvers/solver_newton.hpp"
+#include "sim/testbeds/testbed.hpp"
 
 using namespace drape;
 
@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "--res must be >= 2\n");
     return 2;
   }
-  sim::StudyScene sc = sim::make_hanging_sheet(res);
+  sim::Testbed sc = sim::make_hanging_sheet(res);
   sim::StaticOptions so;
   so.tolerance = 1e-8;
   so.max_iterations = 200;
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
   std::printf("reference: static Newton %dx%d, %d iterations, residual %.1e\n", res, res,
               r.iterations, r.residual);
   // Without bending, for the size of bending's contribution to the reference.
-  sim::StudyScene nb = sim::make_hanging_sheet(res);
+  sim::Testbed nb = sim::make_hanging_sheet(res);
   so.energy.bending = false;
   sim::relax_static(nb.cloth, nb.objects, so);
   double brms = 0, bmax = 0;
@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
                    item.c_str());
       return 2;
     }
-    sim::StudyScene s2 = sim::make_hanging_sheet(res);
+    sim::Testbed s2 = sim::make_hanging_sheet(res);
     sim::SolverConfig cfg;
     cfg.substeps = sub;
     cfg.iterations = it;

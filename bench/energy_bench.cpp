@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/energy.hpp"
+#include "sim/energy/energy.hpp"
 
 using namespace drape::sim;
 

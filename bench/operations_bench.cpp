@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "sim/cut.hpp"
-#include "sim/operation_controller.hpp"
-#include "sim/sim_thread.hpp"
-#include "sim/solver_vbd.hpp"
+#include "sim/ops/cut.hpp"
+#include "sim/ops/operation_controller.hpp"
+#include "sim/runtime/sim_thread.hpp"
+#include "sim/solvers/solver_vbd.hpp"
 
 using namespace drape::sim;
 

@@ -10,8 +10,8 @@
 #include <fstream>
 #include <vector>
 
-#include "sim/dress_form.hpp"
-#include "sim/pattern_pipeline.hpp"
+#include "sim/draping/pattern_pipeline.hpp"
+#include "sim/form/dress_form.hpp"
 
 using namespace drape::sim;
 using Clock = std::chrono::steady_clock;

@@ -14,9 +14,10 @@
 #include <vector>
 
 #include "render/renderer.hpp"
-#include "render/scene_file.hpp"
+#include "xr_app/scene_file.hpp"
 
 using namespace drape::render;
+using namespace drape::app;
 
 namespace {
 
@@ -110,7 +111,7 @@ int main(int argc, char** argv) {
   const int frames = argc > 1 ? std::max(1, std::atoi(argv[1])) : 20;
   const uint32_t size = argc > 2 ? static_cast<uint32_t>(std::max(16, std::atoi(argv[2]))) : 1024;
   const double sim_seconds = argc > 3 ? std::atof(argv[3]) : 1.0;
-  auto scene = default_scene(sim_seconds, "vbd", 128);
+  auto scene = default_scene(sim_seconds, "xpbd", 128);
   if (!scene) {
     std::fprintf(stderr, "render_bench: %s\n", scene.error().c_str());
     return 1;

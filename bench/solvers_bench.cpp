@@ -23,15 +23,15 @@
 #include <vector>
 
 #include "bench/bullet_peer.hpp"
-#include "sim/coarse_correction.hpp"
-#include "sim/dress_form.hpp"
-#include "sim/equilibrium_finisher.hpp"
-#include "sim/scenes.hpp"
-#include "sim/solver_factory.hpp"
-#include "sim/solver_newton.hpp"
-#include "sim/solver_vbd.hpp"
-#include "sim/solver_xpbd.hpp"
-#include "sim/watchdog.hpp"
+#include "sim/form/dress_form.hpp"
+#include "sim/rest/coarse_correction.hpp"
+#include "sim/rest/equilibrium_finisher.hpp"
+#include "sim/solvers/solver_factory.hpp"
+#include "sim/solvers/solver_newton.hpp"
+#include "sim/solvers/solver_vbd.hpp"
+#include "sim/solvers/watchdog.hpp"
+#include "sim/solvers/xpbd/solver_xpbd.hpp"
+#include "sim/testbeds/testbed.hpp"
 
 using namespace drape::sim;
 
@@ -117,9 +117,9 @@ bool path_dependent(const std::string& scene) {
   return scene == "form" || scene == "sphere";
 }
 
-std::vector<Vec3> polished(const StudyScene& end, double& residual, int max_iterations = 0,
+std::vector<Vec3> polished(const Testbed& end, double& residual, int max_iterations = 0,
                            StaticResult* result = nullptr) {
-  StudyScene sc = end;
+  Testbed sc = end;
   StaticOptions so;
   so.tolerance = 1e-8;
   // The frictional equilibrium nearest to it (the scene's objects' mu); PROBE_POLISH_FRICTION=0:
@@ -139,7 +139,7 @@ std::vector<Vec3> polished(const StudyScene& end, double& residual, int max_iter
 
 Row run(const std::string& scene, int res, const Config& c, const std::vector<Vec3>& ref,
         bool measure_error = true) {
-  StudyScene sc = make_scene(scene, res);
+  Testbed sc = make_scene(scene, res);
   SolverConfig cfg;
   cfg.substeps = c.substeps;
   cfg.iterations = c.iterations;
@@ -177,7 +177,7 @@ Row run(const std::string& scene, int res, const Config& c, const std::vector<Ve
 }
 
 std::vector<Vec3> reference(const std::string& scene, int res) {
-  StudyScene sc = make_scene(scene, res);
+  Testbed sc = make_scene(scene, res);
   StaticOptions so;
   so.tolerance = 1e-8;
   so.max_iterations = 200;
@@ -275,7 +275,7 @@ XpbdSolver* xpbd_of(Solver* s) {
 // ends: steps on at the app's pace (1/90 s of wall time per frame; a sleeping frame costs one
 // contact check) until it has. Returns the frames stepped (0: nothing was finishing) and their
 // wall time in `ms`.
-int land_finish(Solver& s, StudyScene& sc, double& ms) {
+int land_finish(Solver& s, Testbed& sc, double& ms) {
   ms = 0;
   XpbdSolver* xp = xpbd_of(&s);
   if (!xp || !xp->finishing()) return 0;
@@ -315,7 +315,7 @@ int probe(int argc, char** argv) {
     std::printf("reference box (%.3f %.3f %.3f)-(%.3f %.3f %.3f)\n", lo.x(), lo.y(), lo.z(), hi.x(),
                 hi.y(), hi.z());
   }
-  StudyScene sc = make_scene(scene, res);
+  Testbed sc = make_scene(scene, res);
   std::unique_ptr<Solver> s;
   VbdSolver* vbd = nullptr;
   if (solver == "vbd") {
@@ -484,7 +484,7 @@ int probe(int argc, char** argv) {
           f.last_move * 1e3, f.sweep_ms, f.coarse_ms);
     }
   }
-  // PROBE_COARSE_ONLY=k: k coarse corrections (sim/coarse_correction.hpp, lattice
+  // PROBE_COARSE_ONLY=k: k coarse corrections (sim/rest/coarse_correction.hpp, lattice
   // PROBE_COARSE_FACTOR) of the end state alone, contacts re-detected before each (a study of
   // the correction without the solver's sweeps).
   CoarseCorrection probe_cc;
@@ -595,7 +595,7 @@ int probe(int argc, char** argv) {
     sc.cloth.state.x_prev = sc.cloth.state.x;
     if (aa_m > 0) std::printf("anderson steps taken: %d of %d\n", aa_taken, kc);
   }
-  // PROBE_FINISH=k: the static finish (sim/equilibrium_finisher.hpp) of the end state, at most
+  // PROBE_FINISH=k: the static finish (sim/rest/equilibrium_finisher.hpp) of the end state, at most
   // k cycles (PROBE_FINISH_SWEEPS, PROBE_COARSE_FACTOR, PROBE_COARSE_ROT=0 for translations).
   if (const int kf = static_cast<int>(env_num("PROBE_FINISH", 0)); kf > 0) {
     EquilibriumFinisher fin;
@@ -744,7 +744,7 @@ void sleep_rows(int sres) {
         "max_error_mm,finish_thread_ms,finish_landed_ms\n";
   double rest[2] = {0, 0};
   for (int fr = 0; fr < 2; ++fr) {
-    StudyScene sc = make_scene("form", sres);
+    Testbed sc = make_scene("form", sres);
     SolverConfig cfg;
     cfg.freeze = fr == 1;
     cfg.threads = 1;
@@ -832,7 +832,7 @@ void thread_rows(int max_res) {
     for (int round = 0; round < rounds; ++round)
       for (int c = 0; c < nc; ++c)
         for (int threads : {1, 2}) {
-          StudyScene sc = make_scene("form", res);
+          Testbed sc = make_scene("form", res);
           SolverConfig cfg;
           cfg.substeps = 10;
           cfg.threads = threads;
@@ -1021,7 +1021,7 @@ int main(int argc, char** argv) {
     for (const Sw& sw :
          {Sw{"contact_reuse", true, true, false}, Sw{"contact_reuse", false, false, false},
           Sw{"self_collision", false, true, false}, Sw{"self_collision", true, true, true}}) {
-      StudyScene sc = make_scene("form", kres);
+      Testbed sc = make_scene("form", kres);
       sc.objects.self_collision = sw.self;
       XpbdOptions o;
       o.substeps = 10;

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <string>
 
-#include "sim/scenes.hpp"
+#include "sim/testbeds/testbed.hpp"
 
 using namespace drape::sim;
 

@@ -15,11 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "sim/cut.hpp"
-#include "sim/energy.hpp"
-#include "sim/scenes.hpp"
-#include "sim/self_collision.hpp"
-#include "sim/solver_xpbd.hpp"
+#include "sim/energy/energy.hpp"
+#include "sim/energy/self_collision.hpp"
+#include "sim/ops/cut.hpp"
+#include "sim/solvers/xpbd/solver_xpbd.hpp"
+#include "sim/testbeds/testbed.hpp"
 
 using namespace drape::sim;
 
@@ -52,7 +52,7 @@ int main() {
   for (int res : {32, 64, 128}) {
     Row r;
     r.res = res;
-    StudyScene sc = make_scene("form", res);
+    Testbed sc = make_scene("form", res);
     XpbdOptions o;
     o.threads = 1;
     XpbdSolver s(o);

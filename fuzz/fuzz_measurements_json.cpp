@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string>
 
-#include "sim/dress_form.hpp"
+#include "sim/form/dress_form.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -3,8 +3,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "sim/dress_form.hpp"
-#include "sim/mesh_io.hpp"
+#include "sim/form/dress_form.hpp"
+#include "sim/io/mesh_io.hpp"
 
 // assimp 5.2.5 leaks inside some importers on malformed files (e.g. PLY with unknown
 // properties); those leaks are assimp's, not ours, and would end every run early.

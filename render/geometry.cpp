@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "sim/dress_form.hpp"
+#include "sim/form/dress_form.hpp"
 
 namespace drape::render {
 namespace {

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "sim/snapshot.hpp"
+#include "sim/core/snapshot.hpp"
 
 namespace drape::sim {
 class DressForm;

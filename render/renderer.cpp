@@ -14,7 +14,7 @@
 
 #include "scene_frag.spv.h"
 #include "scene_vert.spv.h"
-#include "sim/dress_form.hpp"
+#include "sim/form/dress_form.hpp"
 
 namespace drape::render {
 namespace {

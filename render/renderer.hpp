@@ -13,7 +13,7 @@
 #include "render/camera.hpp"
 #include "render/geometry.hpp"
 #include "render/vk_context.hpp"
-#include "sim/snapshot.hpp"
+#include "sim/core/snapshot.hpp"
 
 namespace drape::render {
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/types.hpp"
+#include "sim/core/types.hpp"
 
 namespace drape::render {
 

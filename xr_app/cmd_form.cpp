@@ -6,8 +6,8 @@
 #include <exception>
 #include <string>
 
-#include "sim/dress_form.hpp"
-#include "sim/mesh_io.hpp"
+#include "sim/form/dress_form.hpp"
+#include "sim/io/mesh_io.hpp"
 #include "xr_app/command.hpp"
 
 namespace {

@@ -4,9 +4,9 @@
 #include <cstring>
 #include <string>
 
-#include "sim/dress_form.hpp"
-#include "sim/fabric.hpp"
-#include "sim/pattern_pipeline.hpp"
+#include "sim/core/fabric.hpp"
+#include "sim/draping/pattern_pipeline.hpp"
+#include "sim/form/dress_form.hpp"
 #include "xr_app/command.hpp"
 
 namespace {

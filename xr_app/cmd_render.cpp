@@ -10,12 +10,13 @@
 #include "render/image_io.hpp"
 #include "render/mirror_window.hpp"
 #include "render/renderer.hpp"
-#include "render/scene_file.hpp"
 #include "xr_app/command.hpp"
+#include "xr_app/scene_file.hpp"
 
 namespace {
 
 using namespace drape::render;
+using namespace drape::app;
 
 void usage() {
   std::fprintf(
@@ -29,7 +30,7 @@ void usage() {
       "  --eye X,Y,Z         camera position (look-at camera)\n"
       "  --target X,Y,Z      camera target\n"
       "  --sim-seconds S     default scene: simulated draping time (default 2.5)\n"
-      "  --solver NAME       default scene: solver (default vbd)\n"
+      "  --solver NAME       default scene: solver (default xpbd)\n"
       "  --window [N]        also show N frames (default: until closed) in a mirror window\n"
       "  --validation        enable the Vulkan validation layer (counts messages)\n");
 }
@@ -39,7 +40,7 @@ bool parse_vec(const char* s, Eigen::Vector3f& v) {
 }
 
 int run_render(int argc, char** argv) {
-  std::string scene_path, out = "shot.png", cmap, solver = "vbd";
+  std::string scene_path, out = "shot.png", cmap, solver = "xpbd";
   int w = 1024, h = 1024, samples = 0, window_frames = -1;
   double sim_seconds = 2.5;
   bool validation = false;

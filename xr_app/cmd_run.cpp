@@ -17,11 +17,11 @@
 #include <thread>
 #include <vector>
 
-#include "sim/dress_form.hpp"
-#include "sim/mesh_io.hpp"
-#include "sim/pattern_pipeline.hpp"
-#include "sim/sim_thread.hpp"
-#include "sim/verlet_solver.hpp"
+#include "sim/draping/pattern_pipeline.hpp"
+#include "sim/form/dress_form.hpp"
+#include "sim/io/mesh_io.hpp"
+#include "sim/runtime/sim_thread.hpp"
+#include "sim/solvers/verlet_solver.hpp"
 #include "xr_app/command.hpp"
 #ifdef DRAPE_HAVE_XR_APP
 #include <nlohmann/json.hpp>
@@ -378,7 +378,7 @@ int run_xr(int argc, char** argv) {
     std::printf("wrote %s\n", e.path().c_str());
   for (const auto& w : r.written) std::printf("wrote %s\n", std::filesystem::absolute(w).c_str());
   if (pattern) {
-    // The pattern export of the bundled design on the same form (sim/pattern_pipeline.hpp).
+    // The pattern export of the bundled design on the same form (sim/draping/pattern_pipeline.hpp).
     auto d = drape::sim::load_design(source_path("assets/designs/tight-skirt.json"));
     auto m = drape::sim::measurements_for_size("9AR");
     if (!d || !m) {

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <limits>
 
-#include "sim/dress_form.hpp"
+#include "sim/form/dress_form.hpp"
 #include "test_scenes.hpp"
 
 namespace drape::render {

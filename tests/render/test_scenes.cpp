@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "sim/dress_form.hpp"
+#include "sim/form/dress_form.hpp"
 
 namespace drape::render::test {
 

@@ -5,7 +5,7 @@
 #include <memory>
 
 #include "render/renderer.hpp"
-#include "sim/snapshot.hpp"
+#include "sim/core/snapshot.hpp"
 
 namespace drape::render::test {
 

@@ -1,0 +1,35 @@
+// Fabric parameters (SI) and their loading from JSON presets (assets/fabrics.json).
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "sim/core/types.hpp"
+
+namespace drape::sim {
+
+// Membrane and bending properties of a woven fabric. Warp = grain = material v axis,
+// weft = material u axis.
+struct FabricParams {
+  std::string name = "muslin";
+  double areal_density = 0.13;  // kg/m^2
+  double thickness = 0.0003;    // m
+  double stretch_warp = 8000;   // N/m: force per unit width per unit strain along warp
+  double stretch_weft = 5000;   // N/m
+  double shear = 60;            // N/m per radian of shear angle
+  double bending_warp =
+      8.0e-6;  // N*m: moment per unit width per unit curvature (bending along warp)
+  double bending_weft = 5.0e-6;  // N*m
+  double damping = 0.0;          // dimensionless Rayleigh factor used by solvers that support it
+};
+
+// Loads every preset of a fabrics JSON file. Each value is checked: present, finite, positive
+// (damping may be 0). Errors name the file and the field, e.g. "fabrics.json: muslin.shear: ...".
+Result<std::map<std::string, FabricParams>> load_fabric_presets(const std::string& path);
+// Parses the same format from a string; `source` names it in errors.
+Result<std::map<std::string, FabricParams>> parse_fabric_presets(const std::string& json_text,
+                                                                 const std::string& source);
+// One preset by name from assets/fabrics.json (or the given file).
+Result<FabricParams> load_fabric(const std::string& path, const std::string& name);
+
+}  // namespace drape::sim

@@ -1,0 +1,190 @@
+#include "sim/core/thread_pool.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+namespace drape::sim {
+
+namespace {
+// Lists the items colour by colour (CSR: offsets per colour, items in index order).
+void bucket_by_colour(const std::vector<int>& colour, int colours, std::vector<int>& offsets,
+                      std::vector<int>& items) {
+  const int n = static_cast<int>(colour.size());
+  offsets.assign(colours + 1, 0);
+  for (int i = 0; i < n; ++i) ++offsets[colour[i] + 1];
+  for (int c = 0; c < colours; ++c) offsets[c + 1] += offsets[c];
+  items.assign(n, 0);
+  std::vector<int> fill(offsets.begin(), offsets.end() - 1);
+  for (int i = 0; i < n; ++i) items[fill[colour[i]]++] = i;
+}
+}  // namespace
+
+int greedy_colouring(const std::vector<int>& offsets, const std::vector<int>& nbrs,
+                     std::vector<int>& colour_of, std::vector<int>& colour_offsets,
+                     std::vector<int>& colour_items) {
+  const int n = static_cast<int>(offsets.size()) - 1;
+  colour_of.assign(std::max(n, 0), -1);
+  std::vector<int> mark;
+  int colours = 0;
+  // Largest degree first gives fewer colours on irregular meshes.
+  std::vector<int> order(std::max(n, 0));
+  for (int i = 0; i < n; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return offsets[a + 1] - offsets[a] > offsets[b + 1] - offsets[b];
+  });
+  for (int i : order) {
+    mark.assign(colours + 1, 0);
+    for (int k = offsets[i]; k < offsets[i + 1]; ++k) {
+      const int c = colour_of[nbrs[k]];
+      if (c >= 0) mark[c] = 1;
+    }
+    int c = 0;
+    while (mark[c]) ++c;
+    colour_of[i] = c;
+    colours = std::max(colours, c + 1);
+  }
+  bucket_by_colour(colour_of, colours, colour_offsets, colour_items);
+  return colours;
+}
+
+int colour_elements(int num_vertices, const std::vector<int>& elem_offsets,
+                    const std::vector<int>& elem_verts, std::vector<int>& order,
+                    std::vector<int>& colour_offsets) {
+  const int m = static_cast<int>(elem_offsets.size()) - 1;
+  // Per vertex, the colours already used by its elements (64 per word, grown on demand).
+  std::vector<uint64_t> used(static_cast<size_t>(std::max(num_vertices, 0)), 0);
+  std::vector<std::vector<uint64_t>> more;  // words beyond the first, rarely needed
+  std::vector<int> colour(std::max(m, 0), 0);
+  int colours = 0;
+  for (int e = 0; e < m; ++e) {
+    int c = 0;
+    for (int word = 0;; ++word) {
+      uint64_t taken = 0;
+      for (int k = elem_offsets[e]; k < elem_offsets[e + 1]; ++k) {
+        const int v = elem_verts[k];
+        if (word == 0)
+          taken |= used[v];
+        else if (static_cast<int>(more.size()) >= word && !more[word - 1].empty())
+          taken |= more[word - 1][v];
+      }
+      if (taken != ~uint64_t{0}) {
+        c = 64 * word + __builtin_ctzll(~taken);
+        break;
+      }
+    }
+    const int word = c / 64;
+    if (word > 0) {
+      if (static_cast<int>(more.size()) < word) more.resize(word);
+      if (more[word - 1].empty()) more[word - 1].assign(used.size(), 0);
+    }
+    for (int k = elem_offsets[e]; k < elem_offsets[e + 1]; ++k) {
+      const int v = elem_verts[k];
+      (word == 0 ? used[v] : more[word - 1][v]) |= uint64_t{1} << (c % 64);
+    }
+    colour[e] = c;
+    colours = std::max(colours, c + 1);
+  }
+  bucket_by_colour(colour, colours, colour_offsets, order);
+  return colours;
+}
+
+ThreadPool::ThreadPool(int threads) : threads_(std::max(1, threads)) {
+  for (int w = 1; w < threads_; ++w) workers_.emplace_back([this, w] { worker_main(w); });
+}
+
+ThreadPool::~ThreadPool() {
+  stop_.store(true);
+  generation_.fetch_add(1);
+  generation_.notify_all();
+  for (auto& t : workers_) t.join();
+}
+
+// Chunks are claimed from one counter that also carries the generation (high 32 bits): the
+// caller claims chunks too, so when a worker is not scheduled (a loaded 2-core machine, the
+// renderer's threads) the caller simply runs every chunk itself and waits only for chunks a
+// worker has actually claimed and is running. A late worker cannot claim a chunk of a newer
+// generation with a stale task: its compare-exchange fails on the generation bits. The low 32
+// bits hold the next chunk from the front (bits 0-15) and the end of the unclaimed ones (bits
+// 16-31): the caller and even-numbered workers take chunks from the front, odd-numbered ones
+// from the back, so with two threads each keeps to the same part of the range (the same part
+// of the mesh) from one call to the next instead of trading cache lines.
+void ThreadPool::run(int n, Thunk thunk, void* ctx, int chunks) {
+  thunk_ = thunk;
+  ctx_ = ctx;
+  n_ = n;
+  chunks_.store(chunks, std::memory_order_relaxed);
+  done_.store(0, std::memory_order_relaxed);
+  const uint64_t gen = generation_.load(std::memory_order_relaxed) + 1;
+  next_.store(gen << 32 | static_cast<uint64_t>(chunks) << 16, std::memory_order_release);
+  generation_.store(gen, std::memory_order_release);
+  generation_.notify_all();
+  work(gen, 0);
+  for (int spin = 0; done_.load(std::memory_order_acquire) != chunks; ++spin)
+    if (spin > 64) std::this_thread::yield();
+}
+
+// Chunk k's start: each half of the range is split in chunks that halve toward the middle
+// (1/2, 1/4, ... of the half, the last two equal), so that the threads, taking chunks from
+// opposite ends, meet on small ones.
+int ThreadPool::chunk_start(int k) const {
+  const int m = chunks_.load(std::memory_order_relaxed);
+  const int64_t n = n_;
+  if (m < 4 || m % 2) return static_cast<int>(n * k / m);
+  const int c = m / 2;
+  const int64_t h1 = n / 2, h2 = n - h1;
+  if (k <= c) return static_cast<int>(k == c ? h1 : h1 - (h1 >> k));
+  return static_cast<int>(n - h2 + (h2 >> (m - k)));
+}
+
+void ThreadPool::work(uint64_t gen, int w) {
+  const bool from_back = w % 2 == 1;
+  for (;;) {
+    uint64_t cur = next_.load(std::memory_order_acquire);
+    int k;
+    uint64_t claimed;
+    do {
+      if ((cur >> 32) != gen) return;
+      const int front = static_cast<int>(cur & 0xffffu);
+      const int back = static_cast<int>((cur >> 16) & 0xffffu);
+      if (front >= back) return;
+      k = from_back ? back - 1 : front;
+      claimed = from_back ? cur - (uint64_t{1} << 16) : cur + 1;
+    } while (!next_.compare_exchange_weak(cur, claimed, std::memory_order_acq_rel));
+    // Claimed chunk k of this generation: the caller waits for it, so the task is valid.
+    const int b = chunk_start(k), e = chunk_start(k + 1);
+    if (b < e) thunk_(ctx_, b, e, w);
+    done_.fetch_add(1, std::memory_order_acq_rel);
+  }
+}
+
+// A worker with nothing to do spins for kSpinBeforeSleep before it sleeps on the generation
+// (a futex). A solver's substep runs ~40 parallel loops with short serial parts between them
+// (contacts, settling); a worker asleep in such a gap wakes tens of microseconds late, while the
+// caller runs the chunks alone. Measured, form 128^2 XPBD 10x1 on two threads (120 frames):
+// spinning 2000 iterations (a few microseconds) the worker slept 81 times per frame and the
+// caller waited 1.36 ms per frame at the ends of the loops; with ~200 us it slept 4 times per
+// frame, and the frame took 0.92-0.95x the wall time (64^2: 0.89x; medians of 8-10 paired runs,
+// docs/solvers.md section 3i). The price: a worker burns up to kSpinBeforeSleep of CPU after the
+// last loop of a step before it sleeps (~2 % of a core at 90 steps per second).
+void ThreadPool::worker_main(int w) {
+  constexpr auto kSpinBeforeSleep = std::chrono::microseconds(200);
+  uint64_t seen = 0;
+  for (;;) {
+    uint64_t g = generation_.load(std::memory_order_acquire);
+    if (g == seen) {
+      const auto t0 = std::chrono::steady_clock::now();
+      for (int spin = 0; g == seen; ++spin) {
+        if ((spin & 255) == 255 && std::chrono::steady_clock::now() - t0 > kSpinBeforeSleep) {
+          idle_sleeps_.fetch_add(1, std::memory_order_relaxed);
+          generation_.wait(seen, std::memory_order_acquire);
+        }
+        g = generation_.load(std::memory_order_acquire);
+      }
+    }
+    seen = g;
+    if (stop_.load()) return;
+    work(g, w);
+  }
+}
+
+}  // namespace drape::sim

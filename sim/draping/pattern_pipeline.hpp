@@ -1,0 +1,105 @@
+// The geometric draping pipeline end to end (method chapter 2, issue 4): design (data) ->
+// slit panels -> mapping -> relaxation -> pattern extraction -> remeshing -> mirror + sew ->
+// garment on the form -> SVG/DXF/PDF/glTF + report.json.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "sim/draping/mapping.hpp"
+#include "sim/draping/panel.hpp"
+#include "sim/draping/pattern_export.hpp"
+#include "sim/draping/pattern_extract.hpp"
+#include "sim/draping/relax.hpp"
+#include "sim/draping/remesh.hpp"
+#include "sim/draping/sew.hpp"
+
+namespace drape::sim {
+
+class DressForm;
+
+struct PieceDesign {
+  std::string name = "Front";
+  std::string centre_line = "centre_front";  // centre_front | centre_back
+  std::string side_line = "right_side";      // right_side | left_side
+  std::string top_line = "waist";            // waist
+  std::string bottom_line = "hem";           // hem | hip
+  int quantity = 2;
+  PanelDesign panel;
+};
+
+struct Design {
+  std::string name = "design";
+  std::string form = "9AR";
+  std::string fabric = "muslin";
+  double ease = 0.0;                 // m of girth ease (mapping surface offset ease / 2 pi)
+  double seam_allowance = 0.01;      // m, in print
+  double length_below_waist = 0.55;  // m: the hem line's height below the waist
+  double extraction_step = 0.005;    // m between extracted points
+  double remesh_edge = 0.012;        // m: size bound of the remeshed pieces
+  int relax_iterations = 200;
+  std::vector<PieceDesign> pieces;
+};
+
+// Known reference line names (a design naming any other line is an error).
+const std::vector<std::string>& known_lines();
+
+Result<Design> parse_design(const std::string& json_text, const std::string& source);
+Result<Design> load_design(const std::string& path);
+
+struct PipelineOptions {
+  std::string out_dir;             // empty: write nothing
+  double ease = -1;                // >= 0 overrides the design's ease (m)
+  double seam_allowance = -1;      // >= 0 overrides the design's print seam allowance (m)
+  double spacing = 0;              // > 0 overrides every panel's grid spacing (m)
+  double remesh_edge = 0;          // > 0 overrides the remesh size bound (m)
+  int relax_iterations = -1;       // >= 0 overrides
+  bool use_static_solver = false;  // relax with relax_static (Newton) instead of Gauss-Seidel
+  bool grain_control = true;
+};
+
+struct PieceReport {
+  std::string name;
+  double hip_width_mm = 0, waist_seam_mm = 0, waist_width_mm = 0;
+  std::vector<double> dart_intake_mm, dart_intake_wanted_mm;
+  double outline_error_before_relax_mm = 0;
+  double area_piece_cm2 = 0, area_draped_cm2 = 0, area_error_pct = 0;
+  GrainDeviation grain_before, grain_after;
+  RelaxStats relax;
+  int remesh_vertices = 0, remesh_triangles = 0;
+  double remesh_min_angle_deg = 0, remesh_max_edge_mm = 0;
+};
+
+struct PipelineReport {
+  std::string design, form;
+  double ease_mm = 0;
+  double form_hip_girth_mm = 0, form_waist_girth_mm = 0;
+  double hip_width_sum_mm = 0, hip_width_error_mm = 0;
+  double waist_width_minus_intakes_sum_mm = 0, waist_width_error_mm = 0;
+  double area_error_pct = 0;  // worst piece
+  double garment_hip_girth_mm = 0, garment_hip_girth_error_pct = 0;
+  double outline_error_before_relax_mm = 0;
+  double quarter_difference_mm = 0;  // (hip - waist) / 4
+  double mapping_extraction_ms = 0, relax_ms = 0, remesh_ms = 0, sew_ms = 0, export_ms = 0;
+  double pipeline_ms = 0;
+  std::string relax_backend;
+  std::vector<PieceReport> pieces;
+  std::vector<std::string> files;
+  std::string to_json() const;
+};
+
+struct PipelineResult {
+  Design design;
+  std::vector<Panel> panels;
+  std::vector<PieceMapping> mappings;
+  std::vector<PatternPiece> pieces;
+  std::vector<RemeshedPiece> meshes;
+  Garment garment;
+  PipelineReport report;
+};
+
+Result<PipelineResult> run_pattern_pipeline(const Design& design, const DressForm& form,
+                                            const FabricParams& fabric,
+                                            const PipelineOptions& opt = {});
+
+}  // namespace drape::sim

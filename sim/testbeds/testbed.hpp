@@ -1,0 +1,81 @@
+// The study's scenes, written once and shared by tests and benchmarks (issue 3, item 5):
+// a sheet hanging from two corners, a 20-particle chain, a Peirce cantilever strip, a cloth
+// draped on the dress form, a cloth on a sphere. Plus the exact elastica of the cantilever.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim/core/cloth.hpp"
+#include "sim/core/scene_objects.hpp"
+#include "sim/energy/energy.hpp"
+#include "sim/solvers/solver.hpp"
+
+namespace drape::sim {
+
+struct Testbed {
+  std::string name;
+  Cloth cloth;
+  SceneObjects objects;
+  bool springs_model = false;  // the chain uses springs (no triangles)
+  double duration = 2.0;       // simulated seconds before the error is measured
+  // Air drag (1/s) every solver of the study uses on this scene; < 0: the solvers' default
+  // (1/s). The form scene settles (its error is that of the settled drape, not of a swing).
+  double air_damping = -1;
+};
+
+// Muslin (or `fabric`) sheet of side 0.5 m with res x res vertices, hanging in the x-y plane
+// from its two top corners (pinned) at height 1.2 m; starts flat and sags.
+Testbed make_hanging_sheet(int res, const FabricParams& fabric = {});
+// 20 particles of 1 kg, 0.1 m apart, hanging straight down from the top one (pinned), joined
+// by springs of stiffness k (N/m). The support force must equal the total weight (196.1 N).
+Testbed make_chain(int particles = 20, double mass = 1.0, double k = 1e5);
+// Peirce cantilever strip (ASTM D1388) along the warp: width x overhang, clamped over
+// `clamp` (pinned rows), horizontal at 1 m; `spacing` = grid step.
+Testbed make_cantilever(double overhang, double spacing, double width = 0.01,
+                        const FabricParams& fabric = {});
+// A res x res muslin panel 0.5 x 0.5 m whose top edge is pinned across the upper chest of
+// the parametric 9AR form (form collision). fall = false (the app's default scenario): it
+// hangs straight down from the chest line, 1.5 s. fall = true (the study's "form" scene): it
+// starts horizontal, sticking forward, falls over the bust and drapes against it, 3 s, with
+// an air drag of 4/s so that it has settled when the error is measured.
+Testbed make_form_drape(int res, const FabricParams& fabric = {}, bool fall = false);
+// A res x res panel 0.6 x 0.6 m dropped flat onto a sphere (r = 0.15 m) with its centre
+// vertex pinned on the sphere's top.
+Testbed make_sphere_drape(int res, const FabricParams& fabric = {});
+// Drags the hanging sheet's top-right corner (its last vertex, pinned) along +x at 0.2 m/s for
+// `frames` frames of 1/90 s with `solver`; returns how far the bottom-left vertex moved (m).
+// Tests use it to check that a solver's resting (frozen) cloth wakes and follows.
+double drag_sheet_corner(Testbed& sheet, Solver& solver, int frames);
+// By name: "sheet", "chain", "cantilever", "form", "sphere".
+Testbed make_scene(const std::string& name, int res);
+
+// Exact elastica of a cantilever of length l, rigidity B (N m, whole width) and weight per
+// length q (N/m), clamped horizontally: integrates theta' = M/B, M' = -q (l - s) cos theta by
+// shooting on M(0). Returns the tip (x forward, y down positive) relative to the clamp.
+Vec2 elastica_tip(double l, double B, double q, int steps = 2000);
+// The rigidity B for which the elastica's tip drops by `tip_drop` (bisection on log B).
+double elastica_rigidity_for_drop(double l, double q, double tip_drop);
+
+// Stress cases (issue 3, item 7), shared by tests/sim/stress_test.cpp and bench/stress_bench:
+// "large_dt" (dt = 1/30 s), "stiffness_ratio" (warp/shear = 1e4), "jerk" (a pinned vertex
+// jerked at 10 m/s), "cuts" (random cuts on a dense cloth), "crush" (cloth between the form and
+// a rising plate). `scale` 1 = test size, larger = benchmark size (more steps, cuts, vertices).
+// A step fails when, after the solver (with its watchdog), a position is non-finite, a vertex
+// is beyond 10 m, or the kinetic energy exceeds 1e3 J/kg.
+struct StressResult {
+  int steps = 0;
+  int failures = 0;
+  int rollbacks = 0;  // watchdog retries
+  int vertices = 0;
+  std::string note;
+};
+StressResult run_stress_case(const std::string& name, const std::string& solver, int scale);
+const std::vector<std::string>& stress_case_names();
+
+// RMS and max vertex distance (m) between two position arrays of equal size.
+void position_error(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double& rms,
+                    double& max);
+
+}  // namespace drape::sim

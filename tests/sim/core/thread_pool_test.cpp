@@ -1,0 +1,154 @@
+// sim/core/thread_pool.hpp: the thread pool runs every index exactly once, keeps each thread on its
+// own end of the range, and element colouring gives colours whose elements share no vertex. The
+// file name contains "thread": it also runs in the TSan build.
+#include "sim/core/thread_pool.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <thread>
+#include <vector>
+
+namespace drape::sim {
+namespace {
+
+TEST(ThreadPool, RunsEveryIndexExactlyOnce) {
+  for (int threads : {1, 2, 3}) {
+    ThreadPool pool(threads);
+    pool.set_min_parallel(0);
+    for (int n : {0, 1, 5, 255, 256, 10007}) {
+      for (int rep = 0; rep < 20; ++rep) {
+        std::vector<std::atomic<int>> hits(n);
+        for (auto& h : hits) h.store(0);
+        pool.parallel_for(n, [&](int b, int e, int w) {
+          EXPECT_GE(w, 0);
+          EXPECT_LT(w, threads);
+          for (int i = b; i < e; ++i) hits[i].fetch_add(1);
+        });
+        for (int i = 0; i < n; ++i) ASSERT_EQ(hits[i].load(), 1) << threads << " " << n << " " << i;
+      }
+    }
+  }
+}
+
+// Each half of the range is cut in chunks that halve toward the middle (1/2, 1/4, 1/8, 1/8 of
+// the half with two threads), so that the threads, working from the two ends, meet on small
+// ones: whoever finishes first waits for at most a sixteenth of the loop, not an eighth.
+TEST(ThreadPool, ChunksHalveTowardTheMiddleOfTheRange) {
+  ThreadPool pool(2);
+  pool.set_min_parallel(0);
+  std::vector<std::pair<int, int>> got;
+  std::mutex m;
+  pool.parallel_for(4096, [&](int b, int e, int) {
+    std::lock_guard<std::mutex> lock(m);
+    got.push_back({b, e});
+  });
+  std::sort(got.begin(), got.end());
+  const std::vector<std::pair<int, int>> want{{0, 1024},    {1024, 1536}, {1536, 1792},
+                                              {1792, 2048}, {2048, 2304}, {2304, 2560},
+                                              {2560, 3072}, {3072, 4096}};
+  EXPECT_EQ(got, want);
+}
+
+// parallel_slots: every slot once, each on one thread.
+TEST(ThreadPool, RunsEverySlotExactlyOnce) {
+  for (int threads : {1, 2, 3}) {
+    ThreadPool pool(threads);
+    for (int rep = 0; rep < 200; ++rep) {
+      std::vector<std::atomic<int>> hits(threads);
+      for (auto& h : hits) h.store(0);
+      pool.parallel_slots([&](int slot, int w) {
+        EXPECT_GE(w, 0);
+        EXPECT_LT(w, threads);
+        hits[slot].fetch_add(1);
+      });
+      for (int k = 0; k < threads; ++k) ASSERT_EQ(hits[k].load(), 1) << threads << " " << k;
+    }
+  }
+}
+
+// With two threads the caller claims chunks from the front and the worker from the back, so
+// whatever the timing, every index the caller ran comes before every index the worker ran: each
+// thread keeps to one part of the range (of the mesh) from call to call.
+TEST(ThreadPool, TwoThreadsKeepToTheirOwnEndOfTheRange) {
+  ThreadPool pool(2);
+  pool.set_min_parallel(0);
+  int both = 0;
+  for (int rep = 0; rep < 500; ++rep) {
+    std::atomic<int> max0{-1}, min1{1 << 30};
+    pool.parallel_for(4096, [&](int b, int e, int w) {
+      volatile double sink = 0;  // some work, so that the worker gets a chance to join
+      for (int i = b; i < e; ++i) sink = sink + i * 1e-3;
+      if (w == 0) {
+        int m = max0.load();
+        while (e - 1 > m && !max0.compare_exchange_weak(m, e - 1)) {
+        }
+      } else {
+        int m = min1.load();
+        while (b < m && !min1.compare_exchange_weak(m, b)) {
+        }
+      }
+    });
+    if (max0.load() >= 0 && min1.load() < (1 << 30)) {
+      ++both;
+      ASSERT_LT(max0.load(), min1.load()) << "call " << rep;
+    }
+  }
+  std::printf("calls in which both threads ran chunks: %d of 500\n", both);
+}
+
+// An idle worker spins briefly (so that it is awake for the next of a solver's many short
+// loops) and then sleeps: between steps it does not burn a core.
+TEST(ThreadPool, AnIdleWorkerSleepsAfterSpinning) {
+  ThreadPool pool(2);
+  pool.set_min_parallel(0);
+  std::atomic<long> sum{0};
+  for (int rep = 0; rep < 3; ++rep) {
+    const long before = pool.idle_sleeps();
+    pool.parallel_for(64, [&](int b, int e, int) { sum += e - b; });
+    // The spin lasts 200 us; allow a loaded machine 5 s to schedule the worker.
+    for (int ms = 0; ms < 5000 && pool.idle_sleeps() == before; ++ms)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    EXPECT_GT(pool.idle_sleeps(), before) << "rep " << rep;
+  }
+  EXPECT_EQ(sum.load(), 3 * 64);
+}
+
+TEST(Colouring, ElementsOfOneColourShareNoVertex) {
+  // Triangles of a 20 x 20 grid (two per cell).
+  const int g = 20, n = (g + 1) * (g + 1);
+  std::vector<int> off{0}, verts;
+  for (int j = 0; j < g; ++j)
+    for (int i = 0; i < g; ++i) {
+      const int a = j * (g + 1) + i, b = a + 1, c = a + g + 1, d = c + 1;
+      for (int t : {a, b, d}) verts.push_back(t);
+      off.push_back(static_cast<int>(verts.size()));
+      for (int t : {a, d, c}) verts.push_back(t);
+      off.push_back(static_cast<int>(verts.size()));
+    }
+  std::vector<int> order, col;
+  const int colours = colour_elements(n, off, verts, order, col);
+  ASSERT_EQ(static_cast<int>(col.size()), colours + 1);
+  EXPECT_LE(colours, 13);  // a vertex is in at most 6 triangles: greedy needs at most 13
+  std::vector<int> seen(order.size(), 0);
+  for (int c = 0; c < colours; ++c) {
+    std::set<int> used;
+    for (int k = col[c]; k < col[c + 1]; ++k) {
+      const int e = order[k];
+      ++seen[e];
+      for (int q = off[e]; q < off[e + 1]; ++q)
+        EXPECT_TRUE(used.insert(verts[q]).second) << "colour " << c << " vertex " << verts[q];
+    }
+  }
+  EXPECT_EQ(static_cast<int>(order.size()), 2 * g * g);
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int s) { return s == 1; }));
+}
+
+}  // namespace
+}  // namespace drape::sim
