@@ -16,6 +16,7 @@
 #include "sim/io/mesh_io.hpp"
 #include "sim/runtime/world.hpp"
 #include "sim/solvers/solver_factory.hpp"
+#include "xr_app/paths.hpp"
 
 namespace drape::app {
 using namespace drape::render;
@@ -195,7 +196,7 @@ void parse_cloth(const json& c, const std::string& base, sim::SceneSnapshot& sna
       const std::string solver =
           d.contains("solver") ? text(d["solver"], "cloth.drape.solver") : "xpbd";
       if (d.contains("fabric")) {
-        auto fab = sim::load_fabric(std::string(DRAPE_RENDER_ASSETS) + "/fabrics.json",
+        auto fab = sim::load_fabric(asset("fabrics.json").string(),
                                     text(d["fabric"], "cloth.drape.fabric"));
         if (!fab) bad("cloth.drape.fabric", fab.error());
         cloth.fabric = *fab;

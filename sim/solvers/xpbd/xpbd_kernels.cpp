@@ -3,6 +3,7 @@
 #include "sim/solvers/xpbd/xpbd_kernels.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 
@@ -95,6 +96,27 @@ template struct RowPackDataT<double, 4>;
 template struct RowPackDataT<float, 8>;
 template struct RowPackDataT<float, 16>;
 
+namespace {
+std::atomic<SimdLimit>& limit_store() {
+  static std::atomic<SimdLimit> limit{SimdLimit::kWidest};
+  return limit;
+}
+SimdLimit simd_limit() {
+  return limit_store().load(std::memory_order_relaxed);
+}
+}  // namespace
+
+void limit_simd(SimdLimit limit) {
+  limit_store().store(limit, std::memory_order_relaxed);
+}
+
+std::optional<SimdLimit> parse_simd_limit(const std::string& name) {
+  if (name == "0" || name == "none") return SimdLimit::kNone;
+  if (name == "avx2") return SimdLimit::kAvx2;
+  if (name == "avx512" || name == "widest") return SimdLimit::kWidest;
+  return std::nullopt;
+}
+
 #if defined(DRAPE_XPBD_AVX2)
 namespace avx2 {
 extern const Kernels kKernels;
@@ -104,15 +126,14 @@ extern const Kernels kKernels;
 }
 
 namespace {
-// The SIMD builds this CPU runs, narrowest first (DRAPE_XPBD_SIMD=0: none; =avx2: not AVX-512).
+// The SIMD builds this CPU runs within the limit, narrowest first.
 std::vector<const Kernels*> simd_builds() {
   std::vector<const Kernels*> out;
-  const char* env = std::getenv("DRAPE_XPBD_SIMD");
-  if (env && std::strcmp(env, "0") == 0) return out;
+  if (simd_limit() == SimdLimit::kNone) return out;
   __builtin_cpu_init();
   if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) return out;
   out.push_back(&avx2::kKernels);
-  if (env && std::strcmp(env, "avx2") == 0) return out;
+  if (simd_limit() == SimdLimit::kAvx2) return out;
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
       __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw"))
     out.push_back(&avx512::kKernels);

@@ -16,6 +16,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "sim/core/thread_pool.hpp"
@@ -181,9 +183,15 @@ struct Kernels {
   void (*anchor_rows16)(const RowPacksT<float>& rp, int b, int e, const double* a, float* ca);
 };
 
-// The fastest build this CPU runs (AVX-512, then AVX2+FMA); simd = false: the portable one
-// (tests compare them). DRAPE_XPBD_SIMD=0 in the environment forces the portable build,
-// DRAPE_XPBD_SIMD=avx2 the AVX2 one (when the CPU has it).
+// The widest SIMD build kernels() may choose, process-wide: set by an executable's option
+// (--simd) before the first solver is made; later calls have no effect on kernels().
+enum class SimdLimit { kNone, kAvx2, kWidest };
+void limit_simd(SimdLimit limit);
+// Parses "0"/"none", "avx2", "avx512"/"widest"; nullopt for anything else.
+std::optional<SimdLimit> parse_simd_limit(const std::string& name);
+
+// The fastest build this CPU runs within the limit (AVX-512, then AVX2+FMA); simd = false: the
+// portable one (tests compare them).
 const Kernels& kernels(bool simd = true);
 // Every build this CPU runs, the portable one first.
 std::vector<const Kernels*> all_kernels();

@@ -1,9 +1,9 @@
-// The body of XPBD's hot loops (sim/solvers/xpbd/xpbd_kernels.hpp), included once per instruction set by
-// sim/solvers/xpbd/xpbd_kernels.cpp (portable) and sim/solvers/xpbd/xpbd_kernels_avx2.cpp (AVX2+FMA) inside a namespace
-// of their own. Values are GCC/Clang vector-extension vectors, one element per lane: four
-// doubles or eight floats, which the compiler maps to one AVX register or to two SSE2 ones.
-// Each kernel is written once over a lane type (Dbl4, Flt8, Flt16 below) and instantiated for
-// each.
+// The body of XPBD's hot loops (sim/solvers/xpbd/xpbd_kernels.hpp), included once per instruction
+// set by sim/solvers/xpbd/xpbd_kernels.cpp (portable) and sim/solvers/xpbd/xpbd_kernels_avx2.cpp
+// (AVX2+FMA) inside a namespace of their own. Values are GCC/Clang vector-extension vectors, one
+// element per lane: four doubles or eight floats, which the compiler maps to one AVX register or to
+// two SSE2 ones. Each kernel is written once over a lane type (Dbl4, Flt8, Flt16 below) and
+// instantiated for each.
 
 #if defined(__GNUC__) && !defined(__clang__)
 // The helpers below take and return vectors by value; GCC notes that this ABI differs between

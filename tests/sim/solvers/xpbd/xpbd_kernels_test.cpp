@@ -16,6 +16,15 @@
 #include <string>
 #include <vector>
 
+// ctest runs these tests again with DRAPE_XPBD_SIMD=0 and =avx2 (the builds that CPUs without
+// AVX2 or without AVX-512 run): the test executable caps the library's choice before any solver
+// is made, as `drape --simd` does.
+[[maybe_unused]] const bool kSimdCapped = [] {
+  if (const char* e = std::getenv("DRAPE_XPBD_SIMD"))
+    if (auto limit = drape::sim::xpbd::parse_simd_limit(e)) drape::sim::xpbd::limit_simd(*limit);
+  return true;
+}();
+
 namespace drape::sim::xpbd {
 namespace {
 
