@@ -75,10 +75,10 @@ struct VoiceConfig {
   // Garbage/Combined: reject when (garbage score - command score) per 10 ms frame exceeds this
   // (log base 1.0001); 3 = the garbage path may win by up to 3 per frame. The defaults of this
   // rule, max_outside_s, garbage_lw, min_word_margin and max_command_s are the values
-  // bench/voice.sh picked on its tuning set (2026-11-22, session 4: the enlarged 524-utterance
-  // tuning set), never on a test, held-out or FINAL set.
+  // bench/voice.sh picked on its 524-utterance tuning set, never on a test, held-out or FINAL
+  // set.
   double filler_margin = 1.5;
-  // Garbage/Combined (session 4): the margin rule compares (margin - margin_per_s * speech_s)
+  // Garbage/Combined: the margin rule compares (margin - margin_per_s * speech_s)
   // with -filler_margin, i.e. each second of speech costs this much margin. A sentence that
   // contains a phrase word is long and has a middling margin; an accented or slow command is
   // short with a low margin. 0 = plain margin. Chosen by bench/voice.sh on its tuning set (2 margin
@@ -109,20 +109,19 @@ struct VoiceConfig {
   // false (default): each utterance is decoded whole after its end (batch CMN over the
   // utterance, as the model was trained). true: decoded while it arrives (live CMN that starts
   // from the model's -cmninit and carries over between utterances: the first utterance of a
-  // fresh decoder is normalised with a wrong mean; session 2's clean 'pin here' -> 'redo').
+  // fresh decoder is normalised with a wrong mean: a clean 'pin here' decoded as 'redo').
   bool streaming = false;
   // Language-model weight of the phone loop (the garbage decoder's -lw; pocketsphinx default 6.5):
-  // larger = the phone bigram constrains the garbage path more. Tuned by bench/voice.sh (6.5, 8,
-  // 10; session 4: 10 on the enlarged tuning set, 6.5 on session 3's).
+  // larger = the phone bigram constrains the garbage path more. Tuned by bench/voice.sh over 6.5, 8
+  // and 10 on the tuning set.
   double garbage_lw = 10;
   // Extra pocketsphinx arguments ("-name value ..."): for both decoders / the garbage decoder only.
   std::string decoder_args, garbage_args;
   double outside_db = 10;  // a frame is voiced above the utterance's 10th-percentile energy + this
   // Garbage/Combined: reject when more than this much voiced audio (s) lies outside the phrase
   // words: pocketsphinx lets silence and noise fillers stand around and between the phrase words,
-  // so a sentence that contains a phrase word aligns its other words to them. Tuned (0.1 s on
-  // the enlarged tuning set, the grid's floor: 0.05 s rejects the clean "pin here" cue; 0.15 s on
-  // session 3's).
+  // so a sentence that contains a phrase word aligns its other words to them. Tuned on the tuning
+  // set (the grid's floor; 0.05 s rejects the clean "pin here" cue).
   double max_outside_s = 0.1;
 };
 

@@ -1,4 +1,4 @@
-// The cloth: panel generator (criss-cross triangulation), the study's two initial states,
+// The cloth: panel generator (criss-cross triangulation), the two initial states (spread, rolled),
 // mass lumping, vertex duplication for topology edits, validation and the state hash.
 #include "sim/core/cloth.hpp"
 

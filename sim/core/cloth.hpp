@@ -99,10 +99,10 @@ struct PanelSpec {
 // triangles alternating their diagonal (criss-cross) to avoid a preferred shear direction.
 Cloth make_panel(const PanelSpec& spec, const FabricParams& fabric);
 
-// Initial state 1 of the study: spread open. Places the flat panel in 3D with material
+// Initial state 1: spread open. Places the flat panel in 3D with material
 // point (u, v) at origin + u * axis_u + v * axis_v (axes need not be unit: they are normalised).
 void place_spread(Cloth& cloth, const Vec3& origin, const Vec3& axis_u, const Vec3& axis_v);
-// Initial state 2 of the study: rolled up. The panel is rolled around an axis parallel to
+// Initial state 2: rolled up. The panel is rolled around an axis parallel to
 // axis_u, starting from its v = 0 edge, into a spiral of the given inner radius; the
 // v = height edge ends up at `origin` + height-dependent wrap.
 void place_rolled(Cloth& cloth, const Vec3& origin, const Vec3& axis_u, const Vec3& up,

@@ -1,4 +1,4 @@
-// Rigid objects of a draping scene (the study's plate and cube, spheres for tests) and the
+// Rigid objects of a draping scene (a table plate and a cube, spheres for tests) and the
 // hand proxies operations act with. All analytic; the dress form is in dress_form.hpp.
 #pragma once
 
@@ -12,14 +12,14 @@ namespace drape::sim {
 
 class DressForm;
 
-// Horizontal square plate (the study's table): top face at centre.y, half extents in x and z.
+// Horizontal square plate (a table): top face at centre.y, half extents in x and z.
 struct Plate {
   Vec3 centre{0, 0.8, 0};
   double half_x = 0.3, half_z = 0.3;
   double thickness = 0.01;
 };
 
-// Axis-aligned box (the study's cube).
+// Axis-aligned box (a cube).
 struct Box {
   Vec3 centre{0, 0.9, 0};
   Vec3 half{0.1, 0.1, 0.1};

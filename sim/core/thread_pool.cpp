@@ -100,7 +100,7 @@ ThreadPool::~ThreadPool() {
 }
 
 // Chunks are claimed from one counter that also carries the generation (high 32 bits): the
-// caller claims chunks too, so when a worker is not scheduled (a loaded 2-core machine, the
+// caller claims chunks too, so when a worker is not scheduled (few cores shared with the
 // renderer's threads) the caller simply runs every chunk itself and waits only for chunks a
 // worker has actually claimed and is running. A late worker cannot claim a chunk of a newer
 // generation with a stale task: its compare-exchange fails on the generation bits. The low 32
@@ -163,9 +163,9 @@ void ThreadPool::work(uint64_t gen, int w) {
 // caller runs the chunks alone. Measured, form 128^2 XPBD 10x1 on two threads (120 frames):
 // spinning 2000 iterations (a few microseconds) the worker slept 81 times per frame and the
 // caller waited 1.36 ms per frame at the ends of the loops; with ~200 us it slept 4 times per
-// frame, and the frame took 0.92-0.95x the wall time (64^2: 0.89x; medians of 8-10 paired runs,
-// docs/solvers.md section 3i). The price: a worker burns up to kSpinBeforeSleep of CPU after the
-// last loop of a step before it sleeps (~2 % of a core at 90 steps per second).
+// frame, and the frame took 0.92-0.95x the wall time (64^2: 0.89x). The price: a worker burns up to
+// kSpinBeforeSleep of CPU after the last loop of a step before it sleeps (~2 % of a core at 90
+// steps per second).
 void ThreadPool::worker_main(int w) {
   constexpr auto kSpinBeforeSleep = std::chrono::microseconds(200);
   uint64_t seen = 0;

@@ -1,4 +1,4 @@
-// Mapping of the flat panel onto the form along the grain (method §2.4-2.5, eqs. 2-1..2-10).
+// Mapping of the flat panel onto the form along the grain (eqs. 2-1..2-10 of docs/draping.md).
 #include "sim/draping/mapping.hpp"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Geometric draping by mapping (method §2.4, §2.5): flat cloth -> dress form along the grain.
+// Geometric draping by mapping: flat cloth -> dress form along the grain.
 // General mapping eqs. 2-1..2-9 on the section model, dart mapping eq. 2-10 zone by zone, the
 // hip section's shape below the hip (tight skirt), ease as a radial offset of the surface.
 #pragma once

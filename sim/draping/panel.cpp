@@ -1,4 +1,4 @@
-// Flat panel with dart slits (method §2.3): grid, node duplication along slits, zones.
+// Flat panel with dart slits: grid, node duplication along slits, zones.
 #include "sim/draping/panel.hpp"
 
 #include <algorithm>
@@ -171,7 +171,7 @@ Result<Panel> build_panel(const PanelDesign& d, const FabricParams& fabric,
       t.triangle_zone[p.cell_triangle(i, j, 0)] = z;
       t.triangle_zone[p.cell_triangle(i, j, 1)] = z;
     }
-  // Node duplication (method §2.3): every slit node but the end gets a twin; the triangles
+  // Node duplication: every slit node but the end gets a twin; the triangles
   // on the far side of the slit are re-pointed to the twins.
   for (size_t s = 0; s < p.slits.size(); ++s) {
     PanelSlit& ps = p.slits[s];

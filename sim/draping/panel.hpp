@@ -1,4 +1,4 @@
-// The flat muslin panel of geometric draping (method §2.3): a criss-cross grid with dart
+// The flat muslin panel of geometric draping: a criss-cross grid with dart
 // slits cut along element edges by node duplication, and zones from the slit extensions.
 #pragma once
 
@@ -12,7 +12,7 @@ namespace drape::sim {
 
 class DressForm;
 
-// A dart slit cut into the panel from its top edge before mapping (method §2.3, §2.5).
+// A dart slit cut into the panel from its top edge before mapping.
 struct DartSlit {
   double position = 0.1;  // m: weft distance of the slit from the centre-line edge
   double depth = 0.12;    // m: from the top edge down to the slit end (the dart tip)

@@ -1,4 +1,4 @@
-// Pattern extraction by rays from the section centres and barycentric coordinates (§2.6).
+// Pattern extraction by rays from the section centres and barycentric coordinates.
 #include "sim/draping/pattern_extract.hpp"
 
 #include <Eigen/Geometry>
@@ -513,7 +513,7 @@ Result<PatternPiece> extract_piece(const Panel& panel, const MappingSurface& sur
     lab[n0 - 1] = piece.seg_label[n0 - 1];  // the closing segment belongs to the last run
     piece.seg_label = lab;
   }
-  // A simple polygon for cutting and remeshing (method §2.7): no self-crossings.
+  // A simple polygon for cutting and remeshing: no self-crossings.
   piece.loops_removed = remove_outline_loops(piece);
   const int n = static_cast<int>(piece.outline.size());
   // Darts: tip and leg tops from the labels.

@@ -1,4 +1,4 @@
-// Pattern extraction (method §2.6): points along the reference lines on the form, rays from the
+// Pattern extraction: points along the reference lines on the form, rays from the
 // section centres, the hit cloth triangle chosen by zone where layers overlap, barycentric
 // coordinates evaluated on the flat cloth -> a closed piece outline with labelled seams.
 #pragma once
@@ -72,7 +72,7 @@ double draped_area(const PatternPiece& piece, const Panel& panel);
 // inserted; notches follow). extract_piece calls it; returns the number of loops removed.
 int remove_outline_loops(PatternPiece& piece);
 
-// Point-in-polygon by crossing parity (method §2.7.1).
+// Point-in-polygon by crossing parity.
 bool inside_polygon(const std::vector<Vec2>& poly, const Vec2& p);
 
 }  // namespace drape::sim

@@ -1,4 +1,4 @@
-// The geometric draping pipeline end to end (method chapter 2, issue 4): design (data) ->
+// The geometric draping pipeline end to end (docs/draping.md): design (data) ->
 // slit panels -> mapping -> relaxation -> pattern extraction -> remeshing -> mirror + sew ->
 // garment on the form -> SVG/DXF/PDF/glTF + report.json.
 #pragma once

@@ -1,4 +1,4 @@
-// Static relaxation of mapped cloth: fixed lines, weak pressure, collision (method §2.1-2.2).
+// Static relaxation of mapped cloth: fixed lines, weak pressure, collision.
 #include "sim/draping/relax.hpp"
 
 #include <algorithm>
@@ -97,7 +97,7 @@ RelaxStats relax_gauss_seidel(RelaxProblem& p, const MappingSurface& surf,
         x[i].z() = c.y() + dz * rs / rn;
       }
     }
-    // Collision by section lookup (method §2.2), on the mapping surface (ease, hip shape).
+    // Collision by section lookup, on the mapping surface (ease, hip shape).
     if (opt.collide)
       for (int i = 0; i < nv; ++i) {
         if (!w[i]) continue;

@@ -1,4 +1,4 @@
-// Static relaxation of draped cloth on the mapping surface (method §2.1-2.2): weak pressure
+// Static relaxation of draped cloth on the mapping surface: weak pressure
 // toward the form, fixed lines (hip line fixed, centre and side lines held on their planes),
 // collision by section lookup, and optional grain control near darts. Two back ends: the
 // solvers' Newton static solver (relax_static, sim/solvers/solver_newton.hpp) and a projected
@@ -63,7 +63,7 @@ void edge_strain(const RelaxProblem& p, double* max_strain, double* rms_strain);
 
 struct PanelRelaxOptions {
   int iterations = 200;
-  bool grain_control = true;       // keep warp lines straight near darts (fix of §2.9)
+  bool grain_control = true;       // keep warp lines straight near darts
   bool use_static_solver = false;  // call relax_static (hip/centre/side lines pinned)
   double pressure_pa = 1.0;        // weak pressure for the static solver
 };

@@ -1,6 +1,6 @@
-// Cutting and remeshing a pattern piece for simulation (method §2.7), done as a conforming
-// constrained Delaunay triangulation with quality bounds (CGAL Delaunay_mesher_2) instead of the
-// study's node removal + gap filling. Vertices keep material coordinates and seam labels.
+// Cutting and remeshing a pattern piece for simulation, done as a conforming
+// constrained Delaunay triangulation with quality bounds (CGAL Delaunay_mesher_2) instead of node
+// removal + gap filling. Vertices keep material coordinates and seam labels.
 #pragma once
 
 #include <array>

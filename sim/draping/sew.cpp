@@ -1,4 +1,4 @@
-// Mirror, sew, relax (method §2.8).
+// Mirror, sew, relax.
 #include "sim/draping/sew.hpp"
 
 #include <algorithm>

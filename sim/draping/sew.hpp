@@ -1,4 +1,4 @@
-// Mirroring, sewing and relaxing the garment on the form (method §2.8): right pieces mirrored
+// Mirroring, sewing and relaxing the garment on the form: right pieces mirrored
 // to the left, seams paired by label and joined (vertices identified where the seams are
 // mirror images, stiff seam ties where the vertex counts differ), then a static relaxation.
 #pragma once

@@ -53,9 +53,9 @@ class Collider {
   // objects, changing only x (for position-based solvers). With scene.friction > 0, Coulomb
   // friction against the motion since x_prev (the substep's start).
   CollisionStats project(ClothState& state, const SceneObjects& scene);
-  // eq. 3-7 of the study: for each collidable vertex closer than the offset, the response
-  // displacement F_resp dt^2 / m = -(eps - d) n (it moves the vertex to distance eps) is written
-  // to disp[i] (zero elsewhere). Positions are not changed.
+  // The baseline's collision response: for each collidable vertex closer than the offset, the
+  // response displacement F_resp dt^2 / m = -(eps - d) n (it moves the vertex to distance eps) is
+  // written to disp[i] (zero elsewhere). Positions are not changed.
   CollisionStats response_displacements(const ClothState& state, const SceneObjects& scene,
                                         std::vector<Vec3>& disp);
   int active_objects() const { return n_active_; }

@@ -380,7 +380,7 @@ void transpose(const Csr& A, int ncols, Csr& T) {
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
-// Bending, kTensor (docs/solvers.md "Bending"): per triangle, the shape operator S = (S_uu,
+// Bending, kTensor (docs/solvers.md): per triangle, the shape operator S = (S_uu,
 // S_vv, S_uv) in material coordinates is recovered from the (up to) three hinge angles of its
 // edges, theta_e = L_e . S, and E_t = 1/2 A_t S^T D S with D = diag(B_weft, B_warp, 2 B_twist).
 // With fewer than three hinges (free boundary) S is the least-energy one compatible with the

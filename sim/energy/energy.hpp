@@ -4,7 +4,7 @@
 //          from the hinge vectors, constant Hessian; the discrete-shell dihedral-angle hinges
 //          and the quadratic hinges stay available as EnergyOptions::Bending::kDihedral/kLinear)
 //        + gravity + optional weak pressure toward the form + contact penalty,
-// or, as a second model, the study's 8-neighbour springs (method eq. 3-1) + gravity + contact.
+// or, as a second model, the baseline's 8-neighbour springs + gravity + contact.
 // Everything is cooked once per topology_version into flat arrays (no allocation per step).
 #pragma once
 
@@ -44,7 +44,7 @@ struct EnergyOptions {
   // kLinear: E = 1/2 w |sum_k K_k x_k|^2 per hinge (Bergou et al. 2006 form; constant Hessian).
   // The hinge models use the same w and K. They are not consistent on the criss-cross grid
   // (a warp bend can go through alternating diagonal folds: the Peirce strip is ~15-20 % too
-  // soft, docs/solvers.md "Cantilever").
+  // soft against the elastica).
   enum class Bending { kTensor, kDihedral, kLinear };
   Bending bending_model = Bending::kTensor;
   // Twist rigidity B_twist (N m) of kTensor; <= 0: sqrt(bending_warp * bending_weft) (Huber's

@@ -53,7 +53,7 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
   // Cell size: the mean edge length plus twice the reach, so that a triangle's grown box spans
   // at most two cells per axis. On fine meshes the reach dominates the cell, so a vertex's
   // bucket holds ~170 triangles at 128^2; the bounding-sphere test below rejects most of them
-  // from the entry alone (docs/solvers.md "Topology costs": 18.5 -> 11.2 ms at 128^2).
+  // from the entry alone (18.5 -> 11.2 ms at 128^2).
   double edge = 0;
   for (const auto& t : tris) edge += (x[t[1]] - x[t[0]]).norm();
   const double cell = edge / nt + 2 * reach;

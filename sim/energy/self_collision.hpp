@@ -1,7 +1,6 @@
-// Cloth self-collision (issue 3: "self-collision off unless the scene asks for it, then a
-// spatial hash"): vertex-triangle proximity pairs found through a spatial hash of the
-// triangles' bounds, and their projection (each vertex kept at least `thickness` from the
-// triangle's plane, on the side it was on when the pair was found).
+// Cloth self-collision, off unless the scene asks for it: vertex-triangle proximity pairs found
+// through a spatial hash of the triangles' bounds, and their projection (each vertex kept at least
+// `thickness` from the triangle's plane, on the side it was on when the pair was found).
 //
 // Detection: every triangle is entered in the hash cells its bounding box, grown by the reach
 // (thickness + margin), overlaps; each vertex looks up its own cell and tests the triangles

@@ -1,4 +1,5 @@
-// Mass-spring network of the study (eq. 3-1) derived from the triangle mesh.
+// The baseline's mass-spring network (structural and diagonal springs) derived from the triangle
+// mesh.
 #include "sim/energy/springs.hpp"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// The dress form as the study's section model: horizontal sections at uniform heights, each
+// The dress form as a section model: horizontal sections at uniform heights, each
 // with 256 radii r(section j, angle n) around its own centre, plus reference lines.
 //
 // Frame (stage space): y up, floor at y = 0, the form stands at the origin and its centre
@@ -147,7 +147,7 @@ class DressForm {
   // grows (under the bust, the hips), and sideways where it changes with the angle. The radial
   // direction alone gives a vertical plane on a slope, which carries no weight: a cloth resting
   // there slid down it between contact detections and was pushed out at the next one (a
-  // ratchet that kept a settled drape creeping; docs/solvers.md section 3j). Values >= reach
+  // ratchet that kept a settled drape creeping). Values >= reach
   // may be a lower bound (the widest radius of the two sections and a per-cell bound on |g|,
   // without the angle lookup: atan2 and the interpolation, most of the cost); +inf outside the
   // height range or on the axis (normal untouched then).

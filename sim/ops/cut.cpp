@@ -1,5 +1,5 @@
-// The cut primitive: stroke → surface points → edge path → split by vertex duplication
-// (method §3.5), on any triangulation. Works on the incidence kept with the cloth
+// The cut primitive: stroke → surface points → edge path → split by vertex duplication,
+// on any triangulation. Works on the incidence kept with the cloth
 // (Cloth::incidence), updated in place by each split, so a cut costs O(stroke + path + the
 // pieces it separates) instead of O(cloth): no adjacency rebuild, no global component count,
 // masses re-lumped only at the split vertices, scratch buffers reused (no per-vertex
@@ -130,7 +130,7 @@ bool boundary_vertex(const Cloth& c, const ClothIncidence& I, int32_t v) {
 
 // ---------------------------------------------------------------- surface queries --------
 
-// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5);
+// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5);
 // returns barycentric coordinates.
 Vec3 closest_bary(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
@@ -334,8 +334,8 @@ std::vector<int32_t> dijkstra(const Cloth& cloth, const ClothIncidence& I, int32
 }
 
 // One leg, appended to `path` (which ends at s): greedy walk from s toward t along edges, each
-// step strictly closer to t, preferring edges that stay near the straight line s–t (method §3.5
-// step 2); Dijkstra if stuck. False when t is unreachable.
+// step strictly closer to t, preferring edges that stay near the straight line s–t; Dijkstra
+// if stuck. False when t is unreachable.
 bool leg(const Cloth& cloth, const ClothIncidence& I, int32_t s, int32_t t,
          std::vector<int32_t>& path) {
   const auto& m = cloth.topo.material;
@@ -744,7 +744,7 @@ CutResult cut_along(Cloth& cloth, const std::vector<Vec3>& stroke_points,
     r.reason = "cut: stroke has fewer than 2 usable samples";
     return r;
   }
-  // Laplacian smoothing, end points kept (the study's trajectory was shaken by tracking noise).
+  // Laplacian smoothing, end points kept (a tracked stroke shakes with tracking noise).
   std::vector<Vec3> t(s.size());
   for (int pass = 0; pass < options.smoothing_passes; ++pass) {
     t.front() = s.front(), t.back() = s.back();

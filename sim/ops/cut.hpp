@@ -1,6 +1,6 @@
-// The cut primitive (method §3.5): stroke → points on the cloth surface → a path along mesh
+// The cut primitive: stroke → points on the cloth surface → a path along mesh
 // edges → split by vertex duplication on the left of the cut direction. Material coordinates
-// are kept; works on any triangle mesh (grid or already cut), not only on the study's grid.
+// are kept; works on any triangle mesh (grid or already cut), not only on a regular grid.
 #pragma once
 
 #include <array>
@@ -62,17 +62,17 @@ bool prepare_for_cuts(Cloth& cloth);
 // Nearest point of the cloth surface to p (brute force over triangles).
 SurfacePoint nearest_surface_point(const Cloth& cloth, const Vec3& p);
 
-// A path along mesh edges through the anchor vertices, in order (method §3.5 step 2,
-// generalised to any triangulation: each leg walks edge by edge toward the next anchor, staying
-// close to the straight line between them in material space). Consecutive duplicates and
-// loops are removed. Empty when an anchor is unreachable.
+// A path along mesh edges through the anchor vertices, in order (on any triangulation: each leg
+// walks edge by edge toward the next anchor, staying close to the straight line between them in
+// material space). Consecutive duplicates and loops are removed. Empty when an anchor is
+// unreachable.
 std::vector<int32_t> edge_path(const Cloth& cloth, const std::vector<int32_t>& anchors);
 
-// Splits the cloth along a vertex path whose consecutive vertices share an edge (method §3.5
-// step 3): each path vertex is duplicated and the triangles on the LEFT of the cut direction
-// (in material space) move to the duplicate; an interior end (a slit tip) is not duplicated.
-// Masses are re-lumped (only the split vertices change: bit-identical to relump_masses()) and
-// topology_version bumped when anything changed; the kept incidence is updated in place.
+// Splits the cloth along a vertex path whose consecutive vertices share an edge: each path vertex
+// is duplicated and the triangles on the LEFT of the cut direction (in material space) move to the
+// duplicate; an interior end (a slit tip) is not duplicated. Masses are re-lumped (only the split
+// vertices change: bit-identical to relump_masses()) and topology_version bumped when anything
+// changed; the kept incidence is updated in place.
 CutResult cut_path(Cloth& cloth, const std::vector<int32_t>& path);
 
 // The whole cut from a stroke in 3D (hand samples): smoothed, projected onto the surface,

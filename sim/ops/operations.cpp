@@ -1,4 +1,4 @@
-// The hand operations (method §3.4, Table 3-2), with the study's reported weaknesses fixed:
+// The hand operations (docs/operations.md):
 // release never frees a pinched particle, pin fixes first and offsets out of collision last,
 // candidates come from the surface under the hand (ray) as well as the nearest particle.
 #include "sim/ops/operations.hpp"
@@ -285,7 +285,7 @@ bool ops_pin(World& w, OperationsState& s, const OperationParams& p, int hand) {
   const int32_t v = s.pinched[hand];
   s.pinched[hand] = -1;
   // Fix first, exactly on the chosen point; the rest relaxes around it for a few ticks; then the
-  // particle is offset out of collision along the surface normal (method §3.6, the study's fix).
+  // particle is offset out of collision along the surface normal.
   set_vertex_flags(w.cloth, v, kFlagPinned, kFlagPinched);
   auto& st = w.cloth.state;
   st.x[v] = hc.object_point;
@@ -357,7 +357,7 @@ bool ops_move_end(World& w, OperationsState& s) {
     s.move_grabbed[h] = false;
     s.move_offset[h].setZero();
     if (v < 0 || v >= w.cloth.num_vertices()) continue;
-    // Kept fixed where they are (the study: otherwise the cloth falls).
+    // Kept fixed where they are (otherwise the cloth falls).
     set_vertex_flags(w.cloth, v, kFlagPinned, kFlagKinematic);
     w.cloth.state.x_prev[v] = w.cloth.state.x[v];
     w.cloth.state.v[v].setZero();
@@ -483,7 +483,7 @@ bool ops_map(World& w, OperationsState& s) {
   }
   st.x_prev = st.x;
   for (auto& v : st.v) v.setZero();
-  // Boundary conditions of the study's map (§3.3 (f)): top edge and centre line fixed.
+  // The map's boundary conditions: top edge and centre line fixed.
   const double tol = 0.5 * c.topo.spacing + 1e-9;
   for (int32_t i = 0; i < c.num_vertices(); ++i) {
     const Vec2 m = c.topo.material[i];
@@ -539,7 +539,7 @@ void ops_before_step(World& w, OperationsState& s, const OperationParams& p, dou
     if (s.smoothing[h] && w.scene.form) {
       // Weak pressure toward the form: a force per area (a = pressure / areal density) along
       // the inward radial direction, applied as a velocity change a·dt per tick (Verlet's
-      // x_prev shifted to match), so it accumulates like the study's pressure term; the inward
+      // x_prev shifted to match), so it accumulates like a weak pressure term; the inward
       // speed is capped so that one tick never carries a particle past the surface + offset.
       const DressForm& f = *w.scene.form;
       const double a = p.smooth_pressure / std::max(1e-6, c.fabric.areal_density);

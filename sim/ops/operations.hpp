@@ -1,4 +1,4 @@
-// The hand operations of method §3.4 (Table 3-2) as commands applied between simulation steps:
+// The hand operations as commands applied between simulation steps:
 // move, pinch, release, pin, cut, map, smooth. They act with hand proxies (pose, radius, id)
 // only, never with devices. Bad input is ignored with a reason in World::messages.
 // The OperationController (operation_controller.hpp) maps named triggers to these functions.
@@ -20,7 +20,7 @@ struct OperationParams {
   double pin_reach = 0.15;       // m: the object point to pin at must be this close
   int pin_relax_ticks = 3;       // ticks the pinned particle stays on the object point (relax)
   double smooth_radius = 0.06;   // m around the hand where the cloth is pressed onto the form
-  double smooth_pressure = 0.5;  // Pa: the study's weak pressure toward the form (method §2.1)
+  double smooth_pressure = 0.5;  // Pa: weak pressure toward the form (as geometric draping's)
   double ray_length = 0.40;      // m: candidate ray along the hand's pointing direction
   int max_candidates = 6;        // alternatives exposed per hand
   CutOptions cut;

@@ -13,17 +13,17 @@
 // the coarse model (with it, the nodes around the contact zone locked: measured, the coarse
 // residual stalled at 10 % of its start).
 //
-// What it cannot do (measured on the form drape, docs/solvers.md section 3l): converge alone.
+// What it cannot do (measured on the form drape): converge alone.
 // A bilinear field moving along a soft isometric mode (a flap swinging, a fold rolling)
 // stretches the membrane at second order, so the coarse model sees those modes as stiff
 // (membrane locking): on its own it stops where the remaining error is 99 % in the coarse space
 // and 1.3 mJ of energy away. It is a correction between the fine solver's sweeps, which relax
 // the membrane after each step (sim/rest/equilibrium_finisher.hpp).
 // CoarseOptions::rotations gives every node a small rotation too, so that locally rigid motions
-// of a curved patch lie in the coarse space (section 3m: with Gauss-Seidel sweeps between
-// corrections, 128^2 drape 2.81 -> 0.72 mm from equilibrium in 20 cycles; 1.39 mm with
-// translations only). Its Galerkin matrix is formed from the fine Hessian's 3x3 blocks.
-// Positions only: the caller decides what happens to velocities.
+// of a curved patch lie in the coarse space (with Gauss-Seidel sweeps between corrections, 128^2
+// drape 2.81 -> 0.72 mm from equilibrium in 20 cycles; 1.39 mm with translations only). Its
+// Galerkin matrix is formed from the fine Hessian's 3x3 blocks. Positions only: the caller decides
+// what happens to velocities.
 #pragma once
 
 #include <Eigen/Core>

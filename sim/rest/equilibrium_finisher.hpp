@@ -3,10 +3,10 @@
 // A dynamic solver's settled state is not the static equilibrium: XPBD's sweeps stop at their
 // own biased fixed point, and the last millimetres lie along the cloth's softest global modes
 // (a skirt swinging as a pendulum, a fold rolling: stiffness ~ M g / L against the membrane's
-// ~10^3 N/m), which local sweeps alone do not measurably reduce (180 sweeps at 128^2:
-// docs/solvers.md section 3m). Each cycle here:
+// ~10^3 N/m), which local sweeps alone do not measurably reduce (180 sweeps at 128^2).
+// Each cycle here:
 //   1. contacts re-detected (friction anchored where the finish started: the equilibrium
-//      nearest to the settled state, as the study's reference),
+//      nearest to the settled state, as the benchmark's polish),
 //   2. `sweeps` Gauss-Seidel sweeps of per-vertex Newton steps on the static energy (vertices of
 //      one colour in parallel; the equilibrium is their fixed point, unlike XPBD's),
 //   3. one coarse correction (sim/rest/coarse_correction.hpp, with node rotations) for the long
@@ -31,9 +31,9 @@ struct FinisherOptions {
   int cycles = 20;  // at most
   int sweeps = 3;   // Gauss-Seidel sweeps per cycle
   // Coarse lattice spacing in nominal edges; 0: automatic, about 16 cells across the widest
-  // finished piece, between 2 and 4 edges (measured on the form drape, docs/solvers.md section
-  // 3m: at 32^2 nodes every 4 edges leave 1.56 mm, every 2 edges 0.71 mm; at 128^2 every 4
-  // edges reach 0.71 mm, every 2 would cost ~4x per cycle).
+  // finished piece, between 2 and 4 edges (on the form drape: at 32^2 nodes every 4 edges
+  // leave 1.56 mm, every 2 edges 0.71 mm; at 128^2 every 4 edges reach 0.71 mm, every 2 would cost
+  // ~4x per cycle).
   int coarse_factor = 0;
   bool rotations = true;  // CoarseOptions::rotations
   // Stop once a cycle moved no vertex farther than this (m).
@@ -43,7 +43,7 @@ struct FinisherOptions {
   // Largest extrapolation along a cycle's displacement (in cycles; 0: none). See cycle().
   double extrapolate = 8;
   // The static problem's contact penalty (N/m) and friction smoothing (m): the static solver's
-  // (StaticOptions), so that the finish and the study's reference minimise the same energy.
+  // (StaticOptions), so that the finish and the benchmark's polish minimise the same energy.
   double contact_stiffness = 1e4;
   double friction_eps = 1e-4;
 };

@@ -22,17 +22,17 @@ struct SolverConfig {
   bool finish_thread = true;
   bool settle = true;          // XPBD: settle pieces at rest (XpbdOptions::settle)
   bool chebyshev = false;      // VBD
-  bool springs_model = false;  // the study's 8-spring energy instead of FEM + bending
+  bool springs_model = false;  // the baseline's 8-spring energy instead of FEM + bending
   int threads = 2;
   double air_damping = -1;  // 1/s, VBD and XPBD; < 0: the solver's default (1/s, as Verlet)
 };
 
 // The default real-time solver, chosen on the run-time-against-error chart of
 // `./drape bench solvers` (docs/solvers.md): XPBD reaches a given error in less time than VBD
-// on every scene of the study.
+// on every reference scene (sim/testbeds).
 inline constexpr const char* kDefaultSolver = "xpbd";
 
-// Names: "default" (= kDefaultSolver), "vbd", "xpbd", "newton", "verlet" (the study's
+// Names: "default" (= kDefaultSolver), "vbd", "xpbd", "newton", "verlet" (the explicit
 // baseline).
 Result<std::unique_ptr<Solver>> make_solver(const std::string& name, const SolverConfig& cfg = {});
 

@@ -1,6 +1,6 @@
 // Implicit Euler with Newton's method and a sparse direct solve (CHOLMOD supernodal Cholesky by
-// default, Eigen's SimplicialLDLT as the fallback): the accuracy reference of the study, and the
-// static solver (energy minimisation with pinned vertices) that geometric draping calls through
+// default, Eigen's SimplicialLDLT as the fallback): the accuracy reference of the benchmarks, and
+// the static solver (energy minimisation with pinned vertices) that geometric draping calls through
 // relax_static().
 #pragma once
 
@@ -16,9 +16,8 @@
 namespace drape::sim {
 
 // The sparse factorisation of the Newton systems. kCholmod: CHOLMOD's supernodal LL^T (dense
-// BLAS kernels on the supernodes; several times faster than kSimplicial on the draped panels,
-// docs/solvers.md "Static solver speed (session 4)"). kSimplicial: Eigen's SimplicialLDLT
-// (the earlier path, kept as the cross-check).
+// BLAS kernels on the supernodes; several times faster than kSimplicial on the draped panels).
+// kSimplicial: Eigen's SimplicialLDLT (the cross-check).
 enum class LinearSolver { kCholmod, kSimplicial };
 
 struct NewtonOptions {
@@ -122,7 +121,7 @@ struct StaticOptions {
   bool exact_hessian = true;       // see NewtonOptions::exact_hessian
   bool contact_prediction = true;  // see NewtonOptions::contact_prediction
   // See NewtonOptions::reuse_factorisation. Measured on four XPBD end states of the form
-  // scene (docs/solvers.md section 3k): 1e-2 and 12 iterations (inexact Newton steps) took
+  // scene: 1e-2 and 12 iterations (inexact Newton steps) took
   // 0.87x / 0.86x / 0.35x / 0.82x the time of factorising every system (32^2 3 s, 64^2 3 s,
   // 64^2 12 s, 128^2 9 s); the states' errors against the two polishes agree within
   // 0.007 mm rms.

@@ -1,4 +1,4 @@
-// Baseline mass-spring + damped Verlet of the study (eqs. 3-1 ... 3-4, 3-7).
+// The explicit baseline: mass-spring network + damped Verlet, with the collision response.
 #include "sim/solvers/verlet_solver.hpp"
 
 #include <algorithm>
@@ -114,7 +114,7 @@ void VerletSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, St
     xp[i] = xm[i];
     xm[i] = xn;
   }
-  // Default (not in the study): the same response as a projection of the predicted x(t+h) to
+  // Default: the same response as a projection of the predicted x(t+h) to
   // the offset surface, with x(t) kept as the previous position. The velocity (x(t+h) - x(t)) / h
   // then loses its component into the object, so neither the response nor the velocity that
   // carried the vertex inside survives into the next step. (Moving x(t) and x(t-h) together, as

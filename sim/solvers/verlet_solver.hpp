@@ -22,17 +22,13 @@ struct VerletParams {
   double damping_rate = 1.0;     // 1/s
   double stiffness_scale = 1.0;  // 1 = the fabric's stiffness (build_springs)
   bool collide = true;
-  // Exactly as published, the eq. 3-7 response is a force, so the displacement it causes also
-  // becomes velocity in the next Verlet step. Against the form's radial section lookup that
-  // pushes a vertex falling onto a shallow slope (the shoulders) far sideways and the drop blows
-  // up (measured when written, 2026-11-22: the drop test exploded. Re-run in session 13, the 1 s
-  // drop of Drop.PanelOnFormStaysOutside with this response passes with the radial push-out and
-  // with the normal one that replaced it: at most 0.22 / 0.26 mm into the shell, the cause of the
-  // first blow-up is gone, not identified). false (default): the predicted x(t+h) is
+  // true: the baseline's response as published, a force, so the displacement it causes also
+  // becomes velocity in the next Verlet step (the 1 s drop of Drop.PanelOnFormStaysOutside
+  // passes with it, at most 0.26 mm into the shell). false (default): the predicted x(t+h) is
   // projected to the offset surface after the Verlet update and x(t) stays the previous position,
   // so the velocity loses its component into the object (a position projection; docs/sim-core.md).
   bool response_as_velocity = false;
-  // Not in the study: when the state turns non-finite, restore the frame's start state and
+  // When the state turns non-finite, restore the frame's start state and
   // report `diverged` instead of leaving NaNs in the cloth.
   bool rollback_on_divergence = true;
 };

@@ -1,4 +1,4 @@
-// The study's scenes, written once and shared by tests and benchmarks (issue 3, item 5):
+// The reference scenes (testbeds), written once and shared by tests and benchmarks:
 // a sheet hanging from two corners, a 20-particle chain, a Peirce cantilever strip, a cloth
 // draped on the dress form, a cloth on a sphere. Plus the exact elastica of the cantilever.
 #pragma once
@@ -20,7 +20,7 @@ struct Testbed {
   SceneObjects objects;
   bool springs_model = false;  // the chain uses springs (no triangles)
   double duration = 2.0;       // simulated seconds before the error is measured
-  // Air drag (1/s) every solver of the study uses on this scene; < 0: the solvers' default
+  // Air drag (1/s) every solver uses on this scene in the benchmarks; < 0: the solvers' default
   // (1/s). The form scene settles (its error is that of the settled drape, not of a swing).
   double air_damping = -1;
 };
@@ -37,7 +37,7 @@ Testbed make_cantilever(double overhang, double spacing, double width = 0.01,
                         const FabricParams& fabric = {});
 // A res x res muslin panel 0.5 x 0.5 m whose top edge is pinned across the upper chest of
 // the parametric 9AR form (form collision). fall = false (the app's default scenario): it
-// hangs straight down from the chest line, 1.5 s. fall = true (the study's "form" scene): it
+// hangs straight down from the chest line, 1.5 s. fall = true (the benchmarks' "form" scene): it
 // starts horizontal, sticking forward, falls over the bust and drapes against it, 3 s, with
 // an air drag of 4/s so that it has settled when the error is measured.
 Testbed make_form_drape(int res, const FabricParams& fabric = {}, bool fall = false);
@@ -58,7 +58,7 @@ Vec2 elastica_tip(double l, double B, double q, int steps = 2000);
 // The rigidity B for which the elastica's tip drops by `tip_drop` (bisection on log B).
 double elastica_rigidity_for_drop(double l, double q, double tip_drop);
 
-// Stress cases (issue 3, item 7), shared by tests/sim/stress_test.cpp and bench/stress_bench:
+// Stress cases, shared by tests/sim/solvers/stress_test.cpp and bench/stress_bench:
 // "large_dt" (dt = 1/30 s), "stiffness_ratio" (warp/shear = 1e4), "jerk" (a pinned vertex
 // jerked at 10 m/s), "cuts" (random cuts on a dense cloth), "crush" (cloth between the form and
 // a rising plate). `scale` 1 = test size, larger = benchmark size (more steps, cuts, vertices).

@@ -130,8 +130,8 @@ struct Kernels {
   // eight-lane kernel at 128^2, measured) or 8. Every build has the kernels of both widths
   // (tris8/rows8, tris16/rows16), so that builds and widths can be compared. Bending blocks are
   // packed in eights by every build: a block gathers and scatters ~10 vertices for ~20
-  // multiply-adds, and the sixteen-lane kernel measured 1.1x slower at 128^2 (docs/solvers.md
-  // section 3p); rows16 stays for that comparison.
+  // multiply-adds, and the sixteen-lane kernel measured 1.1x slower at 128^2; rows16 stays for
+  // that comparison.
   int tri_lanes;
   // Projects triangle packs [b, e) once (Gauss-Seidel within a triangle: E_uu, E_vv, E_uv one
   // after the other). lambda: the triangles' multipliers (3 per triangle index), or null when

@@ -1,4 +1,4 @@
-// Mapping along the grain (method §2.4-2.5): arc length kept along every section, centre line
+// Mapping along the grain: arc length kept along every section, centre line
 // on centre front, the hip shape below the hip, ease as an offset, and the dart intake.
 #include "sim/draping/mapping.hpp"
 

@@ -1,4 +1,4 @@
-// Panel with dart slits (method §2.3): node duplication, zones, validation errors by field.
+// Panel with dart slits: node duplication, zones, validation errors by field.
 #include "sim/draping/panel.hpp"
 
 #include <gtest/gtest.h>

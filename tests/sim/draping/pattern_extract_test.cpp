@@ -1,4 +1,4 @@
-// Pattern extraction (method §2.6): before relaxation the extracted outline equals the flat
+// Pattern extraction: before relaxation the extracted outline equals the flat
 // panel region the mapping placed between the reference lines; seams labelled and ordered.
 #include "sim/draping/pattern_extract.hpp"
 

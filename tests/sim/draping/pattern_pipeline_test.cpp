@@ -1,6 +1,6 @@
-// End-to-end tight skirt (issue 4 "Must show"): outline before relaxation equals the flat panel
-// region, hip/waist widths against the form's girths, piece area against draped area, sewn
-// garment girth at the hip, and bad design input named by field.
+// End-to-end tight skirt (the pipeline's acceptance bounds): outline before relaxation equals the
+// flat panel region, hip/waist widths against the form's girths, piece area against draped area,
+// sewn garment girth at the hip, and bad design input named by field.
 #include "sim/draping/pattern_pipeline.hpp"
 
 #include <gtest/gtest.h>
@@ -41,8 +41,8 @@ void check_must_show(double ease_m) {
       ease_m * 1000, rep.outline_error_before_relax_mm, rep.hip_width_error_mm,
       rep.waist_width_error_mm, rep.area_error_pct, rep.garment_hip_girth_error_pct,
       rep.relax_backend.c_str(), rep.pipeline_ms);
-  // The issue's Must-show bounds (measured 2026-11-22 03:40 UTC: outline 0.0000 mm, hip +0.000,
-  // waist -1.2 mm, area 0.74 %, garment hip girth -0.03 %; ease 40 mm see docs/draping.md).
+  // The acceptance bounds (measured: outline 0.0000 mm, hip +0.000, waist -1.2 mm, area 0.74 %,
+  // garment hip girth -0.03 %; ease 40 mm in docs/results.md).
   EXPECT_LT(rep.outline_error_before_relax_mm, 1e-3);
   EXPECT_NEAR(rep.hip_width_error_mm, 0.0, 2.0);
   EXPECT_NEAR(rep.waist_width_error_mm, 0.0, 2.0);

@@ -1,4 +1,4 @@
-// Remeshing a piece (method §2.7 done as constrained Delaunay refinement): conforming to the
+// Remeshing a piece (constrained Delaunay refinement): conforming to the
 // outline, quality bound met, area kept, seam labels on the boundary vertices.
 #include "sim/draping/remesh.hpp"
 

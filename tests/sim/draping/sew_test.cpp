@@ -1,4 +1,4 @@
-// Mirror, sew, relax (method §2.8): the tight skirt's pieces joined into a closed garment whose
+// Mirror, sew, relax: the tight skirt's pieces joined into a closed garment whose
 // hip girth matches the form's; seams closed; centre seams identified.
 #include <gtest/gtest.h>
 
@@ -30,7 +30,7 @@ TEST(Sew, TightSkirtGarment) {
     worst = std::max(worst, (g.x[t.a] - ((1 - t.t) * g.x[t.b0] + t.t * g.x[t.b1])).norm());
   std::printf("%zu vertices, %zu triangles, %zu ties, worst seam gap %.3f mm\n", g.x.size(),
               g.triangles.size(), g.ties.size(), worst * 1000);
-  EXPECT_LT(worst, 1e-3);  // measured 0.27 mm (2026-11-22, 10 mm mesh)
+  EXPECT_LT(worst, 1e-3);  // measured 0.27 mm (10 mm mesh)
   // Left half is the mirror image of the right half.
   double xmin = 1, xmax = -1;
   for (const Vec3& p : g.x) {
@@ -43,7 +43,7 @@ TEST(Sew, TightSkirtGarment) {
   const double girth = garment_girth(g, surf, hip), target = form->girth_at(hip);
   std::printf("garment hip girth %.2f mm vs form %.2f mm (%+.3f %%)\n", girth * 1000, target * 1000,
               (girth - target) / target * 100);
-  EXPECT_NEAR(girth, target, 0.01 * target);  // issue 4: within 1 %
+  EXPECT_NEAR(girth, target, 0.01 * target);  // within 1 %
   // Inside the form by more than 1 mm: none (below the hip the mapping surface is the hip shape
   // pushed out to the form wherever the form is wider).
   int inside = 0;

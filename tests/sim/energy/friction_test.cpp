@@ -116,7 +116,7 @@ TEST(Friction, ClothOnAnInclineSticksBelowTheAngleOfReposeAndSlidesAbove) {
 // The same on the dress form: a 10 x 4 cm strip laid at centre front on a form whose radius
 // shrinks with height so that its surface is inclined 20 degrees from the horizontal, as a
 // shoulder is. Below the angle of repose it stays (0.03 mm). With the contact normal taken
-// radially, as it was before 2026-11-26, the plane under the strip is vertical and carries no
+// radially instead, the plane under the strip is vertical and carries no
 // weight: the strip fell off the form (3.97 m down the slope's direction in the second).
 TEST(Friction, ClothOnASlopeOfTheFormSticksBelowTheAngleOfRepose) {
   const double th = 20 * M_PI / 180, yt = 1.05, rt = 0.3;

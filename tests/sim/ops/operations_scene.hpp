@@ -1,4 +1,4 @@
-// Scenes shared by the operations tests: the study's two initial states (spread, rolled) of a
+// Scenes shared by the operations tests: the two initial states (spread, rolled) of a
 // small panel with some particles fixed, a world stepped like the SimThread's tick, and hands.
 #pragma once
 
@@ -42,9 +42,9 @@ inline World make_world(Initial s, int fixed, int n = 9) {
   for (int k = 2; k < fixed; ++k) pin(top + (n - 1) * (k - 1) / (fixed - 1));
   w.cloth.relump_masses();
   // The operations do not depend on the solver; these tests run XPBD (20 substeps), the solver
-  // that is best on the study's chart. VBD with its adaptive initial guess (the app's default)
-  // under-converges a free fall: a released cloth fell 4.7 cm in 0.22 s instead of ~24 cm
-  // (docs/solvers.md, known gap of issue 3), which ReleaseWithOneFixedLetsTheClothFall detects.
+  // that is best on the benchmarks' chart. VBD with its adaptive initial guess under-converges
+  // a free fall (a released cloth fell 4.7 cm in 0.22 s instead of ~24 cm), which
+  // ReleaseWithOneFixedLetsTheClothFall detects.
   XpbdOptions o;
   o.substeps = 20;
   w.solver = std::make_unique<XpbdSolver>(o);

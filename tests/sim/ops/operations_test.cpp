@@ -1,4 +1,4 @@
-// Every row of the study's Table 3-3 (method §3.4) on both initial states (spread, rolled),
+// Every row of the operations table (docs/operations.md, "Tests") on both initial states,
 // asserting the resulting cloth state, plus candidates, both hands, and bad input.
 #include "sim/ops/operations.hpp"
 
@@ -243,7 +243,8 @@ TEST_P(Ops, ReleaseManyFixedAtAnyPosition) {
 TEST_P(Ops, ReleaseNeverTakesThePinchedParticle) {
   SetUpWorld(2);
   run(3);
-  // Pinch a fixed corner with the right hand, then release right there: the study's conflict.
+  // Pinch a fixed corner with the right hand, then release right there: the pinch/release
+  // conflict.
   set(1, X(top(8)));
   trig("pinch", TriggerPhase::kBegin);
   ASSERT_EQ(c->state().pinched[1], top(8));
@@ -301,7 +302,7 @@ TEST_P(Ops, PinchThenPin) {
 
 // --- cut ---------------------------------------------------------------------------------
 TEST_P(Ops, CutAlongPredeterminedLines) {
-  // Vertical, horizontal and diagonal half-lines, and a full horizontal line (the study's four).
+  // Vertical, horizontal and diagonal half-lines, and a full horizontal line.
   struct L {
     Vec2 a, b;
     int pieces;

@@ -94,7 +94,7 @@ EnergyOptions dihedral() {
 // Issue-3 target: rigidity within +-5 % of the exact elastica at two resolutions (8 and 12
 // cells along the overhang), along the warp and along the weft. Met by the default bending
 // model (kTensor, blended curvature estimator, rigid-boundary rule at the clamp): measured
-// -3.5 % / -1.6 % (warp) (docs/solvers.md "Cantilever").
+// -3.5 % / -1.6 % (warp).
 TEST(Newton, CantileverRigidityAgainstElasticaAtTwoResolutions) {
   const FabricParams f;
   double warp[2], weft[2];
@@ -189,7 +189,7 @@ TEST(Newton, UnknownSceneFallsBackAndBadStateIsNotHidden) {
   EXPECT_FALSE(std::isfinite(st.residual) && st.residual < 1e-6);
 }
 
-// Session 4: the CHOLMOD supernodal factorisation and Eigen's SimplicialLDLT solve the same
+// The CHOLMOD supernodal factorisation and Eigen's SimplicialLDLT solve the same
 // Newton systems: the static sheet ends at the same positions (to round-off of the
 // factorisations) in the same number of iterations.
 // The 12x12 hanging sheet relaxed twice with options set by `configure(so, k)` (k = 0, 1):
@@ -206,7 +206,7 @@ SheetPair relax_sheet_twice(Configure configure) {
     Testbed sc = make_hanging_sheet(12);
     StaticOptions so;
     // 1e-8 of a vertex weight: ten times the round-off floor of this solve (its residual stalls
-    // at 0.98-1.17e-9 with this machine's OpenBLAS kernels, depending on the CPU they pick).
+    // at 0.98-1.17e-9 with OpenBLAS's kernels, depending on the CPU they pick).
     so.tolerance = 1e-8;
     configure(so, k);
     p.r[k] = relax_static(sc.cloth, sc.objects, so);
@@ -231,7 +231,7 @@ TEST(Newton, CholmodAndSimplicialGiveTheSameStaticSheet) {
 
 // The exact Hessian (used where positive definite) and the PSD-projected one reach the same
 // equilibrium of the sheet, the exact one in no more iterations (the sheet is hardly
-// compressed: the gain is on wrinkled drapes, docs/solvers.md "Static solver speed").
+// compressed: the gain is on wrinkled drapes).
 TEST(Newton, ExactHessianReachesTheSameEquilibrium) {
   const SheetPair p = relax_sheet_twice([](StaticOptions& so, int k) {
     so.max_iterations = 400;

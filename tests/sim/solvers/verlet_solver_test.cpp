@@ -1,4 +1,4 @@
-// Tests of sim/solvers/verlet_solver.cpp: the study's baseline (eqs. 3-1 ... 3-4, 3-7).
+// Tests of sim/solvers/verlet_solver.cpp: the explicit mass-spring baseline.
 #include "sim/solvers/verlet_solver.hpp"
 
 #include <gtest/gtest.h>
@@ -112,7 +112,7 @@ TEST(Verlet, DropOnFloorStaysAboveOffset) {
   EXPECT_GT(ymin, scene.offset - 5e-4);  // at most a step's travel into the offset shell
 }
 
-// Regression (drop test, 2026-11-22): a cloth resting on the floor must not keep a velocity into
+// Regression (drop test): a cloth resting on the floor must not keep a velocity into
 // it. The response used to move x(t) and x(t-h) together, which kept the inward velocity, so
 // gravity accelerated resting vertices into the floor by g h more each substep. With the
 // projection default, resting on the floor the vertical velocity stays ~0 (at most g h from the
