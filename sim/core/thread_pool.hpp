@@ -43,7 +43,7 @@ class ThreadPool {
   int size() const { return threads_; }
 
   // Runs fn(begin, end, worker) over [0, n) split in up to 4 size() contiguous chunks (halving
-  // in size toward the middle of the range: parallel.cpp, chunk_start) claimed
+  // in size toward the middle of the range: thread_pool.cpp, chunk_start) claimed
   // by whichever thread is free (the caller included; fn may be called several times per
   // thread, `worker` is the calling thread's index); returns when all are done. fn must be
   // callable as void(int, int, int). No allocation.
@@ -78,7 +78,7 @@ class ThreadPool {
     parallel_slots(
         [&](int k, int) { fn(part_begin(n, k, threads_), part_begin(n, k + 1, threads_), k); });
   }
-  // Times a worker went to sleep after spinning idle (parallel.cpp, kSpinBeforeSleep).
+  // Times a worker went to sleep after spinning idle (thread_pool.cpp, kSpinBeforeSleep).
   long idle_sleeps() const { return idle_sleeps_.load(std::memory_order_relaxed); }
   // Below this many items the caller runs the range alone (sync costs more than it saves).
   void set_min_parallel(int n) { min_parallel_ = n; }

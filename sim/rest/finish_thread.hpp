@@ -10,7 +10,7 @@
 // stops after its current cycle) and its result dropped.
 //
 // Only the job's thread touches its copies while it runs; the solver reads them after joining
-// it, so nothing is shared but two atomic flags (tests/sim/finish_thread_test.cpp runs in the
+// it, so nothing is shared but two atomic flags (tests/sim/rest/finish_thread_test.cpp runs in the
 // TSan build).
 #pragma once
 
