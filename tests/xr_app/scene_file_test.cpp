@@ -44,7 +44,7 @@ TEST(SceneFile, ParsesEveryElement) {
   EXPECT_EQ(s.candidate_vertex[0], 2);
   EXPECT_TRUE(s.candidate_is_form[1]);
   EXPECT_FLOAT_EQ(d->camera.fov_y_deg, 45.0f);
-  EXPECT_EQ(d->options.colour_map, ColourMap::kStrain);
+  EXPECT_EQ(d->options.colour_map, render::ColourMap::kStrain);
   EXPECT_FALSE(d->options.grain);
   EXPECT_FALSE(d->options.floor_grid);
   EXPECT_EQ(d->samples, 1);
@@ -56,7 +56,7 @@ TEST(SceneFile, XrCameraGivesAsymmetricProjection) {
                        "xr.json");
   ASSERT_TRUE(d.ok()) << d.error();
   ASSERT_TRUE(d->camera.xr_fov.has_value());
-  const View v = d->camera.view(100, 100);
+  const render::View v = d->camera.view(100, 100);
   EXPECT_NEAR(v.eye.y(), 1.6f, 1e-6f);
   EXPECT_GT(v.projection(0, 2), 0.0f - 1.0f);  // asymmetric: off-centre term present
   EXPECT_NE(v.projection(0, 2), 0.0f);
