@@ -95,7 +95,7 @@ bool resolve_input_file(const char* command, const char* option, std::string& pa
 std::string commands_file(const std::string& given) {
   if (!given.empty()) return given;
   std::error_code ec;
-  const fs::path bundled = asset("commands.json");
+  const fs::path bundled = user_or_asset("assets/commands.json");
   return fs::exists(bundled, ec) ? bundled.string() : "";
 }
 

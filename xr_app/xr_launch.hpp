@@ -43,8 +43,8 @@ void add_off_switches(CLI::App& cli, std::initializer_list<OffSwitch> switches);
 // "<command>: <option>: no such file: <path>" and returns false.
 bool resolve_input_file(const char* command, const char* option, std::string& path);
 
-// The command map: `given` when set (already resolved), else the bundled commands.json when
-// present, else "" (the built-in defaults).
+// The command map: `given` when set (already resolved), else assets/commands.json (from the
+// working directory, else the assets directory) when present, else "" (the built-in defaults).
 std::string commands_file(const std::string& given);
 
 }  // namespace drape::app

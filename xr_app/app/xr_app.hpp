@@ -32,7 +32,7 @@ const char* to_string(XrAppState s);
 struct XrAppOptions {
   int64_t max_frames = -1;  // stop (xrRequestExitSession) after this many frames; -1: never
   int eye_size = 0;         // swapchain edge (px); 0 = the runtime's recommendation
-  bool render = true;       // draw the scene (drape_render) or only clear the swapchains
+  bool render = true;       // draw the scene (drape_render) or submit the images undrawn
   int cloth_res = 24;       // cloth resolution of the default scene
   int max_session_restarts = 3;
   bool verbose = false;
