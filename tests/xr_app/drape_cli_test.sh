@@ -5,6 +5,8 @@
 #   validation the same under the OpenXR core validation layer: zero validation messages.
 #   run        `drape run` (the default draping scenario) writes frames, the session log, the
 #              cloth glTF and the pattern to its out dir, exits 0, well under 2 minutes.
+#   args       out-of-range and misplaced arguments of `drape xr` and `drape run` exit 2 with a
+#              message naming the option; --help exits 0 and lists every option.
 # usage: drape_cli_test.sh DRAPE_EXE MODE WORKDIR
 set -u
 exe=$1 mode=$2 work=$3
@@ -65,6 +67,48 @@ case $mode in
     grep -q " 1 cut(s)" <<<"$summary" || fail "the cut stroke was not applied"
     grep -q "; 1 -> 2 parts" <<<"$summary" || fail "the cut did not split the cloth in two"
     grep -q "command map: .*commands.json" "$work/out/xr_session.txt" || fail "command map not loaded"
+    ;;
+  args)
+    : >"$log"
+    reject() {  # reject OPTION ARGS...: exit 2, the message names OPTION
+      local opt=$1; shift
+      "$exe" "$@" >"$work/out.txt" 2>&1
+      local rc=$?
+      cat "$work/out.txt" >>"$log"
+      echo "drape $*: exit $rc: $(head -n 1 "$work/out.txt")"
+      [ $rc -eq 2 ] || fail "drape $* exited $rc, not 2"
+      grep -q -- "$opt" "$work/out.txt" || fail "drape $*: the message does not name $opt"
+    }
+    reject --cloth-res xr --cloth-res 0
+    reject --cloth-res xr --cloth-res -3
+    reject --cloth-res xr --cloth-res=-3
+    reject --cloth-res xr --cloth-res twelve
+    reject --eye-size xr --eye-size 0
+    reject --frames xr --frames 0
+    reject --pose-wait-ms xr --pose-wait-ms -1
+    reject --scenario xr --scenario "$work/none.json"
+    reject --commands xr --commands "$work/none.json"
+    reject --eye-size run --eye-size 0
+    reject --cloth-res run --cloth-res 300
+    reject --every run --every 0
+    reject --seconds run --headless --seconds 0
+    reject --resolution run --headless --resolution 2
+    reject --stiffness-scale run --headless --stiffness-scale 11
+    reject --seconds run --seconds 2
+    reject --eye-size run --headless --eye-size 64
+    reject --bogus xr --bogus
+    for cmd in xr run; do
+      "$exe" $cmd --help >"$work/help.txt" 2>&1 || fail "drape $cmd --help exited $?"
+      opts=(--frames --eye-size --cloth-res --verbose --assets)
+      [ $cmd = xr ] && opts+=(--scenario --no-render --sim-free --pose-wait-ms --commands --no-ops
+        --out --json --full-form --no-malloc-tuning)
+      [ $cmd = run ] && opts+=(--scenario --out --no-voice --no-pattern --every --headless
+        --seconds --resolution --fabric --size --realtime --stiffness-scale)
+      for o in "${opts[@]}"; do
+        grep -q -- "$o" "$work/help.txt" || fail "drape $cmd --help does not list $o"
+      done
+      echo "drape $cmd --help lists ${#opts[@]} options"
+    done
     ;;
   *) echo "unknown mode $mode"; exit 2 ;;
 esac

@@ -1,6 +1,8 @@
 // End-to-end runs of the drape OpenXR app on the mock runtime: the lifecycle to EXITING, the
 // core validation layer with zero messages, hand tracking and controller input from a
 // scenario, a scripted session loss (the session is re-created), and a missing runtime.
+// The test plays the executable's part: it sets the loader's and the simulated runtime's
+// variables and passes the scenario, the layers and the command map in the app's options.
 #include "xr_app/app/xr_app.hpp"
 
 #include <gtest/gtest.h>
@@ -17,6 +19,7 @@
 #ifdef DRAPE_XR_TEST_WITH_RENDER
 #include "render/image_io.hpp"
 #endif
+#include "xr_app/xr_launch.hpp"
 
 namespace {
 
@@ -37,7 +40,14 @@ drape::app::XrAppOptions small() {
   drape::app::XrAppOptions o;
   o.eye_size = 128;
   o.cloth_res = 12;
+  o.commands_path = std::string(DRAPE_SOURCE_DIR) + "/assets/commands.json";
   return o;
+}
+
+// The simulated runtime plays `path`; the app hears its audio cues.
+void play_scenario(drape::app::XrAppOptions& o, const std::string& path) {
+  setenv("DRAPE_MOCK_SCENARIO", path.c_str(), 1);
+  o.scenario_path = path;
 }
 
 void print(const drape::app::XrAppResult& r) {
@@ -93,6 +103,7 @@ TEST(XrApp, FrameBudgetRequestsExitUnderCoreValidation) {
   base_env();
   setenv("XR_ENABLE_API_LAYERS", "XR_APILAYER_LUNARG_core_validation", 1);
   auto o = small();
+  o.api_layers = drape::app::loader_api_layers();
   o.max_frames = 10;
   auto r = drape::app::run_xr_app(o);
   print(r);
@@ -107,10 +118,9 @@ TEST(XrApp, FrameBudgetRequestsExitUnderCoreValidation) {
 
 TEST(XrApp, HandsAndControllersFromTheScenario) {
   base_env();
-  setenv("DRAPE_MOCK_SCENARIO",
-         (std::string(DRAPE_SOURCE_DIR) + "/assets/scenarios/mock_basic.json").c_str(), 1);
   setenv("DRAPE_MOCK_END_AFTER_FRAMES", "100", 1);
   auto o = small();
+  play_scenario(o, std::string(DRAPE_SOURCE_DIR) + "/assets/scenarios/mock_basic.json");
   o.render = false;
   auto r = drape::app::run_xr_app(o);
   print(r);
@@ -170,8 +180,8 @@ TEST(XrApp, DefaultScenarioPinchesPinsAndCutsTheCloth) {
   text.replace(at, key.size(), wav);
   const std::string sc = (dir / "scenario.json").string();
   std::ofstream(sc) << text;
-  setenv("DRAPE_MOCK_SCENARIO", sc.c_str(), 1);
   auto o = small();
+  play_scenario(o, sc);
   o.eye_size = 128;
   o.cloth_res = 12;
   o.out_dir = dir.string();
@@ -238,8 +248,8 @@ TEST(XrApp, HandMarkerIsDrawnAtTheFramesOwnPose) {
     "hands": {"right": [
       {"frame": 0, "palm": {"position": [-0.45, 1.1, 0.75]}, "pinch": 0.0},
       {"frame": 30, "palm": {"position": [0.45, 1.3, 0.75]}, "pinch": 0.0}]}})";
-  setenv("DRAPE_MOCK_SCENARIO", sc.c_str(), 1);
   auto o = small();
+  play_scenario(o, sc);
   o.eye_size = 256;
   o.cloth_res = 8;
   o.voice = false;
@@ -352,9 +362,16 @@ TEST(XrApp, MissingRuntimeIsReportedNotCrashed) {
   EXPECT_EQ(r.frames, 0);
 }
 
-TEST(XrApp, SelectRuntimeKeepsAnExplicitChoice) {
+TEST(XrLaunch, SelectRuntimeKeepsAnExplicitChoice) {
   setenv("XR_RUNTIME_JSON", "/some/runtime.json", 1);
   EXPECT_EQ(drape::app::select_runtime(), "/some/runtime.json");
+}
+
+TEST(XrLaunch, LoaderApiLayersSplitAtColonsAndSemicolons) {
+  setenv("XR_ENABLE_API_LAYERS", "A:B;;C", 1);
+  EXPECT_EQ(drape::app::loader_api_layers(), (std::vector<std::string>{"A", "B", "C"}));
+  unsetenv("XR_ENABLE_API_LAYERS");
+  EXPECT_TRUE(drape::app::loader_api_layers().empty());
 }
 
 }  // namespace

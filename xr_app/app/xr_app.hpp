@@ -2,6 +2,11 @@
 // (a missing runtime and a lost session are ordinary states), STAGE space (LOCAL fallback),
 // controller actions, XR_EXT_hand_tracking when offered, and the frame loop that renders the
 // simulation's latest snapshot into the runtime's swapchains. See docs/xr.md.
+// Its parts, as in Khronos' hello_xr: the program (xr_program.*: instance, session, events,
+// frame loop), the graphics (xr_graphics.*: Vulkan handover, swapchains), the input
+// (xr_input.*: actions, hand tracking), the draping session (draping_session.*, interaction.cpp,
+// voice_cues.cpp: sim thread, interaction, voice cues) and the profiling (profiling.*).
+// The library reads no environment variable: files and layers come in through XrAppOptions.
 #pragma once
 
 #include <array>
@@ -27,7 +32,7 @@ const char* to_string(XrAppState s);
 struct XrAppOptions {
   int64_t max_frames = -1;  // stop (xrRequestExitSession) after this many frames; -1: never
   int eye_size = 0;         // swapchain edge (px); 0 = the runtime's recommendation
-  bool render = true;       // draw the scene (drape_render) or only clear the swapchains
+  bool render = true;       // draw the scene (drape_render) or submit the images undrawn
   int cloth_res = 24;       // cloth resolution of the default scene
   int max_session_restarts = 3;
   bool verbose = false;
@@ -35,11 +40,17 @@ struct XrAppOptions {
   // triggers (thumb-index pinch gesture, controller trigger = cut stroke, controller menu = pin,
   // the scenario's audio cues decoded by the voice recogniser) drive the sim operations.
   bool operations = true;
-  bool voice = true;          // decode the scenario's audio cues (DRAPE_MOCK_SCENARIO)
+  bool voice = true;          // decode the scenario's audio cues (scenario_path)
   bool sim_lock_step = true;  // one sim tick per rendered frame; false: sim on its own 90 Hz clock
   std::string out_dir;        // when set: session_log.json and drape_cloth.gltf written there
-  // Triggers -> operations: this command map file ("" = assets/commands.json from the working
-  // directory or the source tree, else tracking::CommandMap::defaults()).
+  // The scenario file the simulated runtime plays ("" = none): its audio cues are the voice
+  // input (docs/xr.md).
+  std::string scenario_path;
+  // The API layers the loader enables (its XR_ENABLE_API_LAYERS): their instance extensions are
+  // offered too (the core validation layer's XR_EXT_debug_utils).
+  std::vector<std::string> api_layers;
+  // Triggers -> operations: this command map file; a file that does not load is an error
+  // ("" = tracking::CommandMap::defaults()).
   std::string commands_path;
   // Free-running sim: how long a frame may wait for the tick that consumed its hand pose
   // before drawing (0 = never wait: draw the newest snapshot at once).
@@ -114,11 +125,6 @@ struct XrAppResult {
   std::vector<PointerProbe> pointer_probe;
   std::string commands_file;  // the command map used
 };
-
-// Points XR_RUNTIME_JSON at the mock runtime next to the executable when no runtime is
-// configured (XR_RUNTIME_JSON unset and no active_runtime.json). Returns the manifest used
-// ("" = the system's active runtime).
-std::string select_runtime();
 
 XrAppResult run_xr_app(const XrAppOptions& opt);
 

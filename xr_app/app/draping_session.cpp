@@ -1,0 +1,287 @@
+// The draping session: set-up, drawing and the end of the run (see draping_session.hpp).
+#include "xr_app/app/draping_session.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "render/camera.hpp"
+#include "sim/io/mesh_io.hpp"
+#include "sim/solvers/solver_factory.hpp"
+#include "sim/testbeds/testbed.hpp"
+
+namespace drape::app {
+
+namespace {
+int count_pinned(const sim::Cloth& c) {
+  int n = 0;
+  for (uint8_t f : c.state.flags) n += (f & sim::kFlagPinned) != 0;
+  return n;
+}
+}  // namespace
+
+std::unique_ptr<SessionContent> make_draping_session(const VulkanDevice& device,
+                                                     const XrAppOptions& opt, Report& rep) {
+  if (!opt.render) return nullptr;
+  auto s = std::make_unique<DrapingSession>(opt, rep);
+  s->create(device);
+  return s;
+}
+
+DrapingSession::~DrapingSession() {
+  reader_ = sim::SnapshotReader();
+  sim_.reset();
+  renderer_.reset();
+}
+
+bool DrapingSession::create(const VulkanDevice& device) {
+  render::ExternalDevice ed;
+  ed.instance = device.instance;
+  ed.physical_device = device.physical;
+  ed.device = device.device;
+  ed.queue_family = device.queue_family;
+  auto rr = render::Renderer::create_on(ed);
+  if (!rr) {
+    rep_.r.error = "renderer: " + rr.error();
+    return false;
+  }
+  renderer_ = std::move(rr.value());
+  threads_.mark_before_sim();
+  auto scene = sim::make_form_drape(opt_.cloth_res);
+  sim::SolverConfig solver_cfg;
+  solver_cfg.freeze = true;  // pieces at rest sleep until a hand, pin or cut disturbs them
+  // A lock-step run replays bit for bit: the static finish of a sleeping piece then runs one
+  // cycle per tick instead of landing whenever its thread ends.
+  solver_cfg.finish_thread = !opt_.sim_lock_step;
+  auto solver = sim::make_solver("default", solver_cfg);
+  if (!solver) {
+    rep_.r.error = "solver: " + solver.error();
+    return false;
+  }
+  sim::World w;
+  w.cloth = std::move(scene.cloth);
+  w.scene = std::move(scene.objects);
+  w.solver = std::move(solver.value());
+  sim::SimThreadOptions so;
+  so.lock_step = opt_.sim_lock_step;
+  sim_ = std::make_unique<sim::SimThread>(std::move(w), so);
+  reader_ = sim_->make_reader();
+  start_sim();
+  return rep_.r.error.empty();
+}
+
+void DrapingSession::start_sim() {
+  sim::World& w = sim_->world();  // the thread is not started yet
+  pinned_at_start_ = count_pinned(w.cloth);
+  if (opt_.operations) {
+    ops_ = std::make_shared<sim::OperationController>();
+    ops_->install(w);
+    ops_->start_recording(w);
+    load_cues();
+    load_commands();
+  }
+  profile_ticks(w);
+  // Lock step: the ticks run on the frame loop's thread inside advance() (no hand-off per frame).
+  if (!opt_.sim_lock_step) sim_->start();
+}
+
+// The command map: triggers -> operations.
+void DrapingSession::load_commands() {
+  if (opt_.commands_path.empty()) {
+    commands_ = tracking::CommandMap::defaults();
+    rep_.r.commands_file = "(built-in defaults)";
+  } else {
+    std::string err;
+    if (auto m = tracking::CommandMap::load(opt_.commands_path, &err)) {
+      commands_ = *m;
+      rep_.r.commands_file = opt_.commands_path;
+    } else {
+      rep_.r.error = "command map: " + err;
+      rep_.note(rep_.r.error);
+    }
+  }
+  rep_.note("command map: " + rep_.r.commands_file + " (" +
+            std::to_string(commands_.bindings().size()) + " bindings)");
+}
+
+// Tick start times (free-running sim: the jitter of its clock under rendering load) and the
+// tick's cost: the solver step (wall and CPU of the thread running it) and fill_snapshot.
+void DrapingSession::profile_ticks(sim::World& w) {
+  auto inner = w.before_step;
+  const bool free = !opt_.sim_lock_step;
+  w.before_step = [this, inner, free](sim::World& world, double dt) {
+    if (free) ticks_.tick_started();
+    if (inner) inner(world, dt);
+    threads_.set_sim_thread(static_cast<int>(gettid()));
+    ticks_.step_started();
+  };
+  auto inner_after = w.after_step;
+  w.after_step = [this, inner_after](sim::World& world, double dt) {
+    ticks_.step_finished();
+    if (inner_after) inner_after(world, dt);
+    ticks_.after_step_finished();
+  };
+  auto inner_decorate = w.decorate_snapshot;
+  w.decorate_snapshot = [this, inner_decorate](const sim::World& world, sim::SceneSnapshot& s) {
+    if (inner_decorate) inner_decorate(world, s);
+    ticks_.snapshot_filled();
+  };
+}
+
+void DrapingSession::frame_started() {
+  threads_.mark_first_frame();
+  snap_ = nullptr;
+  cloth_matched_ = false;
+}
+
+// Free-running sim: waits a bounded time for the tick that consumed this frame's hand pose
+// (posted in interact()), so the cloth drawn now reacts to the hand drawn now. Only when the
+// sim's ticks are short enough to finish within the wait (a 128^2 VBD tick takes ~240 ms of
+// CPU: waiting would only add to every frame).
+void DrapingSession::wait_for_pose(int64_t frame) {
+  snap_ = renderer_ ? &reader_.latest() : nullptr;
+  if (!snap_ || !ops_ || opt_.sim_lock_step || opt_.pose_wait_ms <= 0 || posted_.empty() ||
+      posted_.back().frame != frame || sim_->timing().step_ms_p50 >= opt_.pose_wait_ms)
+    return;
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::microseconds(static_cast<int64_t>(opt_.pose_wait_ms * 1e3));
+  auto holds_pose = [&](const sim::SceneSnapshot& s) {
+    for (const auto& hp : s.hands)
+      if (hp.id == 1 && hp.tracked && hp.position == posted_.back().position) return true;
+    return false;
+  };
+  while (!holds_pose(*snap_) && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::microseconds(250));
+    snap_ = &reader_.latest();
+  }
+}
+
+// Pose-to-photon probes. Cloth (sim) latency: which frame's right-hand pose is in the snapshot
+// drawn now. Hand latency: which frame's pose the drawn hand has.
+void DrapingSession::record_probes(int64_t frame) {
+  if (!snap_ || !ops_) return;
+  for (const auto& hp : snap_->hands)
+    if (hp.id == 1 && hp.tracked)
+      for (auto it = posted_.rbegin(); it != posted_.rend(); ++it)
+        if (it->position == hp.position) {
+          rep_.r.cloth_latency_frames.push_back(static_cast<int>(frame - it->frame));
+          cloth_posted_at_ = it->when;
+          cloth_matched_ = true;
+          break;
+        }
+  for (const auto& ov : overlays_)
+    if (ov.id == 1)
+      for (auto it = posted_.rbegin(); it != posted_.rend(); ++it)
+        if (it->position.cast<float>() == ov.pointer) {
+          rep_.r.latency_frames.push_back(static_cast<int>(frame - it->frame));
+          break;
+        }
+}
+
+// Left eye: where the right-hand pointer of this and the 3 previous frames projects.
+void DrapingSession::record_pointer_probe(int64_t frame, const render::ViewTarget& left_eye) {
+  XrAppResult::PointerProbe pr;
+  pr.frame = frame;
+  int n = 0;
+  for (auto it = posted_.rbegin(); it != posted_.rend() && n < 4; ++it, ++n) {
+    auto px = render::project_to_pixel(left_eye.view, it->position.cast<float>(),
+                                       static_cast<int>(left_eye.target.width),
+                                       static_cast<int>(left_eye.target.height));
+    pr.frames_back[n] = static_cast<int>(frame - it->frame);
+    pr.px[n] = px ? std::array<float, 2>{px->x(), px->y()} : std::array<float, 2>{-1e9f, -1e9f};
+  }
+  pr.count = n;
+  rep_.r.pointer_probe.push_back(pr);
+}
+
+// Both eyes with one geometry build and one submission (render::Renderer::render_views).
+void DrapingSession::draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& laps) {
+  if (!renderer_ || !snap_) return;
+  render::ViewTarget vt[2];
+  for (int e = 0; e < 2; ++e) {
+    render::Pose pose;
+    const XrPosef& p = eyes[e].view.pose;
+    pose.orientation =
+        Eigen::Quaternionf(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z);
+    pose.position = {p.position.x, p.position.y, p.position.z};
+    const XrFovf& f = eyes[e].view.fov;
+    vt[e].view =
+        render::make_view(pose, render::Fov{f.angleLeft, f.angleRight, f.angleUp, f.angleDown});
+    vt[e].target.image = eyes[e].image;
+    vt[e].target.format = eyes[e].format;
+    vt[e].target.width = eyes[e].width;
+    vt[e].target.height = eyes[e].height;
+  }
+  render::DrawOptions dopt;
+  dopt.hands = overlays_;
+  // The form's level of detail from the eyes' pixel size (lavapipe is vertex-bound).
+  const XrFovf& f0 = eyes[0].view.fov;
+  const float rad_per_px = (f0.angleRight - f0.angleLeft) / static_cast<float>(eyes[0].width);
+  const render::FormLod lod = render::form_lod_for_pixels(rad_per_px);
+  if (opt_.form_lod) {
+    dopt.form_section_spacing = lod.section_spacing;
+    dopt.form_angle_step = lod.angle_step;
+  }
+  if (opt_.pointer_probe && ops_) record_pointer_probe(frame, vt[0]);
+  auto st = renderer_->render_views(*snap_, vt, 2, dopt);
+  if (!st) rep_.note("render: " + st.error);
+  laps.lap("render");
+  const render::FrameStats& rs = renderer_->last_frame();
+  laps.add("render.build", rs.build_ms);
+  laps.add("render.upload", rs.upload_ms);
+  laps.add("render.record_submit", rs.submit_ms - rs.upload_ms);
+  laps.add("render.gpu_wait", rs.wait_ms);
+  laps.add("render.cloth_rebuilt", rs.cloth_rebuilt ? 1.0 : 0.0);
+}
+
+void DrapingSession::frame_ended(Clock::time_point end) {
+  if (cloth_matched_) rep_.r.cloth_latency_ms.push_back(ms_between(cloth_posted_at_, end));
+}
+
+void DrapingSession::forget_targets() {
+  if (renderer_) renderer_->forget_targets();
+}
+
+void DrapingSession::finish() {
+  if (!sim_) return;
+  rep_.r.thread_cpu_s = threads_.seconds();  // before the sim's threads end
+  sim_->stop();
+  sim::World& w = sim_->world();
+  rep_.r.pinned_added = count_pinned(w.cloth) - pinned_at_start_;
+  for (const auto& m : w.messages) rep_.r.sim_messages.push_back(m);
+  ticks_.write(rep_.r);
+  if (ops_ && !opt_.out_dir.empty()) write_outputs(w);
+}
+
+// out_dir: session_log.json (the operations as the sim received them), drape_cloth.gltf and
+// xr_session.txt (the log, the triggers, the sim's messages and the outcome).
+void DrapingSession::write_outputs(sim::World& w) {
+  XrAppResult& r = rep_.r;
+  std::error_code ec;
+  std::filesystem::create_directories(opt_.out_dir, ec);
+  sim::SessionLog log = ops_->stop_recording(w);
+  const std::string lp = opt_.out_dir + "/session_log.json";
+  if (std::string e = sim::save_session(lp, log); e.empty())
+    r.written.push_back(lp);
+  else
+    rep_.note("session log: " + e);
+  const std::string cp = opt_.out_dir + "/drape_cloth.gltf";
+  if (std::string e = sim::write_meshes(cp, {sim::cloth_to_mesh(w.cloth, "cloth")}); e.empty())
+    r.written.push_back(cp);
+  else
+    rep_.note("glTF: " + e);
+  const std::string tp = opt_.out_dir + "/xr_session.txt";
+  std::ofstream o(tp);
+  for (const auto& l : r.log) o << l << "\n";
+  for (const auto& l : r.triggers) o << "trigger " << l << "\n";
+  for (const auto& l : r.sim_messages) o << "sim: " << l << "\n";
+  o << "frames " << r.frames << " pinched_frames " << r.frames_pinched << " pinned_added "
+    << r.pinned_added << " cuts " << r.cuts_ok << " components " << r.components_before << " -> "
+    << r.components_after << "\n";
+  if (o) r.written.push_back(tp);
+}
+
+}  // namespace drape::app

@@ -1,0 +1,92 @@
+// The draping session: the simulation on its thread (lock step: one tick per frame; else its
+// own 90 Hz clock), the interaction (hands, controller buttons, gestures and the scenario's
+// voice cues, through the command map, drive the sim's operations), the renderer drawing the
+// latest snapshot, and the pose-to-photon probes. Files: draping_session.cpp (set-up, drawing,
+// the end), interaction.cpp (hands and triggers), voice_cues.cpp (the scenario's audio cues).
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/renderer.hpp"
+#include "sim/ops/operation_controller.hpp"
+#include "sim/runtime/sim_thread.hpp"
+#include "tracking/command_map.hpp"
+#include "tracking/gestures.hpp"
+#include "tracking/hand_source.hpp"
+#include "tracking/voice.hpp"
+#include "xr_app/app/session_content.hpp"
+
+namespace drape::app {
+
+class DrapingSession : public SessionContent {
+ public:
+  DrapingSession(const XrAppOptions& opt, Report& rep) : opt_(opt), rep_(rep) {}
+  ~DrapingSession() override;
+  // The renderer on the device, the default scene and its solver on the sim thread.
+  bool create(const VulkanDevice& device);
+
+  void frame_started() override;
+  void interact(int64_t frame, const HandInput& in) override;
+  void wait_for_pose(int64_t frame) override;
+  void record_probes(int64_t frame) override;
+  void draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& laps) override;
+  void frame_ended(Clock::time_point end) override;
+  void forget_targets() override;
+  void finish() override;
+
+ private:
+  struct Cue {  // a scenario's audio cue
+    int64_t frame = 0;
+    std::string wav, text;
+    bool done = false;
+  };
+  struct Op {  // a trigger mapped to a sim operation
+    std::string name;
+    sim::TriggerPhase phase;
+    int hand;
+  };
+  struct Posted {  // the right hand's pose as posted to the sim
+    int64_t frame;
+    sim::Vec3 position;
+    Clock::time_point when;
+  };
+
+  void start_sim();
+  void load_commands();
+  void profile_ticks(sim::World& w);
+  void load_cues();
+  // One hand's joints and controller -> its proxy, overlay and triggers.
+  void read_hand(int h, double t, const HandInput& in, sim::HandProxy& hand,
+                 std::vector<tracking::Trigger>& trig);
+  void hear_cues(int64_t frame, double t, std::vector<tracking::Trigger>& trig);
+  std::vector<Op> map_triggers(int64_t frame, const std::vector<tracking::Trigger>& trig);
+  void note_lock_step_outcomes(bool cut_trigger);
+  void record_pointer_probe(int64_t frame, const render::ViewTarget& left_eye);
+  void write_outputs(sim::World& w);
+
+  const XrAppOptions opt_;
+  Report& rep_;
+  std::unique_ptr<render::Renderer> renderer_;
+  std::unique_ptr<sim::SimThread> sim_;
+  sim::SnapshotReader reader_;
+  std::shared_ptr<sim::OperationController> ops_;
+  tracking::GestureRecognizer gestures_;
+  std::vector<Cue> cues_;
+  std::unique_ptr<tracking::VoiceRecognizer> voice_;
+  tracking::XrHandSource xr_source_;           // the tracking XR adapter: joints + controllers
+  tracking::CommandMap commands_;              // triggers -> operations (assets/commands.json)
+  std::vector<render::HandOverlay> overlays_;  // this frame's hands, drawn from its own pose
+  bool ops_busy_[2] = {false, false}, cutting_[2] = {false, false};
+  int pinned_at_start_ = 0;
+  std::vector<Posted> posted_;                // right-hand pose posted per frame
+  const sim::SceneSnapshot* snap_ = nullptr;  // the snapshot this frame draws
+  bool cloth_matched_ = false;           // the drawn snapshot holds a posted right-hand pose ...
+  Clock::time_point cloth_posted_at_{};  // ... posted then
+  TickProfile ticks_;
+  ThreadGroups threads_;
+};
+
+}  // namespace drape::app

@@ -1,0 +1,184 @@
+// The draping session's interaction: every hand input goes through the tracking XR adapter
+// (tracking::XrHandSource: the joints of XR_EXT_hand_tracking and the controller's grip pose,
+// trigger, squeeze and a/b buttons); its triggers, the gestures' and the voice cues' go through
+// the command map to the sim's operations.
+#include "xr_app/app/draping_session.hpp"
+
+namespace drape::app {
+
+namespace {
+tracking::Vec3 vec3(const XrVector3f& p) {
+  return tracking::Vec3(p.x, p.y, p.z);
+}
+tracking::Quat quat(const XrQuaternionf& q) {
+  return tracking::Quat(q.w, q.x, q.y, q.z);
+}
+
+sim::TriggerPhase sim_phase(tracking::Phase p) {
+  switch (p) {
+    case tracking::Phase::End:
+      return sim::TriggerPhase::kEnd;
+    case tracking::Phase::Toggle:
+      return sim::TriggerPhase::kToggle;
+    case tracking::Phase::Begin:
+    case tracking::Phase::Once:
+      break;
+  }
+  return sim::TriggerPhase::kBegin;
+}
+}  // namespace
+
+void DrapingSession::interact(int64_t frame, const HandInput& in) {
+  if (!sim_) return;
+  const double t = static_cast<double>(frame) / 90.0;
+  std::array<sim::HandProxy, 2> hands{};
+  std::vector<tracking::Trigger> trig;
+  overlays_.clear();
+  for (int h = 0; h < 2; ++h) read_hand(h, t, in, hands[h], trig);
+  hear_cues(frame, t, trig);
+  const std::vector<Op> use = map_triggers(frame, trig);
+  if (hands[1].tracked) {
+    posted_.push_back({frame, hands[1].position, Clock::now()});
+    if (posted_.size() > 256) posted_.erase(posted_.begin());
+  }
+  bool cut_trigger = false;
+  for (const auto& op : use) cut_trigger = cut_trigger || op.name == "cut" || op.name == "stop";
+  if (ops_) {
+    auto ops = ops_;
+    sim_->post([ops, hands, use](sim::World& w) {
+      ops->set_hands(w, hands);
+      w.scene.hands.assign(hands.begin(), hands.end());  // into the snapshot (latency probe)
+      for (const auto& op : use) ops->trigger(w, op.name, op.phase, op.hand);
+    });
+  }
+  if (opt_.sim_lock_step) {
+    sim_->advance(1);  // orders the sim's writes before these reads (sim_thread.hpp)
+    if (ops_) note_lock_step_outcomes(cut_trigger);
+  }
+}
+
+void DrapingSession::read_hand(int h, double t, const HandInput& in, sim::HandProxy& hand,
+                               std::vector<tracking::Trigger>& trig) {
+  const auto side = static_cast<tracking::Hand>(h);
+  hand.id = h;
+  tracking::HandFrame joint_frame;
+  bool have_joint_frame = false;
+  if (in.has_tracker[h]) {
+    tracking::XrJointInput ji;
+    ji.active = in.joints_active[h];
+    ji.time = t;
+    for (int k = 0; k < tracking::kJointCount; ++k) {
+      const auto& jl = in.joints[h][k];
+      ji.joints[k].position = vec3(jl.pose.position);
+      ji.joints[k].orientation = quat(jl.pose.orientation);
+      if (ji.joints[k].orientation.norm() > 0.5) ji.joints[k].orientation.normalize();
+      ji.valid[k] =
+          in.joints_active[h] && (jl.locationFlags & XR_SPACE_LOCATION_POSITION_VALID_BIT);
+    }
+    xr_source_.feed_joints(side, ji);
+    for (const auto& f : xr_source_.poll()) {
+      gestures_.update(f, trig);  // joint frames only: pinch / grab / open palm
+      if (f.tracked && f.has_joints) {
+        joint_frame = f;
+        have_joint_frame = true;
+      }
+    }
+  }
+  const ControllerState& c = in.controllers[h];
+  tracking::XrControllerInput ci;
+  ci.time = t;
+  if (c.active) {
+    ci.active = true;
+    ci.grip.position = vec3(c.grip.position);
+    ci.grip.orientation = quat(c.grip.orientation);
+  }
+  ci.trigger = c.trigger;
+  ci.squeeze = c.squeeze;
+  ci.a = c.a;
+  ci.b = c.b;
+  xr_source_.feed_controller(side, ci);
+  tracking::HandFrame ctrl_frame;
+  bool have_ctrl = false;
+  for (const auto& f : xr_source_.poll())
+    if (f.tracked) {
+      ctrl_frame = f;
+      have_ctrl = true;
+    }
+  for (auto& tr : xr_source_.take_triggers()) trig.push_back(tr);
+  render::HandOverlay ov;
+  ov.id = h;
+  if (have_joint_frame) {
+    // The hand proxy: the pinch point between the thumb and index tips (palm orientation).
+    const auto& J = joint_frame.joints;
+    hand.tracked = true;
+    hand.position = 0.5 * (J[static_cast<int>(tracking::Joint::ThumbTip)] +
+                           J[static_cast<int>(tracking::Joint::IndexTip)]);
+    hand.orientation = joint_frame.palm.orientation;
+    hand.tip = hand.position;
+    hand.radius = 0.02;
+    ov.has_joints = true;
+    for (int k = 0; k < tracking::kJointCount; ++k) ov.joints[k] = J[k].cast<float>();
+  } else if (have_ctrl) {
+    // No hand tracking for this hand: the controller's grip pose is the hand.
+    hand.tracked = true;
+    hand.position = ctrl_frame.palm.position;
+    hand.orientation = ctrl_frame.palm.orientation;
+    hand.tip = hand.position;
+    hand.radius = 0.03;
+  }
+  if (hand.tracked) {
+    ov.pointer = hand.position.cast<float>();
+    ov.active = gestures_.pinching(side) || ops_busy_[h];
+    overlays_.push_back(ov);
+  }
+}
+
+// Triggers -> the command map (assets/commands.json) -> operations of the sim.
+std::vector<DrapingSession::Op> DrapingSession::map_triggers(
+    int64_t frame, const std::vector<tracking::Trigger>& trig) {
+  std::vector<Op> use;
+  for (const auto& tr : trig) {
+    const auto act = commands_.lookup(tr);
+    std::string line = "frame " + std::to_string(frame) + ": " + tr.source + " " + tr.command +
+                       (tr.begin ? " begin" : " end") + " hand " + tracking::hand_name(tr.hand);
+    if (!act) {
+      if (opt_.verbose) rep_.note("unmapped trigger " + line);
+      continue;
+    }
+    Op op{act->operation, sim_phase(act->phase), static_cast<int>(tr.hand)};
+    if (op.name == "*") {  // "stop": ends whatever is in progress
+      op.name = "stop";
+      op.phase = sim::TriggerPhase::kBegin;
+    }
+    line += " -> " + op.name + " " + tracking::phase_name(act->phase);
+    rep_.r.triggers.push_back(line);
+    if (opt_.verbose) rep_.note("trigger " + line);
+    use.push_back(op);
+  }
+  return use;
+}
+
+// Lock step: the tick of this frame has run; its pinches and cuts are this frame's outcome.
+void DrapingSession::note_lock_step_outcomes(bool cut_trigger) {
+  XrAppResult& r = rep_.r;
+  const auto& st = ops_->state();
+  if (st.pinched[0] >= 0 || st.pinched[1] >= 0) ++r.frames_pinched;
+  bool cut_end = false;
+  for (int h = 0; h < 2; ++h) {
+    cut_end = cut_end || (cut_trigger && cutting_[h] && !st.cutting[h]);
+    cutting_[h] = st.cutting[h];
+    ops_busy_[h] = st.pinched[h] >= 0 || st.cutting[h];
+  }
+  if (!cut_end) return;
+  if (st.last_cut.ok) {
+    ++r.cuts_ok;
+    r.cut_new_vertices += static_cast<int>(st.last_cut.new_vertices.size());
+    r.components_before = st.last_cut.components_before;
+    r.components_after = st.last_cut.components_after;
+  }
+  rep_.note("cut: " + std::string(st.last_cut.ok ? "ok" : "failed: " + st.last_cut.reason) +
+            ", components " + std::to_string(st.last_cut.components_before) + " -> " +
+            std::to_string(st.last_cut.components_after));
+}
+
+}  // namespace drape::app

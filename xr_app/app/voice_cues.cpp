@@ -1,0 +1,66 @@
+// The draping session's voice input: the scenario's audio cues (the simulated runtime's voice
+// side channel, docs/xr.md), each decoded by the voice recogniser when its frame is reached.
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "xr_app/app/draping_session.hpp"
+
+namespace drape::app {
+
+void DrapingSession::load_cues() {
+  if (!opt_.voice || opt_.scenario_path.empty()) return;
+  std::ifstream in(opt_.scenario_path);
+  if (!in) return;  // the runtime reports an unreadable scenario itself
+  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.contains("audio") || !j["audio"].is_array()) return;
+  const std::filesystem::path dir = std::filesystem::path(opt_.scenario_path).parent_path();
+  for (const auto& a : j["audio"]) {
+    if (!a.is_object() || !a.contains("frame") || !a.contains("wav")) continue;
+    Cue c;
+    c.frame = a["frame"].get<int64_t>();
+    std::filesystem::path wav = a["wav"].get<std::string>();
+    c.wav = (wav.is_absolute() ? wav : dir / wav).string();
+    if (a.contains("text") && a["text"].is_string()) c.text = a["text"].get<std::string>();
+    cues_.push_back(c);
+  }
+  if (!cues_.empty()) rep_.note("voice: " + std::to_string(cues_.size()) + " audio cue(s)");
+}
+
+void DrapingSession::hear_cues(int64_t frame, double t, std::vector<tracking::Trigger>& trig) {
+  for (auto& c : cues_) {
+    if (c.done || frame < c.frame) continue;
+    c.done = true;
+    if (!voice_) {
+      voice_ = std::make_unique<tracking::VoiceRecognizer>(tracking::VoiceConfig{});
+      if (!voice_->ok()) rep_.note("voice: recogniser unavailable: " + voice_->error());
+    }
+    std::vector<int16_t> pcm;
+    std::string err;
+    if (!voice_->ok()) continue;
+    if (!tracking::read_wav(c.wav, pcm, &err)) {
+      rep_.note("voice: " + err);
+      continue;
+    }
+    // The recogniser's own energy VAD cuts the utterance out of the recording.
+    tracking::EnergyVad vad(voice_->config());
+    std::vector<tracking::EnergyVad::Segment> segs;
+    vad.feed(pcm.data(), static_cast<long>(pcm.size()), segs);
+    vad.flush(segs);
+    if (segs.empty()) {
+      rep_.note("voice: no speech in " + c.wav);
+      continue;
+    }
+    const auto& sg = segs.front();
+    auto vr = voice_->decode(sg.audio.data(), static_cast<long>(sg.audio.size()),
+                             static_cast<double>(sg.speech_end - sg.start) / tracking::kVoiceRate);
+    rep_.note("voice: frame " + std::to_string(frame) + " '" + c.wav + "' heard '" + vr.hypothesis +
+              "' -> " + (vr.command.empty() ? "(rejected: " + vr.reason + ")" : vr.command));
+    if (!vr.command.empty()) {
+      rep_.r.voice_commands.push_back(vr.command);
+      trig.push_back({vr.command, "voice", t, tracking::Hand::Right, true});
+    }
+  }
+}
+
+}  // namespace drape::app

@@ -1,0 +1,102 @@
+// The executable's side of the OpenXR app (see xr_launch.hpp).
+#include "xr_app/xr_launch.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "xr_app/paths.hpp"
+
+namespace drape::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+std::string env(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? v : "";
+}
+
+std::vector<std::string> split(const std::string& s, const char* separators) {
+  std::vector<std::string> out;
+  size_t p = 0;
+  while (p <= s.size()) {
+    size_t q = s.find_first_of(separators, p);
+    if (q == std::string::npos) q = s.size();
+    if (q > p) out.push_back(s.substr(p, q - p));
+    p = q + 1;
+  }
+  return out;
+}
+}  // namespace
+
+std::string select_runtime() {
+  if (std::string j = env("XR_RUNTIME_JSON"); !j.empty()) return j;
+  std::vector<fs::path> dirs;
+  if (std::string x = env("XDG_CONFIG_HOME"); !x.empty()) dirs.emplace_back(x);
+  if (std::string h = env("HOME"); !h.empty()) dirs.push_back(fs::path(h) / ".config");
+  for (const auto& d : split(env("XDG_CONFIG_DIRS"), ":")) dirs.emplace_back(d);
+  dirs.emplace_back("/etc/xdg");
+  std::error_code ec;
+  for (const auto& d : dirs)
+    if (fs::exists(d / "openxr/1/active_runtime.json", ec)) return "";
+  // No runtime configured: the simulated runtime, through the loader's own variable.
+  const fs::path mock = mock_runtime_manifest();
+  if (mock.empty()) return "";
+  setenv("XR_RUNTIME_JSON", mock.c_str(), 1);
+  return mock.string();
+}
+
+std::vector<std::string> loader_api_layers() {
+  return split(env("XR_ENABLE_API_LAYERS"), ":;");
+}
+
+std::string mock_scenario() {
+  return env("DRAPE_MOCK_SCENARIO");
+}
+
+void set_mock_scenario(const std::string& path) {
+  setenv("DRAPE_MOCK_SCENARIO", path.c_str(), 1);
+}
+
+void add_app_options(CLI::App& cli, XrAppOptions& opt) {
+  cli.option_defaults()->always_capture_default();
+  cli.add_option("--frames", opt.max_frames,
+                 "stop after N frames (default: when the runtime ends the session)")
+      ->check(CLI::Range(int64_t{1}, int64_t{1000000000}));
+  cli.add_option(
+         "--eye-size", opt.eye_size,
+         "swapchain edge in pixels" +
+             std::string(opt.eye_size > 0 ? "" : " (default: the runtime's recommendation)"))
+      ->check(CLI::Range(16, 4096));
+  cli.add_option("--cloth-res", opt.cloth_res, "cloth vertices across the default scene's panel")
+      ->check(CLI::Range(4, 256));
+  cli.add_flag("-v,--verbose", opt.verbose, "print the app's log as it happens");
+  cli.add_option_function<std::string>(
+         "--assets", [](const std::string& dir) { set_assets_dir(dir); },
+         "the assets directory (default: <exe dir>/../share/drape/assets)")
+      ->check(CLI::ExistingDirectory);
+}
+
+void add_off_switches(CLI::App& cli, std::initializer_list<OffSwitch> switches) {
+  for (const OffSwitch& s : switches)
+    cli.add_flag_callback(
+        s.name, [setting = s.setting] { *setting = false; }, s.help);
+}
+
+bool resolve_input_file(const char* command, const char* option, std::string& path) {
+  std::error_code ec;
+  path = user_or_asset(path).string();
+  if (fs::is_regular_file(path, ec)) return true;
+  std::fprintf(stderr, "%s: %s: no such file: %s\n", command, option, path.c_str());
+  return false;
+}
+
+std::string commands_file(const std::string& given) {
+  if (!given.empty()) return given;
+  std::error_code ec;
+  const fs::path bundled = user_or_asset("assets/commands.json");
+  return fs::exists(bundled, ec) ? bundled.string() : "";
+}
+
+}  // namespace drape::app

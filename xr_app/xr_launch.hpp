@@ -1,0 +1,50 @@
+// The executable's side of the OpenXR app (the app library reads no environment variable):
+// which runtime the Khronos loader loads, what the loader and the simulated runtime take from
+// the environment (their own interfaces), the app's files under the asset rule (paths.hpp), and
+// the options `drape xr` and `drape run` share.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+#include "xr_app/app/xr_app.hpp"
+
+namespace drape::app {
+
+// The runtime the loader will load: XR_RUNTIME_JSON when set; else the system's active runtime
+// (openxr/1/active_runtime.json below $XDG_CONFIG_HOME, ~/.config, $XDG_CONFIG_DIRS or
+// /etc/xdg); else the simulated runtime (paths.hpp), which XR_RUNTIME_JSON is then pointed at.
+// Returns the manifest ("" = the system's active runtime).
+std::string select_runtime();
+
+// The API layers the loader enables from XR_ENABLE_API_LAYERS (':' or ';' separated).
+std::vector<std::string> loader_api_layers();
+
+// The scenario the simulated runtime plays (DRAPE_MOCK_SCENARIO; "" = none).
+std::string mock_scenario();
+void set_mock_scenario(const std::string& path);
+
+// The options both commands have: --frames, --eye-size, --cloth-res, -v/--verbose (opt's
+// values are the defaults) and --assets DIR (applied while parsing: set_assets_dir). Added
+// first: it makes --help show every later option's default too.
+void add_app_options(CLI::App& cli, XrAppOptions& opt);
+
+// Flags that turn a setting that is on by default off (--no-render, --sim-free, ...).
+struct OffSwitch {
+  const char* name;
+  bool* setting;
+  const char* help;
+};
+void add_off_switches(CLI::App& cli, std::initializer_list<OffSwitch> switches);
+
+// After parsing: resolves `path` (user_or_asset) and checks that it is a file; else prints
+// "<command>: <option>: no such file: <path>" and returns false.
+bool resolve_input_file(const char* command, const char* option, std::string& path);
+
+// The command map: `given` when set (already resolved), else assets/commands.json (from the
+// working directory, else the assets directory) when present, else "" (the built-in defaults).
+std::string commands_file(const std::string& given);
+
+}  // namespace drape::app
