@@ -521,3 +521,37 @@ TEST(Xpbd, SleepingPiecesAreFinishedTowardTheirEquilibrium) {
   std::printf("own thread vs one per frame: %.3g m max\n", mx);
   EXPECT_LT(mx, 1e-9);
 }
+
+// The rest scheduler on its own (xpbd::RestScheduler, the solver's settling and sleep): of two
+// pieces, the slow one starts settling after settle_steps substeps and grows its inertia toward
+// settle_mass_scale, the fast one keeps its own mass; a push past settle_exit_speed (RMS) ends
+// the settling at once.
+TEST(Xpbd, RestSchedulerSettlesTheSlowPieceAndLetsAFastOneGo) {
+  XpbdOptions o;
+  o.settle_steps = 3;
+  o.settle_grow_steps = 1;
+  xpbd::RestScheduler rest(o);
+  rest.reset(2, {0, 0, 1, 1});
+  const std::vector<double> w(4, 1.0), mass(4, 0.1);
+  std::vector<Vec3> v = {Vec3(0, 0.01, 0), Vec3(0, 0.01, 0), Vec3(0, 1, 0), Vec3(0, 1, 0)};
+  for (int s = 0; s < 3; ++s) {
+    rest.sum_motion(w.data(), v, mass);
+    rest.settle_pieces();
+    EXPECT_EQ(rest.scales()[0], 1.0);  // slow for fewer than settle_steps substeps
+  }
+  rest.masses_set();
+  for (int s = 0; s < 5; ++s) {
+    rest.sum_motion(w.data(), v, mass);
+    rest.settle_pieces();
+  }
+  EXPECT_TRUE(rest.masses_dirty());  // the inverse masses change with the scale
+  EXPECT_GT(rest.scales()[0], 1.0);
+  EXPECT_LE(rest.scales()[0], o.settle_mass_scale);
+  EXPECT_EQ(rest.scales()[1], 1.0);
+  EXPECT_DOUBLE_EQ(rest.settle_scale(), rest.scales()[0]);
+  v[0] = v[1] = Vec3(0, 2 * o.settle_exit_speed, 0);
+  rest.sum_motion(w.data(), v, mass);
+  rest.settle_pieces();
+  EXPECT_EQ(rest.scales()[0], 1.0);
+  EXPECT_EQ(rest.settle_scale(), 1.0);
+}
