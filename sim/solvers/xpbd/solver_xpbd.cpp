@@ -20,13 +20,6 @@ namespace {
 
 // A bending coefficient this small against its block's largest is a cancelled zero (cook()).
 constexpr double kZeroCoefficient = 1e-9;
-// A settling piece with a vertex deeper than this inside a fresh contact plane was pushed (a
-// hand, a moved form): its settling ends. (Not 0.1 mm as for waking a sleeping piece: a
-// settling piece still slides, and a plane re-found on a curved form after half a margin of
-// sliding can sit ~0.1 mm off; measured at 128^2, it ended settling over and over and the
-// drape never came to rest.)
-constexpr double kUnsettleDepth = 1e-3;
-
 // Sorts elements by colour: returns the colour offsets and fills `order`.
 std::vector<int> colour_sorted(int n, int count, int k, const int32_t* verts, size_t stride,
                                std::vector<int>& order) {
@@ -58,6 +51,28 @@ void XpbdSolver::cook(const Cloth& cloth) {
   EnergyOptions eo = opt_.energy;
   eo.bending_matrix = false;
   energy_.build(cloth, eo, pool_.get());
+  const int n = cloth.num_vertices();
+  cook_triangles(cloth);
+  cook_bending(n);
+  cook_hinges_springs(n);
+  const int S = scratch_slots_;
+  lambda_tri_.assign(3 * tris_.size(), 0.0);
+  lambda_hinge_.assign(hinges_.size(), Vec3::Zero());
+  lambda_spring_.assign(springs_.size(), 0.0);
+  // + the scratch vertices of padding, one per share of a colour's packs (xpbd::share_begin)
+  xp_.assign(cooked_f32_ ? 0 : n + S, xpbd::P4{{0, 0, 0, 0}});
+  xp8_.assign(cooked_f32_ ? n + S : 0, xpbd::P4f{{0, 0, 0, 0}});
+  anchors_.clear();  // renewed at the next step
+  tri_anchor8_.assign(static_cast<size_t>(6 * tlanes_) * float_tri_packs(), 0.0f);
+  row_anchor8_.assign(72 * static_cast<size_t>(row_packs8_.packs()), 0.0f);
+  build_sweep(n);
+  w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
+  w0_.assign(n, -1.0);
+  cook_pieces(n);
+}
+
+// The triangles' constraint data, sorted by colour and packed for the kernels.
+void XpbdSolver::cook_triangles(const Cloth& cloth) {
   const FabricParams& fab = cloth.fabric;
   const double kc[3] = {fab.stretch_weft, fab.stretch_warp, 4.0 * fab.shear};
   const int n = cloth.num_vertices();
@@ -114,119 +129,127 @@ void XpbdSolver::cook(const Cloth& cloth) {
   pool_->set_min_parallel(static_cast<int>(tris_.size()) < opt_.min_parallel_triangles
                               ? std::numeric_limits<int>::max()
                               : 64);
-  hinges_.clear();
-  // Bending: the energy's own rows when it has them (tensor bending), else its hinges. The
-  // three rows of a triangle (uu, vv, uv) share their stencil: they are one block, solved
-  // together (3x3 system) with one pass over the stencil.
+}
+
+// Bending: the energy's own rows when it has them (tensor bending). The three rows of a triangle
+// (uu, vv, uv) share their stencil: they are one block, solved together (3x3 system) with one
+// pass over the stencil.
+void XpbdSolver::cook_bending(int n) {
+  const int S = scratch_slots_;
   const int nrows = energy_.num_bending_rows();
-  {
-    const auto& ro = energy_.bending_row_offsets();
-    const auto& rc = energy_.bending_row_columns();
-    const auto& rv = energy_.bending_row_values();
-    std::vector<int> boff(1, 0), bcol;
-    std::vector<double> bval, bik;
-    std::vector<std::array<double, 4>> ent;  // column, value uu, vv, uv
-    // Upper bounds (a block's three rows share most columns): ~1M entries at 128^2, which
-    // growing by push_back copied many times over (a re-cook after every cut).
-    bcol.reserve(rc.size());
-    bval.reserve(3 * rc.size());
-    boff.reserve(nrows / 3 + 2);
-    bik.reserve(nrows + 3);
-    for (int r0 = 0; r0 < nrows; r0 += 3) {
-      // The energy's three rows of a triangle share one pattern, sorted, exact zeros kept: then
-      // the block is read off directly (the merge below costs ~15 ms at 128^2), with the same
-      // values (the merge adds each to zeros).
-      const int len = ro[r0 + 1] - ro[r0];
-      const auto c0 = rc.begin() + ro[r0];
-      if (r0 + 2 < nrows && ro[r0 + 2] - ro[r0 + 1] == len && ro[r0 + 3] - ro[r0 + 2] == len &&
-          std::equal(c0, c0 + len, rc.begin() + ro[r0 + 1]) &&
-          std::equal(c0, c0 + len, rc.begin() + ro[r0 + 2]) &&
-          std::adjacent_find(c0, c0 + len, std::greater_equal<int>()) == c0 + len) {
-        for (int e = 0; e < len; ++e) {
-          bcol.push_back(c0[e]);
-          for (int a = 0; a < 3; ++a) bval.push_back(rv[ro[r0 + a] + e]);
-        }
+  const auto& ro = energy_.bending_row_offsets();
+  const auto& rc = energy_.bending_row_columns();
+  const auto& rv = energy_.bending_row_values();
+  std::vector<int> boff(1, 0), bcol;
+  std::vector<double> bval, bik;
+  std::vector<std::array<double, 4>> ent;  // column, value uu, vv, uv
+  // Upper bounds (a block's three rows share most columns): ~1M entries at 128^2, which
+  // growing by push_back copied many times over (a re-cook after every cut).
+  bcol.reserve(rc.size());
+  bval.reserve(3 * rc.size());
+  boff.reserve(nrows / 3 + 2);
+  bik.reserve(nrows + 3);
+  for (int r0 = 0; r0 < nrows; r0 += 3) {
+    // The energy's three rows of a triangle share one pattern, sorted, exact zeros kept: then
+    // the block is read off directly (the merge below costs ~15 ms at 128^2), with the same
+    // values (the merge adds each to zeros).
+    const int len = ro[r0 + 1] - ro[r0];
+    const auto c0 = rc.begin() + ro[r0];
+    if (r0 + 2 < nrows && ro[r0 + 2] - ro[r0 + 1] == len && ro[r0 + 3] - ro[r0 + 2] == len &&
+        std::equal(c0, c0 + len, rc.begin() + ro[r0 + 1]) &&
+        std::equal(c0, c0 + len, rc.begin() + ro[r0 + 2]) &&
+        std::adjacent_find(c0, c0 + len, std::greater_equal<int>()) == c0 + len) {
+      for (int e = 0; e < len; ++e) {
+        bcol.push_back(c0[e]);
+        for (int a = 0; a < 3; ++a) bval.push_back(rv[ro[r0 + a] + e]);
       }
-      ent.clear();
-      for (int a = 0; a < 3 && r0 + a < nrows && static_cast<int>(bcol.size()) == boff.back(); ++a)
-        for (int e = ro[r0 + a]; e < ro[r0 + a + 1]; ++e) {
-          std::array<double, 4> q{double(rc[e]), 0, 0, 0};
-          q[1 + a] = rv[e];
-          ent.push_back(q);
-        }
-      std::sort(ent.begin(), ent.end(), [](const auto& p, const auto& q) { return p[0] < q[0]; });
-      for (size_t i = 0; i < ent.size(); ++i) {
-        if (!bcol.empty() && static_cast<int>(boff.size()) - 1 >= 0 &&
-            static_cast<int>(bcol.size()) > boff.back() && bcol.back() == int(ent[i][0])) {
-          for (int a = 0; a < 3; ++a) bval[bval.size() - 3 + a] += ent[i][1 + a];
+    }
+    ent.clear();
+    for (int a = 0; a < 3 && r0 + a < nrows && static_cast<int>(bcol.size()) == boff.back(); ++a)
+      for (int e = ro[r0 + a]; e < ro[r0 + a + 1]; ++e) {
+        std::array<double, 4> q{double(rc[e]), 0, 0, 0};
+        q[1 + a] = rv[e];
+        ent.push_back(q);
+      }
+    std::sort(ent.begin(), ent.end(), [](const auto& p, const auto& q) { return p[0] < q[0]; });
+    for (size_t i = 0; i < ent.size(); ++i) {
+      if (!bcol.empty() && static_cast<int>(boff.size()) - 1 >= 0 &&
+          static_cast<int>(bcol.size()) > boff.back() && bcol.back() == int(ent[i][0])) {
+        for (int a = 0; a < 3; ++a) bval[bval.size() - 3 + a] += ent[i][1 + a];
+        continue;
+      }
+      bcol.push_back(static_cast<int>(ent[i][0]));
+      for (int a = 0; a < 3; ++a) bval.push_back(ent[i][1 + a]);
+    }
+    // Columns whose three coefficients are round-off of an exact zero (a cancellation: on a
+    // regular grid one in five, ~1e-11 of the block's largest coefficient) are left out; the
+    // block's rows keep their other coefficients bit for bit.
+    {
+      const int b0 = boff.back(), b1 = static_cast<int>(bcol.size());
+      double big = 0;
+      for (int e = 3 * b0; e < 3 * b1; ++e) big = std::max(big, std::abs(bval[e]));
+      int out = b0;
+      for (int e = b0; e < b1; ++e) {
+        if (std::abs(bval[3 * e]) <= kZeroCoefficient * big &&
+            std::abs(bval[3 * e + 1]) <= kZeroCoefficient * big &&
+            std::abs(bval[3 * e + 2]) <= kZeroCoefficient * big)
           continue;
-        }
-        bcol.push_back(static_cast<int>(ent[i][0]));
-        for (int a = 0; a < 3; ++a) bval.push_back(ent[i][1 + a]);
+        bcol[out] = bcol[e];
+        for (int a = 0; a < 3; ++a) bval[3 * out + a] = bval[3 * e + a];
+        ++out;
       }
-      // Columns whose three coefficients are round-off of an exact zero (a cancellation: on a
-      // regular grid one in five, ~1e-11 of the block's largest coefficient) are left out; the
-      // block's rows keep their other coefficients bit for bit.
-      {
-        const int b0 = boff.back(), b1 = static_cast<int>(bcol.size());
-        double big = 0;
-        for (int e = 3 * b0; e < 3 * b1; ++e) big = std::max(big, std::abs(bval[e]));
-        int out = b0;
-        for (int e = b0; e < b1; ++e) {
-          if (std::abs(bval[3 * e]) <= kZeroCoefficient * big &&
-              std::abs(bval[3 * e + 1]) <= kZeroCoefficient * big &&
-              std::abs(bval[3 * e + 2]) <= kZeroCoefficient * big)
-            continue;
-          bcol[out] = bcol[e];
-          for (int a = 0; a < 3; ++a) bval[3 * out + a] = bval[3 * e + a];
-          ++out;
-        }
-        bcol.resize(out);
-        bval.resize(3 * out);
-      }
-      boff.push_back(static_cast<int>(bcol.size()));
-      for (int a = 0; a < 3; ++a) {
-        const double k = r0 + a < nrows ? energy_.bending_row_stiffness(r0 + a) : 0.0;
-        bik.push_back(k > 0 ? 1.0 / k : 0.0);
-      }
+      bcol.resize(out);
+      bval.resize(3 * out);
     }
-    std::vector<int> order_b, col;
-    colour_elements(n, boff, bcol, order_b, col);
-    row_cols_ = col.empty() ? std::vector<int>(1, 0) : col;
-    row_off_.assign(1, 0);
-    row_colv_.clear();
-    row_val_.clear();
-    row_ik_.clear();
-    row_colv_.reserve(bcol.size());
-    row_val_.reserve(bval.size());
-    row_ik_.reserve(bik.size());
-    row_off_.reserve(boff.size());
-    for (int bk : order_b) {
-      for (int e = boff[bk]; e < boff[bk + 1]; ++e) {
-        row_colv_.push_back(bcol[e]);
-        for (int a = 0; a < 3; ++a) row_val_.push_back(bval[3 * e + a]);
-      }
-      row_off_.push_back(static_cast<int>(row_colv_.size()));
-      for (int a = 0; a < 3; ++a) row_ik_.push_back(bik[3 * bk + a]);
+    boff.push_back(static_cast<int>(bcol.size()));
+    for (int a = 0; a < 3; ++a) {
+      const double k = r0 + a < nrows ? energy_.bending_row_stiffness(r0 + a) : 0.0;
+      bik.push_back(k > 0 ? 1.0 / k : 0.0);
     }
-    lambda_row_.assign(row_ik_.size(), Vec3::Zero());
-    row_packs_.clear();
-    row_packs8_.clear();
-    rpack_col_.assign(1, 0);
-    rpack8_col_.assign(1, 0);
-    for (size_t c = 0; c + 1 < row_cols_.size(); ++c) {
-      if (cooked_f32_) {
-        row_packs8_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
-                           row_cols_[c], row_cols_[c + 1], n, S);
-        rpack8_col_.push_back(row_packs8_.packs());
-      } else {
-        row_packs_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
-                          row_cols_[c], row_cols_[c + 1], n, S);
-        rpack_col_.push_back(row_packs_.packs());
-      }
-    }
-    row_ai_h_ = -1;
   }
+  std::vector<int> order_b, col;
+  colour_elements(n, boff, bcol, order_b, col);
+  row_cols_ = col.empty() ? std::vector<int>(1, 0) : col;
+  row_off_.assign(1, 0);
+  row_colv_.clear();
+  row_val_.clear();
+  row_ik_.clear();
+  row_colv_.reserve(bcol.size());
+  row_val_.reserve(bval.size());
+  row_ik_.reserve(bik.size());
+  row_off_.reserve(boff.size());
+  for (int bk : order_b) {
+    for (int e = boff[bk]; e < boff[bk + 1]; ++e) {
+      row_colv_.push_back(bcol[e]);
+      for (int a = 0; a < 3; ++a) row_val_.push_back(bval[3 * e + a]);
+    }
+    row_off_.push_back(static_cast<int>(row_colv_.size()));
+    for (int a = 0; a < 3; ++a) row_ik_.push_back(bik[3 * bk + a]);
+  }
+  lambda_row_.assign(row_ik_.size(), Vec3::Zero());
+  row_packs_.clear();
+  row_packs8_.clear();
+  rpack_col_.assign(1, 0);
+  rpack8_col_.assign(1, 0);
+  for (size_t c = 0; c + 1 < row_cols_.size(); ++c) {
+    if (cooked_f32_) {
+      row_packs8_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
+                         row_cols_[c], row_cols_[c + 1], n, S);
+      rpack8_col_.push_back(row_packs8_.packs());
+    } else {
+      row_packs_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
+                        row_cols_[c], row_cols_[c + 1], n, S);
+      rpack_col_.push_back(row_packs_.packs());
+    }
+  }
+  row_ai_h_ = -1;
+}
+
+// The hinges (bending without rows) and the springs, sorted by colour.
+void XpbdSolver::cook_hinges_springs(int n) {
+  const int nrows = energy_.num_bending_rows();
+  std::vector<int> order;
+  hinges_.clear();
   for (int h = 0; h < (nrows > 0 ? 0 : energy_.num_hinges()); ++h) {
     Hinge H{};
     for (int a = 0; a < 4; ++a) {
@@ -251,19 +274,11 @@ void XpbdSolver::cook(const Cloth& cloth) {
   spring_col_ = colour_sorted(n, static_cast<int>(springs_.size()), 2,
                               springs_.empty() ? nullptr : springs_[0].v, sizeof(Spring), order);
   apply_order(springs_, order);
-  lambda_tri_.assign(3 * tris_.size(), 0.0);
-  lambda_hinge_.assign(hinges_.size(), Vec3::Zero());
-  lambda_spring_.assign(springs_.size(), 0.0);
-  // + the scratch vertices of padding, one per share of a colour's packs (xpbd::share_begin)
-  xp_.assign(cooked_f32_ ? 0 : n + S, xpbd::P4{{0, 0, 0, 0}});
-  xp8_.assign(cooked_f32_ ? n + S : 0, xpbd::P4f{{0, 0, 0, 0}});
-  anchors_.clear();  // renewed at the next step
-  tri_anchor8_.assign(static_cast<size_t>(6 * tlanes_) * float_tri_packs(), 0.0f);
-  row_anchor8_.assign(72 * static_cast<size_t>(row_packs8_.packs()), 0.0f);
-  build_sweep(n);
-  w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
-  w0_.assign(n, -1.0);
-  // Connected pieces (union-find over the elements' vertices).
+}
+
+// The connected pieces (union-find over the elements' vertices) and the sweep blocks of one
+// piece.
+void XpbdSolver::cook_pieces(int n) {
   std::vector<int> parent(n);
   for (int i = 0; i < n; ++i) parent[i] = i;
   auto find = [&](int i) {
@@ -277,28 +292,19 @@ void XpbdSolver::cook(const Cloth& cloth) {
   for (size_t r = 0; r + 1 < row_off_.size(); ++r)
     for (int e = row_off_[r] + 1; e < row_off_[r + 1]; ++e)
       join(row_colv_[row_off_[r]], row_colv_[e]);
-  piece_of_.assign(n, -1);
+  std::vector<int> piece_of(n, -1);
   std::vector<int> id(n, -1);
-  num_pieces_ = 0;
+  int pieces = 0;
   for (int i = 0; i < n; ++i) {
     const int r = find(i);
-    if (id[r] < 0) id[r] = num_pieces_++;
-    piece_of_[i] = id[r];
+    if (id[r] < 0) id[r] = pieces++;
+    piece_of[i] = id[r];
   }
-  piece_rest_.assign(num_pieces_, 0);
-  piece_scale_.assign(num_pieces_, 1.0);
-  piece_slow_.assign(num_pieces_, 0);
-  piece_frozen_.assign(num_pieces_, 0);
-  piece_awake_.assign(num_pieces_, 0);
-  motion_.assign(num_pieces_, PieceMotion{});
-  fixed_prev_.assign(n, 0);
-  piece_full_.assign(num_pieces_, 0);
-  piece_coarse_.assign(num_pieces_, 0);
-  piece_finish_.assign(num_pieces_, 0);
   block_one_piece_.assign((n + kSweepBlock - 1) / kSweepBlock, 1);
   for (int i = 0; i < n; ++i)
-    if (piece_of_[i] != piece_of_[i / kSweepBlock * kSweepBlock])
+    if (piece_of[i] != piece_of[i / kSweepBlock * kSweepBlock])
       block_one_piece_[i / kSweepBlock] = 0;
+  rest_.reset(pieces, std::move(piece_of));
 }
 
 double XpbdSolver::cooked_bending_energy(const std::vector<Vec3>& x) const {
@@ -379,63 +385,18 @@ void XpbdSolver::build_sweep(int n) {
 }
 
 bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
-  auto& S = cloth.state;
-  const int n = cloth.num_vertices();
-  bool any_frozen = false;
-  for (int p = 0; p < num_pieces_; ++p) any_frozen = any_frozen || piece_frozen_[p];
-  if (!any_frozen) {  // also clears flags left by a cut (re-cook) or by another solver
-    for (int i = 0; i < n; ++i) S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
-    frozen_count_ = 0;
+  if (!rest_.any_frozen()) {  // also clears flags left by a cut (re-cook) or by another solver
+    rest_.thaw(cloth);
     return false;
   }
-  std::fill(piece_awake_.begin(), piece_awake_.end(), 0);
   fresh_penetration_ = energy_.detect_contacts(cloth, scene, pool_.get());
   if (scene.self_collision)
-    self_.detect(cloth, S.x, scene.offset, energy_.options().contact_margin);
+    self_.detect(cloth, cloth.state.x, scene.offset, energy_.options().contact_margin);
   ++detections_;           // (x_det_ is taken at the end, after the snap)
   contacts_fresh_ = true;  // the first substep reuses them (same positions)
-  for (int i = 0; i < n; ++i) {
-    const int p = piece_of_[i];
-    if (!piece_frozen_[p] || piece_awake_[p]) continue;
-    bool go;
-    if (!cloth.is_free(i))
-      go = (S.x[i] - S.x_prev[i]).squaredNorm() > 1e-18;  // a fixed vertex was moved
-    else if (!(S.flags[i] & kFlagFrozen))
-      go = true;  // released, or freed by a command
-    else {
-      const int ci = energy_.contact_of(i);
-      // Deeper than 0.1 mm inside a fresh contact plane: an object entered the shell. (A
-      // sleeping vertex rests on the plane it was last projected to; a fresh plane from the
-      // same surface can sit a few um off it, which must not wake the piece: measured, a 32^2
-      // drape fell asleep at 7.4 s and woke in the next frame.)
-      // A piece that fell asleep while settled crept along the form with stale planes and can
-      // rest ~0.3 mm inside a fresh one: it wakes only on the settling exit's 1 mm push
-      // (measured at 64^2: woken at once, it took its own mass back and sagged 45 mm).
-      const double depth = piece_scale_[p] > 1.0 ? 1e-3 : 1e-4;
-      go = ci >= 0 && energy_.contacts()[ci].n.dot(S.x[i] - energy_.contacts()[ci].p) < -depth;
-    }
-    if (go) piece_awake_[p] = 1;
-  }
-  bool all_frozen = true;
-  for (int p = 0; p < num_pieces_; ++p) {
-    if (piece_awake_[p]) {
-      piece_frozen_[p] = 0;
-      piece_rest_[p] = 0;
-      unsettle(p);
-    }
-    all_frozen = all_frozen && piece_frozen_[p];
-  }
-  frozen_count_ = 0;
-  for (int i = 0; i < n; ++i) {
-    if (!piece_frozen_[piece_of_[i]]) {
-      S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
-    } else if (S.flags[i] & kFlagFrozen) {
-      ++frozen_count_;
-      S.x_prev[i] = S.x[i];
-    }
-  }
+  const bool all_frozen = rest_.wake(cloth, energy_);
   snap_to_contacts(cloth);
-  x_det_ = S.x;
+  x_det_ = cloth.state.x;
   return all_frozen;
 }
 
@@ -456,894 +417,770 @@ void XpbdSolver::snap_onto(Cloth& cloth, const Contact& c) const {
   if (d < 0 && d > -lim) S.x[i] -= d * c.n;
 }
 
-void XpbdSolver::unsettle(int piece) {
-  w_dirty_ = true;
-  piece_scale_[piece] = 1.0;
-  piece_full_[piece] = 0;
-  piece_slow_[piece] = 0;
-  piece_coarse_[piece] = 0;
-  piece_finish_[piece] = 0;
-}
+// The names one step shares between its phases. Those of the frame are set once; those of the
+// substep (from s on) by detect_contacts() and plan_substep().
+struct XpbdSolver::Step {
+  Step(XpbdSolver& sol, Cloth& cl, const SceneObjects& sc, double frame)
+      : cloth(cl),
+        scene(sc),
+        S(cl.state),
+        x(cl.state.x),
+        n(cl.num_vertices()),
+        ns(std::max(1, sol.opt_.substeps)),
+        dt(frame),
+        h(frame / ns),
+        ih2(1.0 / (h * h)),
+        be(std::max(1, sol.opt_.bending_every)),
+        ihb(ih2 / be),
+        w(sol.w_.data()),
+        warm(sol.opt_.warm_start > 0),
+        keep_lambda(sol.opt_.iterations > 1 || warm),
+        padded(!sol.tris_.empty() || sol.row_off_.size() > 1),
+        wide_t(sol.tlanes_ == 16),
+        K(*sol.kern_),
+        xp(sol.xp_.data()),
+        xp8(sol.xp8_.data()),
+        lam_tri(keep_lambda ? sol.lambda_tri_.data() : nullptr),
+        lam_row(keep_lambda && !sol.lambda_row_.empty() ? sol.lambda_row_[0].data() : nullptr),
+        rp(sol.row_packs_.view()),
+        rp8(sol.row_packs8_.view()),
+        damp(std::exp(-sol.opt_.damping * h)),
+        damp_settle(std::exp(-sol.opt_.settle_damping * h)),
+        margin(sol.energy_.options().contact_margin),
+        moved_lim(0.25 * margin * margin),
+        slow2(sol.opt_.settle_speed * sol.opt_.settle_speed),
+        piece_of(sol.rest_.piece_of().data()),
+        scale(sol.rest_.scales().data()) {}
 
-void XpbdSolver::finish_sleeping(Cloth& cloth, const SceneObjects& scene) {
-  if (!opt_.finish || !opt_.freeze || scene.self_collision) return;
-  if (opt_.finish_thread) return finish_on_thread(cloth, scene);
-  bool any = false, fresh = false;
-  for (int p = 0; p < num_pieces_; ++p)
-    if (piece_frozen_[p] && piece_finish_[p] >= 0) {
-      any = true;
-      fresh = fresh || piece_finish_[p] == 0;
-    }
-  if (!any) return;
-  if (!finisher_) finisher_ = std::make_unique<EquilibriumFinisher>();
-  finisher_->options() = opt_.finisher;
-  if (fresh) {  // friction anchored where a piece fell asleep
-    sleeping_group(cloth, false);
-    finisher_->anchor(cloth, coarse_group_);
-  }
-  sleeping_group(cloth, true);
-  finish_last_ = finisher_->cycle(cloth, scene, coarse_group_, opt_.energy, pool_.get());
-  finish_ms_ += finish_last_.total_ms;
-  ++finish_cycles_;
-  const bool done = finish_last_.last_move < opt_.finisher.move_tolerance;
-  for (int p = 0; p < num_pieces_; ++p) {
-    if (!piece_frozen_[p] || piece_finish_[p] < 0) continue;
-    if (piece_finish_[p] == 0) ++finish_count_;
-    if (done || ++piece_finish_[p] >= opt_.finisher.cycles) piece_finish_[p] = -1;
-  }
-}
+  Cloth& cloth;
+  const SceneObjects& scene;
+  ClothState& S;
+  std::vector<Vec3>& x;
+  const int n, ns;  // vertices, substeps
+  const double dt, h, ih2;
+  // Bending blocks projected every be-th substep with compliance alpha / (be h^2): the same
+  // impulse per be substeps (multi-rate splitting; be = 1 is plain XPBD).
+  const int be;
+  const double ihb;
+  const double* w;  // inverse masses (w_)
+  const bool warm, keep_lambda;
+  const bool padded;  // triangles or bending blocks, in packs (the springs model has neither)
+  const bool wide_t;  // single-precision triangles sixteen per pack
+  const xpbd::Kernels& K;
+  xpbd::P4* xp;
+  xpbd::P4f* xp8;
+  double* lam_tri;
+  double* lam_row;
+  const xpbd::RowPacks rp;
+  const xpbd::RowPacksT<float> rp8;
+  const double damp, damp_settle;  // velocity damping per substep, own mass and settling
+  const double margin, moved_lim;  // contact margin, (half the margin)^2
+  const double slow2;              // settle_speed^2
+  const int* piece_of;             // per vertex (RestScheduler)
+  const double* scale;             // inertia scale per piece (RestScheduler)
+  StepStats st;
 
-void XpbdSolver::finish_on_thread(Cloth& cloth, const SceneObjects& scene) {
-  auto& S = cloth.state;
-  const int n = cloth.num_vertices();
-  if (!finish_thread_) finish_thread_ = std::make_unique<FinishThread>();
-  FinishThread& job = *finish_thread_;
-  if (job.busy()) {
-    // A piece's result is kept only while it sleeps on, untouched since the job started: not
-    // woken (unsettle() clears its mark), not re-cooked (a cut or sew: another version), and
-    // (checked when the job has ended) every vertex where it was, free or fixed as it was: a
-    // vertex pinned where it lay or a position set by an operation does not wake a piece.
-    const bool same = finish_version_ == cloth.topology_version &&
-                      static_cast<int>(job.group().size()) == n &&
-                      static_cast<int>(piece_finish_.size()) == num_pieces_;
-    piece_ok_.assign(num_pieces_, 0);
-    bool any = false;
-    for (int p = 0; p < num_pieces_ && same; ++p) {
-      piece_ok_[p] = piece_frozen_[p] && piece_finish_[p] == kFinishing;
-      any = any || piece_ok_[p];
-    }
-    if (!any) job.cancel();
-    if (!job.ended()) return;
-    finish_last_ = job.collect();
-    finish_ms_ += finish_last_.total_ms;
-    finish_cycles_ += finish_last_.cycles;
-    if (!job.completed()) std::fill(piece_ok_.begin(), piece_ok_.end(), 0);
-    const auto& g = job.group();
-    if (any && job.completed()) {
-      const auto& x0 = job.start_positions();
-      for (int i = 0; i < n; ++i)
-        if ((g[i] >= 0) != cloth.is_free(i) || S.x[i] != x0[i]) piece_ok_[piece_of_[i]] = 0;
-      const auto& xf = job.cloth().state.x;
-      for (int i = 0; i < n; ++i)
-        if (g[i] >= 0 && piece_ok_[g[i]]) {
-          S.x[i] = xf[i];
-          S.x_prev[i] = xf[i];
-          S.v[i].setZero();
-        }
-    }
-    bool dropped = false;
-    for (int p = 0; p < num_pieces_; ++p) {
-      if (piece_finish_[p] != kFinishing) continue;
-      if (piece_ok_[p]) {
-        piece_finish_[p] = -1;
-        ++finish_count_;
-      } else {
-        piece_finish_[p] = 0;  // asleep but not finished: a new job takes it
-        dropped = true;
-      }
-    }
-    if (dropped || !any) ++finish_dropped_;
-  }
-  // Pieces asleep and not finished yet: one job for all of them.
-  bool any = false;
-  for (int p = 0; p < num_pieces_ && !any; ++p) any = piece_frozen_[p] && piece_finish_[p] == 0;
-  if (!any) return;
-  sleeping_group(cloth, false);
-  job.set_nice(opt_.finish_nice);
-  job.start(cloth, scene, coarse_group_, opt_.energy, opt_.finisher);
-  finish_version_ = cloth.topology_version;
-  for (int p = 0; p < num_pieces_; ++p)
-    if (piece_frozen_[p] && piece_finish_[p] == 0) piece_finish_[p] = kFinishing;
-}
-
-void XpbdSolver::sleeping_group(const Cloth& cloth, bool started) {
-  const int n = cloth.num_vertices();
-  coarse_group_.resize(n);
-  for (int i = 0; i < n; ++i) {
-    const int p = piece_of_[i];
-    const bool in = piece_frozen_[p] && (started ? piece_finish_[p] >= 0 : piece_finish_[p] == 0);
-    coarse_group_[i] = cloth.is_free(i) && in ? p : -1;
-  }
-}
-
-void XpbdSolver::coarse_step(Cloth& cloth, const SceneObjects& scene) {
-  if (opt_.coarse_factor <= 0 || !opt_.settle || scene.self_collision) return;
-  // A piece is due when it is awake, at the full scale and not yet corrected this episode.
-  auto due = [&](int p) {
-    return !piece_frozen_[p] && piece_scale_[p] >= opt_.settle_mass_scale &&
-           piece_coarse_[p] < opt_.coarse_frames;
-  };
-  bool any = false;
-  for (int p = 0; p < num_pieces_ && !any; ++p) any = due(p);
-  if (!any) return;
-  auto& S = cloth.state;
-  const int n = cloth.num_vertices();
-  coarse_group_.resize(n);
-  for (int i = 0; i < n; ++i)
-    coarse_group_[i] = cloth.is_free(i) && due(piece_of_[i]) ? piece_of_[i] : -1;
-  if (!coarse_) coarse_ = std::make_unique<CoarseCorrection>();
-  coarse_->options() = opt_.coarse;
-  coarse_->options().factor = opt_.coarse_factor;
-  if (scene.friction > 0) {
-    energy_.set_friction(scene.friction, 1e-4, S.x);
-    energy_.lag_friction_load(S.x, S.mass);
-  }
-  coarse_last_ = coarse_->apply(cloth, energy_, coarse_group_, S.x);
-  energy_.clear_friction();
-  coarse_ms_ += coarse_last_.total_ms;
-  // Counted whether or not a step was taken (a piece the correction cannot improve is not
-  // tried again until it settles anew).
-  for (int p = 0; p < num_pieces_; ++p)
-    if (due(p)) ++piece_coarse_[p];
-  if (coarse_last_.applied) {
-    ++coarse_count_;
-    for (int i = 0; i < n; ++i)
-      if (coarse_group_[i] >= 0) S.v[i].setZero();
-  }
-}
-
-double XpbdSolver::settle_scale() const {
-  double m = 1.0;
-  for (double s : piece_scale_) m = std::max(m, s);
-  return m;
-}
+  int s = 0;              // the substep
+  bool copy_det = false;  // contacts detected: the prediction copies x to x_det_
+  bool gravity_only = true;
+  Vec3 gk = Vec3::Zero();  // gravity (zero when off)
+  bool fused = false;      // the substep runs as one sweep (sweep())
+  bool retest = false;     // the sweep tests moved vertices for contact again
+  bool test_moved = false;
+  bool settle_check = false;  // some piece settles
+  bool bending() const { return s % be == be - 1 || s == ns - 1; }
+};
 
 StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
-  StepStats st;
   if (!energy_.up_to_date(cloth) || opt_.single_precision != cooked_f32_ ||
       opt_.kernels != cooked_kernels_)
     cook(cloth);
-  w_dirty_ = true;  // pins, releases, wakes and finishes happen between frames
+  rest_.mark_masses_dirty();  // pins, releases, wakes and finishes happen between frames
   energy_.set_form(&scene);
-  auto& S = cloth.state;
-  auto& x = S.x;
-  const int n = cloth.num_vertices();
-  const int ns = std::max(1, opt_.substeps);
-  const double h = dt / ns;
-  const double ih2 = 1.0 / (h * h);
-  // Bending blocks projected every be-th substep with compliance alpha / (be h^2): the same
-  // impulse per be substeps (multi-rate splitting; be = 1 is plain XPBD).
-  const int be = std::max(1, opt_.bending_every);
-  const double ihb = ih2 / be;
+  Step c(*this, cloth, scene, dt);
+  if (!begin_frame(c)) return c.st;
+  renew_anchors(c);
+  for (c.s = 0; c.s < c.ns; ++c.s) substep(c);
+  if (contacts_unlisted_) {
+    energy_.list_contacts(c.n, pool_.get());
+    contacts_unlisted_ = false;
+  }
+  return c.st;
+}
+
+bool XpbdSolver::begin_frame(Step& c) {
   contacts_fresh_ = false;
   if (!opt_.freeze) {
-    for (int i = 0; i < n; ++i) S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
-    std::fill(piece_frozen_.begin(), piece_frozen_.end(), 0);
-    frozen_count_ = 0;
-  } else if (wake(cloth, scene)) {
+    rest_.thaw(c.cloth);
+  } else if (wake(c.cloth, c.scene)) {
     // Every piece sleeps and nothing disturbed it: nothing to compute this frame but the static
     // finish of pieces that have just fallen asleep.
-    finish_sleeping(cloth, scene);
-    for (int i = 0; i < n; ++i)
-      if (!cloth.is_free(i)) S.x_prev[i] = S.x[i];
-    S.time += dt;
-    return st;
+    rest_.finish_sleeping(c.cloth, c.scene, pool_.get());
+    for (int i = 0; i < c.n; ++i)
+      if (!c.cloth.is_free(i)) c.S.x_prev[i] = c.x[i];
+    c.S.time += c.dt;
+    return false;
   } else {
-    finish_sleeping(cloth, scene);  // pieces asleep while others move
+    rest_.finish_sleeping(c.cloth, c.scene, pool_.get());  // pieces asleep while others move
   }
-  if (opt_.settle) {
-    // A fixed vertex that moved since the last frame (pinched, dragged) or was let go ends its
-    // piece's settling.
-    for (int i = 0; i < n; ++i) {
-      const bool fixed = !cloth.is_free(i);
-      if (piece_scale_[piece_of_[i]] > 1.0 &&
-          ((fixed && (S.x[i] - S.x_prev[i]).squaredNorm() > 1e-18) || (fixed_prev_[i] && !fixed)))
-        unsettle(piece_of_[i]);
-      fixed_prev_[i] = fixed ? 1 : 0;
-    }
-  } else {
-    std::fill(piece_scale_.begin(), piece_scale_.end(), 1.0);
+  rest_.check_fixed(c.cloth);
+  return true;
+}
+
+// Single precision: the anchors are the positions at the start of a frame, renewed once a vertex
+// is more than kAnchorReach from its anchor (or after a cook); the elements' terms at the anchors
+// are summed in double then (xpbd_kernels.hpp, Kernels::tris8). A float resolves a displacement
+// of 5 cm to 3.7e-9 m; a cloth at rest keeps its anchors. (At 2 cm the falling 128^2 drape
+// renews them 75 times in 270 frames, 3 % of its time; at 5 cm 30, with the same error at rest
+// to 5 um.)
+void XpbdSolver::renew_anchors(Step& c) {
+  if (!cooked_f32_ || !c.padded) return;
+  const int n = c.n;
+  const auto& x = c.x;
+  const xpbd::Kernels& K = c.K;
+  const double* xd = reinterpret_cast<const double*>(x.data());
+  bool renew = anchors_.size() != static_cast<size_t>(3 * (n + scratch_slots_));
+  const double reach2 = kAnchorReach * kAnchorReach;
+  for (int i = 0; i < n && !renew; ++i)
+    renew = (x[i] - Vec3(anchors_[3 * i], anchors_[3 * i + 1], anchors_[3 * i + 2])).squaredNorm() >
+            reach2;
+  if (!renew) return;
+  anchors_.assign(xd, xd + 3 * n);
+  anchors_.resize(3 * (n + scratch_slots_), 0.0);  // the scratch vertices (their P4f: 0)
+  pool_->parallel_for(float_tri_packs(), [&](int b, int e, int) {
+    if (c.wide_t)
+      K.anchor_triangles16(tri_packs16_.data(), b, e, anchors_.data(), tri_anchor8_.data());
+    else
+      K.anchor_triangles(tri_packs8_.data(), b, e, anchors_.data(), tri_anchor8_.data());
+  });
+  pool_->parallel_for(row_packs8_.packs(), [&](int b, int e, int) {
+    K.anchor_rows(c.rp8, b, e, anchors_.data(), row_anchor8_.data());
+  });
+  ++anchor_renewals_;
+}
+
+void XpbdSolver::substep(Step& c) {
+  detect_contacts(c);
+  if (c.s == 0) rest_.coarse_step(c.cloth, c.scene, energy_);
+  contacts_fresh_ = false;
+  set_masses(c);
+  plan_substep(c);
+  if (!c.fused) pool_->parallel_for(c.n, [&](int b, int e, int) { predict(c, b, e); });
+  warm_start(c);
+  for (int it = 0; it < opt_.iterations && c.fused; ++it) {
+    sweep(c);
+    ++c.st.iterations;
   }
-  // w = the unscaled inverse mass (w0: 0 when not free or frozen) / the piece's settling scale.
-  // A change of w0 (a pin, a release, a piece falling asleep or waking) needs the bending blocks'
-  // sums over their stencils again; a change of scale alone does not (below).
-  auto set_w = [&] {
-    for (int i = 0; i < n; ++i) {
-      const double w0 = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
-      const double wi = w0 > 0 ? w0 / piece_scale_[piece_of_[i]] : 0.0;
+  collect_retests(c);
+  for (int it = 0; it < opt_.iterations && !c.fused; ++it) {
+    project_triangles(c);
+    project_bending_springs(c);
+    ++c.st.iterations;
+  }
+  if (!c.fused) pool_->parallel_for(c.n, [&](int b, int e, int wk) { velocities(c, b, e, wk); });
+  update_pieces(c);
+  schedule_rest(c);
+  c.S.time += c.h;
+  ++c.st.substeps;
+}
+
+void XpbdSolver::detect_contacts(Step& c) {
+  c.copy_det = false;
+  if (c.s == 0 && contacts_fresh_) c.st.max_penetration = fresh_penetration_;
+  bool detect = c.s == 0 ? !contacts_fresh_ : true;
+  if (c.s > 0 && opt_.reuse_contacts) {
+    // Some vertex more than half the margin from where contacts were last detected (tested per
+    // vertex in the previous substep's velocity loop, on the pool).
+    detect = false;
+    for (char m : moved_part_) detect = detect || m;
+  }
+  if (!detect) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  c.st.max_penetration =
+      std::max(c.st.max_penetration, energy_.detect_contacts(c.cloth, c.scene, pool_.get()));
+  if (c.scene.self_collision) self_.detect(c.cloth, c.x, c.scene.offset, c.margin);
+  rest_.unsettle_pushed(c.x, energy_);
+  snap_to_contacts(c.cloth);
+  x_det_.resize(c.n);
+  c.copy_det = true;  // x_det_ = x, in the prediction
+  ++detections_;
+  c.st.collision_ms +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// w = the unscaled inverse mass (w0: 0 when not free or frozen) / the piece's settling scale.
+// A change of w0 (a pin, a release, a piece falling asleep or waking) needs the bending blocks'
+// sums over their stencils again; a change of scale alone does not (build_row_inverses()).
+void XpbdSolver::set_masses(Step& c) {
+  if (rest_.masses_dirty()) {
+    const auto& S = c.S;
+    for (int i = 0; i < c.n; ++i) {
+      const double w0 = c.cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
+      const double wi = w0 > 0 ? w0 / c.scale[c.piece_of[i]] : 0.0;
       if (wi != w_[i]) w_changed_ = true;
       if (w0 != w0_[i]) w0_changed_ = true;
       w_[i] = wi;
       w0_[i] = w0;
     }
-  };
-  // The bending blocks' inverse system matrices (in row_packs_), for the current w and h:
-  // A = sum_j w_j v_j v_j^T + alpha / (be h^2). A block's stencil lies in one piece, so
-  // w_j = w0_j / scale and A = B / scale + alpha with B = sum_j w0_j v_j v_j^T, kept per block
-  // (row_b_) and summed again only when w0 changed.
-  auto build_row_inverses = [&](int b, int e, int) {
-    for (int r = b; r < e; ++r) {
-      double* B = &row_b_[6 * r];  // 00 01 02 11 12 22
-      if (w0_changed_) {
-        for (int m = 0; m < 6; ++m) B[m] = 0;
-        for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
-          const double wj = w0_[row_colv_[k]];
-          if (wj == 0) continue;
-          const double* v = &row_val_[3 * k];
-          B[0] += wj * v[0] * v[0];
-          B[1] += wj * v[0] * v[1];
-          B[2] += wj * v[0] * v[2];
-          B[3] += wj * v[1] * v[1];
-          B[4] += wj * v[1] * v[2];
-          B[5] += wj * v[2] * v[2];
-        }
-      }
-      const double is = row_off_[r + 1] > row_off_[r]
-                            ? 1.0 / piece_scale_[piece_of_[row_colv_[row_off_[r]]]]
-                            : 1.0;
-      double A[6];
-      for (int m = 0; m < 6; ++m) A[m] = B[m] * is;
-      double ai[6] = {0, 0, 0, 0, 0, 0};
-      auto store = [&] {
-        for (int m = 0; m < 6; ++m) {
-          if (cooked_f32_)
-            row_packs8_.ai_of(r, m) = static_cast<float>(ai[m]);
-          else
-            row_packs_.ai_of(r, m) = ai[m];
-        }
-      };
-      if (A[0] + A[3] + A[5] == 0) {  // every vertex of the block fixed
-        store();
-        continue;
-      }
-      A[0] += ihb * row_ik_[3 * r];
-      A[3] += ihb * row_ik_[3 * r + 1];
-      A[5] += ihb * row_ik_[3 * r + 2];
-      // Closed-form inverse of the symmetric positive definite 3x3 A.
-      const double c00 = A[3] * A[5] - A[4] * A[4];
-      const double c01 = A[2] * A[4] - A[1] * A[5];
-      const double c02 = A[1] * A[4] - A[2] * A[3];
-      const double det = A[0] * c00 + A[1] * c01 + A[2] * c02;
-      if (!(det > 0)) {
-        store();
-        continue;
-      }
-      const double id = 1.0 / det;
-      ai[0] = c00 * id;
-      ai[1] = c01 * id;
-      ai[2] = c02 * id;
-      ai[3] = (A[0] * A[5] - A[2] * A[2]) * id;
-      ai[4] = (A[2] * A[1] - A[0] * A[4]) * id;
-      ai[5] = (A[0] * A[3] - A[1] * A[1]) * id;
-      store();
-    }
-  };
-  const double* w = w_.data();
-  const bool warm = opt_.warm_start > 0;
-  const bool keep_lambda = opt_.iterations > 1 || warm;
-
-  // Triangles and bending blocks: the kernels of sim/solvers/xpbd/xpbd_kernels.hpp on the padded
-  // copy xp_.
-  xpbd::P4* xp = xp_.data();
-  const xpbd::Kernels& K = *kern_;
-  double* lam_tri = keep_lambda ? lambda_tri_.data() : nullptr;
-  double* lam_row = keep_lambda && !lambda_row_.empty() ? lambda_row_[0].data() : nullptr;
-  const xpbd::RowPacks rp = row_packs_.view();
-  auto project_tris = [&](int b, int e, int) { K.tris(tri_packs_.data(), b, e, xp, ih2, lam_tri); };
-  xpbd::P4f* xp8 = xp8_.data();
-  const bool wide_t = tlanes_ == 16;
-  const xpbd::RowPacksT<float> rp8 = row_packs8_.view();
-  auto project_tris8 = [&](int b, int e, int) {
-    if (wide_t)
-      K.tris16(tri_packs16_.data(), tri_anchor8_.data(), b, e, xp8, ih2, lam_tri);
-    else
-      K.tris8(tri_packs8_.data(), tri_anchor8_.data(), b, e, xp8, ih2, lam_tri);
-  };
-  auto project_rows8 = [&](int b, int e, int) {
-    K.rows8(rp8, row_anchor8_.data(), b, e, xp8, ihb, lam_row);
-  };
-  const bool padded = !tris_.empty() || row_off_.size() > 1;  // (the springs model has neither)
-  if (cooked_f32_ && padded) {
-    // Single precision: the anchors are the positions at the start of a frame, renewed once a
-    // vertex is more than kAnchorReach from its anchor (or after a cook); the elements' terms
-    // at the anchors are summed in double then (xpbd_kernels.hpp, Kernels::tris8). A float
-    // resolves a displacement of 5 cm to 3.7e-9 m; a cloth at rest keeps its anchors. (At 2 cm
-    // the falling 128^2 drape renewed them 75 times in 270 frames, 3 % of its time; at 5 cm 30,
-    // and its error at rest the same to 5 um.)
-    const double* xd = reinterpret_cast<const double*>(x.data());
-    bool renew = anchors_.size() != static_cast<size_t>(3 * (n + scratch_slots_));
-    const double reach2 = kAnchorReach * kAnchorReach;
-    for (int i = 0; i < n && !renew; ++i)
-      renew =
-          (x[i] - Vec3(anchors_[3 * i], anchors_[3 * i + 1], anchors_[3 * i + 2])).squaredNorm() >
-          reach2;
-    if (renew) {
-      anchors_.assign(xd, xd + 3 * n);
-      anchors_.resize(3 * (n + scratch_slots_), 0.0);  // the scratch vertices (their P4f: 0)
-      pool_->parallel_for(float_tri_packs(), [&](int b, int e, int) {
-        if (wide_t)
-          K.anchor_triangles16(tri_packs16_.data(), b, e, anchors_.data(), tri_anchor8_.data());
-        else
-          K.anchor_triangles(tri_packs8_.data(), b, e, anchors_.data(), tri_anchor8_.data());
-      });
-      pool_->parallel_for(row_packs8_.packs(), [&](int b, int e, int) {
-        K.anchor_rows(rp8, b, e, anchors_.data(), row_anchor8_.data());
-      });
-      ++anchor_renewals_;
-    }
+    rest_.masses_set();
   }
-  auto project_hinges = [&](int b, int e, int) {
-    for (int k = b; k < e; ++k) {
-      const Hinge& H = hinges_[k];
-      const double wq[4] = {w[H.v[0]], w[H.v[1]], w[H.v[2]], w[H.v[3]]};
-      double denom = ih2 * H.iw;
-      const double alpha = denom;
-      for (int q = 0; q < 4; ++q) denom += wq[q] * H.K[q] * H.K[q];
-      if (denom == alpha) continue;
-      const Vec3 C =
-          H.K[0] * x[H.v[0]] + H.K[1] * x[H.v[1]] + H.K[2] * x[H.v[2]] + H.K[3] * x[H.v[3]];
-      const Vec3 lam = keep_lambda ? lambda_hinge_[k] : Vec3::Zero();
-      const Vec3 dl = (-C - alpha * lam) / denom;
-      if (keep_lambda) lambda_hinge_[k] = lam + dl;
-      for (int q = 0; q < 4; ++q) x[H.v[q]] += (wq[q] * H.K[q]) * dl;
-    }
-  };
-  auto project_rows = [&](int b, int e, int) { K.rows(rp, b, e, xp, ihb, lam_row); };
-  // Spring k's unit direction (v0 - v1) and length; false when degenerate.
-  auto spring_dir = [&](const Spring& Sp, Vec3& nn, double& l) {
-    const Vec3 d = x[Sp.v[0]] - x[Sp.v[1]];
-    l = d.norm();
-    if (l < 1e-15) return false;
-    nn = d / l;
-    return true;
-  };
-  // Moves spring k's ends by w dl along nn (the constraint's gradient).
-  auto spring_move = [&](const Spring& Sp, const Vec3& nn, double dl) {
-    x[Sp.v[0]] += (w[Sp.v[0]] * dl) * nn;
-    x[Sp.v[1]] -= (w[Sp.v[1]] * dl) * nn;
-  };
-  auto project_springs = [&](int b, int e, int) {
-    for (int k = b; k < e; ++k) {
-      const Spring& Sp = springs_[k];
-      Vec3 nn;
-      double l;
-      if (!spring_dir(Sp, nn, l)) continue;
-      const double C = l - Sp.rest;
-      const double alpha = ih2 * Sp.ik;
-      const double denom = w[Sp.v[0]] + w[Sp.v[1]] + alpha;
-      if (denom < 1e-20 || denom == alpha) continue;
-      const double lam = keep_lambda ? lambda_spring_[k] : 0.0;
-      const double dl = (-C - alpha * lam) / denom;
-      if (keep_lambda) lambda_spring_[k] = lam + dl;
-      spring_move(Sp, nn, dl);
-    }
-  };
-  auto by_colour = [&](const std::vector<int>& off, auto& fn) {
-    for (size_t c = 0; c + 1 < off.size(); ++c) {
-      const int b = off[c], cnt = off[c + 1] - off[c];
-      pool_->parallel_for(cnt, [&](int lo, int hi, int wk) { fn(b + lo, b + hi, wk); });
-    }
-  };
-  // Packs (triangles, bending blocks): each thread runs its own share of a colour's packs, whose
-  // padding uses that share's scratch vertex.
-  auto by_colour_packs = [&](const std::vector<int>& off, auto& fn) {
-    const int S = scratch_slots_;
-    for (size_t c = 0; c + 1 < off.size(); ++c) {
-      const int b = off[c], cnt = off[c + 1] - off[c];
-      auto share = [&](int t, int wk) {
-        const int lo = b + xpbd::share_begin(cnt, t, S), hi = b + xpbd::share_begin(cnt, t + 1, S);
-        if (lo < hi) fn(lo, hi, wk);
-      };
-      if (sweep_parallel_ && pool_->size() == S)
-        pool_->parallel_slots(share);
-      else
-        for (int t = 0; t < S; ++t) share(t, 0);
-    }
-  };
+  if (!row_ik_.empty() && (w_changed_ || c.ihb != row_ai_h_)) {
+    row_b_.resize(row_ik_.size() * 2);  // 6 per block (3 rows)
+    pool_->parallel_for(static_cast<int>(row_ik_.size() / 3),
+                        [&](int b, int e, int) { build_row_inverses(c, b, e); });
+    row_ai_h_ = c.ihb;
+    w_changed_ = false;
+    w0_changed_ = false;
+  }
+}
 
-  // Warm start: apply the (scaled) multipliers of the previous substep as displacements.
-  auto warm_tris = [&](int b, int e, int) {
-    for (int k = b; k < e; ++k) {
-      const Tri& T = tris_[k];
-      const double wq[3] = {w[T.v[0]], w[T.v[1]], w[T.v[2]]};
-      const double* L = &lambda_tri_[3 * k];
-      if (wq[0] + wq[1] + wq[2] == 0 || (L[0] == 0 && L[1] == 0 && L[2] == 0)) continue;
-      const double* D = T.D;
-      const Vec3 fu = x[T.v[0]] * D[0] + x[T.v[1]] * D[2] + x[T.v[2]] * D[4];
-      const Vec3 fv = x[T.v[0]] * D[1] + x[T.v[1]] * D[3] + x[T.v[2]] * D[5];
-      for (int q = 0; q < 3; ++q) {
-        const Vec3 g = L[0] * D[2 * q] * fu + L[1] * D[2 * q + 1] * fv +
-                       L[2] * 0.5 * (D[2 * q] * fv + D[2 * q + 1] * fu);
-        x[T.v[q]] += wq[q] * g;
-      }
-    }
-  };
-  auto warm_hinges = [&](int b, int e, int) {
-    for (int k = b; k < e; ++k) {
-      const Hinge& H = hinges_[k];
-      for (int q = 0; q < 4; ++q) x[H.v[q]] += (w[H.v[q]] * H.K[q]) * lambda_hinge_[k];
-    }
-  };
-  auto warm_rows = [&](int b, int e, int) {
-    for (int r = b; r < e; ++r) {
-      const Vec3* lam = &lambda_row_[3 * r];
+// The bending blocks' inverse system matrices (in row_packs_), for the current w and h:
+// A = sum_j w_j v_j v_j^T + alpha / (be h^2). A block's stencil lies in one piece, so
+// w_j = w0_j / scale and A = B / scale + alpha with B = sum_j w0_j v_j v_j^T, kept per block
+// (row_b_) and summed again only when w0 changed.
+void XpbdSolver::build_row_inverses(const Step& c, int b, int e) {
+  for (int r = b; r < e; ++r) {
+    double* B = &row_b_[6 * r];  // 00 01 02 11 12 22
+    if (w0_changed_) {
+      for (int m = 0; m < 6; ++m) B[m] = 0;
       for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
-        const int j = row_colv_[k];
+        const double wj = w0_[row_colv_[k]];
+        if (wj == 0) continue;
         const double* v = &row_val_[3 * k];
-        x[j] += w[j] * (v[0] * lam[0] + v[1] * lam[1] + v[2] * lam[2]);
+        B[0] += wj * v[0] * v[0];
+        B[1] += wj * v[0] * v[1];
+        B[2] += wj * v[0] * v[2];
+        B[3] += wj * v[1] * v[1];
+        B[4] += wj * v[1] * v[2];
+        B[5] += wj * v[2] * v[2];
       }
     }
-  };
-  auto warm_springs = [&](int b, int e, int) {
-    for (int k = b; k < e; ++k) {
-      Vec3 nn;
-      double l;
-      if (spring_dir(springs_[k], nn, l)) spring_move(springs_[k], nn, lambda_spring_[k]);
+    const double is =
+        row_off_[r + 1] > row_off_[r] ? 1.0 / c.scale[c.piece_of[row_colv_[row_off_[r]]]] : 1.0;
+    double A[6];
+    for (int m = 0; m < 6; ++m) A[m] = B[m] * is;
+    double ai[6] = {0, 0, 0, 0, 0, 0};
+    auto store = [&] {
+      for (int m = 0; m < 6; ++m) {
+        if (cooked_f32_)
+          row_packs8_.ai_of(r, m) = static_cast<float>(ai[m]);
+        else
+          row_packs_.ai_of(r, m) = ai[m];
+      }
+    };
+    if (A[0] + A[3] + A[5] == 0) {  // every vertex of the block fixed
+      store();
+      continue;
     }
-  };
+    A[0] += c.ihb * row_ik_[3 * r];
+    A[3] += c.ihb * row_ik_[3 * r + 1];
+    A[5] += c.ihb * row_ik_[3 * r + 2];
+    // Closed-form inverse of the symmetric positive definite 3x3 A.
+    const double c00 = A[3] * A[5] - A[4] * A[4];
+    const double c01 = A[2] * A[4] - A[1] * A[5];
+    const double c02 = A[1] * A[4] - A[2] * A[3];
+    const double det = A[0] * c00 + A[1] * c01 + A[2] * c02;
+    if (!(det > 0)) {
+      store();
+      continue;
+    }
+    const double id = 1.0 / det;
+    ai[0] = c00 * id;
+    ai[1] = c01 * id;
+    ai[2] = c02 * id;
+    ai[3] = (A[0] * A[5] - A[2] * A[2]) * id;
+    ai[4] = (A[2] * A[1] - A[0] * A[4]) * id;
+    ai[5] = (A[0] * A[3] - A[1] * A[1]) * id;
+    store();
+  }
+}
 
-  const double damp = std::exp(-opt_.damping * h);
-  const double damp_settle = std::exp(-opt_.settle_damping * h);
-  const double margin = energy_.options().contact_margin;
-  const double moved_lim = 0.25 * margin * margin;  // (half the margin)^2
-  for (int s = 0; s < ns; ++s) {
-    bool copy_det = false;
-    if (s == 0 && contacts_fresh_) st.max_penetration = fresh_penetration_;
-    bool detect = s == 0 ? !contacts_fresh_ : true;
-    if (s > 0 && opt_.reuse_contacts) {
-      // Some vertex more than half the margin from where contacts were last detected (tested
-      // per vertex in the previous substep's velocity loop, on the pool).
-      detect = false;
-      for (char m : moved_part_) detect = detect || m;
+void XpbdSolver::plan_substep(Step& c) {
+  // Gravity alone is written out in the prediction (the same arithmetic as
+  // ClothEnergy::external_force); the pressure toward the form goes through it.
+  const EnergyOptions& eo = energy_.options();
+  c.gravity_only = !(eo.pressure > 0 && c.scene.form);
+  c.gk = eo.gravity ? eo.g : Vec3::Zero();
+  // The whole substep in one sweep (SweepPhase: the prediction with the packing, the elements,
+  // the unpacking with the contacts, velocities and motion sums) where it applies: single
+  // precision, one iteration, no warm start, no self-collision, bending in this substep.
+  c.fused = c.padded && cooked_f32_ && !sweep_.empty() && pool_->size() <= 2 &&
+            opt_.iterations == 1 && !c.warm && !c.scene.self_collision && hinges_.empty() &&
+            springs_.empty() && c.bending();
+  // With contacts reused, the sweep tests again each vertex that moved more than half the margin
+  // since its own last test (a detection of all vertices happens only at a frame's start);
+  // otherwise such a vertex makes the next substep detect all of them again. (Only when every
+  // substep runs the sweep, bending_every = 1: a substep outside it projects the energy's
+  // contact list, which lists the tested contacts only at the step's end.)
+  c.retest = c.fused && c.be == 1 && opt_.reuse_contacts && opt_.retest_contacts && c.s + 1 < c.ns;
+  c.test_moved = opt_.reuse_contacts && c.s + 1 < c.ns && !c.retest;
+  moved_part_.assign(pool_->size(), 0);
+  if (c.retest) {
+    retest_part_.assign(2, RetestPart{});
+    unsettle_mark_.assign(2 * static_cast<size_t>(rest_.num_pieces()), 0);
+  }
+  c.settle_check = opt_.settle && rest_.settle_scale() > 1.0;
+  if (c.fused && (opt_.settle || opt_.freeze))
+    block_motion_.resize((c.n + kSweepBlock - 1) / kSweepBlock);
+}
+
+// The substep's start positions go straight to x_prev (the velocity update reads them there, and
+// they are what x_prev holds after the step).
+void XpbdSolver::predict(const Step& c, int b, int e) {
+  const EnergyOptions& eo = energy_.options();
+  auto& S = c.S;
+  auto& x = c.x;
+  const double h = c.h;
+  const double* w = c.w;
+  if (c.copy_det) std::copy(x.begin() + b, x.begin() + e, x_det_.begin() + b);
+  for (int i = b; i < e; ++i) {
+    S.x_prev[i] = x[i];
+    if (!(w[i] > 0)) continue;
+    const double m = S.mass[i];
+    const Vec3 f = !c.gravity_only ? energy_.external_force(i, x[i], m)
+                   : eo.gravity    ? Vec3(m * eo.g)
+                                   : Vec3::Zero();
+    x[i] += h * S.v[i] + (h * h / (c.scale[c.piece_of[i]] * m)) * f;
+  }
+}
+
+// The same for sweep vertex block k = [b, e): the kernels' loop when it is of one piece and
+// gravity the only force.
+void XpbdSolver::block_predict(const Step& c, int k, int b, int e) {
+  if (!c.gravity_only || !block_one_piece_[k]) {
+    predict(c, b, e);
+    return;
+  }
+  auto& x = c.x;
+  if (c.copy_det) std::copy(x.begin() + b, x.begin() + e, x_det_.begin() + b);
+  c.K.predict(reinterpret_cast<double*>(x.data()), reinterpret_cast<double*>(c.S.x_prev.data()),
+              reinterpret_cast<const double*>(c.S.v.data()), c.w, c.S.mass.data(),
+              c.scale[c.piece_of[b]], c.h, c.gk.data(), b, e);
+}
+
+template <class Fn>
+void XpbdSolver::by_colour(const std::vector<int>& off, Fn&& fn) {
+  for (size_t c = 0; c + 1 < off.size(); ++c) {
+    const int b = off[c], cnt = off[c + 1] - off[c];
+    pool_->parallel_for(cnt, [&](int lo, int hi, int wk) { fn(b + lo, b + hi, wk); });
+  }
+}
+
+// Packs (triangles, bending blocks): each thread runs its own share of a colour's packs, whose
+// padding uses that share's scratch vertex.
+template <class Fn>
+void XpbdSolver::by_colour_packs(const std::vector<int>& off, Fn&& fn) {
+  const int S = scratch_slots_;
+  for (size_t c = 0; c + 1 < off.size(); ++c) {
+    const int b = off[c], cnt = off[c + 1] - off[c];
+    auto share = [&](int t, int wk) {
+      const int lo = b + xpbd::share_begin(cnt, t, S), hi = b + xpbd::share_begin(cnt, t + 1, S);
+      if (lo < hi) fn(lo, hi, wk);
+    };
+    if (sweep_parallel_ && pool_->size() == S)
+      pool_->parallel_slots(share);
+    else
+      for (int t = 0; t < S; ++t) share(t, 0);
+  }
+}
+
+// Warm start: the multipliers of the previous substep, scaled, applied as displacements; without
+// it the multipliers start from zero.
+void XpbdSolver::warm_start(Step& c) {
+  if (c.warm) {
+    const double h = c.h;
+    const double f = opt_.warm_start * (h_prev_ > 0 ? (h / h_prev_) * (h / h_prev_) : 0.0);
+    for (double& l : lambda_tri_) l *= f;
+    for (Vec3& l : lambda_hinge_) l *= f;
+    for (Vec3& l : lambda_row_) l *= f;
+    for (double& l : lambda_spring_) l *= f;
+    h_prev_ = h;
+    by_colour(tri_col_, [&](int b, int e, int) { warm_tris(c, b, e); });
+    by_colour(hinge_col_, [&](int b, int e, int) { warm_hinges(c, b, e); });
+    by_colour(row_cols_, [&](int b, int e, int) { warm_rows(c, b, e); });
+    by_colour(spring_col_, [&](int b, int e, int) { warm_springs(c, b, e); });
+  } else if (c.keep_lambda) {
+    std::fill(lambda_tri_.begin(), lambda_tri_.end(), 0.0);
+    std::fill(lambda_hinge_.begin(), lambda_hinge_.end(), Vec3::Zero());
+    std::fill(lambda_row_.begin(), lambda_row_.end(), Vec3::Zero());
+    std::fill(lambda_spring_.begin(), lambda_spring_.end(), 0.0);
+  }
+}
+
+void XpbdSolver::warm_tris(const Step& c, int b, int e) {
+  auto& x = c.x;
+  const double* w = c.w;
+  for (int k = b; k < e; ++k) {
+    const Tri& T = tris_[k];
+    const double wq[3] = {w[T.v[0]], w[T.v[1]], w[T.v[2]]};
+    const double* L = &lambda_tri_[3 * k];
+    if (wq[0] + wq[1] + wq[2] == 0 || (L[0] == 0 && L[1] == 0 && L[2] == 0)) continue;
+    const double* D = T.D;
+    const Vec3 fu = x[T.v[0]] * D[0] + x[T.v[1]] * D[2] + x[T.v[2]] * D[4];
+    const Vec3 fv = x[T.v[0]] * D[1] + x[T.v[1]] * D[3] + x[T.v[2]] * D[5];
+    for (int q = 0; q < 3; ++q) {
+      const Vec3 g = L[0] * D[2 * q] * fu + L[1] * D[2 * q + 1] * fv +
+                     L[2] * 0.5 * (D[2 * q] * fv + D[2 * q + 1] * fu);
+      x[T.v[q]] += wq[q] * g;
     }
-    if (detect) {
-      const auto t0 = std::chrono::steady_clock::now();
-      st.max_penetration =
-          std::max(st.max_penetration, energy_.detect_contacts(cloth, scene, pool_.get()));
-      if (scene.self_collision) self_.detect(cloth, x, scene.offset, margin);
-      if (opt_.settle && settle_scale() > 1.0) {
-        // Something pushed into a settling piece (kUnsettleDepth). (The contacts are listed in
-        // vertex order.)
-        for (const Contact& c : energy_.contacts()) {
-          const int i = c.vertex;
-          if (piece_scale_[piece_of_[i]] > 1.0 && c.n.dot(x[i] - c.p) < -kUnsettleDepth)
-            unsettle(piece_of_[i]);
-        }
-      }
-      snap_to_contacts(cloth);
-      x_det_.resize(n);
-      copy_det = true;  // x_det_ = x, in the prediction loop below
-      ++detections_;
-      st.collision_ms +=
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+}
+
+void XpbdSolver::warm_hinges(const Step& c, int b, int e) {
+  for (int k = b; k < e; ++k) {
+    const Hinge& H = hinges_[k];
+    for (int q = 0; q < 4; ++q) c.x[H.v[q]] += (c.w[H.v[q]] * H.K[q]) * lambda_hinge_[k];
+  }
+}
+
+void XpbdSolver::warm_rows(const Step& c, int b, int e) {
+  for (int r = b; r < e; ++r) {
+    const Vec3* lam = &lambda_row_[3 * r];
+    for (int k = row_off_[r]; k < row_off_[r + 1]; ++k) {
+      const int j = row_colv_[k];
+      const double* v = &row_val_[3 * k];
+      c.x[j] += c.w[j] * (v[0] * lam[0] + v[1] * lam[1] + v[2] * lam[2]);
     }
-    if (s == 0) coarse_step(cloth, scene);
-    contacts_fresh_ = false;
-    if (w_dirty_) {
-      set_w();
-      w_dirty_ = false;
+  }
+}
+
+namespace {
+
+// Spring Sp's unit direction (v0 - v1) and length; false when degenerate.
+template <class Spring>
+inline bool spring_dir(const std::vector<Vec3>& x, const Spring& Sp, Vec3& nn, double& l) {
+  const Vec3 d = x[Sp.v[0]] - x[Sp.v[1]];
+  l = d.norm();
+  if (l < 1e-15) return false;
+  nn = d / l;
+  return true;
+}
+
+// Moves spring Sp's ends by w dl along nn (the constraint's gradient).
+template <class Spring>
+inline void spring_move(std::vector<Vec3>& x, const double* w, const Spring& Sp, const Vec3& nn,
+                        double dl) {
+  x[Sp.v[0]] += (w[Sp.v[0]] * dl) * nn;
+  x[Sp.v[1]] -= (w[Sp.v[1]] * dl) * nn;
+}
+
+}  // namespace
+
+void XpbdSolver::warm_springs(const Step& c, int b, int e) {
+  for (int k = b; k < e; ++k) {
+    Vec3 nn;
+    double l;
+    if (spring_dir(c.x, springs_[k], nn, l))
+      spring_move(c.x, c.w, springs_[k], nn, lambda_spring_[k]);
+  }
+}
+
+// Triangles and bending blocks in single precision: the kernels of xpbd_kernels.hpp on the
+// padded copy xp8_.
+void XpbdSolver::project_tris8(const Step& c, int b, int e) {
+  if (c.wide_t)
+    c.K.tris16(tri_packs16_.data(), tri_anchor8_.data(), b, e, c.xp8, c.ih2, c.lam_tri);
+  else
+    c.K.tris8(tri_packs8_.data(), tri_anchor8_.data(), b, e, c.xp8, c.ih2, c.lam_tri);
+}
+
+void XpbdSolver::project_rows8(const Step& c, int b, int e) {
+  c.K.rows8(c.rp8, row_anchor8_.data(), b, e, c.xp8, c.ihb, c.lam_row);
+}
+
+// One iteration's triangles and (in a bending substep) bending blocks: the positions packed, the
+// packs projected colour by colour, the positions unpacked.
+void XpbdSolver::project_triangles(const Step& c) {
+  const int n = c.n;
+  const xpbd::Kernels& K = c.K;
+  double* x = reinterpret_cast<double*>(c.x.data());
+  if (c.padded && cooked_f32_) {
+    pool_->parallel_for(n,
+                        [&](int b, int e, int) { K.pack8(x, c.w, anchors_.data(), c.xp8, b, e); });
+    by_colour_packs(tpack8_col_, [&](int b, int e, int) { project_tris8(c, b, e); });
+    if (c.bending())
+      by_colour_packs(rpack8_col_, [&](int b, int e, int) { project_rows8(c, b, e); });
+    pool_->parallel_for(n, [&](int b, int e, int) { K.unpack8(c.xp8, anchors_.data(), x, b, e); });
+  } else if (c.padded) {
+    pool_->parallel_for(n, [&](int b, int e, int) { K.pack(x, c.w, c.xp, b, e); });
+    by_colour_packs(tpack_col_, [&](int b, int e, int) {
+      K.tris(tri_packs_.data(), b, e, c.xp, c.ih2, c.lam_tri);
+    });
+    if (c.bending())
+      by_colour_packs(rpack_col_,
+                      [&](int b, int e, int) { K.rows(c.rp, b, e, c.xp, c.ihb, c.lam_row); });
+    pool_->parallel_for(n, [&](int b, int e, int) { K.unpack(c.xp, x, b, e); });
+  }
+}
+
+// The rest of an iteration: hinges, springs, contacts and self-collision. (Hinges exist only
+// without bending blocks: the order of the two does not matter.)
+void XpbdSolver::project_bending_springs(Step& c) {
+  by_colour(hinge_col_, [&](int b, int e, int) { project_hinges(c, b, e); });
+  by_colour(spring_col_, [&](int b, int e, int) { project_springs(c, b, e); });
+  energy_.project_contacts(c.x, &c.S.x_prev, c.scene.friction);
+  if (c.scene.self_collision) self_.project(c.cloth, c.x, c.w, c.scene.offset);
+}
+
+void XpbdSolver::project_hinges(const Step& c, int b, int e) {
+  auto& x = c.x;
+  const double* w = c.w;
+  for (int k = b; k < e; ++k) {
+    const Hinge& H = hinges_[k];
+    const double wq[4] = {w[H.v[0]], w[H.v[1]], w[H.v[2]], w[H.v[3]]};
+    double denom = c.ih2 * H.iw;
+    const double alpha = denom;
+    for (int q = 0; q < 4; ++q) denom += wq[q] * H.K[q] * H.K[q];
+    if (denom == alpha) continue;
+    const Vec3 C =
+        H.K[0] * x[H.v[0]] + H.K[1] * x[H.v[1]] + H.K[2] * x[H.v[2]] + H.K[3] * x[H.v[3]];
+    const Vec3 lam = c.keep_lambda ? lambda_hinge_[k] : Vec3::Zero();
+    const Vec3 dl = (-C - alpha * lam) / denom;
+    if (c.keep_lambda) lambda_hinge_[k] = lam + dl;
+    for (int q = 0; q < 4; ++q) x[H.v[q]] += (wq[q] * H.K[q]) * dl;
+  }
+}
+
+void XpbdSolver::project_springs(const Step& c, int b, int e) {
+  const double* w = c.w;
+  for (int k = b; k < e; ++k) {
+    const Spring& Sp = springs_[k];
+    Vec3 nn;
+    double l;
+    if (!spring_dir(c.x, Sp, nn, l)) continue;
+    const double C = l - Sp.rest;
+    const double alpha = c.ih2 * Sp.ik;
+    const double denom = w[Sp.v[0]] + w[Sp.v[1]] + alpha;
+    if (denom < 1e-20 || denom == alpha) continue;
+    const double lam = c.keep_lambda ? lambda_spring_[k] : 0.0;
+    const double dl = (-C - alpha * lam) / denom;
+    if (c.keep_lambda) lambda_spring_[k] = lam + dl;
+    spring_move(c.x, w, Sp, nn, dl);
+  }
+}
+
+// Vertex i moved more than half the margin since its last contact test, and more than its
+// clearance then (ClothEnergy::clearance2: short of it a test finds nothing).
+bool XpbdSolver::moved_beyond(const Step& c, int i) const {
+  const double m2 = (c.x[i] - x_det_[i]).squaredNorm();
+  return m2 > c.moved_lim && m2 > energy_.clearance2(i);
+}
+
+// Vertices [b, e) that moved beyond their last test are tested again as contact detection tests
+// them; then as after a detection, a settling piece pushed more than kUnsettleDepth into a fresh
+// plane ends its settling (unsettle_mark_), a vertex up to contact_snap_depth inside it is put
+// on it, and the test's position is kept (x_det_).
+void XpbdSolver::retest_moved(const Step& c, int b, int e, int slot) {
+  RetestPart& rp = retest_part_[slot];
+  const int pieces = rest_.num_pieces();
+  for (int i = b; i < e; ++i) {
+    if (!moved_beyond(c, i)) continue;
+    rp.deepest = std::max(rp.deepest, energy_.retest_contact(c.cloth, c.scene, i));
+    ++rp.count;
+    const Contact& ct = energy_.tested_contact(i);
+    if (ct.vertex >= 0) {
+      if (c.settle_check && ct.n.dot(c.x[i] - ct.p) < -xpbd::kUnsettleDepth &&
+          c.scale[c.piece_of[i]] > 1.0)
+        unsettle_mark_[static_cast<size_t>(slot) * pieces + c.piece_of[i]] = 1;
+      snap_onto(c.cloth, ct);
     }
-    if (!row_ik_.empty() && (w_changed_ || ihb != row_ai_h_)) {
-      row_b_.resize(row_ik_.size() * 2);  // 6 per block (3 rows)
-      pool_->parallel_for(static_cast<int>(row_ik_.size() / 3), build_row_inverses);
-      row_ai_h_ = ihb;
-      w_changed_ = false;
-      w0_changed_ = false;
-    }
-    // The substep's start positions go straight to x_prev (the velocity update reads them there,
-    // and they are what x_prev holds after the step). Gravity alone is written out here (the same
-    // arithmetic as ClothEnergy::external_force); the pressure toward the form goes through it.
-    const EnergyOptions& eo = energy_.options();
-    const bool gravity_only = !(eo.pressure > 0 && scene.form);
-    auto predict = [&](int b, int e) {
-      if (copy_det) std::copy(x.begin() + b, x.begin() + e, x_det_.begin() + b);
-      for (int i = b; i < e; ++i) {
-        S.x_prev[i] = x[i];
-        if (!(w[i] > 0)) continue;
-        const double m = S.mass[i];
-        const Vec3 f = !gravity_only ? energy_.external_force(i, x[i], m)
-                       : eo.gravity  ? Vec3(m * eo.g)
-                                     : Vec3::Zero();
-        x[i] += h * S.v[i] + (h * h / (piece_scale_[piece_of_[i]] * m)) * f;
+    x_det_[i] = c.x[i];
+  }
+}
+
+// The contact-reuse test: some vertex of [b, e) moved beyond its last test (moved_part_, per
+// thread).
+void XpbdSolver::test_moved_part(const Step& c, int b, int e, int wk) {
+  if (c.test_moved && !moved_part_[wk])
+    for (int i = b; i < e; ++i)
+      if (moved_beyond(c, i)) {
+        moved_part_[wk] = 1;
+        break;
       }
-    };
-    // The same for sweep vertex block k = [b, e): the kernels' loop when it is of one piece and
-    // gravity the only force.
-    const Vec3 gk = eo.gravity ? eo.g : Vec3::Zero();
-    auto block_predict = [&](int k, int b, int e) {
-      if (!gravity_only || !block_one_piece_[k]) {
-        predict(b, e);
-        return;
+}
+
+// Velocities from the substep's motion, and the contact-reuse test.
+void XpbdSolver::velocities(const Step& c, int b, int e, int wk) {
+  auto& S = c.S;
+  auto& x = c.x;
+  const double* w = c.w;
+  for (int i = b; i < e; ++i) {
+    if (w[i] > 0)
+      S.v[i] =
+          ((c.scale[c.piece_of[i]] > 1.0 ? c.damp_settle : c.damp) / c.h) * (x[i] - S.x_prev[i]);
+    else if (S.flags[i] & kFlagFrozen)
+      S.v[i].setZero();
+  }
+  test_moved_part(c, b, e, wk);
+}
+
+// The same for sweep vertex block k = [b, e): the kernels' loop when it is of one piece.
+void XpbdSolver::block_velocities(const Step& c, int k, int b, int e, int wk) {
+  if (!block_one_piece_[k]) {
+    velocities(c, b, e, wk);
+    return;
+  }
+  auto& S = c.S;
+  c.K.velocities(reinterpret_cast<const double*>(c.x.data()),
+                 reinterpret_cast<const double*>(S.x_prev.data()),
+                 reinterpret_cast<double*>(S.v.data()), c.w, S.flags.data(), kFlagFrozen,
+                 c.scale[c.piece_of[b]] > 1.0 ? c.damp_settle : c.damp, c.h, b, e);
+  test_moved_part(c, b, e, wk);
+}
+
+// Sweep vertex block k: the pieces' motion sums over its free vertices (xpbd::PieceMotion), one
+// run per stretch of vertices of one piece.
+void XpbdSolver::block_motion(const Step& c, int k, int b, int e) {
+  auto& runs = block_motion_[k];
+  const auto& S = c.S;
+  const double* w = c.w;
+  runs.clear();
+  if (block_one_piece_[k]) {
+    double sums[4];
+    if (c.K.motion(reinterpret_cast<const double*>(S.v.data()), w, S.mass.data(), c.slow2, b, e,
+                   sums) > 0)
+      runs.push_back({c.piece_of[b], xpbd::PieceMotion{sums[0], sums[1], sums[2], sums[3]}});
+    return;
+  }
+  for (int i = b; i < e; ++i) {
+    if (!(w[i] > 0)) continue;
+    if (runs.empty() || runs.back().first != c.piece_of[i]) runs.push_back({c.piece_of[i], {}});
+    xpbd::PieceMotion& acc = runs.back().second;
+    const double v2 = S.v[i].squaredNorm(), m = S.mass[i];
+    acc.max_v2 = std::max(acc.max_v2, v2);
+    acc.mv2 += m * v2;
+    acc.mv2_capped += m * std::min(v2, c.slow2);
+    acc.m += m;
+  }
+}
+
+// The element sweep (SweepPhase): items [b, e) of phase P.
+void XpbdSolver::sweep_items(const Step& c, const SweepPhase& P, int b, int e, int slot) {
+  if (b >= e) return;
+  const int n = c.n;
+  const xpbd::Kernels& K = c.K;
+  double* x = reinterpret_cast<double*>(c.x.data());
+  switch (P.kind) {
+    case kSweepPack:
+      for (int k = b; k < e; ++k) {
+        const int vb = k * kSweepBlock, ve = std::min(n, vb + kSweepBlock);
+        block_predict(c, k, vb, ve);
+        K.pack8(x, c.w, anchors_.data(), c.xp8, vb, ve);
       }
-      if (copy_det) std::copy(x.begin() + b, x.begin() + e, x_det_.begin() + b);
-      K.predict(reinterpret_cast<double*>(x.data()), reinterpret_cast<double*>(S.x_prev.data()),
-                reinterpret_cast<const double*>(S.v.data()), w, S.mass.data(),
-                piece_scale_[piece_of_[b]], h, gk.data(), b, e);
-    };
-    // The whole substep in one sweep (SweepPhase: the prediction with the packing, the elements,
-    // the unpacking with the contacts, velocities and motion sums) where it applies: single
-    // precision, one iteration, no warm start, no self-collision, bending in this substep.
-    const bool fused = padded && cooked_f32_ && !sweep_.empty() && pool_->size() <= 2 &&
-                       opt_.iterations == 1 && !warm && !scene.self_collision && hinges_.empty() &&
-                       springs_.empty() && (s % be == be - 1 || s == ns - 1);
-    // With contacts reused, the sweep tests again each vertex that moved more than half the
-    // margin since its own last test (a detection of all vertices happens only at a frame's
-    // start); otherwise such a vertex makes the next substep detect all of them again. (Only
-    // when every substep runs the sweep, bending_every = 1: a substep outside it projects the
-    // energy's contact list, which lists the tested contacts only at the step's end.)
-    const bool retest =
-        fused && be == 1 && opt_.reuse_contacts && opt_.retest_contacts && s + 1 < ns;
-    const bool test_moved = opt_.reuse_contacts && s + 1 < ns && !retest;
-    moved_part_.assign(pool_->size(), 0);
-    if (retest) {
-      retest_part_.assign(2, RetestPart{});
-      unsettle_mark_.assign(2 * static_cast<size_t>(num_pieces_), 0);
-    }
-    const bool settle_check = opt_.settle && settle_scale() > 1.0;
-    // Vertices [b, e) that moved more than half the margin since their last test, and more than
-    // their clearance then (ClothEnergy::clearance2: short of it a test finds nothing): tested
-    // again as contact detection tests them; then as after a detection, a settling piece pushed
-    // more than kUnsettleDepth into a fresh plane ends its settling (unsettle_mark_), a vertex up
-    // to contact_snap_depth inside it is put on it, and the test's position is kept (x_det_).
-    auto moved_beyond = [&](int i) {
-      const double m2 = (x[i] - x_det_[i]).squaredNorm();
-      return m2 > moved_lim && m2 > energy_.clearance2(i);
-    };
-    auto retest_moved = [&](int b, int e, int slot) {
-      RetestPart& rp = retest_part_[slot];
-      for (int i = b; i < e; ++i) {
-        if (!moved_beyond(i)) continue;
-        rp.deepest = std::max(rp.deepest, energy_.retest_contact(cloth, scene, i));
-        ++rp.count;
-        const Contact& c = energy_.tested_contact(i);
-        if (c.vertex >= 0) {
-          if (settle_check && c.n.dot(x[i] - c.p) < -kUnsettleDepth &&
-              piece_scale_[piece_of_[i]] > 1.0)
-            unsettle_mark_[static_cast<size_t>(slot) * num_pieces_ + piece_of_[i]] = 1;
-          snap_onto(cloth, c);
-        }
-        x_det_[i] = x[i];
+      break;
+    case kSweepTris:
+      project_tris8(c, b, e);
+      break;
+    case kSweepRows:
+      project_rows8(c, b, e);
+      break;
+    default:
+      for (int k = b; k < e; ++k) {
+        const int vb = k * kSweepBlock, ve = std::min(n, vb + kSweepBlock);
+        K.unpack8(c.xp8, anchors_.data(), x, vb, ve);
+        energy_.project_tested_contacts(c.x, &c.S.x_prev, c.scene.friction, vb, ve);
+        block_velocities(c, k, vb, ve, slot);
+        if (opt_.settle || opt_.freeze) block_motion(c, k, vb, ve);
+        if (c.retest) retest_moved(c, vb, ve, slot);
       }
-    };
-    // The contact-reuse test (some vertex of [b, e) more than half the margin, and more than its
-    // clearance, from where it was last tested: moved_part_, per thread).
-    auto test_moved_part = [&](int b, int e, int wk) {
-      if (test_moved && !moved_part_[wk])
-        for (int i = b; i < e; ++i)
-          if (moved_beyond(i)) {
-            moved_part_[wk] = 1;
-            break;
-          }
-    };
-    // Velocities from the substep's motion, and the contact-reuse test.
-    auto velocities = [&](int b, int e, int wk) {
-      for (int i = b; i < e; ++i) {
-        if (w[i] > 0)
-          S.v[i] =
-              ((piece_scale_[piece_of_[i]] > 1.0 ? damp_settle : damp) / h) * (x[i] - S.x_prev[i]);
-        else if (S.flags[i] & kFlagFrozen)
-          S.v[i].setZero();
-      }
-      test_moved_part(b, e, wk);
-    };
-    // The same for sweep vertex block k = [b, e): the kernels' loop when it is of one piece.
-    auto block_velocities = [&](int k, int b, int e, int wk) {
-      if (!block_one_piece_[k]) {
-        velocities(b, e, wk);
-        return;
-      }
-      K.velocities(reinterpret_cast<const double*>(x.data()),
-                   reinterpret_cast<const double*>(S.x_prev.data()),
-                   reinterpret_cast<double*>(S.v.data()), w, S.flags.data(), kFlagFrozen,
-                   piece_scale_[piece_of_[b]] > 1.0 ? damp_settle : damp, h, b, e);
-      test_moved_part(b, e, wk);
-    };
-    // Per sweep vertex block k: the pieces' motion sums over its free vertices (PieceMotion),
-    // one run per stretch of vertices of one piece.
-    const double slow2 = opt_.settle_speed * opt_.settle_speed;
-    if (fused && (opt_.settle || opt_.freeze))
-      block_motion_.resize((n + kSweepBlock - 1) / kSweepBlock);
-    auto block_motion = [&](int k, int b, int e) {
-      auto& runs = block_motion_[k];
-      runs.clear();
-      if (block_one_piece_[k]) {
-        double sums[4];
-        if (K.motion(reinterpret_cast<const double*>(S.v.data()), w, S.mass.data(), slow2, b, e,
-                     sums) > 0)
-          runs.push_back({piece_of_[b], PieceMotion{sums[0], sums[1], sums[2], sums[3]}});
-        return;
-      }
-      for (int i = b; i < e; ++i) {
-        if (!(w[i] > 0)) continue;
-        if (runs.empty() || runs.back().first != piece_of_[i]) runs.push_back({piece_of_[i], {}});
-        PieceMotion& acc = runs.back().second;
-        const double v2 = S.v[i].squaredNorm(), m = S.mass[i];
-        acc.max_v2 = std::max(acc.max_v2, v2);
-        acc.mv2 += m * v2;
-        acc.mv2_capped += m * std::min(v2, slow2);
-        acc.m += m;
-      }
-    };
-    // The element sweep (SweepPhase): items [b, e) of phase P.
-    auto sweep_items = [&](const SweepPhase& P, int b, int e, int slot) {
-      if (b >= e) return;
-      switch (P.kind) {
-        case kSweepPack:
-          for (int k = b; k < e; ++k) {
-            const int vb = k * kSweepBlock, ve = std::min(n, vb + kSweepBlock);
-            block_predict(k, vb, ve);
-            K.pack8(reinterpret_cast<const double*>(x.data()), w, anchors_.data(), xp8, vb, ve);
-          }
-          break;
-        case kSweepTris:
-          project_tris8(b, e, 0);
-          break;
-        case kSweepRows:
-          project_rows8(b, e, 0);
-          break;
-        default:
-          for (int k = b; k < e; ++k) {
-            const int vb = k * kSweepBlock, ve = std::min(n, vb + kSweepBlock);
-            K.unpack8(xp8, anchors_.data(), reinterpret_cast<double*>(x.data()), vb, ve);
-            energy_.project_tested_contacts(x, &S.x_prev, scene.friction, vb, ve);
-            block_velocities(k, vb, ve, slot);
-            if (opt_.settle || opt_.freeze) block_motion(k, vb, ve);
-            if (retest) retest_moved(vb, ve, slot);
-          }
-      }
-    };
-    auto sweep = [&] {
-      const int np = static_cast<int>(sweep_.size());
-      if (!sweep_parallel_) {
-        for (const SweepPhase& P : sweep_) sweep_items(P, P.b, P.e, 0);
-        return;
-      }
-      ++sweeps_;
-      sweep_done_[0].store(0, std::memory_order_relaxed);
-      sweep_done_[1].store(0, std::memory_order_relaxed);
-      sweep_owner_.store(-1, std::memory_order_relaxed);
-      int phase[2] = {0, 0}, stage[2] = {0, 0};  // where each slot is
-      bool taken_over = false;
-      // Runs slot t until it is done, or (wait = false) until it would wait for the other slot.
-      // With wait, slot 0 takes slot 1 over when nobody has claimed it (a worker not scheduled).
-      auto run_slot = [&](int t, bool wait) {
-        const int o = 1 - t;
-        auto ready = [&](int q) {
-          if (q <= 0 || sweep_done_[o].load(std::memory_order_acquire) >= q) return true;
-          if (!wait) return false;
-          for (int spin = 0;; ++spin) {
-            if (sweep_done_[o].load(std::memory_order_acquire) >= q) return true;
-            if (t == 0) {
-              int nobody = -1;
-              if (sweep_owner_.load(std::memory_order_relaxed) == -1 &&
-                  sweep_owner_.compare_exchange_strong(nobody, 0, std::memory_order_acq_rel)) {
-                taken_over = true;
-                return false;
-              }
-            }
-            if (spin > 256) std::this_thread::yield();
-          }
-        };
-        while (phase[t] < np) {
-          const SweepPhase& P = sweep_[phase[t]];
-          const int mb = P.b + P.half;  // slot 1's first item
-          if (stage[t] == 0) {
-            if (!ready(phase[t] - 1)) return;
-            if (t == 0)
-              sweep_items(P, P.b, P.b + P.safe[0], t);
-            else
-              sweep_items(P, P.e - P.safe[1], P.e, t);
-            stage[t] = 1;
-          }
-          const int rb = t == 0 ? P.b + P.safe[0] : mb, re = t == 0 ? mb : P.e - P.safe[1];
-          if (rb < re) {
-            if (!ready(phase[t])) return;
-            sweep_items(P, rb, re, t);
-          }
-          stage[t] = 0;
-          sweep_done_[t].store(++phase[t], std::memory_order_release);
-        }
-      };
-      pool_->parallel_slots([&](int slot, int wk) {
-        if (slot == 1) {
+  }
+}
+
+void XpbdSolver::sweep(const Step& c) {
+  const int np = static_cast<int>(sweep_.size());
+  if (!sweep_parallel_) {
+    for (const SweepPhase& P : sweep_) sweep_items(c, P, P.b, P.e, 0);
+    return;
+  }
+  ++sweeps_;
+  sweep_done_[0].store(0, std::memory_order_relaxed);
+  sweep_done_[1].store(0, std::memory_order_relaxed);
+  sweep_owner_.store(-1, std::memory_order_relaxed);
+  int phase[2] = {0, 0}, stage[2] = {0, 0};  // where each slot is
+  bool taken_over = false;
+  // Runs slot t until it is done, or (wait = false) until it would wait for the other slot.
+  // With wait, slot 0 takes slot 1 over when nobody has claimed it (a worker not scheduled).
+  auto run_slot = [&](int t, bool wait) {
+    const int o = 1 - t;
+    auto ready = [&](int q) {
+      if (q <= 0 || sweep_done_[o].load(std::memory_order_acquire) >= q) return true;
+      if (!wait) return false;
+      for (int spin = 0;; ++spin) {
+        if (sweep_done_[o].load(std::memory_order_acquire) >= q) return true;
+        if (t == 0) {
           int nobody = -1;
-          if ((opt_.sweep_worker || wk == 0) &&
-              sweep_owner_.compare_exchange_strong(nobody, wk, std::memory_order_acq_rel))
-            run_slot(1, true);
-          return;
+          if (sweep_owner_.load(std::memory_order_relaxed) == -1 &&
+              sweep_owner_.compare_exchange_strong(nobody, 0, std::memory_order_acq_rel)) {
+            taken_over = true;
+            return false;
+          }
         }
-        if (slot != 0) return;
-        run_slot(0, true);
-        if (!taken_over) return;
-        // Both slots on this thread: alternate, each up to where it needs the other.
-        while (phase[0] < np || phase[1] < np) {
-          run_slot(1, false);
-          run_slot(0, false);
-        }
-        ++sweep_takeovers_;
-      });
+        if (spin > 256) std::this_thread::yield();
+      }
     };
-    if (!fused) pool_->parallel_for(n, [&](int b, int e, int) { predict(b, e); });
-    if (warm) {
-      const double f = opt_.warm_start * (h_prev_ > 0 ? (h / h_prev_) * (h / h_prev_) : 0.0);
-      for (double& l : lambda_tri_) l *= f;
-      for (Vec3& l : lambda_hinge_) l *= f;
-      for (Vec3& l : lambda_row_) l *= f;
-      for (double& l : lambda_spring_) l *= f;
-      h_prev_ = h;
-      by_colour(tri_col_, warm_tris);
-      by_colour(hinge_col_, warm_hinges);
-      by_colour(row_cols_, warm_rows);
-      by_colour(spring_col_, warm_springs);
-    } else if (keep_lambda) {
-      std::fill(lambda_tri_.begin(), lambda_tri_.end(), 0.0);
-      std::fill(lambda_hinge_.begin(), lambda_hinge_.end(), Vec3::Zero());
-      std::fill(lambda_row_.begin(), lambda_row_.end(), Vec3::Zero());
-      std::fill(lambda_spring_.begin(), lambda_spring_.end(), 0.0);
-    }
-    for (int it = 0; it < opt_.iterations && fused; ++it) {
-      sweep();
-      ++st.iterations;
-    }
-    if (retest && retest_part_[0].count + retest_part_[1].count > 0) {
-      contacts_unlisted_ = true;  // (listed after the last substep)
-      contact_retests_ += retest_part_[0].count + retest_part_[1].count;
-      st.max_penetration =
-          std::max({st.max_penetration, retest_part_[0].deepest, retest_part_[1].deepest});
-      for (int p = 0; p < num_pieces_; ++p)
-        if (unsettle_mark_[p] || unsettle_mark_[static_cast<size_t>(num_pieces_) + p]) unsettle(p);
-    }
-    for (int it = 0; it < opt_.iterations && !fused; ++it) {
-      if (padded && cooked_f32_) {
-        pool_->parallel_for(n, [&](int b, int e, int) {
-          K.pack8(reinterpret_cast<const double*>(x.data()), w, anchors_.data(), xp8, b, e);
-        });
-        by_colour_packs(tpack8_col_, project_tris8);
-        if (s % be == be - 1 || s == ns - 1) by_colour_packs(rpack8_col_, project_rows8);
-        pool_->parallel_for(n, [&](int b, int e, int) {
-          K.unpack8(xp8, anchors_.data(), reinterpret_cast<double*>(x.data()), b, e);
-        });
-      } else if (padded) {
-        pool_->parallel_for(n, [&](int b, int e, int) {
-          K.pack(reinterpret_cast<const double*>(x.data()), w, xp, b, e);
-        });
-        by_colour_packs(tpack_col_, project_tris);
-        if (s % be == be - 1 || s == ns - 1) by_colour_packs(rpack_col_, project_rows);
-        pool_->parallel_for(
-            n, [&](int b, int e, int) { K.unpack(xp, reinterpret_cast<double*>(x.data()), b, e); });
+    while (phase[t] < np) {
+      const SweepPhase& P = sweep_[phase[t]];
+      const int mb = P.b + P.half;  // slot 1's first item
+      if (stage[t] == 0) {
+        if (!ready(phase[t] - 1)) return;
+        if (t == 0)
+          sweep_items(c, P, P.b, P.b + P.safe[0], t);
+        else
+          sweep_items(c, P, P.e - P.safe[1], P.e, t);
+        stage[t] = 1;
       }
-      // (Hinges exist only without bending rows: the order of the two does not matter.)
-      by_colour(hinge_col_, project_hinges);
-      by_colour(spring_col_, project_springs);
-      energy_.project_contacts(x, &S.x_prev, scene.friction);
-      if (scene.self_collision) self_.project(cloth, x, w, scene.offset);
-      ++st.iterations;
-    }
-    if (!fused) pool_->parallel_for(n, [&](int b, int e, int wk) { velocities(b, e, wk); });
-    if (opt_.settle || opt_.freeze) {
-      // Per piece, once per substep: the largest free-vertex speed (settling may start when
-      // all are below settle_speed; a piece is awake while one is above freeze_speed) and the
-      // mass-weighted RMS speed, plain (faster than settle_exit_speed: settling ends) and with
-      // each vertex capped at settle_speed (a settled piece's rest test). Not the largest speed
-      // for the exit: a contact re-projection moves a single sliding vertex by ~0.2 mm in one
-      // substep, 0.2 m/s (measured at 64^2: it ended settling at rest, and the drape sagged
-      // back by its bias). The exit speed is well above the drape's own motion while its bias
-      // is released (~0.1-0.2 m/s RMS at 128^2, where the drape rises by up to ~80 mm in about
-      // a second).
-      std::fill(motion_.begin(), motion_.end(), PieceMotion{});
-      // Summed in registers over each run of vertices of one piece (a piece's vertices are
-      // mostly contiguous), not through memory vertex by vertex.
-      int cur = -1;
-      PieceMotion acc;
-      auto flush = [&] {
-        if (cur < 0) return;
-        PieceMotion& pm = motion_[cur];
-        pm.max_v2 = std::max(pm.max_v2, acc.max_v2);
-        pm.mv2 += acc.mv2;
-        pm.mv2_capped += acc.mv2_capped;
-        pm.m += acc.m;
-      };
-      if (fused) {
-        // The sweep's sums per vertex block, added in block order.
-        for (const auto& runs : block_motion_)
-          for (const auto& [piece, pm] : runs) {
-            cur = piece;
-            acc = pm;
-            flush();
-          }
-      } else {
-        for (int i = 0; i < n; ++i) {
-          if (!(w[i] > 0)) continue;
-          if (piece_of_[i] != cur) {
-            flush();
-            cur = piece_of_[i];
-            acc = PieceMotion{};
-          }
-          const double v2 = S.v[i].squaredNorm(), m = S.mass[i];
-          acc.max_v2 = std::max(acc.max_v2, v2);
-          acc.mv2 += m * v2;
-          acc.mv2_capped += m * std::min(v2, slow2);
-          acc.m += m;
-        }
-        flush();
+      const int rb = t == 0 ? P.b + P.safe[0] : mb, re = t == 0 ? mb : P.e - P.safe[1];
+      if (rb < re) {
+        if (!ready(phase[t])) return;
+        sweep_items(c, P, rb, re, t);
       }
+      stage[t] = 0;
+      sweep_done_[t].store(++phase[t], std::memory_order_release);
     }
-    if (opt_.settle) {
-      const double exit2 = opt_.settle_exit_speed * opt_.settle_exit_speed;
-      for (int p = 0; p < num_pieces_; ++p) {
-        if (piece_frozen_[p]) continue;
-        const PieceMotion& pm = motion_[p];
-        if (piece_scale_[p] > 1.0 || piece_slow_[p] >= opt_.settle_steps) {
-          if (pm.m > 0 && pm.mv2 > exit2 * pm.m) {
-            unsettle(p);
-          } else if (piece_scale_[p] == 1.0 || (piece_scale_[p] < opt_.settle_mass_scale &&
-                                                ++piece_slow_[p] >= opt_.settle_grow_steps)) {
-            // Start or grow; w changes, the bending inverses are rebuilt once for it.
-            w_dirty_ = true;
-            piece_scale_[p] = std::min(std::max(opt_.settle_growth, 1.0 + 1e-9) * piece_scale_[p],
-                                       opt_.settle_mass_scale);
-            piece_slow_[p] = 0;
-          }
-        } else {
-          piece_slow_[p] =
-              pm.max_v2 < opt_.settle_speed * opt_.settle_speed ? piece_slow_[p] + 1 : 0;
-        }
-      }
+  };
+  pool_->parallel_slots([&](int slot, int wk) {
+    if (slot == 1) {
+      int nobody = -1;
+      if ((opt_.sweep_worker || wk == 0) &&
+          sweep_owner_.compare_exchange_strong(nobody, wk, std::memory_order_acq_rel))
+        run_slot(1, true);
+      return;
     }
-    if (opt_.freeze) {
-      // A piece rests when all its free vertices are slow; after freeze_steps substeps it sleeps.
-      const double v2 = opt_.freeze_speed * opt_.freeze_speed;
-      for (int p = 0; p < num_pieces_; ++p) {
-        if (piece_frozen_[p]) continue;
-        const PieceMotion& pm = motion_[p];
-        bool moving = pm.max_v2 >= v2;
-        // A fully settled piece rests on its RMS speed, each vertex's speed capped at
-        // settle_speed (single sliding vertices re-projected onto the form jump ~0.2 m/s for one
-        // substep), and sleeps anyway after settle_sleep_steps substeps at the full scale: a
-        // settled 128^2 drape kept creeping along the frictionless form at ~2 mm/s RMS for
-        // good (it settled only after every vertex had been slower than settle_speed, so no
-        // flap is still swinging).
-        bool settled_long = false;
-        if (opt_.settle && piece_scale_[p] >= opt_.settle_mass_scale) {
-          settled_long = ++piece_full_[p] >= opt_.settle_sleep_steps;
-          if (moving && pm.m > 0 && pm.mv2_capped < v2 * pm.m) moving = false;
-        }
-        piece_rest_[p] = moving ? 0 : piece_rest_[p] + 1;
-        if (piece_rest_[p] >= opt_.freeze_steps || settled_long) {
-          piece_frozen_[p] = 1;
-          w_dirty_ = true;
-        }
-      }
-      // (Once per frame, and in a substep in which a piece fell asleep: nothing else changes
-      // the flags between substeps.)
-      if (s == 0 || w_dirty_) {
-        frozen_count_ = 0;
-        for (int i = 0; i < n; ++i)
-          if (piece_frozen_[piece_of_[i]] && cloth.is_free(i)) {
-            S.flags[i] |= kFlagFrozen;
-            S.v[i].setZero();
-            ++frozen_count_;
-          }
-      }
+    if (slot != 0) return;
+    run_slot(0, true);
+    if (!taken_over) return;
+    // Both slots on this thread: alternate, each up to where it needs the other.
+    while (phase[0] < np || phase[1] < np) {
+      run_slot(1, false);
+      run_slot(0, false);
     }
-    S.time += h;
-    ++st.substeps;
-  }
-  if (contacts_unlisted_) {
-    energy_.list_contacts(n, pool_.get());
-    contacts_unlisted_ = false;
-  }
-  return st;
+    ++sweep_takeovers_;
+  });
+}
+
+// The sweep's contact retests: counted, their deepest penetration, the settling they end.
+void XpbdSolver::collect_retests(Step& c) {
+  if (!c.retest || retest_part_[0].count + retest_part_[1].count == 0) return;
+  contacts_unlisted_ = true;  // (listed after the last substep)
+  contact_retests_ += retest_part_[0].count + retest_part_[1].count;
+  c.st.max_penetration =
+      std::max({c.st.max_penetration, retest_part_[0].deepest, retest_part_[1].deepest});
+  const int pieces = rest_.num_pieces();
+  for (int p = 0; p < pieces; ++p)
+    if (unsettle_mark_[p] || unsettle_mark_[static_cast<size_t>(pieces) + p]) rest_.unsettle(p);
+}
+
+void XpbdSolver::update_pieces(Step& c) {
+  if (!(opt_.settle || opt_.freeze)) return;
+  if (c.fused)
+    rest_.sum_motion(block_motion_);
+  else
+    rest_.sum_motion(c.w, c.S.v, c.S.mass);
+}
+
+void XpbdSolver::schedule_rest(Step& c) {
+  rest_.settle_pieces();
+  rest_.freeze_pieces(c.cloth, c.s);
 }
 
 }  // namespace drape::sim

@@ -7,6 +7,11 @@
 // The element data are cooked once per topology into flat arrays sorted by colour (elements
 // of one colour share no vertex); a substep runs on the thread pool as one element sweep
 // (SweepPhase) or, in the configurations the sweep does not serve, one pool call per colour.
+// A step runs as named phases on one context (Step): begin_frame (wake, static finish, settling
+// checks) and renew_anchors once per frame; per substep detect_contacts, set_masses,
+// plan_substep, predict, warm_start, then either the sweep or project_triangles and
+// project_bending_springs with velocities, and last update_pieces and schedule_rest. The pieces'
+// sleep, settling, coarse correction and finish are xpbd::RestScheduler's (xpbd_rest.hpp).
 #pragma once
 
 #include <atomic>
@@ -18,146 +23,12 @@
 #include "sim/core/thread_pool.hpp"
 #include "sim/energy/energy.hpp"
 #include "sim/energy/self_collision.hpp"
-#include "sim/rest/coarse_correction.hpp"
-#include "sim/rest/equilibrium_finisher.hpp"
-#include "sim/rest/finish_thread.hpp"
 #include "sim/solvers/solver.hpp"
 #include "sim/solvers/xpbd/xpbd_kernels.hpp"
+#include "sim/solvers/xpbd/xpbd_options.hpp"
+#include "sim/solvers/xpbd/xpbd_rest.hpp"
 
 namespace drape::sim {
-
-struct XpbdOptions {
-  int substeps = 10;
-  int iterations = 1;  // per substep (small steps: 1)
-  EnergyOptions energy;
-  double damping = 1.0;  // velocity damping rate (1/s), air drag as in Verlet and VBD
-  int threads = 2;       // colours projected in parallel (results do not depend on it)
-  // Cloths with fewer triangles run on the calling thread alone: a colour of a small cloth is
-  // too little work to share (measured, form 10x1 on this 2-core VM: 32^2 1.49 ms per frame on
-  // one thread, 1.83 on two; 64^2 6.2 vs 4.7 ms wall).
-  int min_parallel_triangles = 4000;
-  // Tests only: false keeps the pool's worker from taking its part of the element sweep (as if
-  // it were never scheduled), so that the caller takes it over (XpbdSolver::SweepPhase).
-  bool sweep_worker = true;
-  // With reuse_contacts, in the element sweep: each vertex that moved more than half the margin
-  // and its clearance (ClothEnergy::clearance2) since its own last contact test is tested again
-  // there, instead of all vertices being tested again in the next substep (the frame's first
-  // substep still tests all).
-  bool retest_contacts = true;
-  // Warm start (0..1): each substep starts from the previous substep's multipliers scaled by
-  // this factor (and by (h / h_prev)^2), applying their displacement w grad C lambda with the
-  // prediction. 0 (default) is classic XPBD: multipliers reset every substep, whose fixed point
-  // at rest is not the energy's equilibrium with few iterations (too soft: a sheet sags by mm
-  // to cm). With f the bias shrinks about as (1 - f), but the warm displacement is an explicit
-  // application of stiff forces: measured on hanging sheets (10^2, 24^2, 10 substeps) 0.5 halves
-  // the error (12.1 -> 6.5 mm at 24^2) and 0.7 and above diverge, so it stays off by default.
-  double warm_start = 0.0;
-  // Freezing of pieces at rest (island sleeping): a connected piece of cloth whose free
-  // vertices have all been slower than freeze_speed for freeze_steps substeps is frozen
-  // (kFlagFrozen: not simulated; a frame in which every piece sleeps costs one contact check)
-  // until one of its fixed vertices moves (pinch, move), a free vertex of it is released, or
-  // an object enters its contact shell (a hand, a moved form). Whole pieces, not single
-  // vertices: freezing one vertex of a piece moves XPBD's under-converged fixed point of its
-  // neighbours, which then wake it again (measured: a sheet never settled). After a cut each
-  // piece sleeps on its own.
-  // Contacts are detected at each frame's start (objects may have moved) and again in a later
-  // substep only once some vertex has moved more than half the contact margin since the last
-  // detection: a vertex outside the margin then cannot have reached the surface, and the
-  // contact planes of the others are still tangent within a few hundredths of a mm. false:
-  // detection every substep (the old behaviour, kept to measure against).
-  bool reuse_contacts = true;
-  // At each contact detection, a simulated vertex found at most this deep (m) inside its fresh
-  // contact plane is moved onto it before the substep starts, as a correction of position and
-  // not as motion (its velocity is kept). Between detections a vertex slides on the plane
-  // found last; where the form curves inward (under the bust, at the waist) that tangent plane
-  // runs up to ~0.2 mm inside the surface, and the next detection's push, taken as motion,
-  // gave the vertex ~0.2 m/s for a substep: the settled drape never stopped jittering
-  // (docs/solvers.md section 3g). Deeper pushes (an object moving into the cloth) are motion as
-  // before. 0: off.
-  double contact_snap_depth = 1e-3;
-  // Bending blocks projected every n-th substep with compliance alpha / (n h^2) (multi-rate: the
-  // same bending impulse per n substeps). Measured (docs/solvers.md): n = 2 costs ~30 % less
-  // per frame; at 32^2 the error is the same (form 40 substeps 1.45 vs 1.66 mm, sphere 20
-  // substeps 5.8 vs 6.4 mm) but at 16^2 it grows (form 20 substeps 2.1 vs 1.3 mm), so plain
-  // XPBD (1) stays the default.
-  int bending_every = 1;
-  // Triangles and bending blocks projected in single precision, eight per pack (AVX: one
-  // register), on the positions' displacements from their place at the frame's start
-  // (xpbd_kernels.hpp, P4f); the state stays double and receives the kernels' moves. false: the
-  // double kernels, four per pack. Measured in docs/solvers.md section 3o.
-  bool single_precision = true;
-  // The build of the hot loops by name ("portable", "avx2", "avx512"; xpbd_kernels.hpp), or
-  // empty: the fastest this CPU runs. A name the CPU does not run is ignored. For benchmarks
-  // that compare builds in one process.
-  std::string kernels;
-  bool freeze = false;
-  double freeze_speed = 1e-3;  // m/s
-  int freeze_steps = 30;
-  // Settling (quasi-static refinement of a piece at rest; docs/solvers.md "Settling"). With
-  // multipliers reset every substep, XPBD's fixed point at rest is not the energy's
-  // equilibrium: each substep rebuilds a constraint's whole load lambda ~ h^2 x (its tension)
-  // from a violation of about w lambda, so the cloth is too stretchy by ~ w h^2 x load, which
-  // grows with the hanging length (7 mm at 32^2, 22 mm at 64^2 on the form, 10 substeps). A
-  // piece whose free vertices have all been slower than settle_speed for settle_steps substeps
-  // settles: its inertia grows by settle_growth every settle_grow_steps substeps (gently: a
-  // sudden step releases the stretch as a jolt) up to settle_mass_scale
-  // (w and the prediction's acceleration divided by the scale: the forces, and so the
-  // equilibrium, are unchanged, the bias shrinks by the scale) and its air drag is
-  // settle_damping. It returns to its own mass at once when its RMS speed exceeds
-  // settle_exit_speed, one of its fixed vertices moves or is let go (pinch, drag, release),
-  // something pushes 1 mm into its contact shell, it is woken from sleep or the topology
-  // changes. A settling piece
-  // answers a push like a heavier cloth until the push speeds it past settle_exit_speed.
-  bool settle = true;
-  double settle_speed = 0.05;      // m/s
-  double settle_exit_speed = 0.5;  // m/s, RMS over the piece
-  int settle_steps = 30;
-  double settle_growth = 1.05;
-  int settle_grow_steps = 10;
-  double settle_mass_scale = 64;
-  // A settling piece's air drag (1/s). About critical for its slowest mode, the free flap's
-  // swing under gravity, sqrt(g / L / scale) ~ 0.7 rad/s at the full scale (L ~ 0.3 m): a
-  // heavier drag makes that mode creep (overdamped, rate ~ omega^2 / c), a lighter one lets it
-  // swing. Measured on the form drape (10x1, error from the nearest equilibrium after 3 / 8 s,
-  // docs/solvers.md section 3g): 16^2 3.46 / 2.98 mm at 5/s -> 2.80 / 0.41 mm at 1.5/s, 32^2
-  // 1.46 / 0.89 -> 2.06 / 0.86 mm, 64^2 10.4 / 4.43 -> 6.19 / 1.87 mm.
-  double settle_damping = 1.5;
-  // With freeze: a piece at the full scale for this many substeps sleeps even if it still
-  // moves (a safety net: a settled piece normally sleeps on the rest test above). It was 900
-  // while re-detected contacts kept a settled drape jittering (contact_snap_depth), which
-  // froze the 128^2 drape at 4.2 s, still 8.2 mm RMS from its equilibrium; at 4500 it rests
-  // at 8.2 s, 3.2 mm from it (docs/solvers.md section 3g).
-  int settle_sleep_steps = 4500;
-  // Coarse-grid correction of settled pieces (sim/rest/coarse_correction.hpp): on each of the first
-  // coarse_frames frames after a piece has settled to the full inertia scale, at the frame's
-  // contact detection, the piece's static residual is reduced on a lattice of nodes every
-  // coarse_factor fine edges (a Galerkin Newton step with a line search; positions only, and
-  // the corrected vertices' velocities are zeroed: a settled piece is quasi-static). It moves
-  // the long-wavelength part of what is left between the settled drape and its equilibrium,
-  // which the sweeps would take seconds of settling to move (docs/solvers.md section 3l).
-  // Correcting every frame while a piece settles was measured and is worse: the corrections
-  // and the sweeps' own fixed point pull against each other and the piece never sleeps.
-  // Not done in scenes with self-collision (the coarse model has none). 0: off.
-  int coarse_factor = 4;
-  int coarse_frames = 1;
-  CoarseOptions coarse;  // the correction's own options (coarse.factor is set from coarse_factor)
-  // With freeze on: a piece that has fallen asleep is finished statically while it sleeps
-  // (sim/rest/equilibrium_finisher.hpp: Gauss-Seidel sweeps on the static energy and a coarse
-  // correction with node rotations per cycle, friction anchored where it fell asleep), one
-  // cycle per frame until a cycle moves no vertex farther than finisher.move_tolerance or
-  // finisher.cycles were run; waking ends it. XPBD's own sweeps would pull an awake piece back
-  // toward their biased fixed point, hence only while it sleeps (docs/solvers.md section 3m).
-  bool finish = true;
-  FinisherOptions finisher;
-  // Where the finish runs: on a thread of its own (sim/rest/finish_thread.hpp; all its cycles on a
-  // copy taken when the pieces fall asleep, copied back in the frame after it ends, dropped if
-  // a piece woke meanwhile), so that the fixed-rate loop keeps its ticks while a drape is
-  // finished; or, when false, one cycle per step on the solver's own threads (deterministic
-  // frame by frame; the end state is the same). The thread runs at nice + finish_nice (Linux),
-  // below the simulation and the renderer (FinishThread::set_nice).
-  bool finish_thread = true;
-  int finish_nice = 10;
-};
 
 class XpbdSolver : public Solver {
  public:
@@ -167,7 +38,7 @@ class XpbdSolver : public Solver {
   StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) override;
   ThreadPool* pool() override { return pool_.get(); }
   XpbdOptions& options() { return opt_; }
-  int frozen_count() const { return frozen_count_; }
+  int frozen_count() const { return rest_.frozen_count(); }
   int contact_detections() const { return detections_; }
   // Single precision: how many times the anchors were renewed (XpbdOptions::single_precision).
   long anchor_renewals() const { return anchor_renewals_; }
@@ -186,24 +57,26 @@ class XpbdSolver : public Solver {
   int bending_entries() const { return static_cast<int>(row_colv_.size()); }
   // The build of the hot loops in use (xpbd_kernels.hpp: portable, AVX2 or AVX-512).
   const xpbd::Kernels& kernels() const { return *kern_; }
+  // The pieces' sleep, settling, coarse correction and static finish.
+  const xpbd::RestScheduler& rest() const { return rest_; }
   // Largest inertia scale of any piece (1: nothing settling; XpbdOptions::settle).
-  double settle_scale() const;
+  double settle_scale() const { return rest_.settle_scale(); }
   // Self-collision pairs found at the last detection (scenes with self_collision on).
   const SelfCollision& self_collision() const { return self_; }
   // The last coarse correction (XpbdOptions::coarse_factor) and how many were applied.
-  const CoarseStats& last_coarse() const { return coarse_last_; }
-  int coarse_count() const { return coarse_count_; }
-  double coarse_ms() const { return coarse_ms_; }
+  const CoarseStats& last_coarse() const { return rest_.last_coarse(); }
+  int coarse_count() const { return rest_.coarse_count(); }
+  double coarse_ms() const { return rest_.coarse_ms(); }
   // The last static finish cycle (XpbdOptions::finish; with finish_thread: the last job, all
   // its cycles), the pieces finished, the cycles and their time (on the finish's thread too).
-  const FinisherStats& last_finish() const { return finish_last_; }
-  int finish_count() const { return finish_count_; }    // pieces whose finish started
-  int finish_cycles() const { return finish_cycles_; }  // cycles run
-  double finish_ms() const { return finish_ms_; }
+  const FinisherStats& last_finish() const { return rest_.last_finish(); }
+  int finish_count() const { return rest_.finish_count(); }    // pieces whose finish started
+  int finish_cycles() const { return rest_.finish_cycles(); }  // cycles run
+  double finish_ms() const { return rest_.finish_ms(); }
   // With finish_thread: jobs whose result was dropped (a piece woke, the cloth was cut), and
   // whether a job is running now.
-  int finish_dropped() const { return finish_dropped_; }
-  bool finishing() const { return finish_thread_ && finish_thread_->busy(); }
+  int finish_dropped() const { return rest_.finish_dropped(); }
+  bool finishing() const { return rest_.finishing(); }
   int num_colours() const {
     return static_cast<int>(tri_col_.size() + hinge_col_.size() + spring_col_.size() +
                             row_cols_.size()) -
@@ -221,11 +94,72 @@ class XpbdSolver : public Solver {
     int32_t v[2];
     double rest, ik;  // rest length, 1 / k
   };
+  // The names one step shares between its phases (solver_xpbd.cpp): the cloth, the substep's
+  // length and what it runs.
+  struct Step;
+  struct SweepPhase;  // below
+
+  // Cooking: the element data of a new topology (cook() and its parts).
   void cook(const Cloth& cloth);
+  void cook_triangles(const Cloth& cloth);
+  void cook_bending(int n);
+  void cook_hinges_springs(int n);
+  void cook_pieces(int n);
+  void build_sweep(int n);
+
+  // The step's phases, in the order step() and substep() run them.
+  bool begin_frame(Step& c);    // wake, finish, settling checks; false: everything sleeps
+  void renew_anchors(Step& c);  // single precision: new anchors once a vertex left its own
+  void substep(Step& c);
+  void detect_contacts(Step& c);
+  void set_masses(Step& c);  // w and the bending blocks' inverses
+  void plan_substep(Step& c);
+  void predict(const Step& c, int b, int e);
+  void warm_start(Step& c);
+  void sweep(const Step& c);  // the whole substep as one element sweep (SweepPhase)
+  void collect_retests(Step& c);
+  void project_triangles(const Step& c);  // and the bending blocks (packed alike)
+  void project_bending_springs(Step& c);  // hinges, springs, contacts, self-collision
+  void velocities(const Step& c, int b, int e, int wk);
+  void update_pieces(Step& c);  // the pieces' motion sums
+  void schedule_rest(Step& c);  // settling and sleep
+
+  // The phases' loops over items [b, e): vertices, vertex blocks k, elements or packs.
+  void build_row_inverses(const Step& c, int b, int e);
+  void block_predict(const Step& c, int k, int b, int e);
+  void warm_tris(const Step& c, int b, int e);
+  void warm_hinges(const Step& c, int b, int e);
+  void warm_rows(const Step& c, int b, int e);
+  void warm_springs(const Step& c, int b, int e);
+  void sweep_items(const Step& c, const SweepPhase& P, int b, int e, int slot);
+  void project_tris8(const Step& c, int b, int e);
+  void project_rows8(const Step& c, int b, int e);
+  void project_hinges(const Step& c, int b, int e);
+  void project_springs(const Step& c, int b, int e);
+  void block_velocities(const Step& c, int k, int b, int e, int wk);
+  void block_motion(const Step& c, int k, int b, int e);
+  bool moved_beyond(const Step& c, int i) const;
+  void retest_moved(const Step& c, int b, int e, int slot);
+  void test_moved_part(const Step& c, int b, int e, int wk);
+  // Runs fn(b, e, worker) over each colour's items (offsets off), colour after colour; the packs'
+  // version gives each share of a colour's packs to its own thread (xpbd::share_begin).
+  template <class Fn>
+  void by_colour(const std::vector<int>& off, Fn&& fn);
+  template <class Fn>
+  void by_colour_packs(const std::vector<int>& off, Fn&& fn);
+
+  // Wakes frozen pieces that something disturbs; true when every piece is (still) frozen.
+  bool wake(Cloth& cloth, const SceneObjects& scene);
+  // Moves simulated vertices lying up to contact_snap_depth inside a fresh contact plane onto
+  // it (position only; see XpbdOptions::contact_snap_depth).
+  void snap_to_contacts(Cloth& cloth);
+  // The same for one contact's vertex.
+  void snap_onto(Cloth& cloth, const Contact& c) const;
 
   XpbdOptions opt_;
   ClothEnergy energy_;
   std::unique_ptr<ThreadPool> pool_;
+  xpbd::RestScheduler rest_{opt_};
   std::vector<Tri> tris_;
   std::vector<Hinge> hinges_;
   std::vector<Spring> springs_;
@@ -255,9 +189,6 @@ class XpbdSolver : public Solver {
   // since the last detection (XpbdOptions::reuse_contacts).
   std::vector<char> moved_part_;
   bool w0_changed_ = true;
-  // The inverse masses w_ must be recomputed (each frame's start; a piece's settling scale
-  // changed or a piece fell asleep within the frame); otherwise they are kept between substeps.
-  bool w_dirty_ = true;
   std::vector<Vec3> lambda_row_;
   std::vector<double> lambda_tri_, lambda_spring_;
   std::vector<Vec3> lambda_hinge_;
@@ -303,7 +234,6 @@ class XpbdSolver : public Solver {
   enum { kSweepPack, kSweepTris, kSweepRows, kSweepUnpack };
   static constexpr int kSweepBlock = 256;
   std::vector<SweepPhase> sweep_;
-  void build_sweep(int n);
   std::atomic<int> sweep_done_[2] = {};  // phases a slot has finished
   std::atomic<int> sweep_owner_{-1};     // the thread running slot 1 (-1: nobody yet)
   long sweeps_ = 0, sweep_takeovers_ = 0, contact_retests_ = 0;
@@ -329,61 +259,15 @@ class XpbdSolver : public Solver {
   const xpbd::Kernels* kern_ = &xpbd::kernels();
   double h_prev_ = 0;
   std::vector<double> w_;  // inverse mass of each vertex, 0 when not free or frozen
-  std::vector<int> piece_of_, piece_rest_;  // connected piece per vertex; rest substeps
-  std::vector<uint8_t> piece_frozen_, piece_awake_;
-  std::vector<double> piece_scale_;  // settling: inertia scale per piece (1: own mass)
-  std::vector<int> piece_slow_;      // settling: slow substeps, then substeps since growing
-  // Per piece, each substep (settling and sleeping): the largest squared free-vertex speed,
-  // sum of m v^2, the same with v^2 capped at settle_speed^2, and the mass.
-  struct PieceMotion {
-    double max_v2 = 0, mv2 = 0, mv2_capped = 0, m = 0;
-  };
-  std::vector<PieceMotion> motion_;
   // The sweep's motion sums per vertex block: (piece, sums) per run of one piece's vertices.
-  std::vector<std::vector<std::pair<int, PieceMotion>>> block_motion_;
+  std::vector<std::vector<std::pair<int, xpbd::PieceMotion>>> block_motion_;
   // Per sweep vertex block: its vertices all of one piece (the per-vertex kernels then run it).
   std::vector<uint8_t> block_one_piece_;
-  std::vector<int> piece_full_;      // settling: substeps at the full scale
-  std::vector<uint8_t> fixed_prev_;  // settling: vertex was fixed at the last step
-  void unsettle(int piece);
-  // Moves simulated vertices lying up to contact_snap_depth inside a fresh contact plane onto
-  // it (position only; see XpbdOptions::contact_snap_depth).
-  void snap_to_contacts(Cloth& cloth);
-  // The same for one contact's vertex.
-  void snap_onto(Cloth& cloth, const Contact& c) const;
-  int num_pieces_ = 0, frozen_count_ = 0;
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
   std::vector<Vec3> x_det_;      // each vertex's position at its last contact test
   SelfCollision self_;
-  // Coarse correction of settled pieces (XpbdOptions::coarse_factor).
-  std::unique_ptr<CoarseCorrection> coarse_;
-  std::vector<int> coarse_group_;
-  std::vector<int> piece_coarse_;  // corrections in the piece's current settling episode
-  CoarseStats coarse_last_;
-  int coarse_count_ = 0;
-  double coarse_ms_ = 0;
-  std::unique_ptr<EquilibriumFinisher> finisher_;
-  FinisherStats finish_last_;
-  int finish_count_ = 0, finish_cycles_ = 0;
-  // Per piece: cycles run in its sleep (0: none yet); -1: finished; kFinishing: in the job of
-  // finish_thread_.
-  std::vector<int> piece_finish_;
-  static constexpr int kFinishing = -2;
-  void finish_sleeping(Cloth& cloth, const SceneObjects& scene);
-  void finish_on_thread(Cloth& cloth, const SceneObjects& scene);
-  // coarse_group_ = the piece of every free vertex of a sleeping piece whose finish has not
-  // started (started false) or is not finished (true), else -1.
-  void sleeping_group(const Cloth& cloth, bool started);
-  std::vector<uint8_t> piece_ok_;  // finish_on_thread: the job's result stands for the piece
-  std::unique_ptr<FinishThread> finish_thread_;
-  uint64_t finish_version_ = 0;  // topology_version of the cloth the job copied
-  double finish_ms_ = 0;
-  int finish_dropped_ = 0;
-  void coarse_step(Cloth& cloth, const SceneObjects& scene);
   int detections_ = 0;  // contact detections so far (for tests and the bench)
   double fresh_penetration_ = 0;
-  // Wakes frozen pieces that something disturbs; true when every piece is (still) frozen.
-  bool wake(Cloth& cloth, const SceneObjects& scene);
 };
 
 }  // namespace drape::sim

@@ -120,8 +120,8 @@ TEST(Xpbd, SinglePrecisionKernelsFollowTheDoubleOnes) {
     XpbdSolver s(o);
     for (int k = 0; k < 180; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
     out[dbl] = sc.cloth.state.x;
-    // The anchors are renewed once a vertex is 2 cm from its own (the sheet swings as it sags:
-    // 19 times in 180 frames, measured), not every frame.
+    // The anchors are renewed once a vertex is far from its own (the sheet swings as it sags),
+    // not every frame.
     if (dbl) {
       EXPECT_EQ(s.anchor_renewals(), 0);
     } else {
@@ -139,7 +139,7 @@ TEST(Xpbd, SinglePrecisionKernelsFollowTheDoubleOnes) {
   std::printf("single vs double after 2 s: %.3g m RMS, %.3g m max (the sheet moved %.3g m max)\n",
               rms, mx, mmx);
   EXPECT_GT(mmx, 1e-3);
-  EXPECT_LT(mx, 1e-6);  // measured 7.2e-8 m
+  EXPECT_LT(mx, 1e-6);  // ~7e-8 m
 }
 
 // Every build of the hot loops this CPU runs (XpbdOptions::kernels; on an AVX-512 CPU the
@@ -187,8 +187,8 @@ TEST(Xpbd, FreezingSkipsRestingVerticesWakesAndKeepsTheRestState) {
   EXPECT_GT(expect_frozen_then_woken_by_a_drag(sc, s), 5e-3);
 }
 
-// Warm-started multipliers shrink XPBD's under-converged sag of a hanging sheet (measured:
-// 12.1 -> 6.5 mm at 24^2 with 0.5); the option stays off by default (>= 0.7 diverges).
+// Warm-started multipliers shrink XPBD's under-converged sag of a hanging sheet (12.1 -> 6.5 mm
+// at 24^2 with 0.5); the option stays off by default (>= 0.7 diverges).
 TEST(Xpbd, WarmStartHalvesTheSagBiasOfAHangingSheet) {
   double err[2];
   for (int k = 0; k < 2; ++k) {
@@ -205,7 +205,7 @@ TEST(Xpbd, WarmStartHalvesTheSagBiasOfAHangingSheet) {
   EXPECT_LT(err[1], 0.7 * err[0]);
 }
 
-// The study's 3 s form drape at 16^2 with options o: contact detections, the closest vertex's
+// The 3 s form drape at 16^2 with options o: contact detections, the closest vertex's
 // distance to the form, and the RMS distance of the end state to its nearest equilibrium.
 struct DrapeEnd {
   int detections = 0;
@@ -313,7 +313,7 @@ TEST(Xpbd, BendingEverySecondSubstepKeepsTheDrape) {
   EXPECT_TRUE(asked.listed);
 }
 
-// The study's form drape at 32^2 settles (its last wrinkles stop at ~7 s) and then sleeps for
+// The form drape at 32^2 settles (its last wrinkles stop at ~7 s) and then sleeps for
 // good: a vertex resting on its contact plane must not read as an object entering the shell
 // (before the 0.1 mm wake depth it fell asleep at 7.4 s and woke in the next frame).
 TEST(Xpbd, FormDrapeFallsAsleepAndStaysAsleep) {
@@ -422,9 +422,8 @@ TEST(Xpbd, ContactSnapCorrectsPositionWithoutVelocity) {
 
 // The coarse-grid correction of a piece that has settled to the full inertia scale
 // (XpbdOptions::coarse_factor, sim/rest/coarse_correction.hpp): the form drape at 32^2 after 12 s,
-// asleep either way, ends nearer its nearest frictional equilibrium with it (measured
-// 2.12 / 7.38 -> 1.64 / 5.91 mm RMS / max; at 128^2 4.86 / 16.2 -> 2.81 / 5.40 mm, docs/solvers.md
-// section 3l); one correction per settling episode.
+// asleep either way, ends nearer its nearest frictional equilibrium with it (2.12 -> 1.64 mm
+// RMS); one correction per settling episode.
 // The 32^2 form drape after 12 s with sleeping on and the given options, all its free vertices
 // asleep by then; returns its RMS distance (and `mx` the max) from the frictional equilibrium
 // nearest to that end state; `s` is the solver that ran it.
@@ -462,9 +461,9 @@ double settled_drape_error(XpbdOptions o, std::unique_ptr<XpbdSolver>& s, double
 }  // namespace
 
 // Each run is one drape, and the drape's path on the form (friction, contacts, the frame it
-// sleeps in) follows round-off: the gain of the single correction measured 23 % with the double
-// kernels and 8 % with the single-precision ones (the same code otherwise; session 17), so both
-// are run and each must gain at least 5 %.
+// sleeps in) follows round-off: the gain of the single correction is 23 % with the double
+// kernels and 8 % with the single-precision ones (the same code otherwise), so both are run and
+// each must gain at least 5 %.
 TEST(Xpbd, CoarseCorrectionBringsTheSettledDrapeNearerItsEquilibrium) {
   for (bool single : {false, true}) {
     double err[2] = {0, 0};
@@ -493,7 +492,7 @@ TEST(Xpbd, CoarseCorrectionBringsTheSettledDrapeNearerItsEquilibrium) {
 // With sleeping on, a piece that falls asleep is finished toward its static equilibrium
 // (sim/rest/equilibrium_finisher.hpp), on a thread of its own (the default) or one cycle per frame;
 // the drape then stays asleep, the distance to the nearest frictional equilibrium drops, and
-// both ways end in the same state (docs/solvers.md sections 3m, 3n).
+// both ways end in the same state.
 TEST(Xpbd, SleepingPiecesAreFinishedTowardTheirEquilibrium) {
   double err[3] = {0, 0, 0};
   std::vector<Vec3> end[3];
@@ -521,4 +520,38 @@ TEST(Xpbd, SleepingPiecesAreFinishedTowardTheirEquilibrium) {
   position_error(end[1], end[2], rms, mx);
   std::printf("own thread vs one per frame: %.3g m max\n", mx);
   EXPECT_LT(mx, 1e-9);
+}
+
+// The rest scheduler on its own (xpbd::RestScheduler, the solver's settling and sleep): of two
+// pieces, the slow one starts settling after settle_steps substeps and grows its inertia toward
+// settle_mass_scale, the fast one keeps its own mass; a push past settle_exit_speed (RMS) ends
+// the settling at once.
+TEST(Xpbd, RestSchedulerSettlesTheSlowPieceAndLetsAFastOneGo) {
+  XpbdOptions o;
+  o.settle_steps = 3;
+  o.settle_grow_steps = 1;
+  xpbd::RestScheduler rest(o);
+  rest.reset(2, {0, 0, 1, 1});
+  const std::vector<double> w(4, 1.0), mass(4, 0.1);
+  std::vector<Vec3> v = {Vec3(0, 0.01, 0), Vec3(0, 0.01, 0), Vec3(0, 1, 0), Vec3(0, 1, 0)};
+  for (int s = 0; s < 3; ++s) {
+    rest.sum_motion(w.data(), v, mass);
+    rest.settle_pieces();
+    EXPECT_EQ(rest.scales()[0], 1.0);  // slow for fewer than settle_steps substeps
+  }
+  rest.masses_set();
+  for (int s = 0; s < 5; ++s) {
+    rest.sum_motion(w.data(), v, mass);
+    rest.settle_pieces();
+  }
+  EXPECT_TRUE(rest.masses_dirty());  // the inverse masses change with the scale
+  EXPECT_GT(rest.scales()[0], 1.0);
+  EXPECT_LE(rest.scales()[0], o.settle_mass_scale);
+  EXPECT_EQ(rest.scales()[1], 1.0);
+  EXPECT_DOUBLE_EQ(rest.settle_scale(), rest.scales()[0]);
+  v[0] = v[1] = Vec3(0, 2 * o.settle_exit_speed, 0);
+  rest.sum_motion(w.data(), v, mass);
+  rest.settle_pieces();
+  EXPECT_EQ(rest.scales()[0], 1.0);
+  EXPECT_EQ(rest.settle_scale(), 1.0);
 }

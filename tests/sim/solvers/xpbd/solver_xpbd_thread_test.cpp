@@ -21,7 +21,7 @@ struct DrapeRun {
   int frozen = 0;
 };
 
-// The study's form drape (falls onto the form: contacts, friction, settling, sleeping).
+// The form drape (falls onto the form: contacts, friction, settling, sleeping).
 DrapeRun form_drape(int res, int frames, int threads, bool worker = true) {
   Testbed sc = make_scene("form", res);
   XpbdOptions o;
