@@ -40,7 +40,7 @@ int run_pattern(int argc, char** argv) {
       cli.add_option("--spacing", spacing_mm, "panel grid spacing in mm (default: the design's)")
           ->default_str("")
           ->type_name("MM")
-          ->check(CLI::PositiveNumber & CLI::Range(0.0, 1000.0));
+          ->check(drape::app::positive_up_to(1000));
   cli.add_option("--relax-iterations", opt.relax_iterations,
                  "relaxation iterations (default: the design's)")
       ->default_str("")

@@ -77,7 +77,7 @@ int run_render(int argc, char** argv) {
       ->check(check_vec, "");
   cli.add_option("--sim-seconds", sim_seconds, "default scene: simulated draping time (s)")
       ->type_name("S")
-      ->check(CLI::Range(0.0, 60.0));
+      ->check(positive_up_to(60));
   cli.add_option("--solver", solver, "default scene: solver")->type_name("NAME");
   auto* o_window =
       cli.add_option("--window", window,

@@ -8,6 +8,7 @@
 
 namespace CLI {
 class App;
+class Validator;
 }  // namespace CLI
 
 namespace drape::app {
@@ -27,6 +28,8 @@ std::vector<Command>& command_registry();
 // argument prints "<app name>: <what is wrong>" and returns 2; otherwise returns -1 (go on).
 // Name the CLI::App "drape <command>". Defined in main.cpp.
 int parse_command_line(CLI::App& cli, int argc, char** argv);
+// A CLI11 check: a number in (0, max].
+CLI::Validator positive_up_to(double max);
 
 struct CommandRegistrar {
   CommandRegistrar(std::string name, std::string summary, CommandFn fn) {

@@ -31,6 +31,19 @@ int parse_command_line(CLI::App& cli, int argc, char** argv) {
     return 2;
   }
 }
+
+CLI::Validator positive_up_to(double max) {
+  char range[64];
+  std::snprintf(range, sizeof range, "in (0, %g]", max);
+  return CLI::Validator(
+      [max, text = std::string(range)](std::string& s) -> std::string {
+        double v = 0;
+        char tail = 0;
+        if (std::sscanf(s.c_str(), "%lf%c", &v, &tail) == 1 && v > 0 && v <= max) return {};
+        return "expected a number " + text + ", got '" + s + "'";
+      },
+      std::string("NUMBER ") + range);
+}
 }  // namespace drape::app
 
 namespace {

@@ -47,6 +47,6 @@ if "$exe" --help 2>&1 | grep -q "^  render "; then
   expect 2 "--samples" -- render --samples 1000
   expect 2 "--eye" -- render --eye 1,2
   expect 2 "--colour-map" -- render --color-map rainbow
-  expect 2 "--sim-seconds" -- render --sim-seconds -3
+  expect 2 "--sim-seconds" -- render --sim-seconds 0
 fi
 echo PASS
