@@ -52,6 +52,10 @@ TEST(Measurements, StandardSizesMatchReadme) {
       EXPECT_EQ(s->hip_height, f->hip_height) << dir;
       EXPECT_EQ(s->neck_height, f->neck_height) << dir;
       EXPECT_EQ(s->bottom_height, f->bottom_height) << dir;
+      EXPECT_EQ(s->height, f->height) << dir;
+      EXPECT_EQ(s->bust_aspect, f->bust_aspect) << dir;
+      EXPECT_EQ(s->waist_aspect, f->waist_aspect) << dir;
+      EXPECT_EQ(s->hip_aspect, f->hip_aspect) << dir;
     }
   }
   auto bad = measurements_for_size("99XL");
