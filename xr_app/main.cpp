@@ -61,7 +61,7 @@ std::string command_list() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App cli{"drape: immersive virtual draping", "drape"};
+  CLI::App cli{"drape [OPTIONS] COMMAND [ARGS...]: immersive virtual draping", "drape"};
   // The first positional argument names the command; it and everything after it go to the
   // command (so `drape form --help` is the form command's help).
   cli.prefix_command();
