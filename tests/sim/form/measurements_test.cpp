@@ -44,18 +44,12 @@ TEST(Measurements, StandardSizesMatchReadme) {
          {std::string(DRAPE_SOURCE_DIR) + "/assets/forms", std::string()}) {
       auto s = measurements_for_size(r.size, dir);
       ASSERT_TRUE(s.ok()) << s.error();
-      EXPECT_EQ(s->bust_girth, f->bust_girth) << dir;
-      EXPECT_EQ(s->waist_girth, f->waist_girth) << dir;
-      EXPECT_EQ(s->hip_girth, f->hip_girth) << dir;
-      EXPECT_EQ(s->bust_height, f->bust_height) << dir;
-      EXPECT_EQ(s->waist_height, f->waist_height) << dir;
-      EXPECT_EQ(s->hip_height, f->hip_height) << dir;
-      EXPECT_EQ(s->neck_height, f->neck_height) << dir;
-      EXPECT_EQ(s->bottom_height, f->bottom_height) << dir;
-      EXPECT_EQ(s->height, f->height) << dir;
-      EXPECT_EQ(s->bust_aspect, f->bust_aspect) << dir;
-      EXPECT_EQ(s->waist_aspect, f->waist_aspect) << dir;
-      EXPECT_EQ(s->hip_aspect, f->hip_aspect) << dir;
+      using M = FormMeasurements;
+      for (double M::*field :
+           {&M::bust_girth, &M::waist_girth, &M::hip_girth, &M::height, &M::bust_height,
+            &M::waist_height, &M::hip_height, &M::neck_height, &M::bottom_height, &M::bust_aspect,
+            &M::waist_aspect, &M::hip_aspect})
+        EXPECT_EQ((*s).*field, (*f).*field) << dir;
     }
   }
   auto bad = measurements_for_size("99XL");
