@@ -8,7 +8,9 @@
 #    from; the environment (DRAPE_MOCK_*) is its only channel, like XR_RUNTIME_JSON is the
 #    loader's.
 #  - executables: bench/, tests/, fuzz/, xr_app/cmd_*.cpp and xr_app/main.cpp may read the
-#    environment and pass what they read on as options.
+#    environment and pass what they read on as options (so may the executable's launch side of
+#    the OpenXR app, xr_app/xr_launch.*, where the xr_app conversion puts it: it sets the
+#    loader's XR_RUNTIME_JSON and the mock runtime's DRAPE_MOCK_*).
 cmake_minimum_required(VERSION 3.25)
 set(patterns "")
 foreach(dir sim render tracking xr_app/app)
