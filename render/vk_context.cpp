@@ -166,8 +166,7 @@ sim::Result<std::unique_ptr<VulkanContext>> VulkanContext::create(const ContextO
     return sim::Error{
         "vulkan: no Vulkan device found (no GPU driver and no lavapipe: install "
         "mesa-vulkan-drivers; check VK_ICD_FILENAMES)"};
-  std::string filter = opt.device_filter;
-  if (const char* env = std::getenv("DRAPE_VK_DEVICE"); env && *env && filter.empty()) filter = env;
+  const std::string& filter = opt.device_filter;
   int best = -1, best_score = -1;
   std::string seen;
   for (uint32_t i = 0; i < n; ++i) {

@@ -35,7 +35,7 @@ struct ExternalDevice {
 
 struct ContextOptions {
   bool validation = false;    // VK_LAYER_KHRONOS_validation + a counting messenger
-  std::string device_filter;  // substring of the device name; env DRAPE_VK_DEVICE too
+  std::string device_filter;  // substring of the device name (drape render --vk-device)
   bool prefer_cpu = false;    // pick lavapipe even when a GPU is present (golden images)
   std::vector<std::string> instance_extensions;  // e.g. the surface extensions GLFW asks for
   bool swapchain = false;  // enable VK_KHR_swapchain on the device (mirror window)

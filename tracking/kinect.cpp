@@ -159,18 +159,20 @@ void depth_cb(freenect_device* dev, void* data, uint32_t) {
 }
 }  // namespace
 
-KinectSource::KinectSource(SegmenterParams p, int device_index) : impl_(std::make_unique<Impl>()) {
+KinectSource::KinectSource(SegmenterParams p, int device_index,
+                           const std::string& fakenect_recording)
+    : impl_(std::make_unique<Impl>()) {
   impl_->seg = HandSegmenter(p);
   auto set = [&](SourceState s, const std::string& m) {
     std::lock_guard lk(impl_->mu);
     impl_->status = {s, m};
   };
   // Under fakenect a missing recording directory would make the library exit(): check first.
-  if (const char* fp = std::getenv("FAKENECT_PATH")) {
+  if (!fakenect_recording.empty()) {
     struct stat st {};
-    const std::string index = std::string(fp) + "/INDEX.txt";
+    const std::string index = fakenect_recording + "/INDEX.txt";
     if (::stat(index.c_str(), &st) != 0) {
-      set(SourceState::Unavailable, "kinect: FAKENECT_PATH set but " + index + " is missing");
+      set(SourceState::Unavailable, "kinect: fakenect recording " + index + " is missing");
       return;
     }
   }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -64,9 +65,13 @@ class HandSegmenter {
 // Live Kinect via libfreenect on its own thread. A missing device or library error gives a
 // clear status (Unavailable) and the other sources keep working. Under fakenect
 // (FAKENECT_PATH + LD_LIBRARY_PATH, see docs/tracking.md) it replays a recording.
+// `fakenect_recording`: the recording's directory when the program runs under fakenect (the
+// executable passes on the FAKENECT_PATH that libfreenect's replay library reads itself). It is
+// checked for INDEX.txt first, since fakenect exit()s on a missing recording; empty: no check.
 class KinectSource : public HandSource {
  public:
-  explicit KinectSource(SegmenterParams p = {}, int device_index = 0);
+  explicit KinectSource(SegmenterParams p = {}, int device_index = 0,
+                        const std::string& fakenect_recording = {});
   ~KinectSource() override;
   KinectSource(const KinectSource&) = delete;
   KinectSource& operator=(const KinectSource&) = delete;

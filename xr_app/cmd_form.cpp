@@ -1,29 +1,20 @@
 // `drape form`: build a dress form (standard size, measurement JSON or mesh) and report its
 // girths and landmarks, or export it as a mesh.
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <exception>
 #include <string>
 
 #include "sim/form/dress_form.hpp"
 #include "sim/io/mesh_io.hpp"
 #include "xr_app/command.hpp"
+#include "xr_app/paths.hpp"
 
 namespace {
 
 using drape::sim::DressForm;
 using drape::sim::MeshImportOptions;
-
-void usage() {
-  std::printf(
-      "usage: drape form [--size 7AR|9AR|11AR|13AR | --measurements FILE.json |\n"
-      "                   --mesh FILE [--units m|cm|mm|in] [--up y|z|x|-y|-z|-x]\n"
-      "                   [--front x|z|-x|-z]]\n"
-      "                  [--spacing M] [--report] [--export FILE.gltf|.glb|.obj]\n"
-      "Builds the dress form (default: the 9AR form) and prints its girths at bust, waist and\n"
-      "hip in mm and the landmark heights (--report, the default), or writes it as a mesh.\n");
-}
 
 bool parse_units(const std::string& s, MeshImportOptions::Units& u) {
   using U = MeshImportOptions::Units;
@@ -78,73 +69,44 @@ bool parse_front(const std::string& s, drape::sim::Vec3& f) {
 }
 
 int run(int argc, char** argv) {
-  std::string size, measurements, mesh, export_path;
+  std::string size, measurements, mesh, export_path, units, up, front;
   bool report = false;
   double spacing = 0.0025;
   MeshImportOptions opt;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* what) -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "drape form: %s needs a value\n", what);
-        return nullptr;
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      usage();
-      return 0;
-    } else if (a == "--report") {
-      report = true;
-    } else if (a == "--size" || a == "--measurements" || a == "--mesh" || a == "--export" ||
-               a == "--units" || a == "--up" || a == "--front" || a == "--spacing") {
-      const char* v = value(a.c_str());
-      if (!v) return 2;
-      if (a == "--size")
-        size = v;
-      else if (a == "--measurements")
-        measurements = v;
-      else if (a == "--mesh")
-        mesh = v;
-      else if (a == "--export")
-        export_path = v;
-      else if (a == "--units") {
-        if (!parse_units(v, opt.units)) {
-          std::fprintf(stderr, "drape form: --units '%s': use m, cm, mm or in\n", v);
-          return 2;
-        }
-      } else if (a == "--up") {
-        if (!parse_up(v, opt.up)) {
-          std::fprintf(stderr, "drape form: --up '%s': use y, z, x, -y, -z or -x\n", v);
-          return 2;
-        }
-      } else if (a == "--front") {
-        if (!parse_front(v, opt.front_axis)) {
-          std::fprintf(stderr, "drape form: --front '%s': use z, -z, x or -x\n", v);
-          return 2;
-        }
-        opt.front_auto = false;
-      } else {
-        char* end = nullptr;
-        spacing = std::strtod(v, &end);
-        if (!end || *end || !(spacing >= 0.0005 && spacing <= 0.05)) {
-          std::fprintf(stderr, "drape form: --spacing '%s': a length in metres in [0.0005, 0.05]\n",
-                       v);
-          return 2;
-        }
-      }
-    } else {
-      std::fprintf(stderr, "drape form: unknown argument '%s'\n", a.c_str());
-      usage();
-      return 2;
-    }
+  CLI::App cli{
+      "Builds the dress form (default: the 9AR form) and prints its girths at bust, waist and\n"
+      "hip in mm and the landmark heights (--report, the default), or writes it as a mesh.",
+      "drape form"};
+  cli.option_defaults()->always_capture_default();
+  auto* o_size =
+      cli.add_option("--size", size, "standard size: 7AR, 9AR, 11AR or 13AR (default 9AR)")
+          ->type_name("SIZE");
+  auto* o_meas =
+      cli.add_option("--measurements", measurements, "measurements JSON (docs/dress-form.md)")
+          ->type_name("FILE.json");
+  auto* o_mesh = cli.add_option("--mesh", mesh, "a scanned or modelled form (glTF, OBJ, ...)")
+                     ->type_name("FILE");
+  o_size->excludes(o_meas)->excludes(o_mesh);
+  o_meas->excludes(o_mesh);
+  cli.add_option("--units", units, "--mesh: the file's units (default: detected)")
+      ->check(CLI::IsMember({"m", "cm", "mm", "in", "auto"}));
+  cli.add_option("--up", up, "--mesh: the file's up axis (default: detected)")
+      ->check(CLI::IsMember({"y", "+y", "z", "+z", "x", "+x", "-y", "-z", "-x", "auto"}));
+  cli.add_option("--front", front, "--mesh: the centre front axis (default: detected)")
+      ->check(CLI::IsMember({"z", "+z", "-z", "x", "+x", "-x"}));
+  cli.add_option("--spacing", spacing, "section spacing in metres")
+      ->check(CLI::Range(0.0005, 0.05));
+  cli.add_flag("--report", report, "print girths and landmarks (the default without --export)");
+  cli.add_option("--export", export_path, "write the form as a mesh")
+      ->type_name("FILE.gltf|.glb|.obj");
+  if (int rc = drape::app::parse_command_line(cli, argc, argv); rc >= 0) return rc;
+  if (!units.empty()) parse_units(units, opt.units);
+  if (!up.empty()) parse_up(up, opt.up);
+  if (!front.empty()) {
+    parse_front(front, opt.front_axis);
+    opt.front_auto = false;
   }
-  const int sources = !size.empty() + !measurements.empty() + !mesh.empty();
-  if (sources > 1) {
-    std::fprintf(stderr, "drape form: give only one of --size, --measurements, --mesh\n");
-    return 2;
-  }
-  if (sources == 0) size = "9AR";
+  if (size.empty() && measurements.empty() && mesh.empty()) size = "9AR";
   if (export_path.empty()) report = true;
 
   drape::sim::Result<DressForm> form = drape::sim::Error{"no form"};
@@ -160,8 +122,9 @@ int run(int argc, char** argv) {
     form = DressForm::from_triangles(*m, opt, mesh, &info);
     what = "mesh " + mesh;
   } else {
-    auto meas = measurements.empty() ? drape::sim::measurements_for_size(size)
-                                     : drape::sim::load_measurements(measurements);
+    auto meas = measurements.empty()
+                    ? drape::sim::measurements_for_size(size, drape::app::asset("forms"))
+                    : drape::sim::load_measurements(measurements);
     if (!meas) {
       std::fprintf(stderr, "drape form: %s\n", meas.error().c_str());
       return 1;

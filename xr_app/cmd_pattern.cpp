@@ -1,85 +1,63 @@
 // `drape pattern`: the geometric draping pipeline from a design file to printable patterns.
+#include <CLI/CLI.hpp>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <string>
 
 #include "sim/core/fabric.hpp"
 #include "sim/draping/pattern_pipeline.hpp"
 #include "sim/form/dress_form.hpp"
 #include "xr_app/command.hpp"
+#include "xr_app/paths.hpp"
 
 namespace {
-
-void usage() {
-  std::fprintf(
-      stderr,
-      "usage: drape pattern --design NAME|FILE.json [--form 9AR|FILE.json] [--out DIR]\n"
-      "                     [--ease MM] [--seam-allowance MM] [--spacing MM]\n"
-      "                     [--relax-iterations N] [--static-solver] [--no-grain-control]\n"
-      "Drapes the design's panels on the form, extracts the pattern, sews the garment and\n"
-      "writes pattern.svg, pattern.dxf, pattern_a4.pdf, pattern_letter.pdf,\n"
-      "draped_panels.gltf, garment.gltf and report.json into DIR (out/pattern/).\n");
-}
-
-bool parse_mm(const char* s, double* out) {
-  char* end = nullptr;
-  const double v = std::strtod(s, &end);
-  if (!end || *end || !(v >= 0) || v > 1000) return false;
-  *out = v / 1000.0;
-  return true;
-}
 
 int run_pattern(int argc, char** argv) {
   std::string design = "tight-skirt", form_name = "9AR", out = "out/pattern";
   drape::sim::PipelineOptions opt;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const bool has = i + 1 < argc;
-    if (a == "--help" || a == "-h") {
-      usage();
-      return 0;
-    } else if (a == "--design" && has) {
-      design = argv[++i];
-    } else if (a == "--form" && has) {
-      form_name = argv[++i];
-    } else if (a == "--out" && has) {
-      out = argv[++i];
-    } else if (a == "--ease" && has) {
-      if (!parse_mm(argv[++i], &opt.ease)) {
-        std::fprintf(stderr,
-                     "drape pattern: --ease: expected millimetres within 0..1000, got '%s'\n",
-                     argv[i]);
-        return 2;
-      }
-    } else if (a == "--seam-allowance" && has) {
-      if (!parse_mm(argv[++i], &opt.seam_allowance)) {
-        std::fprintf(stderr, "drape pattern: --seam-allowance: expected millimetres, got '%s'\n",
-                     argv[i]);
-        return 2;
-      }
-    } else if (a == "--spacing" && has) {
-      if (!parse_mm(argv[++i], &opt.spacing) || opt.spacing <= 0) {
-        std::fprintf(stderr, "drape pattern: --spacing: expected positive millimetres, got '%s'\n",
-                     argv[i]);
-        return 2;
-      }
-    } else if (a == "--relax-iterations" && has) {
-      opt.relax_iterations = std::atoi(argv[++i]);
-    } else if (a == "--static-solver") {
-      opt.use_static_solver = true;
-    } else if (a == "--no-grain-control") {
-      opt.grain_control = false;
-    } else {
-      std::fprintf(stderr, "drape pattern: unknown or incomplete option '%s'\n", a.c_str());
-      usage();
-      return 2;
-    }
-  }
-  const std::string root = DRAPE_SOURCE_DIR;
+  double ease_mm = 0, seam_mm = 0, spacing_mm = 0;
+  CLI::App cli{
+      "Drapes the design's panels on the form, extracts the pattern, sews the garment and\n"
+      "writes pattern.svg, pattern.dxf, pattern_a4.pdf, pattern_letter.pdf,\n"
+      "draped_panels.gltf, garment.gltf and report.json into DIR.",
+      "drape pattern"};
+  cli.option_defaults()->always_capture_default();
+  cli.add_option("--design", design, "a design of assets/designs/ by name, or a design file")
+      ->type_name("NAME|FILE.json");
+  cli.add_option("--form", form_name, "standard size or measurements file")
+      ->type_name("9AR|FILE.json");
+  cli.add_option("--out", out, "output directory")->type_name("DIR");
+  // Without these the design's own values apply.
+  auto* o_ease = cli.add_option("--ease", ease_mm, "ease in mm (default: the design's)")
+                     ->default_str("")
+                     ->type_name("MM")
+                     ->check(CLI::Range(0.0, 1000.0));
+  auto* o_seam = cli.add_option("--seam-allowance", seam_mm,
+                                "print seam allowance in mm (default: the design's)")
+                     ->default_str("")
+                     ->type_name("MM")
+                     ->check(CLI::Range(0.0, 1000.0));
+  auto* o_spacing =
+      cli.add_option("--spacing", spacing_mm, "panel grid spacing in mm (default: the design's)")
+          ->default_str("")
+          ->type_name("MM")
+          ->check(drape::app::positive_up_to(1000));
+  cli.add_option("--relax-iterations", opt.relax_iterations,
+                 "relaxation iterations (default: the design's)")
+      ->default_str("")
+      ->type_name("N")
+      ->check(CLI::Range(0, 1000000));
+  cli.add_flag("--static-solver", opt.use_static_solver,
+               "relax with the static Newton solver instead of Gauss-Seidel");
+  bool no_grain = false;
+  cli.add_flag("--no-grain-control", no_grain, "do not keep the grain lines straight");
+  if (int rc = drape::app::parse_command_line(cli, argc, argv); rc >= 0) return rc;
+  if (o_ease->count()) opt.ease = ease_mm / 1000.0;
+  if (o_seam->count()) opt.seam_allowance = seam_mm / 1000.0;
+  if (o_spacing->count()) opt.spacing = spacing_mm / 1000.0;
+  if (no_grain) opt.grain_control = false;
   std::string design_path = design;
   if (design_path.find('/') == std::string::npos && design_path.find(".json") == std::string::npos)
-    design_path = root + "/assets/designs/" + design + ".json";
+    design_path = drape::app::asset("designs/" + design + ".json").string();
   auto d = drape::sim::load_design(design_path);
   if (!d) {
     std::fprintf(stderr, "drape pattern: %s\n", d.error().c_str());
@@ -87,7 +65,7 @@ int run_pattern(int argc, char** argv) {
   }
   auto m = form_name.find(".json") != std::string::npos
                ? drape::sim::load_measurements(form_name)
-               : drape::sim::measurements_for_size(form_name);
+               : drape::sim::measurements_for_size(form_name, drape::app::asset("forms"));
   if (!m) {
     std::fprintf(stderr, "drape pattern: --form: %s\n", m.error().c_str());
     return 1;
@@ -99,7 +77,7 @@ int run_pattern(int argc, char** argv) {
   }
   d->form = m->size;
   drape::sim::FabricParams fabric;
-  if (auto f = drape::sim::load_fabric(root + "/assets/fabrics.json", d->fabric))
+  if (auto f = drape::sim::load_fabric(drape::app::asset("fabrics.json").string(), d->fabric))
     fabric = *f;
   else
     std::fprintf(stderr, "drape pattern: note: %s; using the default muslin\n", f.error().c_str());

@@ -2,9 +2,10 @@
 // window. With no --scene it renders the default scene (muslin draped on the 9AR form).
 #ifdef DRAPE_HAVE_RENDER
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
+#include <map>
 #include <string>
 
 #include "render/image_io.hpp"
@@ -18,100 +19,98 @@ namespace {
 using namespace drape::render;
 using namespace drape::app;
 
-void usage() {
-  std::fprintf(
-      stderr,
-      "usage: drape render [--scene FILE] --out shot.png [--size WxH] [options]\n"
-      "  --scene FILE        scene JSON (docs/rendering.md); default: muslin on the 9AR form\n"
-      "  --out FILE          PNG to write (default shot.png)\n"
-      "  --size WxH          image size (default 1024x1024)\n"
-      "  --samples N         MSAA samples (default from the scene, 4)\n"
-      "  --colour-map M      none | strain | ease\n"
-      "  --eye X,Y,Z         camera position (look-at camera)\n"
-      "  --target X,Y,Z      camera target\n"
-      "  --sim-seconds S     default scene: simulated draping time (default 2.5)\n"
-      "  --solver NAME       default scene: solver (default xpbd)\n"
-      "  --window [N]        also show N frames (default: until closed) in a mirror window\n"
-      "  --validation        enable the Vulkan validation layer (counts messages)\n");
+// "X,Y,Z" -> a vector; "" when it parses, else what is wrong (a CLI11 check).
+std::string check_vec(const std::string& s) {
+  Eigen::Vector3f v;
+  char tail = 0;
+  return std::sscanf(s.c_str(), "%f,%f,%f%c", &v.x(), &v.y(), &v.z(), &tail) == 3
+             ? std::string()
+             : "expected X,Y,Z (three numbers), got '" + s + "'";
 }
 
-bool parse_vec(const char* s, Eigen::Vector3f& v) {
-  return std::sscanf(s, "%f,%f,%f", &v.x(), &v.y(), &v.z()) == 3;
+bool parse_vec(const std::string& s, Eigen::Vector3f& v) {
+  return std::sscanf(s.c_str(), "%f,%f,%f", &v.x(), &v.y(), &v.z()) == 3;
 }
 
 int run_render(int argc, char** argv) {
-  std::string scene_path, out = "shot.png", cmap, solver = "xpbd";
+  std::string scene_path, out = "shot.png", cmap, solver = "xpbd", size = "1024x1024", window;
+  std::string eye_text, target_text;
   int w = 1024, h = 1024, samples = 0, window_frames = -1;
   double sim_seconds = 2.5;
   bool validation = false;
   Eigen::Vector3f eye, target;
-  bool have_eye = false, have_target = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "drape render: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      usage();
-      return 0;
-    } else if (a == "--scene") {
-      scene_path = next();
-    } else if (a == "--out") {
-      out = next();
-    } else if (a == "--size") {
-      if (std::sscanf(next(), "%dx%d", &w, &h) != 2 || w <= 0 || h <= 0 || w > 16384 || h > 16384) {
-        std::fprintf(stderr, "drape render: --size expects WxH (1..16384)\n");
-        return 2;
-      }
-    } else if (a == "--samples") {
-      samples = std::atoi(next());
-    } else if (a == "--colour-map" || a == "--color-map") {
-      cmap = next();
-    } else if (a == "--eye") {
-      have_eye = parse_vec(next(), eye);
-      if (!have_eye) return std::fprintf(stderr, "drape render: --eye expects X,Y,Z\n"), 2;
-    } else if (a == "--target") {
-      have_target = parse_vec(next(), target);
-      if (!have_target) return std::fprintf(stderr, "drape render: --target expects X,Y,Z\n"), 2;
-    } else if (a == "--sim-seconds") {
-      sim_seconds = std::atof(next());
-    } else if (a == "--solver") {
-      solver = next();
-    } else if (a == "--window") {
-      window_frames = 0;
-      if (i + 1 < argc && argv[i + 1][0] != '-') window_frames = std::atoi(argv[++i]);
-    } else if (a == "--validation") {
-      validation = true;
-    } else {
-      std::fprintf(stderr, "drape render: unknown option '%s'\n", a.c_str());
-      usage();
-      return 2;
-    }
-  }
+  RendererOptions ro;
+  const std::map<std::string, ColourMap> colour_maps = {
+      {"none", ColourMap::kNone}, {"strain", ColourMap::kStrain}, {"ease", ColourMap::kEase}};
+  CLI::App cli{
+      "Renders a scene headless to PNG (default: muslin draped on the 9AR form), optionally\n"
+      "also in a mirror window.",
+      "drape render"};
+  cli.option_defaults()->always_capture_default();
+  cli.add_option("--scene", scene_path,
+                 "scene JSON (docs/rendering.md); default: muslin on the 9AR form")
+      ->type_name("FILE");
+  cli.add_option("--out", out, "PNG to write")->type_name("FILE");
+  cli.add_option("--size", size, "image size")
+      ->type_name("WxH")
+      ->check(
+          [&](const std::string& s) -> std::string {
+            char tail = 0;
+            return std::sscanf(s.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w <= 0 || h <= 0 ||
+                           w > 16384 || h > 16384
+                       ? "expected WxH, each 1..16384, got '" + s + "'"
+                       : std::string();
+          },
+          "");
+  cli.add_option("--samples", samples, "MSAA samples (default from the scene, 4)")
+      ->default_str("")
+      ->type_name("N")
+      ->check(CLI::Range(0, 64));
+  cli.add_option("--colour-map,--color-map", cmap, "colour map")
+      ->type_name("MAP")
+      ->check(CLI::IsMember(colour_maps));
+  cli.add_option("--eye", eye_text, "camera position (look-at camera)")
+      ->type_name("X,Y,Z")
+      ->check(check_vec, "");
+  cli.add_option("--target", target_text, "camera target")
+      ->type_name("X,Y,Z")
+      ->check(check_vec, "");
+  cli.add_option("--sim-seconds", sim_seconds, "default scene: simulated draping time (s)")
+      ->type_name("S")
+      ->check(positive_up_to(60));
+  cli.add_option("--solver", solver, "default scene: solver")->type_name("NAME");
+  auto* o_window =
+      cli.add_option("--window", window,
+                     "also show N frames (default: until closed) in a mirror window")
+          ->type_name("[N]")
+          ->expected(0, 1)
+          ->check(
+              [](const std::string& s) -> std::string {
+                int n = 0;
+                char tail = 0;
+                return s.empty() || (std::sscanf(s.c_str(), "%d%c", &n, &tail) == 1 && n >= 0)
+                           ? std::string()
+                           : "expected a number of frames, got '" + s + "'";
+              },
+              "");
+  cli.add_flag("--validation", validation, "enable the Vulkan validation layer (counts messages)");
+  cli.add_option("--vk-device", ro.context.device_filter,
+                 "use the Vulkan device whose name contains TEXT (default: the best one)")
+      ->type_name("TEXT");
+  if (int rc = parse_command_line(cli, argc, argv); rc >= 0) return rc;
+  const bool have_eye = !eye_text.empty() && parse_vec(eye_text, eye);
+  const bool have_target = !target_text.empty() && parse_vec(target_text, target);
+  if (o_window->count()) window_frames = window.empty() ? 0 : std::atoi(window.c_str());
   auto scene = scene_path.empty() ? default_scene(sim_seconds, solver) : load_scene(scene_path);
   if (!scene) {
     std::fprintf(stderr, "drape render: %s\n", scene.error().c_str());
     return 1;
   }
   SceneDescription& d = *scene;
-  if (!cmap.empty()) {
-    if (cmap == "none")
-      d.options.colour_map = ColourMap::kNone;
-    else if (cmap == "strain")
-      d.options.colour_map = ColourMap::kStrain;
-    else if (cmap == "ease")
-      d.options.colour_map = ColourMap::kEase;
-    else
-      return std::fprintf(stderr, "drape render: --colour-map: none, strain or ease\n"), 2;
-  }
+  if (!cmap.empty()) d.options.colour_map = colour_maps.at(cmap);
   if (have_eye) d.camera.eye = eye, d.camera.xr_fov.reset();
   if (have_target) d.camera.target = target, d.camera.xr_fov.reset();
 
-  RendererOptions ro;
   ro.samples = samples > 0 ? samples : d.samples;
   ro.context.validation = validation;
   bool want_window = window_frames >= 0;

@@ -5,6 +5,8 @@
 //             install: <prefix>/bin/drape and <prefix>/share/drape/assets)
 //   runtime  <exe dir>/drape_mock_runtime.json (build tree: both in build/bin), else
 //            <exe dir>/../lib/drape/drape_mock_runtime.json (install)
+// `cmake --install` lays out <prefix>/bin, lib/drape and share/drape/assets so; a moved prefix
+// still works (ctest build_relocatable_install).
 // The libraries take paths as arguments; only the executable applies this rule.
 #pragma once
 

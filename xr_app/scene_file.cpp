@@ -81,7 +81,7 @@ std::string resolve(const std::string& base, const std::string& p) {
 void parse_form(const json& f, const std::string& base, sim::SceneSnapshot& snap) {
   sim::Result<sim::DressForm> form = sim::Error{""};
   if (f.contains("size")) {
-    auto m = sim::measurements_for_size(text(f["size"], "form.size"));
+    auto m = sim::measurements_for_size(text(f["size"], "form.size"), asset("forms"));
     if (!m) bad("form.size", m.error());
     form = sim::DressForm::from_measurements(*m);
   } else if (f.contains("measurements")) {

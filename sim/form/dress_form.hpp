@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <vector>
@@ -35,8 +36,11 @@ struct FormMeasurements {
   double bust_aspect = 1.3, waist_aspect = 1.3, hip_aspect = 1.4;
 };
 
-// The measurements of a standard size ("7AR", "9AR", "11AR", "13AR"; assets/forms/).
-Result<FormMeasurements> measurements_for_size(const std::string& size);
+// The measurements of a standard size ("7AR", "9AR", "11AR", "13AR"): read from
+// `forms_dir`/<size>.json (the assets/forms/ directory, which the caller finds) when that file
+// exists, else the built-in copy of assets/forms/ (a test checks that both agree).
+Result<FormMeasurements> measurements_for_size(const std::string& size,
+                                               const std::filesystem::path& forms_dir = {});
 // Measurements from a JSON file (fields as above, in metres); errors name the file and field.
 Result<FormMeasurements> load_measurements(const std::string& path);
 // The same from JSON text; `source` names the origin in error messages.

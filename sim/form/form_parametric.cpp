@@ -164,8 +164,8 @@ std::string validate(const FormMeasurements& m, const std::string& src) {
   return {};
 }
 
-// Built-in copies of assets/forms/*.json (used when the assets directory cannot be found; a
-// test checks that both agree).
+// Built-in copies of assets/forms/*.json (used when the caller gives no forms directory or it
+// lacks the size; a test checks that both agree).
 std::optional<FormMeasurements> builtin_size(const std::string& size) {
   FormMeasurements m;
   m.size = size;
@@ -181,22 +181,6 @@ std::optional<FormMeasurements> builtin_size(const std::string& size) {
     return std::nullopt;
   }
   return m;
-}
-
-std::vector<std::filesystem::path> asset_roots() {
-  namespace fs = std::filesystem;
-  std::vector<fs::path> roots;
-  if (const char* env = std::getenv("DRAPE_ASSETS_DIR")) roots.emplace_back(env);
-  std::error_code ec;
-  fs::path cwd = fs::current_path(ec);
-  for (int i = 0; i < 4 && !cwd.empty(); ++i, cwd = cwd.parent_path())
-    roots.push_back(cwd / "assets");
-  fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    fs::path d = exe.parent_path();
-    for (int i = 0; i < 4 && !d.empty(); ++i, d = d.parent_path()) roots.push_back(d / "assets");
-  }
-  return roots;
 }
 
 }  // namespace
@@ -261,12 +245,13 @@ Result<FormMeasurements> load_measurements(const std::string& path) {
   return parse_measurements(ss.str(), path);
 }
 
-Result<FormMeasurements> measurements_for_size(const std::string& size) {
+Result<FormMeasurements> measurements_for_size(const std::string& size,
+                                               const std::filesystem::path& forms_dir) {
   auto builtin = builtin_size(size);
   if (!builtin) return make_error(size, "unknown form size (known: 7AR, 9AR, 11AR, 13AR)");
-  for (const auto& root : asset_roots()) {
+  if (!forms_dir.empty()) {
     std::error_code ec;
-    const auto f = root / "forms" / (size + ".json");
+    const auto f = forms_dir / (size + ".json");
     if (std::filesystem::is_regular_file(f, ec)) return load_measurements(f.string());
   }
   return *builtin;

@@ -62,13 +62,13 @@ struct NewtonSolver::Linear {
     entries.clear();
     entries.shrink_to_fit();
   }
-  void analyse() {
+  void analyse(bool trace) {
     factor_ok = false;
     if (kind == LinearSolver::kCholmod) {
       chol = std::make_unique<Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>>();
       chol->cholmod().print = 0;  // "not positive definite" is expected (exact H): no message
       chol->analyzePattern(H);
-      if (std::getenv("DRAPE_NEWTON_TRACE"))
+      if (trace)
         std::fprintf(stderr, "cholmod: n %ld nnz(H) %ld nnz(L) %.0f flops %.3g ordering %d\n",
                      static_cast<long>(H.rows()), static_cast<long>(H.nonZeros()),
                      chol->cholmod().lnz, chol->cholmod().fl,
@@ -339,7 +339,7 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
       lin_->entries.clear();
       assemble(cloth, inv_h2, mu, false, true);
       lin_->build_pattern(3 * nd);
-      lin_->analyse();
+      lin_->analyse(opt_.trace);
       analysed_ = true;
     }
     bool exact = allow_exact && exact_hold == 0;
@@ -503,7 +503,7 @@ int NewtonSolver::minimise(Cloth& cloth, const SceneObjects& scene, double h,
       ++counters_.projected_steps;
     const double step = alpha * dx_.cwiseAbs().maxCoeff();
     counters_.last_step = step;
-    if (trace_)
+    if (opt_.trace)
       std::fprintf(stderr, "newton it %d res %.3e alpha %.3g step %.3e exact %d mu %.1e\n", it,
                    residual, alpha, step, exact ? 1 : 0, mu);
     if (mu > 0) mu = std::max(mu * 0.3, 1e-9);

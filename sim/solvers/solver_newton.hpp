@@ -50,6 +50,9 @@ struct NewtonOptions {
   bool reuse_factorisation = false;
   int reuse_max_cg = 25;
   double reuse_cg_tolerance = 1e-6;
+  // Diagnostics: one line per Newton iteration on stderr (residual, step, Hessian) and the
+  // CHOLMOD analysis (sizes, flops, ordering).
+  bool trace = false;
 };
 
 class NewtonSolver : public Solver {
@@ -102,8 +105,6 @@ class NewtonSolver : public Solver {
   bool analysed_ = false;
   double step_tolerance_ = 0;
   bool redetect_ = false;
-  // DRAPE_NEWTON_TRACE set: one line per Newton iteration on stderr (residual, step, Hessian).
-  bool trace_ = std::getenv("DRAPE_NEWTON_TRACE") != nullptr;
   Counters counters_;
   std::vector<Vec3> grad_, xtrial_, y_, xt_;
   std::vector<char> contact_active_;  // per contact: in the Newton model's active set

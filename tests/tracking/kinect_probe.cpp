@@ -11,7 +11,8 @@
 int main(int argc, char** argv) {
   using namespace drape::tracking;
   const unsigned frames = argc > 1 ? static_cast<unsigned>(std::atoi(argv[1])) : 3;
-  KinectSource k;
+  const char* recording = std::getenv("FAKENECT_PATH");  // set by the fakenect wrapper
+  KinectSource k({}, 0, recording ? recording : "");
   const auto t0 = std::chrono::steady_clock::now();
   unsigned printed = 0;
   while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20)) {

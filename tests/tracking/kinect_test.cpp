@@ -122,9 +122,7 @@ TEST(Kinect, ReplaysThroughFakenect) {
 }
 
 TEST(Kinect, MissingRecordingGivesStatusNotExit) {
-  ::setenv("FAKENECT_PATH", "/nonexistent/rec", 1);
-  KinectSource k;
-  ::unsetenv("FAKENECT_PATH");
+  KinectSource k({}, 0, "/nonexistent/rec");
   EXPECT_EQ(k.status().state, SourceState::Unavailable);
   EXPECT_NE(k.status().message.find("INDEX.txt"), std::string::npos);
   EXPECT_TRUE(k.poll().empty());

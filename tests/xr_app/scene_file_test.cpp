@@ -8,6 +8,9 @@
 namespace drape::app {
 namespace {
 
+using render::ColourMap;
+using render::View;
+
 const char* kScene = R"({
   "cloth": {"positions": [[0,1,0],[0.1,1,0],[0,1.1,0]], "indices": [0,1,2],
             "material": [[0,0],[0.1,0],[0,0.1]], "strain": [0, 0.01, -0.02]},

@@ -38,17 +38,19 @@ TEST(Measurements, StandardSizesMatchReadme) {
     EXPECT_NEAR(f->waist_girth, r.waist / 100, 1e-12);
     EXPECT_NEAR(f->hip_girth, r.hip / 100, 1e-12);
     EXPECT_NEAR(f->height, 1.58, 1e-12);
-    // measurements_for_size (file or built-in copy) gives the same.
-    auto s = measurements_for_size(r.size);
-    ASSERT_TRUE(s.ok()) << s.error();
-    EXPECT_EQ(s->bust_girth, f->bust_girth);
-    EXPECT_EQ(s->waist_girth, f->waist_girth);
-    EXPECT_EQ(s->hip_girth, f->hip_girth);
-    EXPECT_EQ(s->bust_height, f->bust_height);
-    EXPECT_EQ(s->waist_height, f->waist_height);
-    EXPECT_EQ(s->hip_height, f->hip_height);
-    EXPECT_EQ(s->neck_height, f->neck_height);
-    EXPECT_EQ(s->bottom_height, f->bottom_height);
+    // measurements_for_size (the file in the forms directory, or the built-in copy without
+    // one) gives the same.
+    for (const std::string& dir :
+         {std::string(DRAPE_SOURCE_DIR) + "/assets/forms", std::string()}) {
+      auto s = measurements_for_size(r.size, dir);
+      ASSERT_TRUE(s.ok()) << s.error();
+      using M = FormMeasurements;
+      for (double M::*field :
+           {&M::bust_girth, &M::waist_girth, &M::hip_girth, &M::height, &M::bust_height,
+            &M::waist_height, &M::hip_height, &M::neck_height, &M::bottom_height, &M::bust_aspect,
+            &M::waist_aspect, &M::hip_aspect})
+        EXPECT_EQ((*s).*field, (*f).*field) << dir;
+    }
   }
   auto bad = measurements_for_size("99XL");
   ASSERT_FALSE(bad.ok());
