@@ -23,7 +23,7 @@ const char* kGood = R"({"size": "X", "bust_girth": 0.83, "waist_girth": 0.64, "h
   "neck_height": 1.34, "bottom_height": 0.60})";
 
 TEST(Measurements, StandardSizesMatchReadme) {
-  // JIS L 4005 bust / hip and the usual form waist (cm), /work/shared/data/README.md.
+  // JIS L 4005 bust / hip and the usual form waist (cm).
   struct Row {
     const char* size;
     double bust, waist, hip;
