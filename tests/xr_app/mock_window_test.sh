@@ -104,6 +104,9 @@ check "left button pinches the right hand" "'$(field pinch)' == '0,1'"
 [ "$MODE" = depth ] && cp "$OUT/stdout" "$OUT/stdout_pinched"
 xdotool mouseup 1; frames 4
 check "releasing the button opens the pinch" "'$(field pinch)' == '0,0'"
+n=$(lines); xdotool click 1; frames 4
+tail -n +$((n + 1)) "$LOG" | grep -q " pinch=0,1 " || fail "a quick click pinches for at least one frame"
+check "a quick click pinches, then opens" "'$(field pinch)' == '0,0'"
 xdotool keydown f; frames 4
 check "F makes a fist" "'$(field fist)' == '0,1'"
 xdotool keyup f; frames 4

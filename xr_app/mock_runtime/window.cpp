@@ -32,12 +32,12 @@ constexpr float kSelfHit = 0.05f;        // depth hits this close in front of th
 struct RawInput {
   int win_w = 0, win_h = 0;
   double cx = -1, cy = -1;
-  bool lmb = false, rmb = false, shift = false;
+  bool lmb = false, shift = false;
   bool w = false, a = false, s = false, d = false, q = false, e = false, f = false;
   bool button[5] = {false, false, false, false, false};  // 1 2 3 4 M: A B X Y menu
   double look_dx = 0, look_dy = 0;                       // accumulated until taken
   double wheel = 0;                                      // accumulated until taken
-  int tab = 0, reset = 0, view = 0;                      // presses until taken
+  int tab = 0, reset = 0, view = 0, lmb_presses = 0;     // presses until taken
   bool quit = false;
 };
 
@@ -80,6 +80,8 @@ struct Window {
   std::string title;
   bool title_dirty = false;
   bool stop = false;
+  bool dragging = false;  // right button held
+  double drag_x = 0, drag_y = 0;
   std::thread thread;
   int req_w = kDefaultWidth, req_h = kDefaultHeight;
 
@@ -167,6 +169,34 @@ void on_key(GLFWwindow* gw, int key, int, int action, int) {
   }
 }
 
+// Mouse buttons. The right one starts and ends a look drag (on_cursor adds up the motion in
+// between, in order); the left one is held, and counted when pressed (a quick click pinches for
+// at least one frame).
+void on_button(GLFWwindow* gw, int button, int action, int) {
+  Window* w = self_of(gw);
+  double x = 0, y = 0;
+  glfwGetCursorPos(gw, &x, &y);
+  std::lock_guard<std::mutex> g(w->mu);
+  if (button == GLFW_MOUSE_BUTTON_LEFT) {
+    w->raw.lmb = action == GLFW_PRESS;
+    if (w->raw.lmb) ++w->raw.lmb_presses;
+  }
+  if (button != GLFW_MOUSE_BUTTON_RIGHT) return;
+  w->dragging = action == GLFW_PRESS;
+  w->drag_x = x;
+  w->drag_y = y;
+}
+
+void on_cursor(GLFWwindow* gw, double x, double y) {
+  Window* w = self_of(gw);
+  std::lock_guard<std::mutex> g(w->mu);
+  if (!w->dragging) return;
+  w->raw.look_dx += x - w->drag_x;
+  w->raw.look_dy += y - w->drag_y;
+  w->drag_x = x;
+  w->drag_y = y;
+}
+
 void on_scroll(GLFWwindow* gw, double, double dy) {
   Window* w = self_of(gw);
   std::lock_guard<std::mutex> g(w->mu);
@@ -197,6 +227,8 @@ void Window::run(std::promise<std::string> ready) {
   glfwSetWindowUserPointer(win, this);
   glfwSetKeyCallback(win, on_key);
   glfwSetScrollCallback(win, on_scroll);
+  glfwSetMouseButtonCallback(win, on_button);
+  glfwSetCursorPosCallback(win, on_cursor);
   glfwMakeContextCurrent(win);
   glfwSwapInterval(0);
   GLuint tex = 0;
@@ -209,8 +241,6 @@ void Window::run(std::promise<std::string> ready) {
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   ready.set_value("");
 
-  double last_x = 0, last_y = 0;
-  glfwGetCursorPos(win, &last_x, &last_y);
   int tex_w = 0, tex_h = 0, drawn_w = 0, drawn_h = 0;
   std::vector<unsigned char> px;
   for (;;) {
@@ -221,7 +251,6 @@ void Window::run(std::promise<std::string> ready) {
     double cx = 0, cy = 0;
     glfwGetCursorPos(win, &cx, &cy);
     auto key = [&](int k) { return glfwGetKey(win, k) == GLFW_PRESS; };
-    bool rmb = glfwGetMouseButton(win, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
     bool upload = false;
     std::string new_title;
     {
@@ -230,14 +259,8 @@ void Window::run(std::promise<std::string> ready) {
       RawInput& r = raw;
       r.win_w = ww;
       r.win_h = wh;
-      if (r.rmb && rmb) {
-        r.look_dx += cx - last_x;
-        r.look_dy += cy - last_y;
-      }
-      r.rmb = rmb;
       r.cx = cx;
       r.cy = cy;
-      r.lmb = glfwGetMouseButton(win, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
       r.shift = key(GLFW_KEY_LEFT_SHIFT) || key(GLFW_KEY_RIGHT_SHIFT);
       r.w = key(GLFW_KEY_W);
       r.a = key(GLFW_KEY_A);
@@ -261,8 +284,6 @@ void Window::run(std::promise<std::string> ready) {
         title_dirty = false;
       }
     }
-    last_x = cx;
-    last_y = cy;
     if (!new_title.empty()) glfwSetWindowTitle(win, new_title.c_str());
     if (upload && tex_w > 0 && tex_h > 0 &&
         px.size() >= static_cast<size_t>(tex_w) * static_cast<size_t>(tex_h) * 4)
@@ -368,7 +389,7 @@ void window_wait_frame(Session* s, int64_t frame) {
     std::lock_guard<std::mutex> g(w->mu);
     r = w->raw;
     w->raw.look_dx = w->raw.look_dy = w->raw.wheel = 0;
-    w->raw.tab = w->raw.reset = w->raw.view = 0;
+    w->raw.tab = w->raw.reset = w->raw.view = w->raw.lmb_presses = 0;
   }
   const int64_t now = now_ns();
   const float dt =
@@ -425,7 +446,7 @@ void window_wait_frame(Session* s, int64_t frame) {
   const int act = r.shift ? 0 : 1;
   Window::Hand& hd = w->hands[act];
   const bool was_pinching = hd.pinch > 0.5f;
-  hd.pinch = r.lmb ? 1.f : 0.f;
+  hd.pinch = r.lmb || r.lmb_presses > 0 ? 1.f : 0.f;
   hd.fist = r.f ? 1.f : 0.f;
   hd.wheel += static_cast<float>(r.wheel) * kWheelStep;
   int eye = 0;
