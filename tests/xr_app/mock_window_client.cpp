@@ -1,6 +1,7 @@
 // A small OpenXR client for mock_window_test.sh (window mode of the mock runtime): it submits
 // a projection layer with XR_KHR_composition_layer_depth (a plane 0.8 m away over the left half
-// of each eye, nothing on the right half) and prints, per frame, what it reads back as an app
+// of each eye, nothing on the right half, and the right hand's joints as small squares) and
+// prints, per frame, what it reads back as an app
 // would: the right hand's thumb-to-index gap (XR_EXT_hand_tracking), the select action
 // (khr/simple_controller) and interaction profile changes. It runs until the session exits.
 #define XR_USE_GRAPHICS_API_VULKAN
@@ -71,6 +72,47 @@ VkBuffer make_buffer(const Gpu& g, const std::vector<unsigned char>& bytes, VkDe
   std::memcpy(p, bytes.data(), bytes.size());
   vkUnmapMemory(g.dev, *mem);
   return b;
+}
+
+void fill(const Gpu& g, VkDeviceMemory mem, const std::vector<unsigned char>& bytes) {
+  void* p;
+  CHECK(vkMapMemory(g.dev, mem, 0, bytes.size(), 0, &p) == VK_SUCCESS);
+  std::memcpy(p, bytes.data(), bytes.size());
+  vkUnmapMemory(g.dev, mem);
+}
+
+float depth_value(float z) {  // of a view distance z, for kNear at 0 and kFar at 1
+  return (1 / z - 1 / kNear) / (1 / kFar - 1 / kNear);
+}
+
+// Draws a 7x7 white square with depth test at the projection of p (stage) through `view`.
+void draw_joint(const XrView& view, const XrVector3f& p, std::vector<unsigned char>* rgba,
+                std::vector<unsigned char>* zbytes) {
+  const XrQuaternionf& q = view.pose.orientation;
+  XrVector3f d{p.x - view.pose.position.x, p.y - view.pose.position.y, p.z - view.pose.position.z};
+  // d rotated by the conjugate of q: d + 2w(u x d) + 2u x (u x d), u = -q.xyz.
+  XrVector3f u{-q.x, -q.y, -q.z};
+  auto cross = [](XrVector3f a, XrVector3f b) {
+    return XrVector3f{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+  };
+  XrVector3f c = cross(u, d), cc = cross(u, c);
+  XrVector3f l{d.x + 2 * q.w * c.x + 2 * cc.x, d.y + 2 * q.w * c.y + 2 * cc.y,
+               d.z + 2 * q.w * c.z + 2 * cc.z};
+  if (l.z > -kNear) return;
+  const float z = -l.z, tx = l.x / z, ty = l.y / z;
+  const float tl = std::tan(view.fov.angleLeft), tr = std::tan(view.fov.angleRight);
+  const float tu = std::tan(view.fov.angleUp), td = std::tan(view.fov.angleDown);
+  const int px = static_cast<int>((tx - tl) / (tr - tl) * kSize);
+  const int py = static_cast<int>((tu - ty) / (tu - td) * kSize);
+  const float dv = depth_value(z);
+  for (int y = py - 3; y <= py + 3; ++y)
+    for (int x = px - 3; x <= px + 3; ++x) {
+      if (x < 0 || y < 0 || x >= kSize || y >= kSize) continue;
+      float* old = reinterpret_cast<float*>(&(*zbytes)[(y * kSize + x) * 4]);
+      if (dv >= *old) continue;
+      *old = dv;
+      std::memset(&(*rgba)[(y * kSize + x) * 4], 255, 4);
+    }
 }
 
 // Copies `buf` into `img` (in its attachment layout before and after).
@@ -261,7 +303,7 @@ int main() {
       make_chain(session, VK_FORMAT_D32_SFLOAT, XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
   // Left half: an orange plane with a grid at kPlane; right half: dark blue, nothing (far).
   std::vector<unsigned char> rgba(kSize * kSize * 4), zbytes(kSize * kSize * 4);
-  const float d_plane = (1 / kPlane - 1 / kNear) / (1 / kFar - 1 / kNear);
+  const float d_plane = depth_value(kPlane);
   for (int y = 0; y < kSize; ++y)
     for (int x = 0; x < kSize; ++x) {
       unsigned char* p = &rgba[(y * kSize + x) * 4];
@@ -368,6 +410,14 @@ int main() {
     XrView xv[2] = {{XR_TYPE_VIEW}, {XR_TYPE_VIEW}};
     uint32_t nv = 0;
     XR(xrLocateViews(session, &vli, &vs, 2, &nv, xv));
+    // The app draws the right hand's joints (in the left eye's projection, with depth), as an
+    // app draws its hands: the runtime must not take them for the surface under the cursor.
+    std::vector<unsigned char> rgba_frame = rgba, z_frame = zbytes;
+    if (locs.isActive)
+      for (const XrHandJointLocationEXT& j : joints)
+        draw_joint(xv[0], j.pose.position, &rgba_frame, &z_frame);
+    fill(g, cmem, rgba_frame);
+    fill(g, zmem, z_frame);
     XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
     ei.displayTime = fs.predictedDisplayTime;
     ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;

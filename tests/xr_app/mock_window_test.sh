@@ -59,8 +59,29 @@ field() {
   v=$(tail -1 "$LOG" | tr ' ' '\n' | sed -n "s/^$1=//p")
   if [ $# -ge 2 ]; then echo "$v" | cut -d, -f"$2"; else echo "$v"; fi
 }
-check() {  # check "description" python-expression
-  python3 -c "import sys; sys.exit(0 if ($2) else 1)" || fail "$1 ($2)"
+# expect "description" EXPR: polls the last log line (up to 15 s) until the Python expression
+# EXPR holds; in it f(NAME) is a field as text and v(NAME, I) the I-th (1-based) number of it.
+expect() {
+  python3 - "$LOG" "$2" <<'PY' || fail "$1 ($2)"
+import sys, time
+log, expr = sys.argv[1], sys.argv[2]
+deadline = time.time() + 15
+while True:
+    with open(log) as fh:
+        lines = fh.read().splitlines()
+    d = dict(kv.split("=", 1) for kv in lines[-1].split() if "=" in kv) if lines else {}
+    f = lambda name: d[name]
+    v = lambda name, i=1: float(d[name].split(",")[i - 1])
+    try:
+        if eval(expr):
+            sys.exit(0)
+    except (KeyError, ValueError, IndexError):
+        pass
+    if time.time() > deadline:
+        print("last line:", lines[-1] if lines else "(none)")
+        sys.exit(1)
+    time.sleep(0.02)
+PY
   echo "ok: $1"
 }
 
@@ -71,87 +92,97 @@ WID=$(xdotool search --name "drape mock runtime" | head -1)
 xdotool getwindowgeometry "$WID" | tee "$OUT/geometry" | grep -q "Geometry: 800x600" || fail "window geometry"
 
 # --- the right hand follows the cursor
-xdotool mousemove 150 300; frames 4
-x1=$(field right 1); y1=$(field right 2)
-xdotool mousemove 650 300; frames 4
-x2=$(field right 1)
-check "right hand follows the cursor to the right ($x1 -> $x2)" "$x2 - $x1 > 0.3"
-xdotool mousemove 400 120; frames 4
+xdotool mousemove 150 300
+expect "the cursor is over the view, on the left" "f('cursor') == 'in' and v('right', 1) < -0.3"
+x1=$(field right 1)
+xdotool mousemove 650 300
+expect "the right hand follows the cursor to the right" "v('right', 1) - $x1 > 0.5"
+xdotool mousemove 400 120
+expect "the right hand follows the cursor up" "v('right', 2) > 1.8"
 ya=$(field right 2)
-xdotool mousemove 400 480; frames 4
-yb=$(field right 2)
-check "right hand follows the cursor down ($ya -> $yb)" "$ya - $yb > 0.2"
-check "the cursor is over the view" "'$(field cursor)' == 'in'"
+xdotool mousemove 400 480
+expect "the right hand follows the cursor down" "$ya - v('right', 2) > 0.4"
 
 # --- head: W moves forward (-z), R resets, right-drag looks
 z0=$(field head 3)
-xdotool keydown w; sleep 0.5; xdotool keyup w; frames 4
-z1=$(field head 3)
-check "W moves the head forward ($z0 -> $z1)" "$z0 - $z1 > 0.1"
-xdotool key r; frames 4
-check "R resets the head" "abs($(field head 3) - $z0) < 1e-3"
-xdotool mousedown 3; xdotool mousemove_relative -- 150 0; frames 3; xdotool mouseup 3; frames 4
-yaw=$(field yaw)
-check "right-drag to the right turns the head right (yaw $yaw)" "$yaw < -0.3"
-xdotool key r; frames 4
-check "R resets the look" "abs($(field yaw)) < 1e-6"
+xdotool keydown w; sleep 0.5; xdotool keyup w
+expect "W moves the head forward" "$z0 - v('head', 3) > 0.1"
+frames 3; z1=$(field head 3)
+frames 5
+expect "releasing W stops the head" "v('head', 3) == $z1"
+xdotool key r
+expect "R resets the head" "abs(v('head', 3) - $z0) < 1e-3"
+xdotool mousedown 3; xdotool mousemove_relative -- 150 0; xdotool mouseup 3
+expect "right-drag to the right turns the head right" "abs(v('yaw') + 150 * 0.004) < 1e-3"
+xdotool key r
+expect "R resets the look" "v('yaw') == 0 and v('pitch') == 0"
 
-# --- pinch on the left button, fist on F
-xdotool mousemove 400 300; frames 3
-check "no pinch before the button" "'$(field pinch)' == '0,0'"
-xdotool mousedown 1; frames 4
-check "left button pinches the right hand" "'$(field pinch)' == '0,1'"
+# --- pinch on the left button (held, or a quick click), fist on F
+xdotool mousemove 400 300
+expect "no pinch before the button" "f('pinch') == '0,0'"
+xdotool mousedown 1
+expect "left button pinches the right hand" "f('pinch') == '0,1'"
+frames 3
 [ "$MODE" = depth ] && cp "$OUT/stdout" "$OUT/stdout_pinched"
-xdotool mouseup 1; frames 4
-check "releasing the button opens the pinch" "'$(field pinch)' == '0,0'"
-n=$(lines); xdotool click 1; frames 4
-tail -n +$((n + 1)) "$LOG" | grep -q " pinch=0,1 " || fail "a quick click pinches for at least one frame"
-check "a quick click pinches, then opens" "'$(field pinch)' == '0,0'"
-xdotool keydown f; frames 4
-check "F makes a fist" "'$(field fist)' == '0,1'"
-xdotool keyup f; frames 4
-check "releasing F opens the fist" "'$(field fist)' == '0,0'"
+xdotool mouseup 1
+expect "releasing the button opens the pinch" "f('pinch') == '0,0'"
+n=$(lines); xdotool click 1
+expect "a quick click pinches for a frame, then opens" "f('pinch') == '0,0' and any(' pinch=0,1 ' in l for l in open('$LOG').read().splitlines()[$n:])"
+xdotool keydown f
+expect "F makes a fist" "f('fist') == '0,1'"
+xdotool keyup f
+expect "releasing F opens the fist" "f('fist') == '0,0'"
 
 # --- the left hand with Shift; the right hand stays
 rx=$(field right 1); lx0=$(field left 1)
-xdotool keydown shift; xdotool mousemove 200 300; frames 4
-check "Shift makes the left hand the active one" "'$(field active)' == 'left'"
-lx1=$(field left 1)
-check "the left hand follows the cursor ($lx0 -> $lx1)" "abs($lx1 - $lx0) > 0.05"
-check "the right hand stays" "abs($(field right 1) - $rx) < 1e-4"
-xdotool keyup shift; frames 3
+xdotool keydown shift; xdotool mousemove 200 300
+expect "Shift makes the left hand follow the cursor" "f('active') == 'left' and abs(v('left', 1) - $lx0) > 0.05"
+expect "the right hand stays" "v('right', 1) == $rx"
+xdotool keyup shift
+expect "without Shift the right hand is active again" "f('active') == 'right'"
 
 # --- wheel: the hand farther (up) and nearer (down)
-xdotool mousemove 400 300; frames 3
-xdotool click --repeat 3 --delay 30 4; frames 4
-check "wheel up moves the right hand 3 notches farther" "abs($(field wheel 2) - 0.06) < 1e-6"
-xdotool click --repeat 3 --delay 30 5; frames 4
-check "wheel down brings it back" "abs($(field wheel 2)) < 1e-6"
+xdotool mousemove 400 300
+xdotool click --repeat 3 --delay 30 4
+expect "wheel up: the right hand 3 notches (6 cm) farther" "abs(v('wheel', 2) - 0.06) < 1e-6"
+xdotool click --repeat 3 --delay 30 5
+expect "wheel down brings it back" "abs(v('wheel', 2)) < 1e-6"
 
 # --- Tab switches the interaction profile
 p0=$(field profile)
-xdotool key Tab; frames 4
-p1=$(field profile)
-check "Tab switches the profile ($p0 -> $p1)" "'$p0' != '$p1'"
+xdotool key Tab
+expect "Tab switches the profile (from $p0)" "f('profile') != '$p0'"
+echo "   profile now $(field profile)"
 
 # --- V: both eyes side by side
-xdotool key v; frames 4
-check "V shows both eyes" "'$(field view)' == 'both'"
-xdotool key v; frames 4
+xdotool key v
+expect "V shows both eyes" "f('view') == 'both'"
+xdotool key v
+expect "V again: the left eye" "f('view') == 'left'"
 
 if [ "$MODE" = depth ]; then
-  # The client draws a plane at 0.8 m over the left half of each eye image, nothing on the
-  # right half; the runtime reads the depth under the cursor.
-  xdotool mousemove 250 300; frames 6
-  d=$(field depth)
-  check "depth under the cursor is the submitted plane ($d)" "'$d' != '-' and abs(float('$d') - 0.8) < 0.01"
+  # The client draws a plane at 0.8 m over the left half of each eye and the hand's joints
+  # (with depth); hits on the joints are not the surface.
+  xdotool mousemove 250 300
+  expect "the hand's depth is the submitted plane's" "abs(v('z') - 0.8) < 0.005"
   # The hand sits on the plane: at view depth 0.8 m (head z 1.0, looking down -z).
-  check "the right hand sits on the surface (z $(field right 3))" "abs($(field right 3) - (1.0 - 0.8)) < 0.02"
-  xdotool mousemove 600 300; frames 6
-  check "nothing drawn under the cursor: no depth hit" "'$(field depth)' == '-'"
-  check "over nothing the hand keeps the last surface depth" "abs($(field right 3) - 0.2) < 0.02"
+  expect "the right hand sits on the surface" "abs(v('right', 3) - (1.0 - 0.8)) < 0.01"
+  frames 10
+  expect "and stays there (the drawn hand does not pull it)" "abs(v('right', 3) - 0.2) < 0.01"
+  xdotool mousemove 600 300
+  expect "over nothing but the drawn hand: no surface hit" "f('depth') == '-' or f('depth').endswith('(hand)')"
+  frames 10
+  expect "over nothing the hand keeps the last surface depth" "abs(v('right', 3) - 0.2) < 0.01 and abs(v('right', 1)) > 0.1"
+  xdotool click --repeat 5 --delay 30 5
+  expect "the wheel brings the hand 10 cm nearer than the surface" "abs(v('right', 3) - 0.3) < 0.01"
+  xdotool mousemove 250 300
+  frames 10
+  expect "and it hovers 10 cm in front of the plane" "abs(v('right', 3) - 0.3) < 0.01 and abs(v('z') - 0.8) < 0.005"
+  xdotool key r
+  expect "R resets the wheel" "v('wheel', 2) == 0"
 fi
 
+frames 6  # the last image drawn in the window
 # --- a screenshot of the window: the submitted image is shown
 xwd -root -silent >"$OUT/screen.xwd" || fail "xwd"
 python3 - "$OUT/screen.xwd" "$OUT/window.png" <<'PY' || fail "screenshot check"

@@ -6,6 +6,7 @@
 #include <GLFW/glfw3.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -26,7 +27,7 @@ constexpr float kMinDistance = 0.05f;
 constexpr float kMoveSpeed = 1.0f;       // m/s
 constexpr float kLookPerPixel = 0.004f;  // rad per pixel of right-drag
 constexpr float kWheelStep = 0.02f;      // m per wheel notch
-constexpr float kSelfHit = 0.05f;        // depth hits this close in front of the hand: the hand
+constexpr float kSelfHit = 0.01f;  // depth hits this much beyond a joint's radius: not the hand
 
 // What the window thread gathers; the runtime takes it once per frame.
 struct RawInput {
@@ -95,11 +96,44 @@ struct Window {
     float z = kDefaultDistance;  // view depth of the surface it sits on
     float wheel = 0;             // nearer (<0) / farther (>0) than that surface
     float pinch = 0, fist = 0;
+    HandSample published;  // the joints as last published (stage)
   } hands[2];
+
+  // A depth hit on the app's drawing of a hand: within a joint's radius (plus kSelfHit) of one
+  // of the joints published last or of a bone between two of them.
+  bool on_a_hand(const XrVector3f& p) const {
+    auto near_segment = [&](const XrVector3f& a, const XrVector3f& b, float r) {
+      XrVector3f ab = sub(b, a);
+      float l2 = ab.x * ab.x + ab.y * ab.y + ab.z * ab.z;
+      XrVector3f ap = sub(p, a);
+      float t = l2 > 0 ? std::clamp((ap.x * ab.x + ap.y * ab.y + ap.z * ab.z) / l2, 0.f, 1.f) : 0;
+      return len(sub(p, add(a, mul(ab, t)))) < r + kSelfHit;
+    };
+    for (const Hand& h : hands) {
+      const HandSample& s = h.published;
+      if (!s.tracked) continue;
+      for (int j = 0; j < kHandJointCount; ++j) {
+        // Each joint's bone toward the wrist: the metacarpals from the wrist, the others from
+        // the joint before them on the finger; the palm and the wrist as spheres.
+        int from = j;
+        if (j == XR_HAND_JOINT_THUMB_METACARPAL_EXT || j == XR_HAND_JOINT_INDEX_METACARPAL_EXT ||
+            j == XR_HAND_JOINT_MIDDLE_METACARPAL_EXT || j == XR_HAND_JOINT_RING_METACARPAL_EXT ||
+            j == XR_HAND_JOINT_LITTLE_METACARPAL_EXT)
+          from = XR_HAND_JOINT_WRIST_EXT;
+        else if (j > XR_HAND_JOINT_WRIST_EXT)
+          from = j - 1;
+        if (near_segment(s.joints[from].position, s.joints[j].position,
+                         std::max(s.radii[from], s.radii[j])))
+          return true;
+      }
+    }
+    return false;
+  }
   bool both = false;  // both eyes side by side
   int eye_w = 0, eye_h = 0;
   bool depth_seen = false;  // the app has submitted depth
   bool hit_valid = false;
+  bool hit_hand = false;  // the hit was on the app's drawing of a hand (ignored)
   float hit_z = 0;
   int hit_eye = 0;
   std::vector<XrPath> cycle;  // XR_NULL_PATH: hand tracking only
@@ -452,6 +486,7 @@ void window_wait_frame(Session* s, int64_t frame) {
   int eye = 0;
   float u = 0, v = 0;
   const bool over = w->cursor_in_view(r, &eye, &u, &v);
+  w->hit_hand = false;
   if (over) {
     const XrPosef eye_pose =
         pose_mul(head, XrPosef{{0, 0, 0, 1}, {eye == 0 ? -kIpd / 2 : kIpd / 2, 0, 0}});
@@ -461,8 +496,8 @@ void window_wait_frame(Session* s, int64_t frame) {
     if (!pinching && !was_pinching) {  // a held pinch keeps its depth
       if (w->hit_valid && w->hit_eye == eye) {
         XrVector3f hit = pose_mul(eye_pose, XrPosef{{0, 0, 0, 1}, mul(dir, w->hit_z)}).position;
-        bool self = w->hit_z < hd.z + hd.wheel && len(sub(hit, hd.pos)) < kSelfHit;
-        if (!self) hd.z = w->hit_z;
+        w->hit_hand = w->on_a_hand(hit);
+        if (!w->hit_hand) hd.z = w->hit_z;
       } else if (!w->depth_seen) {
         hd.z = kDefaultDistance;
       }
@@ -477,7 +512,7 @@ void window_wait_frame(Session* s, int64_t frame) {
   sc.head = {PoseKey{0, w->home}, PoseKey{1e-3, head}};
   if (frame == 0) sc.head.resize(1);
   for (int h = 0; h < 2; ++h) {
-    const Window::Hand& k = w->hands[h];
+    Window::Hand& k = w->hands[h];
     HandKey hk;
     hk.tracked = true;
     hk.pinch = k.pinch;
@@ -491,6 +526,7 @@ void window_wait_frame(Session* s, int64_t frame) {
             0.5f);
     hk.palm = XrPosef{body, sub(k.pos, quat_rotate(body, mid))};
     sc.hands[h] = {hk};
+    k.published = sc.hand(h, 0);
     ControllerKey ck;
     ck.tracked = controllers;
     XrQuaternionf aim = rotation_between({0, 0, -1}, k.ray);
@@ -527,17 +563,18 @@ void window_wait_frame(Session* s, int64_t frame) {
   if (w->log_file) {
     const XrVector3f& L = w->hands[0].pos;
     const XrVector3f& R = w->hands[1].pos;
-    char depth[32] = "-";
-    if (w->hit_valid) std::snprintf(depth, sizeof(depth), "%.4f", w->hit_z);
+    char depth[48] = "-";
+    if (w->hit_valid)
+      std::snprintf(depth, sizeof(depth), "%.4f%s", w->hit_z, w->hit_hand ? "(hand)" : "");
     std::fprintf(w->log_file,
                  "frame=%lld head=%.4f,%.4f,%.4f yaw=%.4f pitch=%.4f active=%s "
                  "left=%.4f,%.4f,%.4f right=%.4f,%.4f,%.4f pinch=%d,%d fist=%d,%d "
-                 "wheel=%.3f,%.3f cursor=%s eye=%d depth=%s view=%s profile=%s\n",
+                 "wheel=%.3f,%.3f z=%.4f cursor=%s eye=%d depth=%s view=%s profile=%s\n",
                  static_cast<long long>(frame), head.position.x, head.position.y, head.position.z,
                  w->yaw, w->pitch, act ? "right" : "left", L.x, L.y, L.z, R.x, R.y, R.z,
                  w->hands[0].pinch > 0.5f, w->hands[1].pinch > 0.5f, w->hands[0].fist > 0.5f,
-                 w->hands[1].fist > 0.5f, w->hands[0].wheel, w->hands[1].wheel, over ? "in" : "out",
-                 eye, depth, w->both ? "both" : "left", profile.c_str());
+                 w->hands[1].fist > 0.5f, w->hands[0].wheel, w->hands[1].wheel, hd.z,
+                 over ? "in" : "out", eye, depth, w->both ? "both" : "left", profile.c_str());
     std::fflush(w->log_file);
   }
 }
