@@ -110,8 +110,11 @@ expect "W moves the head forward" "$z0 - v('head', 3) > 0.1"
 frames 3; z1=$(field head 3)
 frames 5
 expect "releasing W stops the head" "v('head', 3) == $z1"
+y0=$(field head 2)
+xdotool keydown e; sleep 0.3; xdotool keyup e
+expect "E moves the head up" "v('head', 2) - $y0 > 0.05"
 xdotool key r
-expect "R resets the head" "abs(v('head', 3) - $z0) < 1e-3"
+expect "R resets the head" "abs(v('head', 3) - $z0) < 1e-3 and abs(v('head', 2) - $y0) < 1e-3"
 xdotool mousedown 3; xdotool mousemove_relative -- 150 0; xdotool mouseup 3
 expect "right-drag to the right turns the head right" "abs(v('yaw') + 150 * 0.004) < 1e-3"
 xdotool key r
@@ -122,6 +125,9 @@ xdotool mousemove 400 300
 expect "no pinch before the button" "f('pinch') == '0,0'"
 xdotool mousedown 1
 expect "left button pinches the right hand" "f('pinch') == '0,1'"
+xdotool search --name "drape mock runtime" getwindowname | grep -q "right hand pinch" ||
+  fail "the window title does not show the pinch: $(xdotool search --name 'drape mock runtime' getwindowname)"
+echo "ok: the window title shows it"
 frames 3
 [ "$MODE" = depth ] && cp "$OUT/stdout" "$OUT/stdout_pinched"
 xdotool mouseup 1
@@ -132,6 +138,18 @@ xdotool keydown f
 expect "F makes a fist" "f('fist') == '0,1'"
 xdotool keyup f
 expect "releasing F opens the fist" "f('fist') == '0,0'"
+
+# --- the controllers' buttons: 1 2 3 4 M = A B X Y menu (hello_xr quits on menu: its M is
+# the last step)
+keys="1 2 3 4"
+[ "$MODE" = depth ] && keys="1 2 3 4 m"
+for k in $keys; do
+  xdotool keydown $k
+  want=$(case $k in 1) echo 10000;; 2) echo 01000;; 3) echo 00100;; 4) echo 00010;; m) echo 00001;; esac)
+  expect "key $k presses button $want" "f('buttons') == '$want'"
+  xdotool keyup $k
+done
+expect "buttons released" "f('buttons') == '00000'"
 
 # --- the left hand with Shift; the right hand stays
 rx=$(field right 1); lx0=$(field left 1)
@@ -212,25 +230,37 @@ assert len(bars) == 1, "the letterbox bars are not plain"
 PY
 echo "ok: screenshot $OUT/window.png shows the submitted image"
 
-# --- Escape ends the session the way a headset's quit does: STOPPING, IDLE, EXITING
-xdotool key Escape
+# --- Escape ends the session the way a headset's quit does: STOPPING, IDLE, EXITING. hello_xr
+# binds its quit action to the menu button: there M ends it through the action path.
+if [ "$MODE" = hello ]; then
+  xdotool keydown m; sleep 0.3; xdotool keyup m
+else
+  xdotool key Escape
+fi
 for _ in $(seq 300); do kill -0 $CLIENT_PID 2>/dev/null || break; sleep 0.1; done
-kill -0 $CLIENT_PID 2>/dev/null && fail "the client did not exit within 30 s of Escape"
+kill -0 $CLIENT_PID 2>/dev/null && fail "the client did not exit within 30 s"
 wait $CLIENT_PID; rc=$?; CLIENT_PID=""
 [ "$rc" -eq 0 ] || fail "the client exited with $rc"
-grep -q "closed or Escape: ending the session" "$OUT/stderr" || fail "the runtime did not log the quit"
 if [ "$MODE" = hello ]; then
+  grep -q "closed or Escape" "$OUT/stderr" && fail "the session ended by Escape, not by the menu button"
+  grep -q "buttons=00001" "$LOG" || fail "M did not press the menu button"
+  echo "ok: M (menu) made hello_xr request the exit"
   grep -q "XR_SESSION_STATE_STOPPING->XR_SESSION_STATE_IDLE" "$OUT/stdout" || fail "no STOPPING->IDLE"
   grep -q "XR_SESSION_STATE_IDLE->XR_SESSION_STATE_EXITING" "$OUT/stdout" || fail "no IDLE->EXITING"
   grep -q "XR_ERROR" "$OUT/stdout" "$OUT/stderr" && fail "an XR_ERROR result was logged"
 else
+  grep -q "closed or Escape: ending the session" "$OUT/stderr" || fail "the runtime did not log the quit"
   grep -q "^state EXITING" "$OUT/stdout" || fail "the client saw no EXITING"
   # What the app sees: hand joints with thumb and index tips together while pinched, the
   # select action pressed, the profile change event.
   grep -q "pinch_gap=0.005" "$OUT/stdout_pinched" || fail "the client never saw the thumb and index tips together"
   grep -q "select=1" "$OUT/stdout_pinched" || fail "the client never saw select pressed"
-  grep -q "^profile changed" "$OUT/stdout" || fail "the client saw no interaction profile change"
+  grep -q "^profile changed: /interaction_profiles/khr/simple_controller" "$OUT/stdout" ||
+    fail "the client never saw khr/simple_controller"
+  grep -q "^profile changed: none" "$OUT/stdout" || fail "the client never saw the change to hand tracking alone"
+  awk '/^state/ && seen { exit } /pinch_gap/ { seen = 1 } seen && /hand not tracked/ { bad = 1 }
+       END { exit bad }' "$OUT/stdout" || fail "the client saw the hand untracked while focused"
   echo "ok: the client saw the pinch as hand joints and as select, and the profile change"
 fi
-echo "ok: Escape ended the session, exit 0"
+echo "ok: the session ended (STOPPING, IDLE, EXITING), exit 0"
 echo PASS

@@ -569,12 +569,14 @@ void window_wait_frame(Session* s, int64_t frame) {
     std::fprintf(w->log_file,
                  "frame=%lld head=%.4f,%.4f,%.4f yaw=%.4f pitch=%.4f active=%s "
                  "left=%.4f,%.4f,%.4f right=%.4f,%.4f,%.4f pinch=%d,%d fist=%d,%d "
-                 "wheel=%.3f,%.3f z=%.4f cursor=%s eye=%d depth=%s view=%s profile=%s\n",
+                 "wheel=%.3f,%.3f z=%.4f buttons=%d%d%d%d%d cursor=%s eye=%d depth=%s view=%s "
+                 "profile=%s\n",
                  static_cast<long long>(frame), head.position.x, head.position.y, head.position.z,
                  w->yaw, w->pitch, act ? "right" : "left", L.x, L.y, L.z, R.x, R.y, R.z,
                  w->hands[0].pinch > 0.5f, w->hands[1].pinch > 0.5f, w->hands[0].fist > 0.5f,
-                 w->hands[1].fist > 0.5f, w->hands[0].wheel, w->hands[1].wheel, hd.z,
-                 over ? "in" : "out", eye, depth, w->both ? "both" : "left", profile.c_str());
+                 w->hands[1].fist > 0.5f, w->hands[0].wheel, w->hands[1].wheel, hd.z, r.button[0],
+                 r.button[1], r.button[2], r.button[3], r.button[4], over ? "in" : "out", eye,
+                 depth, w->both ? "both" : "left", profile.c_str());
     std::fflush(w->log_file);
   }
 }
