@@ -842,7 +842,7 @@ XrResult XRAPI_CALL EndFrame(XrSession h, const XrFrameEndInfo* info) {
         if (XrResult r = check_sub_image(s, p->views[v].subImage); r != XR_SUCCESS) return r;
         if (const XrCompositionLayerDepthInfoKHR* d = depth_info(inst, p->views[v])) {
           if (XrResult r = check_sub_image(s, d->subImage); r != XR_SUCCESS) return r;
-          if (!(d->minDepth >= 0.f && d->minDepth < d->maxDepth && d->maxDepth <= 1.f &&
+          if (!(d->minDepth >= 0.f && d->minDepth <= d->maxDepth && d->maxDepth <= 1.f &&
                 d->nearZ > 0.f && d->farZ > 0.f && d->nearZ != d->farZ))
             return XR_ERROR_VALIDATION_FAILURE;
         }

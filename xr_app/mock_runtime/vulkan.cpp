@@ -406,8 +406,9 @@ Swapchain::~Swapchain() {
 }
 
 namespace {
-// Copies a region of one array layer of a swapchain's last released image to host memory.
-// `layout`/`access` are the image's layout and last writes between frames (attachment).
+// Copies a region (texel bytes per texel) of one array layer of a swapchain's last released
+// image to host memory. Between frames the image is in its attachment layout (as
+// XR_KHR_vulkan_enable has it) and it is returned to that layout.
 bool read_region(Session* s, const XrSwapchainSubImage& sub, int x, int y, uint32_t w, uint32_t h,
                  size_t texel, std::vector<unsigned char>* out) {
   Swapchain* sc = lookup<Swapchain>(sub.swapchain);

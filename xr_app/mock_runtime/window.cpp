@@ -27,18 +27,37 @@ constexpr float kMinDistance = 0.05f;
 constexpr float kMoveSpeed = 1.0f;       // m/s
 constexpr float kLookPerPixel = 0.004f;  // rad per pixel of right-drag
 constexpr float kWheelStep = 0.02f;      // m per wheel notch
-constexpr float kSelfHit = 0.01f;  // depth hits this much beyond a joint's radius: not the hand
+constexpr float kSelfHit = 0.01f;        // depth hits within a joint's radius plus this: the hand
+
+// The keys held down (besides the one-shot ones: Tab, R, V, Escape).
+enum Key { kW, kA, kS, kD, kQ, kE, kF, k1, k2, k3, k4, kM, kLeftShift, kRightShift, kKeys };
+constexpr int kGlfwKeys[kKeys] = {GLFW_KEY_W,          GLFW_KEY_A,          GLFW_KEY_S, GLFW_KEY_D,
+                                  GLFW_KEY_Q,          GLFW_KEY_E,          GLFW_KEY_F, GLFW_KEY_1,
+                                  GLFW_KEY_2,          GLFW_KEY_3,          GLFW_KEY_4, GLFW_KEY_M,
+                                  GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT};
+
+double seconds_now() {
+  return static_cast<double>(now_ns()) * 1e-9;
+}
+
+// A key from its press and release events: whether it is down, pressed at all, and for how long
+// since it was last taken (so a frame sees a quick tap, and the head moves for exactly as long
+// as a key was held however seldom the app's frames come).
+struct KeyState {
+  bool down = false;
+  int presses = 0;
+  double since = 0, held = 0;
+};
 
 // What the window thread gathers; the runtime takes it once per frame.
 struct RawInput {
   int win_w = 0, win_h = 0;
   double cx = -1, cy = -1;
-  bool lmb = false, shift = false;
-  bool w = false, a = false, s = false, d = false, q = false, e = false, f = false;
-  bool button[5] = {false, false, false, false, false};  // 1 2 3 4 M: A B X Y menu
-  double look_dx = 0, look_dy = 0;                       // accumulated until taken
-  double wheel = 0;                                      // accumulated until taken
-  int tab = 0, reset = 0, view = 0, lmb_presses = 0;     // presses until taken
+  bool lmb = false;
+  KeyState key[kKeys];
+  double look_dx = 0, look_dy = 0;                    // accumulated until taken
+  double wheel = 0;                                   // accumulated until taken
+  int tab = 0, reset = 0, view = 0, lmb_presses = 0;  // presses until taken
   bool quit = false;
 };
 
@@ -82,7 +101,8 @@ struct Window {
   bool title_dirty = false;
   bool stop = false;
   bool dragging = false;  // right button held
-  double drag_x = 0, drag_y = 0;
+  bool motion_seen = false;
+  double motion_x = 0, motion_y = 0;  // the cursor as of the last motion event
   std::thread thread;
   int req_w = kDefaultWidth, req_h = kDefaultHeight;
 
@@ -140,7 +160,6 @@ struct Window {
   size_t cycle_at = 0;
   bool cycle_ready = false;
   bool quit_sent = false;
-  int64_t last_ns = 0;
   FILE* log_file = nullptr;
   std::string shown_title;
 
@@ -182,9 +201,23 @@ Window* self_of(GLFWwindow* w) {
 }
 
 void on_key(GLFWwindow* gw, int key, int, int action, int) {
-  if (action != GLFW_PRESS) return;
+  if (action == GLFW_REPEAT) return;
   Window* w = self_of(gw);
   std::lock_guard<std::mutex> g(w->mu);
+  for (int k = 0; k < kKeys; ++k) {
+    if (kGlfwKeys[k] != key) continue;
+    KeyState& ks = w->raw.key[k];
+    const double t = seconds_now();
+    if (action == GLFW_PRESS && !ks.down) {
+      ks.down = true;
+      ++ks.presses;
+      ks.since = t;
+    } else if (action == GLFW_RELEASE && ks.down) {
+      ks.down = false;
+      ks.held += t - ks.since;
+    }
+  }
+  if (action != GLFW_PRESS) return;
   switch (key) {
     case GLFW_KEY_TAB:
       ++w->raw.tab;
@@ -203,13 +236,11 @@ void on_key(GLFWwindow* gw, int key, int, int action, int) {
   }
 }
 
-// Mouse buttons. The right one starts and ends a look drag (on_cursor adds up the motion in
-// between, in order); the left one is held, and counted when pressed (a quick click pinches for
-// at least one frame).
+// Mouse buttons. The right one starts and ends a look drag (on_cursor adds up the motion events
+// in between, in the order of the events, not from where the pointer is when they are handled); the
+// left one is held, and counted when pressed (a quick click pinches for at least one frame).
 void on_button(GLFWwindow* gw, int button, int action, int) {
   Window* w = self_of(gw);
-  double x = 0, y = 0;
-  glfwGetCursorPos(gw, &x, &y);
   std::lock_guard<std::mutex> g(w->mu);
   if (button == GLFW_MOUSE_BUTTON_LEFT) {
     w->raw.lmb = action == GLFW_PRESS;
@@ -217,18 +248,18 @@ void on_button(GLFWwindow* gw, int button, int action, int) {
   }
   if (button != GLFW_MOUSE_BUTTON_RIGHT) return;
   w->dragging = action == GLFW_PRESS;
-  w->drag_x = x;
-  w->drag_y = y;
 }
 
 void on_cursor(GLFWwindow* gw, double x, double y) {
   Window* w = self_of(gw);
   std::lock_guard<std::mutex> g(w->mu);
-  if (!w->dragging) return;
-  w->raw.look_dx += x - w->drag_x;
-  w->raw.look_dy += y - w->drag_y;
-  w->drag_x = x;
-  w->drag_y = y;
+  if (w->dragging && w->motion_seen) {
+    w->raw.look_dx += x - w->motion_x;
+    w->raw.look_dy += y - w->motion_y;
+  }
+  w->motion_seen = true;
+  w->motion_x = x;
+  w->motion_y = y;
 }
 
 void on_scroll(GLFWwindow* gw, double, double dy) {
@@ -284,7 +315,6 @@ void Window::run(std::promise<std::string> ready) {
     glfwGetFramebufferSize(win, &fw, &fh);
     double cx = 0, cy = 0;
     glfwGetCursorPos(win, &cx, &cy);
-    auto key = [&](int k) { return glfwGetKey(win, k) == GLFW_PRESS; };
     bool upload = false;
     std::string new_title;
     {
@@ -295,16 +325,6 @@ void Window::run(std::promise<std::string> ready) {
       r.win_h = wh;
       r.cx = cx;
       r.cy = cy;
-      r.shift = key(GLFW_KEY_LEFT_SHIFT) || key(GLFW_KEY_RIGHT_SHIFT);
-      r.w = key(GLFW_KEY_W);
-      r.a = key(GLFW_KEY_A);
-      r.s = key(GLFW_KEY_S);
-      r.d = key(GLFW_KEY_D);
-      r.q = key(GLFW_KEY_Q);
-      r.e = key(GLFW_KEY_E);
-      r.f = key(GLFW_KEY_F);
-      const int buttons[5] = {GLFW_KEY_1, GLFW_KEY_2, GLFW_KEY_3, GLFW_KEY_4, GLFW_KEY_M};
-      for (int i = 0; i < 5; ++i) r.button[i] = key(buttons[i]);
       if (glfwWindowShouldClose(win)) r.quit = true;
       if (fresh) {
         px.swap(pixels);
@@ -421,14 +441,21 @@ void window_wait_frame(Session* s, int64_t frame) {
   RawInput r;
   {
     std::lock_guard<std::mutex> g(w->mu);
+    const double t = seconds_now();
+    for (KeyState& k : w->raw.key) {
+      if (k.down) {
+        k.held += t - k.since;
+        k.since = t;
+      }
+    }
     r = w->raw;
     w->raw.look_dx = w->raw.look_dy = w->raw.wheel = 0;
     w->raw.tab = w->raw.reset = w->raw.view = w->raw.lmb_presses = 0;
+    for (KeyState& k : w->raw.key) k.presses = 0, k.held = 0;
   }
-  const int64_t now = now_ns();
-  const float dt =
-      w->last_ns ? std::clamp(static_cast<float>(now - w->last_ns) * 1e-9f, 0.f, 0.1f) : 0.f;
-  w->last_ns = now;
+  // A key is on for this frame when it is down or was pressed since the last one.
+  auto on = [&](Key k) { return r.key[k].down || r.key[k].presses > 0; };
+  auto held = [&](Key k) { return static_cast<float>(std::min(r.key[k].held, 0.25)); };
 
   // Interaction profile: the one chosen at attach, then Tab cycles through the suggested ones
   // and, with XR_EXT_hand_tracking enabled, hand tracking alone (no controller).
@@ -468,20 +495,19 @@ void window_wait_frame(Session* s, int64_t frame) {
   w->pitch = std::clamp(w->pitch - static_cast<float>(r.look_dy) * kLookPerPixel, -1.5f, 1.5f);
   const XrQuaternionf body = quat_mul(w->home.orientation, axis_angle({0, 1, 0}, w->yaw));
   const XrVector3f fwd = quat_rotate(body, {0, 0, -1}), right = quat_rotate(body, {1, 0, 0});
-  XrVector3f move = add(mul(fwd, (r.w ? 1.f : 0.f) - (r.s ? 1.f : 0.f)),
-                        mul(right, (r.d ? 1.f : 0.f) - (r.a ? 1.f : 0.f)));
-  move.y += (r.e ? 1.f : 0.f) - (r.q ? 1.f : 0.f);
-  w->head_pos = add(w->head_pos, mul(move, kMoveSpeed * dt));
+  XrVector3f move = add(mul(fwd, held(kW) - held(kS)), mul(right, held(kD) - held(kA)));
+  move.y += held(kE) - held(kQ);
+  w->head_pos = add(w->head_pos, mul(move, kMoveSpeed));
   const XrPosef head{quat_normalize(quat_mul(body, axis_angle({1, 0, 0}, w->pitch))), w->head_pos};
 
   // The hand under the mouse (left with Shift): pinch on the left button, fist on F, on the ray
   // under the cursor at the depth the app submitted there (else kDefaultDistance), the wheel
   // nearer/farther. The other hand keeps its place, pinch and fist.
-  const int act = r.shift ? 0 : 1;
+  const int act = on(kLeftShift) || on(kRightShift) ? 0 : 1;
   Window::Hand& hd = w->hands[act];
   const bool was_pinching = hd.pinch > 0.5f;
   hd.pinch = r.lmb || r.lmb_presses > 0 ? 1.f : 0.f;
-  hd.fist = r.f ? 1.f : 0.f;
+  hd.fist = on(kF) ? 1.f : 0.f;
   hd.wheel += static_cast<float>(r.wheel) * kWheelStep;
   int eye = 0;
   float u = 0, v = 0;
@@ -536,13 +562,13 @@ void window_wait_frame(Session* s, int64_t frame) {
     ck.inputs["trigger/touch"] = {k.pinch, 0};
     ck.inputs["select/click"] = {k.pinch, 0};
     ck.inputs["squeeze/value"] = {k.fist, 0};
-    ck.inputs["menu/click"] = {r.button[4] ? 1.f : 0.f, 0};
+    ck.inputs["menu/click"] = {on(kM) ? 1.f : 0.f, 0};
     if (h == 1) {
-      ck.inputs["a/click"] = {r.button[0] ? 1.f : 0.f, 0};
-      ck.inputs["b/click"] = {r.button[1] ? 1.f : 0.f, 0};
+      ck.inputs["a/click"] = {on(k1) ? 1.f : 0.f, 0};
+      ck.inputs["b/click"] = {on(k2) ? 1.f : 0.f, 0};
     } else {
-      ck.inputs["x/click"] = {r.button[2] ? 1.f : 0.f, 0};
-      ck.inputs["y/click"] = {r.button[3] ? 1.f : 0.f, 0};
+      ck.inputs["x/click"] = {on(k3) ? 1.f : 0.f, 0};
+      ck.inputs["y/click"] = {on(k4) ? 1.f : 0.f, 0};
     }
     sc.controllers[h] = {ck};
   }
@@ -574,9 +600,9 @@ void window_wait_frame(Session* s, int64_t frame) {
                  static_cast<long long>(frame), head.position.x, head.position.y, head.position.z,
                  w->yaw, w->pitch, act ? "right" : "left", L.x, L.y, L.z, R.x, R.y, R.z,
                  w->hands[0].pinch > 0.5f, w->hands[1].pinch > 0.5f, w->hands[0].fist > 0.5f,
-                 w->hands[1].fist > 0.5f, w->hands[0].wheel, w->hands[1].wheel, hd.z, r.button[0],
-                 r.button[1], r.button[2], r.button[3], r.button[4], over ? "in" : "out", eye,
-                 depth, w->both ? "both" : "left", profile.c_str());
+                 w->hands[1].fist > 0.5f, w->hands[0].wheel, w->hands[1].wheel, hd.z, on(k1),
+                 on(k2), on(k3), on(k4), on(kM), over ? "in" : "out", eye, depth,
+                 w->both ? "both" : "left", profile.c_str());
     std::fflush(w->log_file);
   }
 }
