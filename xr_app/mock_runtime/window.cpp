@@ -118,6 +118,19 @@ struct Window {
     float pinch = 0, fist = 0;
     HandSample published;  // the joints as last published (stage)
   } hands[2];
+  bool both = false;  // both eyes side by side
+  int eye_w = 0, eye_h = 0;
+  bool depth_seen = false;  // the app has submitted depth
+  bool hit_valid = false;
+  bool hit_hand = false;  // the hit was on the app's drawing of a hand (ignored)
+  float hit_z = 0;
+  int hit_eye = 0;
+  std::vector<XrPath> cycle;  // XR_NULL_PATH: hand tracking only
+  size_t cycle_at = 0;
+  bool cycle_ready = false;
+  bool quit_sent = false;
+  FILE* log_file = nullptr;
+  std::string shown_title;
 
   // A depth hit on the app's drawing of a hand: within a joint's radius (plus kSelfHit) of one
   // of the joints published last or of a bone between two of them.
@@ -149,19 +162,6 @@ struct Window {
     }
     return false;
   }
-  bool both = false;  // both eyes side by side
-  int eye_w = 0, eye_h = 0;
-  bool depth_seen = false;  // the app has submitted depth
-  bool hit_valid = false;
-  bool hit_hand = false;  // the hit was on the app's drawing of a hand (ignored)
-  float hit_z = 0;
-  int hit_eye = 0;
-  std::vector<XrPath> cycle;  // XR_NULL_PATH: hand tracking only
-  size_t cycle_at = 0;
-  bool cycle_ready = false;
-  bool quit_sent = false;
-  FILE* log_file = nullptr;
-  std::string shown_title;
 
   ~Window() {
     {
