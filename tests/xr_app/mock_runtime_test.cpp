@@ -37,7 +37,8 @@ std::string write_scenario(const std::string& name, const std::string& text) {
 void clear_env() {
   for (const char* v : {"DRAPE_MOCK_SCENARIO", "DRAPE_MOCK_END_AFTER_FRAMES", "DRAPE_MOCK_FAST",
                         "DRAPE_MOCK_WRITE_FRAMES", "DRAPE_MOCK_WRITE_EVERY",
-                        "DRAPE_MOCK_LOSE_SESSION_AT_FRAME", "XR_ENABLE_API_LAYERS"})
+                        "DRAPE_MOCK_LOSE_SESSION_AT_FRAME", "DRAPE_MOCK_WINDOW",
+                        "DRAPE_MOCK_WINDOW_SIZE", "DRAPE_MOCK_WINDOW_LOG", "XR_ENABLE_API_LAYERS"})
     unsetenv(v);
   setenv("XR_RUNTIME_JSON", kManifest.c_str(), 1);
   setenv("DRAPE_MOCK_FAST", "1", 1);
@@ -140,7 +141,8 @@ TEST_F(MockRuntime, NegotiatesAndListsExtensions) {
   for (auto& p : props) names.push_back(p.extensionName);
   for (const char* want :
        {XR_KHR_VULKAN_ENABLE_EXTENSION_NAME, XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME,
-        XR_EXT_HAND_TRACKING_EXTENSION_NAME, XR_MND_HEADLESS_EXTENSION_NAME})
+        XR_EXT_HAND_TRACKING_EXTENSION_NAME, XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME,
+        XR_MND_HEADLESS_EXTENSION_NAME})
     EXPECT_NE(std::find(names.begin(), names.end(), want), names.end()) << want;
   create();
   XrInstanceProperties ip{XR_TYPE_INSTANCE_PROPERTIES};
@@ -353,6 +355,25 @@ TEST_F(MockRuntime, HandJointsFromPalmAndPinch) {
   loc.jointCount = XR_HAND_JOINT_COUNT_EXT;
   li.time = 0;
   EXPECT_EQ(locate(right, &li, &loc), XR_ERROR_TIME_INVALID);
+}
+
+TEST(Scenario, FistCurlsTheFingersIntoThePalm) {
+  using namespace drape::mock;
+  std::array<XrPosef, kHandJointCount> open, open0, fist;
+  std::array<float, kHandJointCount> r;
+  generate_hand(1, pose_identity(), 0.f, &open, &r);
+  generate_hand(1, pose_identity(), 0.f, &open0, &r, 0.f);
+  generate_hand(1, pose_identity(), 0.f, &fist, &r, 1.f);
+  auto dist = [](const XrPosef& a, const XrPosef& b) { return len(sub(a.position, b.position)); };
+  for (int j = 0; j < kHandJointCount; ++j) EXPECT_EQ(dist(open[j], open0[j]), 0.f) << j;
+  const XrPosef& palm = open[XR_HAND_JOINT_PALM_EXT];
+  for (int tip : {XR_HAND_JOINT_INDEX_TIP_EXT, XR_HAND_JOINT_MIDDLE_TIP_EXT,
+                  XR_HAND_JOINT_RING_TIP_EXT, XR_HAND_JOINT_LITTLE_TIP_EXT}) {
+    EXPECT_GT(dist(open[tip], palm), 0.08f) << tip;
+    EXPECT_LT(dist(fist[tip], palm), 0.06f) << tip;
+  }
+  EXPECT_EQ(dist(fist[XR_HAND_JOINT_PALM_EXT], palm), 0.f);
+  EXPECT_EQ(dist(fist[XR_HAND_JOINT_THUMB_TIP_EXT], open[XR_HAND_JOINT_THUMB_TIP_EXT]), 0.f);
 }
 
 TEST_F(MockRuntime, ActionsFollowScenarioControllerInputs) {

@@ -745,6 +745,20 @@ XrResult XRAPI_CALL LocateHandJointsEXT(XrHandTrackerEXT h, const XrHandJointsLo
 
 }  // namespace
 
+std::vector<XrPath> suggested_profiles(Session* s) {
+  Instance* inst = instance_of(s);
+  std::set<XrPath> suggested;
+  for_each_of_kind(Kind::Action, [&](Object* o) {
+    auto* a = static_cast<Action*>(o);
+    if (!attached_to(s, a)) return;
+    for (auto& [p, b] : a->suggested) suggested.insert(p);
+  });
+  std::vector<XrPath> out;
+  for (const auto& p : profiles())
+    if (XrPath pp = intern_path(inst, p.path); suggested.count(pp)) out.push_back(pp);
+  return out;
+}
+
 bool action_pose(Session* s, Action* a, XrPath subaction, XrTime t, XrPosef* out, bool* tracked) {
   if (!attached_to(s, a)) return false;
   Instance* inst = instance_of(s);

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "xr_app/mock_runtime/loader_negotiation.hpp"
+#include "xr_app/mock_runtime/window.hpp"
 
 namespace drape::mock {
 
@@ -156,8 +157,6 @@ XrResult two_call_string(uint32_t capacity, uint32_t* count, char* out, const st
 namespace {
 
 constexpr XrSystemId kSystemId = 1;
-constexpr float kIpd = 0.063f;
-constexpr float kHalfFov = 0.785398f;  // 45 degrees
 constexpr uint32_t kRecommendedSize = 1024, kMaxSize = 4096;
 constexpr uint32_t kMaxLayers = 16;
 
@@ -169,6 +168,7 @@ const ExtensionInfo kExtensions[] = {
     {XR_KHR_VULKAN_ENABLE_EXTENSION_NAME, XR_KHR_vulkan_enable_SPEC_VERSION},
     {XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME, XR_KHR_vulkan_enable2_SPEC_VERSION},
     {XR_EXT_HAND_TRACKING_EXTENSION_NAME, XR_EXT_hand_tracking_SPEC_VERSION},
+    {XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME, XR_KHR_composition_layer_depth_SPEC_VERSION},
     {XR_MND_HEADLESS_EXTENSION_NAME, XR_MND_headless_SPEC_VERSION},
 };
 
@@ -259,6 +259,11 @@ XrResult XRAPI_CALL CreateInstance(const XrInstanceCreateInfo* info, XrInstance*
   if (const char* w = std::getenv("DRAPE_MOCK_WRITE_FRAMES"); w && *w) inst->write_dir = w;
   inst->write_every = static_cast<int>(env_int("DRAPE_MOCK_WRITE_EVERY", inst->write_every));
   if (inst->write_every < 1) inst->write_every = 1;
+  inst->window_mode = window_requested();
+  if (inst->window_mode && inst->fast) {
+    log("DRAPE_MOCK_WINDOW: frames are paced at 90 Hz (DRAPE_MOCK_FAST ignored)");
+    inst->fast = false;
+  }
   if (int64_t f = env_int("DRAPE_MOCK_LOSE_SESSION_AT_FRAME", -1); f >= 0)
     inst->scenario.events.push_back({f, "session_loss"});
   if (!inst->write_dir.empty()) {
@@ -365,7 +370,8 @@ XrResult XRAPI_CALL GetSystemProperties(XrInstance h, XrSystemId id, XrSystemPro
   if (!p || p->type != XR_TYPE_SYSTEM_PROPERTIES) return XR_ERROR_VALIDATION_FAILURE;
   p->systemId = id;
   p->vendorId = 0xD7A9;
-  std::snprintf(p->systemName, XR_MAX_SYSTEM_NAME_SIZE, "Drape mock HMD (headless)");
+  std::snprintf(p->systemName, XR_MAX_SYSTEM_NAME_SIZE, "Drape mock HMD (%s)",
+                inst->window_mode ? "window" : "headless");
   p->graphicsProperties.maxSwapchainImageWidth = kMaxSize;
   p->graphicsProperties.maxSwapchainImageHeight = kMaxSize;
   p->graphicsProperties.maxLayerCount = kMaxLayers;
@@ -479,6 +485,17 @@ XrResult XRAPI_CALL CreateSession(XrInstance h, const XrSessionCreateInfo* info,
     destroy_object(handle);
     return XR_ERROR_GRAPHICS_DEVICE_INVALID;
   }
+  if (inst->window_mode && sp->headless) {
+    log("DRAPE_MOCK_WINDOW: a headless session (XR_MND_headless) has no window");
+  } else if (inst->window_mode) {
+    std::string why;
+    sp->window = open_window(sp, &why);
+    if (!sp->window) {
+      log("DRAPE_MOCK_WINDOW: cannot open the window: %s", why.c_str());
+      destroy_object(handle);
+      return XR_ERROR_RUNTIME_FAILURE;
+    }
+  }
   queue_state(sp, XR_SESSION_STATE_IDLE);
   queue_state(sp, XR_SESSION_STATE_READY);
   *out = to_handle<XrSession>(handle);
@@ -521,6 +538,8 @@ XrResult XRAPI_CALL BeginSession(XrSession h, const XrSessionBeginInfo* info) {
   return XR_SUCCESS;
 }
 
+}  // namespace
+
 void begin_stopping(Session* s) {
   if (s->ending) return;
   s->ending = true;
@@ -528,6 +547,8 @@ void begin_stopping(Session* s) {
   if (s->state == XR_SESSION_STATE_VISIBLE) queue_state(s, XR_SESSION_STATE_SYNCHRONIZED);
   queue_state(s, XR_SESSION_STATE_STOPPING);
 }
+
+namespace {
 
 XrResult XRAPI_CALL EndSession(XrSession h) {
   DRAPE_LOCK;
@@ -734,6 +755,7 @@ XrResult XRAPI_CALL WaitFrame(XrSession h, const XrFrameWaitInfo* info, XrFrameS
     }
     fire_scenario_events(s, inst, i);
     if (s->lost) return XR_ERROR_SESSION_LOST;
+    if (s->window) window_wait_frame(s, i);
     s->frame_waited = true;
     state->predictedDisplayTime = s->epoch + i * kFramePeriodNs;
     state->predictedDisplayPeriod = kFramePeriodNs;
@@ -764,6 +786,19 @@ XrResult XRAPI_CALL BeginFrame(XrSession h, const XrFrameBeginInfo* info) {
   return XR_SUCCESS;
 }
 
+}  // namespace
+
+const XrCompositionLayerDepthInfoKHR* depth_info(Instance* inst,
+                                                 const XrCompositionLayerProjectionView& view) {
+  if (!inst->extensions.count(XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME)) return nullptr;
+  for (auto* n = static_cast<const XrBaseInStructure*>(view.next); n; n = n->next)
+    if (n->type == XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR)
+      return reinterpret_cast<const XrCompositionLayerDepthInfoKHR*>(n);
+  return nullptr;
+}
+
+namespace {
+
 XrResult check_sub_image(Session* s, const XrSwapchainSubImage& sub) {
   Swapchain* sc = lookup<Swapchain>(sub.swapchain);
   if (!sc || sc->parent != s->handle) return XR_ERROR_HANDLE_INVALID;
@@ -791,6 +826,7 @@ XrResult XRAPI_CALL EndFrame(XrSession h, const XrFrameEndInfo* info) {
   if (info->layerCount > kMaxLayers) return XR_ERROR_LAYER_LIMIT_EXCEEDED;
   if (info->layerCount > 0 && !info->layers) return XR_ERROR_LAYER_INVALID;
   const XrCompositionLayerProjection* first_projection = nullptr;
+  Instance* inst = instance_of(s);
   for (uint32_t i = 0; i < info->layerCount; ++i) {
     const XrCompositionLayerBaseHeader* l = info->layers[i];
     if (!l) return XR_ERROR_LAYER_INVALID;
@@ -804,6 +840,12 @@ XrResult XRAPI_CALL EndFrame(XrSession h, const XrFrameEndInfo* info) {
           return XR_ERROR_VALIDATION_FAILURE;
         if (!valid_pose(p->views[v].pose)) return XR_ERROR_POSE_INVALID;
         if (XrResult r = check_sub_image(s, p->views[v].subImage); r != XR_SUCCESS) return r;
+        if (const XrCompositionLayerDepthInfoKHR* d = depth_info(inst, p->views[v])) {
+          if (XrResult r = check_sub_image(s, d->subImage); r != XR_SUCCESS) return r;
+          if (!(d->minDepth >= 0.f && d->minDepth <= d->maxDepth && d->maxDepth <= 1.f &&
+                d->nearZ > 0.f && d->farZ > 0.f && d->nearZ != d->farZ))
+            return XR_ERROR_VALIDATION_FAILURE;
+        }
       }
       if (!first_projection) first_projection = p;
     } else if (l->type == XR_TYPE_COMPOSITION_LAYER_QUAD) {
@@ -815,7 +857,6 @@ XrResult XRAPI_CALL EndFrame(XrSession h, const XrFrameEndInfo* info) {
     }
   }
   s->frame_begun = false;
-  Instance* inst = instance_of(s);
   int64_t n = ++inst->frames_composed;
   if (info->layerCount > 0) ++inst->frames_with_layers;
   if (first_projection && !inst->write_dir.empty() && !s->headless &&
@@ -825,6 +866,7 @@ XrResult XRAPI_CALL EndFrame(XrSession h, const XrFrameEndInfo* info) {
     write_layer_png(s, first_projection, inst->write_dir + name);
     ++inst->frames_written;
   }
+  if (s->window && first_projection) window_end_frame(s, first_projection);
   if (inst->end_after_frames > 0 && n >= inst->end_after_frames) begin_stopping(s);
   return XR_SUCCESS;
 }

@@ -36,6 +36,7 @@ struct Object {
 
 struct Instance;
 struct Session;
+struct Window;  // window.cpp: the desktop window of window mode
 
 struct ActionSet : Object {
   static constexpr Kind kKind = Kind::ActionSet;
@@ -130,6 +131,7 @@ struct Session : Object {
   XrPath profile[2] = {XR_NULL_PATH, XR_NULL_PATH};
   bool profile_event_sent = false;
   bool synced_once = false;
+  std::shared_ptr<Window> window;  // window mode only (DRAPE_MOCK_WINDOW)
 };
 
 struct Instance : Object {
@@ -154,6 +156,7 @@ struct Instance : Object {
   int64_t frames_written = 0;
   bool suggested_any = false;
   std::set<size_t> fired_events;  // scenario events already fired (once per instance)
+  bool window_mode = false;       // DRAPE_MOCK_WINDOW=1: live input from a desktop window
   std::map<XrPath, std::set<uint64_t>> suggested_profiles;  // profile -> actions
 };
 
@@ -192,6 +195,8 @@ void queue_state(Session* s, XrSessionState state);
 XrTime now_ns();
 double frame_of_time(const Session* s, XrTime t);
 constexpr int64_t kFramePeriodNs = 11111111;  // 90 Hz
+constexpr float kIpd = 0.063f;
+constexpr float kHalfFov = 0.785398f;  // 45 degrees, all four sides of both views
 void log(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 
 template <class T>
@@ -215,7 +220,20 @@ void* vulkan_proc(const std::string& name);
 // Frame readback (vulkan.cpp): writes the left eye of a projection layer to PNG.
 void write_layer_png(Session* s, const XrCompositionLayerProjection* layer,
                      const std::string& path);
+// Reads back a sub-image of a colour swapchain's last released image as RGBA (alpha 255).
+bool read_color(Session* s, const XrSwapchainSubImage& sub, std::vector<unsigned char>* rgba);
+// Reads one texel (x, y inside the sub-image's rect) of a depth swapchain's last released image.
+bool read_depth_texel(Session* s, const XrSwapchainSubImage& sub, int x, int y, float* depth);
 void update_actions_on_sync(Session* s, Instance* inst);  // input.cpp
+// The interaction profiles the app suggested bindings for (attached sets), in the runtime's
+// order of preference (input.cpp).
+std::vector<XrPath> suggested_profiles(Session* s);
+// The XrCompositionLayerDepthInfoKHR chained to a projection view (when the app enabled
+// XR_KHR_composition_layer_depth), else null.
+const XrCompositionLayerDepthInfoKHR* depth_info(Instance* inst,
+                                                 const XrCompositionLayerProjectionView& view);
+// Queues STOPPING (after VISIBLE/SYNCHRONIZED as needed), once.
+void begin_stopping(Session* s);
 bool action_pose(Session* s, Action* a, XrPath subaction, XrTime t, XrPosef* out, bool* tracked);
 
 }  // namespace drape::mock

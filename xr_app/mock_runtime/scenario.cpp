@@ -106,6 +106,8 @@ constexpr float kRightHand[kHandJointCount][3] = {
 XrVector3f v3(const float* p) {
   return {p[0], p[1], p[2]};
 }
+}  // namespace
+
 XrVector3f add(XrVector3f a, XrVector3f b) {
   return {a.x + b.x, a.y + b.y, a.z + b.z};
 }
@@ -118,11 +120,10 @@ XrVector3f mul(XrVector3f a, float s) {
 float len(XrVector3f a) {
   return std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
 }
-}  // namespace
 
 void generate_hand(int hand, const XrPosef& palm, float pinch,
                    std::array<XrPosef, kHandJointCount>* joints,
-                   std::array<float, kHandJointCount>* radii) {
+                   std::array<float, kHandJointCount>* radii, float fist) {
   pinch = std::clamp(pinch, 0.f, 1.f);
   XrVector3f p[kHandJointCount];
   for (int j = 0; j < kHandJointCount; ++j) p[j] = v3(kRightHand[j]);
@@ -148,6 +149,20 @@ void generate_hand(int hand, const XrPosef& palm, float pinch,
   p[XR_HAND_JOINT_INDEX_DISTAL_EXT] = add(p[XR_HAND_JOINT_INDEX_DISTAL_EXT], mul(di_rest, 0.6f));
   p[XR_HAND_JOINT_INDEX_INTERMEDIATE_EXT] =
       add(p[XR_HAND_JOINT_INDEX_INTERMEDIATE_EXT], mul(di_rest, 0.3f));
+  fist = std::clamp(fist, 0.f, 1.f);
+  if (fist > 0.f) {
+    // Each finger's intermediate, distal and tip joints move toward a point under the palm.
+    const int first[] = {pinch > 0.5f ? -1 : XR_HAND_JOINT_INDEX_INTERMEDIATE_EXT,
+                         XR_HAND_JOINT_MIDDLE_INTERMEDIATE_EXT, XR_HAND_JOINT_RING_INTERMEDIATE_EXT,
+                         XR_HAND_JOINT_LITTLE_INTERMEDIATE_EXT};
+    const float amount[] = {0.4f, 0.75f, 0.9f};
+    for (int f0 : first) {
+      if (f0 < 0) continue;
+      XrVector3f curl{p[f0].x, -0.03f, -0.01f};
+      for (int k = 0; k < 3; ++k)
+        p[f0 + k] = add(p[f0 + k], mul(sub(curl, p[f0 + k]), amount[k] * fist));
+    }
+  }
   for (int j = 0; j < kHandJointCount; ++j) {
     XrVector3f q = p[j];
     if (hand == 0) q.x = -q.x;  // left hand: mirror image
@@ -224,13 +239,14 @@ HandSample Scenario::hand(int h, double frame) const {
       std::array<XrPosef, kHandJointCount> tmp;
       generate_hand(h, dummy, 0, &tmp, r);
     } else {
-      generate_hand(h, k.palm, k.pinch, j, r);
+      generate_hand(h, k.palm, k.pinch, j, r, k.fist);
     }
   };
   if (!ka.explicit_joints && !kb.explicit_joints) {
     // Interpolate palm and pinch, then generate: keeps the pinch gap exactly linear.
     XrPosef palm = pose_lerp(ka.palm, kb.palm, t);
-    generate_hand(h, palm, ka.pinch + (kb.pinch - ka.pinch) * t, &s.joints, &s.radii);
+    generate_hand(h, palm, ka.pinch + (kb.pinch - ka.pinch) * t, &s.joints, &s.radii,
+                  ka.fist + (kb.fist - ka.fist) * t);
     return s;
   }
   joints_of(ka, &ja, &ra);

@@ -22,6 +22,10 @@ XrPosef pose_mul(const XrPosef& a, const XrPosef& b);  // a * b (b expressed in 
 XrPosef pose_inverse(const XrPosef& p);
 XrPosef pose_identity();
 XrPosef pose_lerp(const XrPosef& a, const XrPosef& b, float t);
+XrVector3f add(XrVector3f a, XrVector3f b);
+XrVector3f sub(XrVector3f a, XrVector3f b);
+XrVector3f mul(XrVector3f a, float s);
+float len(XrVector3f a);
 
 constexpr int kHandJointCount = XR_HAND_JOINT_COUNT_EXT;  // 26
 
@@ -37,6 +41,7 @@ struct HandKey {
   bool explicit_joints = false;
   XrPosef palm{};  // palm pose (generated mode)
   float pinch = 0.f;
+  float fist = 0.f;                               // fingers curled into the palm (generated mode)
   std::array<XrPosef, kHandJointCount> joints{};  // explicit mode
 };
 
@@ -91,12 +96,14 @@ struct Scenario {
 bool load_scenario(const std::string& path, Scenario* out, std::string* error);
 
 // The 26 joints of a hand (0 = left, 1 = right) from a palm pose and a pinch amount in [0, 1]:
-// the thumb-tip to index-tip distance is lerp(kOpenPinchGap, kClosedPinchGap, pinch).
+// the thumb-tip to index-tip distance is lerp(kOpenPinchGap, kClosedPinchGap, pinch). `fist` in
+// [0, 1] curls the middle, ring and little fingers (and the index, unless pinching) into the
+// palm; 0 leaves the hand as without it.
 constexpr float kOpenPinchGap = 0.085f;
 constexpr float kClosedPinchGap = 0.005f;
 void generate_hand(int hand, const XrPosef& palm, float pinch,
                    std::array<XrPosef, kHandJointCount>* joints,
-                   std::array<float, kHandJointCount>* radii);
+                   std::array<float, kHandJointCount>* radii, float fist = 0.f);
 
 // Minimal PNG writer (8-bit RGBA, zlib "stored" blocks). Returns false on I/O error.
 bool write_png_rgba(const std::string& path, int width, int height, const unsigned char* rgba);

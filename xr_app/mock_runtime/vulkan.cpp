@@ -405,20 +405,31 @@ Swapchain::~Swapchain() {
   }
 }
 
-void write_layer_png(Session* s, const XrCompositionLayerProjection* layer,
-                     const std::string& path) {
-  const XrSwapchainSubImage& sub = layer->views[0].subImage;
+namespace {
+// Copies a region (texel bytes per texel) of one array layer of a swapchain's last released
+// image to host memory. Between frames the image is in its attachment layout (as
+// XR_KHR_vulkan_enable has it) and it is returned to that layout.
+bool read_region(Session* s, const XrSwapchainSubImage& sub, int x, int y, uint32_t w, uint32_t h,
+                 size_t texel, std::vector<unsigned char>* out) {
   Swapchain* sc = lookup<Swapchain>(sub.swapchain);
-  if (!sc || sc->depth || sc->last_released < 0) return;
+  if (!sc || sc->last_released < 0) return false;
   const VkImage img = sc->images[static_cast<size_t>(sc->last_released)].image;
-  const uint32_t w = static_cast<uint32_t>(sub.imageRect.extent.width);
-  const uint32_t hgt = static_cast<uint32_t>(sub.imageRect.extent.height);
+  const VkImageAspectFlags aspect =
+      sc->depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+  const VkImageLayout layout = sc->depth ? VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL
+                                         : VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  const VkAccessFlags written = sc->depth ? VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT
+                                          : VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  const VkAccessFlags used =
+      sc->depth ? VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+                      VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT
+                : VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT;
   VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  bi.size = static_cast<VkDeviceSize>(w) * hgt * 4;
+  bi.size = static_cast<VkDeviceSize>(w) * h * texel;
   bi.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   VkBuffer buf = VK_NULL_HANDLE;
   VkDeviceMemory mem = VK_NULL_HANDLE;
-  if (vkCreateBuffer(s->vk_device, &bi, nullptr, &buf) != VK_SUCCESS) return;
+  if (vkCreateBuffer(s->vk_device, &bi, nullptr, &buf) != VK_SUCCESS) return false;
   VkMemoryRequirements mr;
   vkGetBufferMemoryRequirements(s->vk_device, buf, &mr);
   VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
@@ -430,50 +441,91 @@ void write_layer_png(Session* s, const XrCompositionLayerProjection* layer,
       vkBindBufferMemory(s->vk_device, buf, mem, 0) != VK_SUCCESS) {
     vkDestroyBuffer(s->vk_device, buf, nullptr);
     if (mem) vkFreeMemory(s->vk_device, mem, nullptr);
-    return;
+    return false;
   }
+  bool ok = false;
   VkCommandBuffer cb = begin_commands(s);
   if (cb != VK_NULL_HANDLE) {
     VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-    b.srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+    b.srcAccessMask = written;
     b.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-    b.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    b.oldLayout = layout;
     b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
     b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     b.image = img;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, sub.imageArrayIndex, 1};
+    b.subresourceRange = {aspect, 0, 1, sub.imageArrayIndex, 1};
     vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
                          0, nullptr, 0, nullptr, 1, &b);
     VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, sub.imageArrayIndex, 1};
-    region.imageOffset = {sub.imageRect.offset.x, sub.imageRect.offset.y, 0};
-    region.imageExtent = {w, hgt, 1};
+    region.imageSubresource = {aspect, 0, sub.imageArrayIndex, 1};
+    region.imageOffset = {x, y, 0};
+    region.imageExtent = {w, h, 1};
     vkCmdCopyImageToBuffer(cb, img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buf, 1, &region);
     b.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-    b.dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT;
+    b.dstAccessMask = used;
     b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-    b.newLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    b.newLayout = layout;
     vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0,
                          0, nullptr, 0, nullptr, 1, &b);
     if (submit_and_wait(s, cb)) {
       void* p = nullptr;
       if (vkMapMemory(s->vk_device, mem, 0, bi.size, 0, &p) == VK_SUCCESS) {
-        std::vector<unsigned char> rgba(static_cast<size_t>(bi.size));
-        std::memcpy(rgba.data(), p, rgba.size());
+        out->resize(static_cast<size_t>(bi.size));
+        std::memcpy(out->data(), p, out->size());
         vkUnmapMemory(s->vk_device, mem);
-        bool bgra = sc->info.format == VK_FORMAT_B8G8R8A8_SRGB ||
-                    sc->info.format == VK_FORMAT_B8G8R8A8_UNORM;
-        for (size_t i = 0; i < rgba.size(); i += 4) {
-          if (bgra) std::swap(rgba[i], rgba[i + 2]);
-          rgba[i + 3] = 255;
-        }
-        if (!write_png_rgba(path, static_cast<int>(w), static_cast<int>(hgt), rgba.data()))
-          log("cannot write %s", path.c_str());
+        ok = true;
       }
     }
   }
   vkDestroyBuffer(s->vk_device, buf, nullptr);
   vkFreeMemory(s->vk_device, mem, nullptr);
+  return ok;
+}
+}  // namespace
+
+bool read_color(Session* s, const XrSwapchainSubImage& sub, std::vector<unsigned char>* rgba) {
+  Swapchain* sc = lookup<Swapchain>(sub.swapchain);
+  if (!sc || sc->depth) return false;
+  const uint32_t w = static_cast<uint32_t>(sub.imageRect.extent.width);
+  const uint32_t h = static_cast<uint32_t>(sub.imageRect.extent.height);
+  if (!read_region(s, sub, sub.imageRect.offset.x, sub.imageRect.offset.y, w, h, 4, rgba))
+    return false;
+  bool bgra =
+      sc->info.format == VK_FORMAT_B8G8R8A8_SRGB || sc->info.format == VK_FORMAT_B8G8R8A8_UNORM;
+  for (size_t i = 0; i < rgba->size(); i += 4) {
+    if (bgra) std::swap((*rgba)[i], (*rgba)[i + 2]);
+    (*rgba)[i + 3] = 255;
+  }
+  return true;
+}
+
+bool read_depth_texel(Session* s, const XrSwapchainSubImage& sub, int x, int y, float* depth) {
+  Swapchain* sc = lookup<Swapchain>(sub.swapchain);
+  if (!sc || !sc->depth) return false;
+  if (x < 0 || y < 0 || x >= sub.imageRect.extent.width || y >= sub.imageRect.extent.height)
+    return false;
+  const bool d16 = sc->info.format == VK_FORMAT_D16_UNORM;
+  std::vector<unsigned char> texel;
+  if (!read_region(s, sub, sub.imageRect.offset.x + x, sub.imageRect.offset.y + y, 1, 1,
+                   d16 ? 2 : 4, &texel))
+    return false;
+  if (d16) {
+    uint16_t v;
+    std::memcpy(&v, texel.data(), 2);
+    *depth = static_cast<float>(v) / 65535.f;
+  } else {
+    std::memcpy(depth, texel.data(), 4);
+  }
+  return true;
+}
+
+void write_layer_png(Session* s, const XrCompositionLayerProjection* layer,
+                     const std::string& path) {
+  const XrSwapchainSubImage& sub = layer->views[0].subImage;
+  std::vector<unsigned char> rgba;
+  if (!read_color(s, sub, &rgba)) return;
+  if (!write_png_rgba(path, sub.imageRect.extent.width, sub.imageRect.extent.height, rgba.data()))
+    log("cannot write %s", path.c_str());
 }
 
 #define DRAPE_ENTRY(fn) \

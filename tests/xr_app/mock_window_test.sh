@@ -1,0 +1,266 @@
+#!/usr/bin/env bash
+# Window mode of the mock runtime (DRAPE_MOCK_WINDOW=1) driven like a person would: a real X
+# server (Xvfb), real X input events (xdotool, through XTEST), a real OpenXR client.
+#   mock_window_test.sh MANIFEST OUTDIR hello HELLO_XR    Khronos hello_xr (no depth submitted)
+#   mock_window_test.sh MANIFEST OUTDIR depth CLIENT      mock_window_client (submits depth and
+#                                                         reads hand joints and actions back)
+# The runtime writes one line per frame to DRAPE_MOCK_WINDOW_LOG (head, hands, pinch, fist,
+# wheel, depth under the cursor, profile); the checks read it. The window is 800x600 at (0, 0)
+# (no window manager) and shows one 1024x1024 eye scaled to 600x600 at x 100..700.
+set -uo pipefail
+MANIFEST="$1" OUT="$2" MODE="$3" CLIENT="$4"
+rm -rf "$OUT" && mkdir -p "$OUT"
+LOG="$OUT/window.log"
+XVFB_PID="" CLIENT_PID=""
+cleanup() {
+  [ -n "$CLIENT_PID" ] && kill "$CLIENT_PID" 2>/dev/null
+  [ -n "$XVFB_PID" ] && kill "$XVFB_PID" 2>/dev/null
+  wait 2>/dev/null
+}
+trap cleanup EXIT
+fail() {
+  echo "FAIL: $*"
+  echo "--- window log (tail)"; tail -3 "$LOG" 2>/dev/null
+  echo "--- client stdout (tail)"; tail -15 "$OUT/stdout" 2>/dev/null
+  echo "--- client stderr (tail)"; tail -15 "$OUT/stderr" 2>/dev/null
+  exit 1
+}
+for tool in Xvfb xdotool xwd; do command -v $tool >/dev/null || fail "$tool is not installed (./drape setup)"; done
+
+# A free display: Xvfb picks it and writes its number to fd 3.
+Xvfb -displayfd 3 -screen 0 1024x768x24 -nolisten tcp 3>"$OUT/display" 2>"$OUT/xvfb.log" &
+XVFB_PID=$!
+for _ in $(seq 100); do [ -s "$OUT/display" ] && break; sleep 0.1; done
+[ -s "$OUT/display" ] || fail "Xvfb did not start"
+export DISPLAY=":$(head -1 "$OUT/display")"
+echo "Xvfb on $DISPLAY"
+
+export XR_RUNTIME_JSON="$MANIFEST" DRAPE_MOCK_WINDOW=1 DRAPE_MOCK_WINDOW_SIZE=800x600 \
+  DRAPE_MOCK_WINDOW_LOG="$LOG"
+unset DRAPE_MOCK_SCENARIO DRAPE_MOCK_WRITE_FRAMES XR_ENABLE_API_LAYERS DRAPE_MOCK_END_AFTER_FRAMES
+if [ "$MODE" = hello ]; then
+  # hello_xr quits on a key on stdin: hold stdin open.
+  bash -c "exec '$CLIENT' -g Vulkan2 < <(sleep 300)" >"$OUT/stdout" 2>"$OUT/stderr" &
+else
+  "$CLIENT" >"$OUT/stdout" 2>"$OUT/stderr" &
+fi
+CLIENT_PID=$!
+
+lines() { [ -f "$LOG" ] && wc -l <"$LOG" || echo 0; }
+# Waits until the runtime has logged N more frames (the input of the action is then taken).
+frames() {
+  local want=$(( $(lines) + $1 ))
+  for _ in $(seq 600); do [ "$(lines)" -ge "$want" ] && return 0; sleep 0.05; done
+  fail "the runtime logged no frames for 30 s"
+}
+# field NAME [INDEX]: the value of NAME= in the last log line (INDEX: 1-based part of x,y,z).
+field() {
+  local v
+  v=$(tail -1 "$LOG" | tr ' ' '\n' | sed -n "s/^$1=//p")
+  if [ $# -ge 2 ]; then echo "$v" | cut -d, -f"$2"; else echo "$v"; fi
+}
+# expect "description" EXPR: polls the last log line (up to 15 s) until the Python expression
+# EXPR holds; in it f(NAME) is a field as text and v(NAME, I) the I-th (1-based) number of it.
+expect() {
+  python3 - "$LOG" "$2" <<'PY' || fail "$1 ($2)"
+import sys, time
+log, expr = sys.argv[1], sys.argv[2]
+deadline = time.time() + 15
+while True:
+    with open(log) as fh:
+        lines = fh.read().splitlines()
+    d = dict(kv.split("=", 1) for kv in lines[-1].split() if "=" in kv) if lines else {}
+    f = lambda name: d[name]
+    v = lambda name, i=1: float(d[name].split(",")[i - 1])
+    try:
+        if eval(expr):
+            sys.exit(0)
+    except (KeyError, ValueError, IndexError):
+        pass
+    if time.time() > deadline:
+        print("last line:", lines[-1] if lines else "(none)")
+        sys.exit(1)
+    time.sleep(0.02)
+PY
+  echo "ok: $1"
+}
+
+for _ in $(seq 600); do [ "$(lines)" -ge 5 ] && break; kill -0 $CLIENT_PID 2>/dev/null || break; sleep 0.05; done
+[ "$(lines)" -ge 5 ] || fail "no window frames logged (did the window open?)"
+WID=$(xdotool search --name "drape mock runtime" | head -1)
+[ -n "$WID" ] || fail "no window named 'drape mock runtime'"
+xdotool getwindowgeometry "$WID" | tee "$OUT/geometry" | grep -q "Geometry: 800x600" || fail "window geometry"
+
+# --- the right hand follows the cursor
+xdotool mousemove 150 300
+expect "the cursor is over the view, on the left" "f('cursor') == 'in' and v('right', 1) < -0.3"
+x1=$(field right 1)
+xdotool mousemove 650 300
+expect "the right hand follows the cursor to the right" "v('right', 1) - $x1 > 0.5"
+xdotool mousemove 400 120
+expect "the right hand follows the cursor up" "v('right', 2) > 1.8"
+ya=$(field right 2)
+xdotool mousemove 400 480
+expect "the right hand follows the cursor down" "$ya - v('right', 2) > 0.4"
+
+# --- head: W moves forward (-z), R resets, right-drag looks
+z0=$(field head 3)
+xdotool keydown w; sleep 0.5; xdotool keyup w
+expect "W moves the head forward" "$z0 - v('head', 3) > 0.1"
+frames 3; z1=$(field head 3)
+frames 5
+expect "releasing W stops the head" "v('head', 3) == $z1"
+y0=$(field head 2)
+xdotool keydown e; sleep 0.3; xdotool keyup e
+expect "E moves the head up" "v('head', 2) - $y0 > 0.05"
+xdotool key r
+expect "R resets the head" "abs(v('head', 3) - $z0) < 1e-3 and abs(v('head', 2) - $y0) < 1e-3"
+xdotool mousedown 3; xdotool mousemove_relative -- 150 0; xdotool mouseup 3
+expect "right-drag to the right turns the head right" "abs(v('yaw') + 150 * 0.004) < 1e-3"
+xdotool key r
+expect "R resets the look" "v('yaw') == 0 and v('pitch') == 0"
+
+# --- pinch on the left button (held, or a quick click), fist on F
+xdotool mousemove 400 300
+expect "no pinch before the button" "f('pinch') == '0,0'"
+xdotool mousedown 1
+expect "left button pinches the right hand" "f('pinch') == '0,1'"
+xdotool search --name "drape mock runtime" getwindowname | grep -q "right hand pinch" ||
+  fail "the window title does not show the pinch: $(xdotool search --name 'drape mock runtime' getwindowname)"
+echo "ok: the window title shows it"
+frames 3
+[ "$MODE" = depth ] && cp "$OUT/stdout" "$OUT/stdout_pinched"
+xdotool mouseup 1
+expect "releasing the button opens the pinch" "f('pinch') == '0,0'"
+n=$(lines); xdotool click 1
+expect "a quick click pinches for a frame, then opens" "f('pinch') == '0,0' and any(' pinch=0,1 ' in l for l in open('$LOG').read().splitlines()[$n:])"
+xdotool keydown f
+expect "F makes a fist" "f('fist') == '0,1'"
+xdotool keyup f
+expect "releasing F opens the fist" "f('fist') == '0,0'"
+
+# --- the controllers' buttons: 1 2 3 4 M = A B X Y menu (hello_xr quits on menu: its M is
+# the last step)
+keys="1 2 3 4"
+[ "$MODE" = depth ] && keys="1 2 3 4 m"
+for k in $keys; do
+  xdotool keydown $k
+  want=$(case $k in 1) echo 10000;; 2) echo 01000;; 3) echo 00100;; 4) echo 00010;; m) echo 00001;; esac)
+  expect "key $k presses button $want" "f('buttons') == '$want'"
+  xdotool keyup $k
+done
+expect "buttons released" "f('buttons') == '00000'"
+
+# --- the left hand with Shift; the right hand stays
+rx=$(field right 1); lx0=$(field left 1)
+xdotool keydown shift; xdotool mousemove 200 300
+expect "Shift makes the left hand follow the cursor" "f('active') == 'left' and abs(v('left', 1) - $lx0) > 0.05"
+expect "the right hand stays" "v('right', 1) == $rx"
+xdotool keyup shift
+expect "without Shift the right hand is active again" "f('active') == 'right'"
+
+# --- wheel: the hand farther (up) and nearer (down)
+xdotool mousemove 400 300
+xdotool click --repeat 3 --delay 30 4
+expect "wheel up: the right hand 3 notches (6 cm) farther" "abs(v('wheel', 2) - 0.06) < 1e-6"
+xdotool click --repeat 3 --delay 30 5
+expect "wheel down brings it back" "abs(v('wheel', 2)) < 1e-6"
+
+# --- Tab switches the interaction profile
+p0=$(field profile)
+xdotool key Tab
+expect "Tab switches the profile (from $p0)" "f('profile') != '$p0'"
+echo "   profile now $(field profile)"
+
+# --- V: both eyes side by side
+xdotool key v
+expect "V shows both eyes" "f('view') == 'both'"
+xdotool key v
+expect "V again: the left eye" "f('view') == 'left'"
+
+if [ "$MODE" = depth ]; then
+  # The client draws a plane at 0.8 m over the left half of each eye and the hand's joints
+  # (with depth); hits on the joints are not the surface.
+  xdotool mousemove 250 300
+  expect "the hand's depth is the submitted plane's" "abs(v('z') - 0.8) < 0.005"
+  # The hand sits on the plane: at view depth 0.8 m (head z 1.0, looking down -z).
+  expect "the right hand sits on the surface" "abs(v('right', 3) - (1.0 - 0.8)) < 0.01"
+  frames 10
+  expect "and stays there (the drawn hand does not pull it)" "abs(v('right', 3) - 0.2) < 0.01"
+  xdotool mousemove 600 300
+  expect "over nothing but the drawn hand: no surface hit" "f('depth') == '-' or f('depth').endswith('(hand)')"
+  frames 10
+  expect "over nothing the hand keeps the last surface depth" "abs(v('right', 3) - 0.2) < 0.01 and abs(v('right', 1)) > 0.1"
+  xdotool click --repeat 5 --delay 30 5
+  expect "the wheel brings the hand 10 cm nearer than the surface" "abs(v('right', 3) - 0.3) < 0.01"
+  xdotool mousemove 250 300
+  frames 10
+  expect "and it hovers 10 cm in front of the plane" "abs(v('right', 3) - 0.3) < 0.01 and abs(v('z') - 0.8) < 0.005"
+  xdotool key r
+  expect "R resets the wheel" "v('wheel', 2) == 0"
+fi
+
+frames 6  # the last image drawn in the window
+# --- a screenshot of the window: the submitted image is shown
+xwd -root -silent >"$OUT/screen.xwd" || fail "xwd"
+python3 - "$OUT/screen.xwd" "$OUT/window.png" <<'PY' || fail "screenshot check"
+import struct, sys, zlib
+d = open(sys.argv[1], "rb").read()
+f = struct.unpack(">25I", d[:100])
+hsize, fmt, depth, w, h, byte_order, bpp, bpl, ncolors = f[0], f[2], f[3], f[4], f[5], f[7], f[11], f[12], f[19]
+assert fmt == 2 and bpp in (24, 32), (fmt, bpp)
+px, n = d[hsize + 12 * ncolors:], bpp // 8
+order = "little" if byte_order == 0 else "big"
+rows = []
+for y in range(600):  # the window: 800x600 at (0, 0)
+    row = bytearray()
+    for x in range(800):
+        v = int.from_bytes(px[y * bpl + n * x:y * bpl + n * x + n], order)
+        row += bytes(((v >> 16) & 255, (v >> 8) & 255, v & 255))
+    rows.append(bytes(row))
+raw = b"".join(b"\0" + r for r in rows)
+def chunk(t, b): return struct.pack(">I", len(b)) + t + b + struct.pack(">I", zlib.crc32(t + b))
+open(sys.argv[2], "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 800, 600, 8, 2, 0, 0, 0))
+                              + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+view = {rows[y][3 * x:3 * x + 3] for y in range(0, 600, 4) for x in range(100, 700, 4)}
+bars = {rows[y][3 * x:3 * x + 3] for y in range(0, 600, 4) for x in list(range(0, 96, 4)) + list(range(704, 800, 4))}
+print(f"screenshot: {len(view)} distinct colours in the view, {len(bars)} in the side bars")
+assert len(view) >= 3, "the view is blank: the submitted image is not shown"
+assert len(bars) == 1, "the letterbox bars are not plain"
+PY
+echo "ok: screenshot $OUT/window.png shows the submitted image"
+
+# --- Escape ends the session the way a headset's quit does: STOPPING, IDLE, EXITING. hello_xr
+# binds its quit action to the menu button: there M ends it through the action path.
+if [ "$MODE" = hello ]; then
+  xdotool keydown m; sleep 0.3; xdotool keyup m
+else
+  xdotool key Escape
+fi
+for _ in $(seq 300); do kill -0 $CLIENT_PID 2>/dev/null || break; sleep 0.1; done
+kill -0 $CLIENT_PID 2>/dev/null && fail "the client did not exit within 30 s"
+wait $CLIENT_PID; rc=$?; CLIENT_PID=""
+[ "$rc" -eq 0 ] || fail "the client exited with $rc"
+if [ "$MODE" = hello ]; then
+  grep -q "closed or Escape" "$OUT/stderr" && fail "the session ended by Escape, not by the menu button"
+  grep -q "buttons=00001" "$LOG" || fail "M did not press the menu button"
+  echo "ok: M (menu) made hello_xr request the exit"
+  grep -q "XR_SESSION_STATE_STOPPING->XR_SESSION_STATE_IDLE" "$OUT/stdout" || fail "no STOPPING->IDLE"
+  grep -q "XR_SESSION_STATE_IDLE->XR_SESSION_STATE_EXITING" "$OUT/stdout" || fail "no IDLE->EXITING"
+  grep -q "XR_ERROR" "$OUT/stdout" "$OUT/stderr" && fail "an XR_ERROR result was logged"
+else
+  grep -q "closed or Escape: ending the session" "$OUT/stderr" || fail "the runtime did not log the quit"
+  grep -q "^state EXITING" "$OUT/stdout" || fail "the client saw no EXITING"
+  # What the app sees: hand joints with thumb and index tips together while pinched, the
+  # select action pressed, the profile change event.
+  grep -q "pinch_gap=0.005" "$OUT/stdout_pinched" || fail "the client never saw the thumb and index tips together"
+  grep -q "select=1" "$OUT/stdout_pinched" || fail "the client never saw select pressed"
+  grep -q "^profile changed: /interaction_profiles/khr/simple_controller" "$OUT/stdout" ||
+    fail "the client never saw khr/simple_controller"
+  grep -q "^profile changed: none" "$OUT/stdout" || fail "the client never saw the change to hand tracking alone"
+  awk '/^state/ && seen { exit } /pinch_gap/ { seen = 1 } seen && /hand not tracked/ { bad = 1 }
+       END { exit bad }' "$OUT/stdout" || fail "the client saw the hand untracked while focused"
+  echo "ok: the client saw the pinch as hand joints and as select, and the profile change"
+fi
+echo "ok: the session ended (STOPPING, IDLE, EXITING), exit 0"
+echo PASS
