@@ -146,7 +146,7 @@ int run_headless(const HeadlessOptions& o) {
   world.cloth.relump_masses();
   VerletParams vp;
   vp.stiffness_scale = o.stiffness_scale;
-  vp.damping_rate = 2.0;
+  vp.air_drag = 2.0;
   auto solver = std::make_unique<VerletSolver>(vp);
   const int substeps = solver->substeps_for(world.cloth, 1.0 / 90);
   const double dt_bound = solver->stable_dt_bound(world.cloth);

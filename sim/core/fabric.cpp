@@ -63,7 +63,7 @@ Result<std::map<std::string, FabricParams>> parse_fabric_presets(const std::stri
         {"shear", &p.shear, true, false},
         {"bending_warp", &p.bending_warp, true, false},
         {"bending_weft", &p.bending_weft, true, false},
-        {"damping", &p.damping, false, true},
+        {"damping", &p.rayleigh_damping, false, true},
     };
     for (const Field& f : fields) {
       std::string e = read_field(*it, name, f.key, f.required, f.allow_zero, *f.dst);

@@ -20,7 +20,9 @@ struct FabricParams {
   double bending_warp =
       8.0e-6;  // N*m: moment per unit width per unit curvature (bending along warp)
   double bending_weft = 5.0e-6;  // N*m
-  double damping = 0.0;          // dimensionless Rayleigh factor used by solvers that support it
+  // Rayleigh factor (s), the preset's "damping": read and validated, kept in session logs; the
+  // solvers take their damping from their own options (VbdOptions::rayleigh_damping, air drag).
+  double rayleigh_damping = 0.0;
 };
 
 // Loads every preset of a fabrics JSON file. Each value is checked: present, finite, positive

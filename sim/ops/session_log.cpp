@@ -240,7 +240,7 @@ bool read_cloth(Reader& r, const json& c, Cloth& cloth) {
               {"shear", &fp.shear, false},
               {"bending_warp", &fp.bending_warp, false},
               {"bending_weft", &fp.bending_weft, false},
-              {"damping", &fp.damping, true}};
+              {"damping", &fp.rayleigh_damping, true}};
   for (auto& e : nums) {
     if (!r.number(*f, F, e.key, *e.v)) return false;
     if (*e.v < 0 || (!e.may_be_zero && *e.v == 0)) return r.fail(F + "." + e.key, "must be > 0");
@@ -340,7 +340,7 @@ std::string session_to_json(const SessionLog& log) {
                   {"shear", f.shear},
                   {"bending_warp", f.bending_warp},
                   {"bending_weft", f.bending_weft},
-                  {"damping", f.damping}};
+                  {"damping", f.rayleigh_damping}};
   j["cloth"] = std::move(jc);
   std::vector<double> plates, boxes, spheres;
   for (const Plate& p : log.plates)

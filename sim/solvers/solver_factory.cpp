@@ -22,14 +22,14 @@ Result<std::unique_ptr<Solver>> make_solver(const std::string& name_in, const So
     o.freeze = cfg.freeze;
     o.chebyshev = cfg.chebyshev;
     o.threads = cfg.threads;
-    if (cfg.air_damping >= 0) o.air_damping = cfg.air_damping;
+    if (cfg.air_drag >= 0) o.air_drag = cfg.air_drag;
     s = std::make_unique<VbdSolver>(o);
   } else if (name == "xpbd") {
     XpbdOptions o;
     o.energy = eo;
     if (cfg.substeps > 0) o.substeps = cfg.substeps;
     if (cfg.iterations > 0) o.iterations = cfg.iterations;
-    if (cfg.air_damping >= 0) o.damping = cfg.air_damping;
+    if (cfg.air_drag >= 0) o.air_drag = cfg.air_drag;
     o.threads = cfg.threads;
     o.freeze = cfg.freeze;
     o.finish_thread = cfg.finish_thread;
@@ -41,12 +41,12 @@ Result<std::unique_ptr<Solver>> make_solver(const std::string& name_in, const So
     if (cfg.substeps > 0) o.substeps = cfg.substeps;
     if (cfg.iterations > 0) o.max_iterations = cfg.iterations;
     if (cfg.tolerance > 0) o.tolerance = cfg.tolerance;
-    if (cfg.air_damping >= 0) o.air_damping = cfg.air_damping;
+    if (cfg.air_drag >= 0) o.air_drag = cfg.air_drag;
     s = std::make_unique<NewtonSolver>(o);
   } else if (name == "verlet") {
     VerletParams p;
     if (cfg.substeps > 0) p.substeps = cfg.substeps;
-    if (cfg.air_damping >= 0) p.damping_rate = cfg.air_damping;
+    if (cfg.air_drag >= 0) p.air_drag = cfg.air_drag;
     s = std::make_unique<VerletSolver>(p);
   } else {
     return make_error("make_solver", "unknown solver '" + name +

@@ -24,7 +24,7 @@ struct SolverConfig {
   bool chebyshev = false;      // VBD
   bool springs_model = false;  // the baseline's 8-spring energy instead of FEM + bending
   int threads = 2;
-  double air_damping = -1;  // 1/s, VBD and XPBD; < 0: the solver's default (1/s, as Verlet)
+  double air_drag = -1;  // 1/s, VBD and XPBD; < 0: the solver's default (1/s, as Verlet)
 };
 
 // The default real-time solver, chosen on the run-time-against-error chart of

@@ -553,7 +553,7 @@ StepStats NewtonSolver::step(Cloth& cloth, const SceneObjects& scene, double dt)
     for (int i = 0; i < n; ++i) {
       xt_[i] = S.x[i];
       if (cloth.is_free(i)) {
-        y_[i] = S.x[i] + (h * std::exp(-opt_.air_damping * h)) * S.v[i];
+        y_[i] = S.x[i] + (h * std::exp(-opt_.air_drag * h)) * S.v[i];
         S.x[i] = y_[i] + h * h * g;
       } else {
         y_[i] = S.x[i];

@@ -27,8 +27,8 @@ struct NewtonOptions {
   bool line_search = true;  // backtracking (Armijo) on G
   EnergyOptions energy;
   double contact_stiffness = 0;  // 0: automatic
-  // Air drag (1/s) as in VBD: the inertia target is y = x + h v exp(-air_damping h).
-  double air_damping = 0;
+  // Air drag (1/s) as in VBD: the inertia target is y = x + h v exp(-air_drag h).
+  double air_drag = 0;
   LinearSolver linear_solver = LinearSolver::kCholmod;
   // Static mode (h <= 0) only: use the exact Hessian (no PSD projection of the membrane
   // stress / hinge curvature) whenever it factorises as positive definite, falling back to the

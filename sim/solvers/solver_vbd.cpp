@@ -107,7 +107,7 @@ double VbdSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, Ste
   const double gn = g.norm();
   const Vec3 gdir = gn > 0 ? Vec3(g / gn) : Vec3::Zero();
   const double h_prev = h_prev_ > 0 ? h_prev_ : h;
-  const double drag = std::exp(-opt_.air_damping * h);
+  const double drag = std::exp(-opt_.air_drag * h);
   for (int i = 0; i < n; ++i) {
     xt_[i] = S.x[i];
     if (cloth.is_free(i) && !(S.flags[i] & kFlagFrozen)) {
@@ -149,7 +149,7 @@ double VbdSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, Ste
     }
   }
   const double inv_h2 = 1.0 / (h * h);
-  const double kd_h = opt_.damping / h;
+  const double kd_h = opt_.rayleigh_damping / h;
   double omega = 1.0;
   double residual = 0;
   for (int it = 0; it < opt_.iterations; ++it) {

@@ -43,11 +43,11 @@ struct VbdOptions {
   int freeze_steps = 30;
   // Rayleigh factor k_d (s): adds k_d/h * H_i (x_i - x_i,t) with the vertex's own 3x3 block
   // only (the paper's form): NOT invariant under rigid motion (it also slows a falling cloth),
-  // so off by default; use air_damping to settle swinging cloth.
-  double damping = 0.0;
-  // Air drag (1/s), the same as VerletParams::damping_rate and XpbdOptions::damping: the
-  // inertia target is y = x + h v exp(-air_damping h).
-  double air_damping = 1.0;
+  // so off by default; use air_drag to settle swinging cloth.
+  double rayleigh_damping = 0.0;
+  // Air drag (1/s), the same as VerletParams::air_drag and XpbdOptions::air_drag: the
+  // inertia target is y = x + h v exp(-air_drag h).
+  double air_drag = 1.0;
   int threads = 2;
   EnergyOptions energy;
   double contact_stiffness = 0;  // 0: automatic

@@ -97,7 +97,7 @@ void VerletSolver::substep(Cloth& cloth, const SceneObjects& scene, double h, St
     any_contact = cs.contacts > 0;
   }
   // eq. 3-4: x(t+h) = x(t) + alpha (x(t) - x(t-h)) + F h^2 / m.
-  const double alpha = p_.alpha > 0 ? p_.alpha : std::exp(-p_.damping_rate * h);
+  const double alpha = p_.alpha > 0 ? p_.alpha : std::exp(-p_.air_drag * h);
   const double h2 = h * h, inv_h = 1.0 / h;
   const double* inv_m = st.inv_mass.data();
   Vec3* xm = st.x.data();

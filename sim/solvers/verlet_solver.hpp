@@ -17,9 +17,9 @@ struct VerletParams {
   int substeps = 0;
   double safety = 0.9;
   // Damping alpha of eq. 3-4. The study gives no value; alpha <= 0 derives it from a rate per
-  // second so that the damping does not change with the substep: alpha = exp(-damping_rate h).
+  // second so that the damping does not change with the substep: alpha = exp(-air_drag h).
   double alpha = 0;
-  double damping_rate = 1.0;     // 1/s
+  double air_drag = 1.0;         // 1/s
   double stiffness_scale = 1.0;  // 1 = the fabric's stiffness (build_springs)
   bool collide = true;
   // true: the baseline's response as published, a force, so the displacement it causes also

@@ -97,7 +97,7 @@ Testbed make_form_drape(int res, const FabricParams& fabric, bool fall) {
     // and drapes against it (3 s).
     place_spread(s.cloth, Vec3(-0.25, top, zf + 0.51), Vec3::UnitX(), -Vec3::UnitZ());
     s.duration = 3.0;
-    s.air_damping = 4.0;
+    s.air_drag = 4.0;
   } else {
     // The app's default scenario: top edge across the chest at z = front surface + 1 cm, the
     // panel hanging down but tilted forward by the least angle (whole degrees) that keeps every

@@ -22,7 +22,7 @@ struct Testbed {
   double duration = 2.0;       // simulated seconds before the error is measured
   // Air drag (1/s) every solver uses on this scene in the benchmarks; < 0: the solvers' default
   // (1/s). The form scene settles (its error is that of the settled drape, not of a swing).
-  double air_damping = -1;
+  double air_drag = -1;
 };
 
 // Muslin (or `fabric`) sheet of side 0.5 m with res x res vertices, hanging in the x-y plane

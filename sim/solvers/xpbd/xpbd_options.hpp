@@ -17,8 +17,8 @@ struct XpbdOptions {
   int substeps = 10;
   int iterations = 1;  // per substep (small steps: 1)
   EnergyOptions energy;
-  double damping = 1.0;  // velocity damping rate (1/s), air drag as in Verlet and VBD
-  int threads = 2;       // colours projected in parallel (results do not depend on it)
+  double air_drag = 1.0;  // 1/s: velocities decay as exp(-air_drag t), as in Verlet, VBD and Newton
+  int threads = 2;        // colours projected in parallel (results do not depend on it)
   // Cloths with fewer triangles run on the calling thread alone: a colour of a small cloth is
   // too little work to share (on two cores, 32^2 takes 1.49 ms per frame on one thread and 1.83
   // on two).
@@ -85,7 +85,7 @@ struct XpbdOptions {
   // inertia grows by settle_growth every settle_grow_steps substeps (gently: a sudden step
   // releases the stretch as a jolt) up to settle_mass_scale (w and the prediction's
   // acceleration divided by the scale: the forces, and so the equilibrium, are unchanged, the
-  // bias shrinks by the scale) and its air drag is settle_damping. It returns to its own mass
+  // bias shrinks by the scale) and its air drag is settle_air_drag. It returns to its own mass
   // at once when its RMS speed exceeds settle_exit_speed, one of its fixed vertices moves or is
   // let go (pinch, drag, release), something pushes 1 mm into its contact shell, it is woken
   // from sleep or the topology changes. A settling piece answers a push like a heavier cloth
@@ -102,7 +102,7 @@ struct XpbdOptions {
   // heavier drag makes that mode creep (overdamped, rate ~ omega^2 / c), a lighter one lets it
   // swing (at 64^2 the error from the nearest equilibrium after 8 s falls from 4.4 mm at 5/s
   // to 1.9 mm at 1.5/s).
-  double settle_damping = 1.5;
+  double settle_air_drag = 1.5;
   // With freeze: a piece at the full scale for this many substeps sleeps even if it still
   // moves (a safety net: a settled piece normally sleeps on the rest test above). Long enough
   // for the 128^2 drape to come within 3.2 mm of its equilibrium before it sleeps.

@@ -21,7 +21,7 @@ TEST(Fabric, LoadsAssetPresets) {
   EXPECT_DOUBLE_EQ(m->stretch_weft, 5000);
   EXPECT_DOUBLE_EQ(m->shear, 60);
   EXPECT_DOUBLE_EQ(m->bending_warp, 8.0e-6);
-  EXPECT_DOUBLE_EQ(m->damping, 0.0);
+  EXPECT_DOUBLE_EQ(m->rayleigh_damping, 0.0);
   auto d = load_fabric(kAssets, "denim");
   ASSERT_TRUE(d);
   EXPECT_DOUBLE_EQ(d->areal_density, 0.40);

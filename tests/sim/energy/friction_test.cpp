@@ -65,7 +65,7 @@ Vec3 centroid(const Cloth& c) {
 double slide(const std::string& solver, double theta_deg, double mu, double seconds) {
   Incline s = make_incline(theta_deg, mu);
   SolverConfig cfg;
-  cfg.air_damping = 0;
+  cfg.air_drag = 0;
   cfg.threads = 1;
   cfg.settle = false;  // an inertia-scaled piece would still slide the same way, but slower
   auto sv = make_solver(solver, cfg);
@@ -145,7 +145,7 @@ TEST(Friction, ClothOnASlopeOfTheFormSticksBelowTheAngleOfRepose) {
     place_spread(cloth, touch + objects.offset * n - 0.05 * down - 0.02 * side, down, side);
     cloth.relump_masses();
     SolverConfig cfg;
-    cfg.air_damping = 0;
+    cfg.air_drag = 0;
     cfg.threads = 1;
     cfg.settle = false;
     auto sv = make_solver(solver, cfg);

@@ -118,7 +118,7 @@ TEST(SelfCollision, FoldedSheetOnTheFloorKeepsItsLayersApart) {
     scene.self_collision = on == 1;
     XpbdOptions o;
     o.substeps = 10;
-    o.damping = 2.0;
+    o.air_drag = 2.0;
     o.threads = 1;
     XpbdSolver s(o);
     for (int f = 0; f < 135; ++f) s.step(c, scene, 1.0 / 90);

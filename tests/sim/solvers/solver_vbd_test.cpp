@@ -43,14 +43,14 @@ TEST(Vbd, ChainSupportForceEqualsTotalWeight) {
   VbdOptions o = vbd_options(4, 50);
   o.energy.model = EnergyOptions::Model::kSprings;
   o.tolerance = 1e-9;
-  o.damping = 0.001;
+  o.rayleigh_damping = 0.001;
   VbdSolver s(o);
   expect_chain_carries_its_weight(s, 900, "VBD", 0.01);
 }
 
 TEST(Vbd, HangingSheetConvergesToNewtonReference) {
   VbdOptions o = vbd_options(2, 20);
-  o.damping = 0.01;
+  o.rayleigh_damping = 0.01;
   VbdSolver s(o);
   double rms, mx;
   sheet_error_vs_newton(s, 12, 450, "VBD sheet after 5 s vs static Newton", rms, mx);
@@ -77,7 +77,7 @@ TEST(Vbd, FreezingSkipsRestingVerticesAndWakes) {
   Testbed sc = make_hanging_sheet(10);
   VbdOptions o;
   o.freeze = true;
-  o.damping = 0.02;
+  o.rayleigh_damping = 0.02;
   VbdSolver s(o);
   run_frames(s, sc, 600);
   std::printf("frozen after rest: %d of %d\n", s.frozen_count(), sc.cloth.num_vertices());

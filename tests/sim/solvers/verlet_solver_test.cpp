@@ -41,7 +41,7 @@ TEST(Verlet, HangingStripSupportEqualsWeight) {
   for (int i = 0; i < nx; ++i) c.state.flags[i] |= kFlagPinned;
   c.relump_masses();
   VerletParams p;
-  p.damping_rate = 60;  // strong damping to settle fast
+  p.air_drag = 60;  // strong damping to settle fast
   VerletSolver s(p);
   SceneObjects scene;
   scene.floor = false;

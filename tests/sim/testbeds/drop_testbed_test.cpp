@@ -47,7 +47,7 @@ TEST(Drop, PanelOnFormStaysOutside) {
   DropTestbed d = make_front_drop(form, 17);  // 0.4 m, 2.5 cm spacing
   Cloth& c = d.cloth;
   VerletParams vp;
-  vp.damping_rate = 2.0;
+  vp.air_drag = 2.0;
   VerletSolver s(vp);
   double pen = 0, coll_ms = 0, max_inside_during = 0;
   int substeps = 0;

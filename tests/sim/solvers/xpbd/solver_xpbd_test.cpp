@@ -33,7 +33,7 @@ TEST(Xpbd, ChainSupportForceEqualsTotalWeight) {
   o.energy.model = EnergyOptions::Model::kSprings;
   o.substeps = 20;
   o.iterations = 20;
-  o.damping = 2.0;
+  o.air_drag = 2.0;
   XpbdSolver s(o);
   // 900 frames (10 s): with the settling drag near critical for the slowest mode (1.5/s) the
   // chain still swings at 400 frames (support force 8.5 % off); at 900 it is 0.009 % off.
@@ -44,7 +44,7 @@ TEST(Xpbd, HangingSheetNearNewtonReference) {
   XpbdOptions o;
   o.substeps = 20;
   o.iterations = 2;
-  o.damping = 2.0;
+  o.air_drag = 2.0;
   XpbdSolver s(o);
   double rms, mx;
   sheet_error_vs_newton(s, 10, 360, "XPBD sheet after 4 s vs static Newton", rms, mx);
@@ -116,7 +116,7 @@ TEST(Xpbd, SinglePrecisionKernelsFollowTheDoubleOnes) {
     start = sc.cloth.state.x;
     XpbdOptions o;
     o.single_precision = dbl == 0;
-    o.damping = sc.air_damping;
+    o.air_drag = sc.air_drag;
     XpbdSolver s(o);
     for (int k = 0; k < 180; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
     out[dbl] = sc.cloth.state.x;
@@ -149,7 +149,7 @@ TEST(Xpbd, EveryKernelBuildGivesTheSameSheet) {
   for (const xpbd::Kernels* K : xpbd::all_kernels()) {
     Testbed sc = make_hanging_sheet(24);
     XpbdOptions o;
-    o.damping = sc.air_damping;
+    o.air_drag = sc.air_drag;
     o.kernels = K->name;
     XpbdSolver s(o);
     for (int k = 0; k < 180; ++k) s.step(sc.cloth, sc.objects, 1.0 / 90);
@@ -170,7 +170,7 @@ TEST(Xpbd, FreezingSkipsRestingVerticesWakesAndKeepsTheRestState) {
   Testbed free_run = make_hanging_sheet(10);
   Testbed sc = make_hanging_sheet(10);
   XpbdOptions o;
-  o.damping = 3.0;
+  o.air_drag = 3.0;
   XpbdSolver plain(o);
   o.freeze = true;
   XpbdSolver s(o);
@@ -193,7 +193,7 @@ TEST(Xpbd, WarmStartHalvesTheSagBiasOfAHangingSheet) {
   double err[2];
   for (int k = 0; k < 2; ++k) {
     XpbdOptions o;
-    o.damping = 2.0;
+    o.air_drag = 2.0;
     o.settle = false;  // the warm start alone
     o.warm_start = 0.5 * k;
     XpbdSolver s(o);
@@ -215,7 +215,7 @@ struct DrapeEnd {
 };
 DrapeEnd form_drape_end(XpbdOptions o, const char* label, int res = 16, int frames = 270) {
   Testbed sc = make_scene("form", res);
-  o.damping = sc.air_damping;
+  o.air_drag = sc.air_drag;
   o.threads = 1;
   XpbdSolver s(o);
   for (int f = 0; f < frames; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
@@ -320,7 +320,7 @@ TEST(Xpbd, FormDrapeFallsAsleepAndStaysAsleep) {
   Testbed sc = make_scene("form", 32);
   XpbdOptions o;
   o.substeps = 10;
-  o.damping = sc.air_damping;
+  o.air_drag = sc.air_drag;
   o.threads = 1;
   o.freeze = true;
   XpbdSolver s(o);
@@ -349,7 +349,7 @@ TEST(Xpbd, SettlingRemovesTheRestBiasOfAHangingSheet) {
   double err[2], scale[2];
   for (int k = 0; k < 2; ++k) {
     XpbdOptions o;
-    o.damping = 2.0;
+    o.air_drag = 2.0;
     o.settle = k == 1;
     XpbdSolver s(o);
     double mx;
@@ -373,7 +373,7 @@ TEST(Xpbd, SettlingEndsWhenAPinnedCornerMoves) {
   for (int k = 0; k < 2; ++k) {
     Testbed sc = make_hanging_sheet(10);
     XpbdOptions o;
-    o.damping = 3.0;
+    o.air_drag = 3.0;
     o.settle = k == 1;
     XpbdSolver s(o);
     run_frames(s, sc, 600);
@@ -431,7 +431,7 @@ namespace {
 double settled_drape_error(XpbdOptions o, std::unique_ptr<XpbdSolver>& s, double& mx,
                            std::vector<Vec3>* end_state = nullptr) {
   Testbed sc = make_scene("form", 32);
-  o.damping = sc.air_damping;
+  o.air_drag = sc.air_drag;
   o.threads = 1;
   o.freeze = true;
   s = std::make_unique<XpbdSolver>(o);

@@ -26,7 +26,7 @@ DrapeRun form_drape(int res, int frames, int threads, bool worker = true) {
   Testbed sc = make_scene("form", res);
   XpbdOptions o;
   o.substeps = 10;
-  o.damping = sc.air_damping;
+  o.air_drag = sc.air_drag;
   o.threads = threads;
   o.min_parallel_triangles = 0;  // small test cloths run on two threads too
   o.freeze = true;
