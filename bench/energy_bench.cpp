@@ -2,10 +2,10 @@
 // update (ns, CPU time of one thread), per bending model, on a res x res muslin sheet in a
 // curved, slightly rumpled state. Writes out/bench/energy.csv (model,res,ns_per_vertex,
 // ns_bending_per_vertex). Usage: energy_bench [--res N] [--sweeps K].
+#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -47,10 +47,16 @@ double time_vertex_blocks(const ClothEnergy& e, const Cloth& c, int sweeps, doub
 
 int main(int argc, char** argv) {
   int res = 128, sweeps = 5;
-  for (int i = 1; i + 1 < argc; ++i) {
-    if (!std::strcmp(argv[i], "--res")) res = std::max(4, std::atoi(argv[i + 1]));
-    if (!std::strcmp(argv[i], "--sweeps")) sweeps = std::max(1, std::atoi(argv[i + 1]));
-  }
+  CLI::App app{
+      "CPU time of vertex_force_hessian per vertex update on a bent sheet, per bending model "
+      "(out/bench/energy.csv)."};
+  app.add_option("--res", res, "sheet resolution")
+      ->check(CLI::Range(4, 4096))
+      ->capture_default_str();
+  app.add_option("--sweeps", sweeps, "sweeps over the vertices per timing")
+      ->check(CLI::Range(1, 1 << 20))
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
   PanelSpec p;
   p.width = p.height = 0.5;
   p.nx = p.ny = res;

@@ -2,6 +2,7 @@
 // latency of every operation through the SimThread in lock-step (target: visible in the snapshot
 // after the next tick). Writes out/bench/operations.csv: operation,resolution,ms,latency_ticks.
 // Times are CPU time of the thread doing the work (median over repetitions).
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
 #include <ctime>
@@ -227,7 +228,9 @@ void bench_latency(int n, std::vector<Row>& rows) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  CLI::App app{"Cost and latency of the cloth operations (out/bench/operations.csv)."};
+  CLI11_PARSE(app, argc, argv);
   if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
     char buf[64] = {};
     if (std::fgets(buf, sizeof buf, f)) std::printf("load average: %s", buf);

@@ -4,6 +4,7 @@
 // Usage: render_bench [frames=20] [size=1024] [sim_seconds=1.0]
 #include <time.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -108,9 +109,17 @@ bool run(const SceneDescription& d, int samples, int frames, uint32_t size, Resu
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int frames = argc > 1 ? std::max(1, std::atoi(argv[1])) : 20;
-  const uint32_t size = argc > 2 ? static_cast<uint32_t>(std::max(16, std::atoi(argv[2]))) : 1024;
-  const double sim_seconds = argc > 3 ? std::atof(argv[3]) : 1.0;
+  int frames = 20;
+  uint32_t size = 1024;
+  double sim_seconds = 1.0;
+  CLI::App app{
+      "Renderer benchmark: per-eye frame time and render CPU time (out/bench/render.json)."};
+  app.option_defaults()->always_capture_default();
+  app.add_option("frames", frames, "frames timed per MSAA setting")->check(CLI::Range(1, 100000));
+  app.add_option("size", size, "eye image size (pixels)")->check(CLI::Range(16, 8192));
+  app.add_option("sim_seconds", sim_seconds, "seconds the drape is simulated before drawing")
+      ->check(CLI::Range(0.0, 600.0));
+  CLI11_PARSE(app, argc, argv);
   auto scene = default_scene(sim_seconds, "xpbd", 128);
   if (!scene) {
     std::fprintf(stderr, "render_bench: %s\n", scene.error().c_str());

@@ -4,22 +4,60 @@
 // sheet. Writes out/bench/solvers.csv and Pareto charts out/bench/solvers.svg (form) and
 // solvers_sheet.svg (error vs time, log axes, one curve per solver), prints time-at-equal-
 // error ratios of the default solver against the explicit baseline, Bullet and XPBD.
-// Usage: solvers_bench [--quick] [--max-res N] [--sleep-only] [--threads-only] | --probe SCENE RES
-// SOLVER SUBSTEPS ITERATIONS
+// Usage: solvers_bench [--quick] [--max-res N] [--sleep-only] [--threads-only] [FLAGS]
+//        solvers_bench --probe SCENE RES SOLVER SUBSTEPS ITERATIONS [FLAGS]
+// `solvers_bench --help` lists every flag with its default and range. They replace environment
+// variables (NAME=v before the command; a 0/1 switch became --x / --no-x, both exist):
+//   SOLVERS_THREADS         --threads                 REF_ITERS               --ref-iters
+//   REF_SETTLE_FRAMES       --ref-settle-frames       SLEEP_REF_ITERS         --sleep-ref-iters
+//   PROBE_POLISH_FRICTION=0 --no-polish-friction      POLISH_REUSE=0          --no-polish-reuse
+//   POLISH_CG_MAX           --polish-cg-max           POLISH_CG_TOL           --polish-cg-tol
+//   PROBE_FRAMES            --frames                  PROBE_REF=0             --no-ref
+//   PROBE_POLISH=0          --no-polish               PROBE_FRICTION          --friction
+//   PROBE_LOAD              --load                    PROBE_SAVE              --save
+//   PROBE_SAVE_POLISHED     --save-polished           PROBE_DRIFT=1           --drift
+//   PROBE_POLISH_STEPS      --polish-steps            PROBE_SMOOTH            --smooth
+//   PROBE_COARSE_ONLY       --coarse-only             PROBE_COARSE_K          --coarse-k
+//   PROBE_COARSE_FACTOR     --coarse-factor           PROBE_COARSE_ROT=0|1    --[no-]coarse-rot
+//   PROBE_COARSE_MU=0       --no-coarse-mu            PROBE_MG_AA             --mg-aa
+//   PROBE_MG_SWEEPS         --mg-sweeps               PROBE_MG_TAU            --mg-tau
+//   PROBE_MG_NOCOARSE=1     --mg-nocoarse             PROBE_MG_REFRESH        --mg-refresh
+//   PROBE_FINISH            --finish                  PROBE_FINISH_SWEEPS     --finish-sweeps
+//   PROBE_FINISH_EXTRA      --finish-extra            VBD_INIT                --vbd-init
+//   VBD_RHO                 --vbd-rho                 VBD_DAMP                --vbd-damp
+//   VBD_AIR                 --vbd-air                 VBD_FREEZE=1            --vbd-freeze
+//   VBD_TOL                 --vbd-tol                 VBD_FTOL                --vbd-ftol
+//   VBD_THREADS             --vbd-threads             XPBD_WARM               --xpbd-warm
+//   XPBD_WARM_FRAME         --xpbd-warm-frame         XPBD_WARM_LATE          --xpbd-warm-late
+//   XPBD_REUSE=0            --no-xpbd-reuse           XPBD_BEND_EVERY         --xpbd-bend-every
+//   XPBD_RETEST=0           --no-xpbd-retest          XPBD_SETTLE=0           --no-xpbd-settle
+//   XPBD_FREEZE=1           --xpbd-freeze             XPBD_SETTLE_SCALE       --xpbd-settle-scale
+//   XPBD_SETTLE_DAMP        --xpbd-settle-damp        XPBD_SNAP               --xpbd-snap
+//   XPBD_SLEEP_STEPS        --xpbd-sleep-steps        XPBD_SETTLE_SPEED       --xpbd-settle-speed
+//   XPBD_SETTLE_GROWTH      --xpbd-settle-growth      XPBD_COARSE             --xpbd-coarse
+//   XPBD_COARSE_FRAMES      --xpbd-coarse-frames      XPBD_COARSE_ROT=1       --xpbd-coarse-rot
+//   XPBD_FINISH=0           --no-xpbd-finish          XPBD_FINISH_CYCLES      --xpbd-finish-cycles
+//   XPBD_FINISH_THREAD=0    --no-xpbd-finish-thread   XPBD_F32=0              --no-xpbd-f32
+//   XPBD_KERNELS            --xpbd-kernels
+//   DRAPE_XPBD_SIMD (a library knob before) --simd none|avx2|widest (0: none, avx512: widest)
+// e.g. PROBE_FRAMES=270 SOLVERS_THREADS=2 solvers_bench --probe form 128 xpbd 10 1 is now
+// solvers_bench --probe form 128 xpbd 10 1 --frames 270 --threads 2.
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "bench/bullet_peer.hpp"
@@ -31,6 +69,7 @@
 #include "sim/solvers/solver_vbd.hpp"
 #include "sim/solvers/watchdog.hpp"
 #include "sim/solvers/xpbd/solver_xpbd.hpp"
+#include "sim/solvers/xpbd/xpbd_kernels.hpp"
 #include "sim/testbeds/testbed.hpp"
 
 using namespace drape::sim;
@@ -57,19 +96,68 @@ double cpu_ms() {
   return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-double env_num(const char* name, double def) {
-  const char* v = std::getenv(name);
-  return v ? std::atof(v) : def;
-}
+// The study's and the probe's knobs (command-line flags; `solvers_bench --help` lists them).
+// Unset optionals take the default named in their help: the solver's own or the scene's value,
+// or one that depends on where the knob is used.
+struct Knobs {
+  // The study (and the probe, where they apply).
+  bool quick = false, sleep_only = false, threads_only = false;
+  int max_res = 64;
+  std::optional<int> threads;    // solver threads: study 1, probe 2, the probe's --finish pool 1
+  std::optional<int> ref_iters;  // Newton iterations: polish 300, contact scenes' reference 150
+  int ref_settle_frames = 360;
+  int sleep_ref_iters = 100;
+  bool polish_friction = true;
+  bool polish_reuse = true;
+  int polish_cg_max = StaticOptions{}.reuse_max_cg;
+  double polish_cg_tol = StaticOptions{}.reuse_cg_tolerance;
+  // The probe (--probe SCENE RES SOLVER SUBSTEPS ITERATIONS).
+  std::tuple<std::string, int, std::string, int, int> probe{"", 0, "", 0, 0};
+  std::optional<int> frames;       // the scene's duration
+  std::optional<double> friction;  // the scene's objects'
+  bool ref = true, polish = true, drift = false;
+  std::string load, save, save_polished;
+  std::vector<int> polish_steps;
+  int smooth = 0;
+  int coarse_only = 0;
+  double coarse_k = 1e4;
+  std::optional<int> coarse_factor;  // --coarse-only 4, --finish 0
+  std::optional<bool> coarse_rot;    // --coarse-only off, --finish on
+  bool coarse_mu = true;
+  int mg_aa = 0, mg_sweeps = 0, mg_refresh = 1;
+  double mg_tau = 0.05;
+  bool mg_nocoarse = false;
+  int finish = 0;
+  int finish_sweeps = FinisherOptions{}.sweeps;
+  double finish_extra = FinisherOptions{}.extrapolate;
+  // The probe's VBD solver.
+  int vbd_init = 2;
+  double vbd_rho = 0, vbd_damp = 0;
+  std::optional<double> vbd_air;  // the scene's air damping (1 where it has none)
+  bool vbd_freeze = false;
+  double vbd_tol = 1e-6, vbd_ftol = 1e-2;
+  int vbd_threads = 2;
+  // The probe's XPBD solver (unset optionals: the solver's own value).
+  std::optional<double> xpbd_warm, xpbd_settle_damp, xpbd_snap, xpbd_settle_speed,
+      xpbd_settle_growth;
+  std::optional<int> xpbd_sleep_steps, xpbd_coarse, xpbd_coarse_frames, xpbd_finish_cycles;
+  std::optional<std::string> xpbd_kernels;
+  bool xpbd_reuse = true, xpbd_retest = true, xpbd_settle = true, xpbd_freeze = false;
+  bool xpbd_coarse_rot = false, xpbd_finish = true, xpbd_finish_thread = true, xpbd_f32 = true;
+  int xpbd_bend_every = 1;
+  double xpbd_settle_scale = 64;
+  int xpbd_warm_frame = -1;
+  double xpbd_warm_late = 1.0;
+};
 
-// Probe state files (PROBE_SAVE / PROBE_LOAD): a header (magic, vertex count) then x and v as
+// Probe state files (--save / --load): a header (magic, vertex count) then x and v as
 // doubles, in the machine's byte order (scratch files of one build, not an exchange format).
 constexpr std::uint32_t kStateMagic = 0x44525354;  // "DRST"
 
-bool save_state(const char* path, const Cloth& cloth) {
-  std::FILE* f = std::fopen(path, "wb");
+bool save_state(const std::string& path, const Cloth& cloth) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) {
-    std::fprintf(stderr, "PROBE_SAVE: cannot write %s\n", path);
+    std::fprintf(stderr, "save: cannot write %s\n", path.c_str());
     return false;
   }
   const std::uint32_t head[2] = {kStateMagic, static_cast<std::uint32_t>(cloth.num_vertices())};
@@ -77,14 +165,14 @@ bool save_state(const char* path, const Cloth& cloth) {
   for (const auto* vec : {&cloth.state.x, &cloth.state.v})
     ok = ok && std::fwrite(vec->data(), sizeof(Vec3), vec->size(), f) == vec->size();
   ok = std::fclose(f) == 0 && ok;
-  if (!ok) std::fprintf(stderr, "PROBE_SAVE: writing %s failed\n", path);
+  if (!ok) std::fprintf(stderr, "save: writing %s failed\n", path.c_str());
   return ok;
 }
 
-bool load_state(const char* path, Cloth& cloth) {
-  std::FILE* f = std::fopen(path, "rb");
+bool load_state(const std::string& path, Cloth& cloth) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) {
-    std::fprintf(stderr, "PROBE_LOAD: cannot open %s\n", path);
+    std::fprintf(stderr, "--load: cannot open %s\n", path.c_str());
     return false;
   }
   std::uint32_t head[2] = {0, 0};
@@ -96,8 +184,8 @@ bool load_state(const char* path, Cloth& cloth) {
     ok = ok && std::fread(vec->data(), sizeof(Vec3), vec->size(), f) == vec->size();
   std::fclose(f);
   if (!ok) {
-    std::fprintf(stderr, "PROBE_LOAD: %s is not a state of this scene (%u vertices; expected %d)\n",
-                 path, head[1], cloth.num_vertices());
+    std::fprintf(stderr, "--load: %s is not a state of this scene (%u vertices; expected %d)\n",
+                 path.c_str(), head[1], cloth.num_vertices());
     return false;
   }
   cloth.state.x = x;
@@ -117,34 +205,33 @@ bool path_dependent(const std::string& scene) {
   return scene == "form" || scene == "sphere";
 }
 
-std::vector<Vec3> polished(const Testbed& end, double& residual, int max_iterations = 0,
-                           StaticResult* result = nullptr) {
+std::vector<Vec3> polished(const Knobs& kn, const Testbed& end, double& residual,
+                           int max_iterations = 0, StaticResult* result = nullptr) {
   Testbed sc = end;
   StaticOptions so;
   so.tolerance = 1e-8;
-  // The frictional equilibrium nearest to it (the scene's objects' mu); PROBE_POLISH_FRICTION=0:
+  // The frictional equilibrium nearest to it (the scene's objects' mu); --no-polish-friction:
   // the frictionless one (a probe study).
-  so.friction = env_num("PROBE_POLISH_FRICTION", 1) > 0;
-  so.reuse_factorisation = env_num("POLISH_REUSE", 1) > 0;
-  so.reuse_max_cg = static_cast<int>(env_num("POLISH_CG_MAX", so.reuse_max_cg));
-  so.reuse_cg_tolerance = env_num("POLISH_CG_TOL", so.reuse_cg_tolerance);
+  so.friction = kn.polish_friction;
+  so.reuse_factorisation = kn.polish_reuse;
+  so.reuse_max_cg = kn.polish_cg_max;
+  so.reuse_cg_tolerance = kn.polish_cg_tol;
   // 300: a less-settled 64^2 state needed 282 iterations (docs/solvers.md "Static solver speed").
-  so.max_iterations =
-      max_iterations > 0 ? max_iterations : static_cast<int>(env_num("REF_ITERS", 300));
+  so.max_iterations = max_iterations > 0 ? max_iterations : kn.ref_iters.value_or(300);
   StaticResult r = relax_static(sc.cloth, sc.objects, so);
   residual = r.residual;
   if (result) *result = r;
   return sc.cloth.state.x;
 }
 
-Row run(const std::string& scene, int res, const Config& c, const std::vector<Vec3>& ref,
-        bool measure_error = true) {
+Row run(const Knobs& kn, const std::string& scene, int res, const Config& c,
+        const std::vector<Vec3>& ref, bool measure_error = true) {
   Testbed sc = make_scene(scene, res);
   SolverConfig cfg;
   cfg.substeps = c.substeps;
   cfg.iterations = c.iterations;
   cfg.springs_model = sc.springs_model;
-  cfg.threads = static_cast<int>(env_num("SOLVERS_THREADS", 1));
+  cfg.threads = kn.threads.value_or(1);
   cfg.air_damping = sc.air_damping;
   // "xpbd-nosettle": XPBD without settling pieces at rest (XpbdOptions::settle, on in "xpbd").
   cfg.settle = c.solver != "xpbd-nosettle";
@@ -166,7 +253,7 @@ Row run(const std::string& scene, int res, const Config& c, const std::vector<Ve
     rms = mx = std::numeric_limits<double>::quiet_NaN();
   } else if (path_dependent(scene) && stable) {
     double res_polish = 0;
-    position_error(sc.cloth.state.x, polished(sc, res_polish), rms, mx);
+    position_error(sc.cloth.state.x, polished(kn, sc, res_polish), rms, mx);
     if (!(res_polish < 1e-2))
       std::printf("  (static polish of the end state stopped at residual %.1e)\n", res_polish);
   } else {
@@ -176,7 +263,7 @@ Row run(const std::string& scene, int res, const Config& c, const std::vector<Ve
           rms * 1e3, mx * 1e3, stable};
 }
 
-std::vector<Vec3> reference(const std::string& scene, int res) {
+std::vector<Vec3> reference(const Knobs& kn, const std::string& scene, int res) {
   Testbed sc = make_scene(scene, res);
   StaticOptions so;
   so.tolerance = 1e-8;
@@ -192,9 +279,8 @@ std::vector<Vec3> reference(const std::string& scene, int res) {
     o.tolerance = 1e-9;
     o.force_tolerance = 1e-4;
     VbdSolver v(o);
-    const int frames = static_cast<int>(env_num("REF_SETTLE_FRAMES", 360));
-    for (int f = 0; f < frames; ++f) v.step(sc.cloth, sc.objects, 1.0 / 90);
-    so.max_iterations = static_cast<int>(env_num("REF_ITERS", 150));
+    for (int f = 0; f < kn.ref_settle_frames; ++f) v.step(sc.cloth, sc.objects, 1.0 / 90);
+    so.max_iterations = kn.ref_iters.value_or(150);
   }
   const std::vector<Vec3> settled = sc.cloth.state.x;
   StaticResult r = relax_static(sc.cloth, sc.objects, so);
@@ -289,23 +375,21 @@ int land_finish(Solver& s, Testbed& sc, double& ms) {
   return frames;
 }
 
-// --probe SCENE RES SOLVER SUBSTEPS ITERATIONS: one configuration with every VBD option from
-// the environment (VBD_INIT 0/1/2, VBD_RHO, VBD_DAMP, VBD_FREEZE, VBD_TOL, VBD_THREADS,
-// PROBE_FRAMES, REF_ITERS, PROBE_POLISH=0 skips the final scoring, PROBE_FRICTION the objects'
-// friction coefficient; XPBD: XPBD_WARM,
-// XPBD_REUSE 0/1, XPBD_BEND_EVERY, XPBD_WARM_FRAME + XPBD_WARM_LATE: warm start from a frame on),
-// printing wall and CPU time per frame and the error per 0.1 s.
-int probe(int argc, char** argv) {
-  if (argc < 7) {
-    std::fprintf(stderr, "usage: solvers_bench --probe SCENE RES SOLVER SUBSTEPS ITERATIONS\n");
+// --probe SCENE RES SOLVER SUBSTEPS ITERATIONS: one configuration with the options of the
+// "probe" groups of --help (the VBD and XPBD solvers' options, --frames, --ref-iters, --no-polish
+// skips the final scoring, --friction the objects' friction coefficient, --xpbd-warm-frame +
+// --xpbd-warm-late: warm start from a frame on), printing wall and CPU time per frame and the
+// error per 0.1 s.
+int probe(const Knobs& kn) {
+  const auto& [scene, res, solver, ns, it] = kn.probe;
+  if (res < 2 || ns < 0 || it < 0) {
+    std::fprintf(stderr, "--probe: RES must be >= 2, SUBSTEPS and ITERATIONS >= 0\n");
     return 2;
   }
-  const std::string scene = argv[2], solver = argv[4];
-  const int res = std::atoi(argv[3]), ns = std::atoi(argv[5]), it = std::atoi(argv[6]);
   // Path-dependent scenes are scored against the equilibrium nearest to the end state (at the
-  // end); PROBE_REF=0 skips the static reference the progress lines compare with.
+  // end); --no-ref skips the static reference the progress lines compare with.
   const std::vector<Vec3> refx =
-      env_num("PROBE_REF", 1) > 0 ? reference(scene, res) : make_scene(scene, res).cloth.state.x;
+      kn.ref ? reference(kn, scene, res) : make_scene(scene, res).cloth.state.x;
   {
     Vec3 lo = refx[0], hi = lo;
     for (const auto& p : refx) {
@@ -322,15 +406,15 @@ int probe(int argc, char** argv) {
     VbdOptions o;
     o.substeps = ns;
     o.iterations = it;
-    o.init = static_cast<VbdOptions::Init>(static_cast<int>(env_num("VBD_INIT", 2)));
-    o.chebyshev_rho = env_num("VBD_RHO", 0);
+    o.init = static_cast<VbdOptions::Init>(kn.vbd_init);
+    o.chebyshev_rho = kn.vbd_rho;
     o.chebyshev = o.chebyshev_rho > 0;
-    o.damping = env_num("VBD_DAMP", 0);
-    o.air_damping = env_num("VBD_AIR", sc.air_damping >= 0 ? sc.air_damping : 1.0);
-    o.freeze = env_num("VBD_FREEZE", 0) > 0;
-    o.tolerance = env_num("VBD_TOL", 1e-6);
-    o.force_tolerance = env_num("VBD_FTOL", 1e-2);
-    o.threads = static_cast<int>(env_num("VBD_THREADS", 2));
+    o.damping = kn.vbd_damp;
+    o.air_damping = kn.vbd_air.value_or(sc.air_damping >= 0 ? sc.air_damping : 1.0);
+    o.freeze = kn.vbd_freeze;
+    o.tolerance = kn.vbd_tol;
+    o.force_tolerance = kn.vbd_ftol;
+    o.threads = kn.vbd_threads;
     auto v = std::make_unique<VbdSolver>(o);
     vbd = v.get();
     s = std::move(v);
@@ -339,54 +423,52 @@ int probe(int argc, char** argv) {
     cfg.substeps = ns;
     cfg.iterations = it;
     cfg.springs_model = sc.springs_model;
-    cfg.threads = static_cast<int>(env_num("SOLVERS_THREADS", 2));
+    cfg.threads = kn.threads.value_or(2);
     cfg.air_damping = sc.air_damping;
     auto made = make_solver(solver, cfg);
+    if (!made) {
+      std::fprintf(stderr, "--probe: %s\n", made.error().c_str());
+      return 2;
+    }
     s = std::move(made.value());
-    if (auto* xp = xpbd_of(s.get())) {  // XPBD_WARM, XPBD_REUSE
-      xp->options().warm_start = env_num("XPBD_WARM", xp->options().warm_start);
-      xp->options().reuse_contacts = env_num("XPBD_REUSE", 1) > 0;
-      xp->options().bending_every = static_cast<int>(env_num("XPBD_BEND_EVERY", 1));
-      xp->options().retest_contacts = env_num("XPBD_RETEST", 1) > 0;
-      xp->options().settle = env_num("XPBD_SETTLE", 1) > 0;
-      xp->options().freeze = env_num("XPBD_FREEZE", 0) > 0;
-      xp->options().settle_mass_scale = env_num("XPBD_SETTLE_SCALE", 64);
-      xp->options().settle_damping = env_num("XPBD_SETTLE_DAMP", xp->options().settle_damping);
-      xp->options().contact_snap_depth = env_num("XPBD_SNAP", xp->options().contact_snap_depth);
-      xp->options().settle_sleep_steps =
-          static_cast<int>(env_num("XPBD_SLEEP_STEPS", xp->options().settle_sleep_steps));
-      xp->options().settle_speed = env_num("XPBD_SETTLE_SPEED", xp->options().settle_speed);
-      xp->options().settle_growth = env_num("XPBD_SETTLE_GROWTH", xp->options().settle_growth);
-      xp->options().coarse_factor =
-          static_cast<int>(env_num("XPBD_COARSE", xp->options().coarse_factor));
-      xp->options().coarse_frames =
-          static_cast<int>(env_num("XPBD_COARSE_FRAMES", xp->options().coarse_frames));
-      xp->options().coarse.rotations = env_num("XPBD_COARSE_ROT", 0) > 0;
-      xp->options().finish = env_num("XPBD_FINISH", 1) > 0;
-      xp->options().finisher.cycles =
-          static_cast<int>(env_num("XPBD_FINISH_CYCLES", xp->options().finisher.cycles));
-      xp->options().finish_thread = env_num("XPBD_FINISH_THREAD", 1) > 0;
-      xp->options().single_precision = env_num("XPBD_F32", 1) > 0;
-      if (const char* k = std::getenv("XPBD_KERNELS")) xp->options().kernels = k;
+    if (auto* xp = xpbd_of(s.get())) {
+      XpbdOptions& o = xp->options();
+      o.warm_start = kn.xpbd_warm.value_or(o.warm_start);
+      o.reuse_contacts = kn.xpbd_reuse;
+      o.bending_every = kn.xpbd_bend_every;
+      o.retest_contacts = kn.xpbd_retest;
+      o.settle = kn.xpbd_settle;
+      o.freeze = kn.xpbd_freeze;
+      o.settle_mass_scale = kn.xpbd_settle_scale;
+      o.settle_damping = kn.xpbd_settle_damp.value_or(o.settle_damping);
+      o.contact_snap_depth = kn.xpbd_snap.value_or(o.contact_snap_depth);
+      o.settle_sleep_steps = kn.xpbd_sleep_steps.value_or(o.settle_sleep_steps);
+      o.settle_speed = kn.xpbd_settle_speed.value_or(o.settle_speed);
+      o.settle_growth = kn.xpbd_settle_growth.value_or(o.settle_growth);
+      o.coarse_factor = kn.xpbd_coarse.value_or(o.coarse_factor);
+      o.coarse_frames = kn.xpbd_coarse_frames.value_or(o.coarse_frames);
+      o.coarse.rotations = kn.xpbd_coarse_rot;
+      o.finish = kn.xpbd_finish;
+      o.finisher.cycles = kn.xpbd_finish_cycles.value_or(o.finisher.cycles);
+      o.finish_thread = kn.xpbd_finish_thread;
+      o.single_precision = kn.xpbd_f32;
+      o.kernels = kn.xpbd_kernels.value_or(o.kernels);
     }
   }
-  sc.objects.friction = env_num("PROBE_FRICTION", sc.objects.friction);
+  sc.objects.friction = kn.friction.value_or(sc.objects.friction);
   const double frame = 1.0 / 90;
-  const int frames = static_cast<int>(env_num("PROBE_FRAMES", std::lround(sc.duration / frame)));
+  const int frames = kn.frames.value_or(static_cast<int>(std::lround(sc.duration / frame)));
   double wall = 0, cpu = 0, max_wall = 0, first_wall = 0;
   int max_frame = -1;
   long iters = 0;
-  const int warm_frame = static_cast<int>(env_num("XPBD_WARM_FRAME", -1));
-  // PROBE_LOAD=file: start from a state PROBE_SAVE=file wrote (positions and velocities of the
-  // same scene and resolution), e.g. to study the polish of one end state without re-running
-  // the drape (PROBE_FRAMES=0).
-  if (const char* path = std::getenv("PROBE_LOAD")) {
-    if (!load_state(path, sc.cloth)) return 1;
-  }
+  // --load FILE: start from a state --save FILE wrote (positions and velocities of the same
+  // scene and resolution), e.g. to study the polish of one end state without re-running the
+  // drape (--frames 0).
+  if (!kn.load.empty() && !load_state(kn.load, sc.cloth)) return 1;
   const std::vector<Vec3> start_x = sc.cloth.state.x;
   for (int f = 0; f < frames; ++f) {
-    if (f == warm_frame) {
-      if (auto* xp = xpbd_of(s.get())) xp->options().warm_start = env_num("XPBD_WARM_LATE", 1.0);
+    if (f == kn.xpbd_warm_frame) {
+      if (auto* xp = xpbd_of(s.get())) xp->options().warm_start = kn.xpbd_warm_late;
     }
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = cpu_ms();
@@ -418,7 +500,7 @@ int probe(int argc, char** argv) {
           ke, sd * 1e3, lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
     }
   }
-  if (env_num("PROBE_DRIFT", 0) > 0) {
+  if (kn.drift) {
     double rms = 0, mx = 0;
     position_error(sc.cloth.state.x, start_x, rms, mx);
     std::printf("drift from the start state: rms %.3f mm, max %.3f mm\n", rms * 1e3, mx * 1e3);
@@ -433,9 +515,7 @@ int probe(int argc, char** argv) {
   double land_ms = 0;
   if (const int extra = land_finish(*s, sc, land_ms); extra > 0)
     std::printf("finish thread: landed %d frames (%.0f ms) after the last frame\n", extra, land_ms);
-  if (const char* path = std::getenv("PROBE_SAVE")) {
-    if (!save_state(path, sc.cloth)) return 1;
-  }
+  if (!kn.save.empty() && !save_state(kn.save, sc.cloth)) return 1;
   {
     // The fastest vertices at the end (a drape at rest should have none): speed, height, distance
     // from the form's surface.
@@ -484,27 +564,27 @@ int probe(int argc, char** argv) {
           f.last_move * 1e3, f.sweep_ms, f.coarse_ms);
     }
   }
-  // PROBE_COARSE_ONLY=k: k coarse corrections (sim/rest/coarse_correction.hpp, lattice
-  // PROBE_COARSE_FACTOR) of the end state alone, contacts re-detected before each (a study of
+  // --coarse-only k: k coarse corrections (sim/rest/coarse_correction.hpp, lattice
+  // --coarse-factor) of the end state alone, contacts re-detected before each (a study of
   // the correction without the solver's sweeps).
   CoarseCorrection probe_cc;
   bool probe_cc_used = false;
-  if (const int kc = static_cast<int>(env_num("PROBE_COARSE_ONLY", 0)); kc > 0) {
+  if (const int kc = kn.coarse_only; kc > 0) {
     probe_cc_used = true;
     ClothEnergy e;
     EnergyOptions eo;
     e.build(sc.cloth, eo);
     e.set_form(&sc.objects);
-    e.set_contact_stiffness(env_num("PROBE_COARSE_K", 1e4));
+    e.set_contact_stiffness(kn.coarse_k);
     CoarseCorrection& cc = probe_cc;
-    cc.options().factor = static_cast<int>(env_num("PROBE_COARSE_FACTOR", 4));
-    cc.options().rotations = env_num("PROBE_COARSE_ROT", 0) > 0;
+    cc.options().factor = kn.coarse_factor.value_or(4);
+    cc.options().rotations = kn.coarse_rot.value_or(false);
     std::vector<int> group(sc.cloth.num_vertices());
     for (int i = 0; i < sc.cloth.num_vertices(); ++i) group[i] = sc.cloth.is_free(i) ? 0 : -1;
     const std::vector<Vec3> anchor = sc.cloth.state.x;  // friction's, as the polish's
-    // PROBE_MG_AA=m: Anderson acceleration (Peng et al. 2018) of the cycle x -> G(x) over the
+    // --mg-aa m: Anderson acceleration (Peng et al. 2018) of the cycle x -> G(x) over the
     // last m cycles, kept only when it lowers E below G(x)'s (else the history restarts).
-    const int aa_m = static_cast<int>(env_num("PROBE_MG_AA", 0));
+    const int aa_m = kn.mg_aa;
     const int nx = 3 * sc.cloth.num_vertices();
     std::vector<Eigen::VectorXd> dF, dG;
     Eigen::VectorXd f_prev, g_prev;
@@ -512,18 +592,18 @@ int probe(int argc, char** argv) {
     auto flat = [&](const std::vector<Vec3>& v) {
       return Eigen::Map<const Eigen::VectorXd>(v[0].data(), nx);
     };
-    for (int k = 0; k < kc; ++k) {
+    for (int cycle = 0; cycle < kc; ++cycle) {
       const Eigen::VectorXd xin = flat(sc.cloth.state.x);
       e.detect_contacts(sc.cloth, sc.objects);
-      if (sc.objects.friction > 0 && env_num("PROBE_COARSE_MU", 1) > 0) {
+      if (sc.objects.friction > 0 && kn.coarse_mu) {
         e.set_friction(sc.objects.friction, 1e-4, anchor);
         e.lag_friction_load(sc.cloth.state.x, sc.cloth.state.mass);
       }
-      // PROBE_MG_SWEEPS=v: v Gauss-Seidel sweeps of per-vertex Newton steps on the static
+      // --mg-sweeps v: v Gauss-Seidel sweeps of per-vertex Newton steps on the static
       // energy before each correction (a two-level cycle's smoother; the equilibrium is its
       // fixed point).
-      const int sweeps = static_cast<int>(env_num("PROBE_MG_SWEEPS", 0));
-      const double tau2 = std::pow(env_num("PROBE_MG_TAU", 0.05), 2);
+      const int sweeps = kn.mg_sweeps;
+      const double tau2 = std::pow(kn.mg_tau, 2);
       const double e0 = e.energy(sc.cloth.state.x, sc.cloth.state.mass);
       const double cs0 = cpu_ms();
       for (int sw = 0; sw < sweeps; ++sw)
@@ -539,12 +619,10 @@ int probe(int argc, char** argv) {
       if (sweeps > 0)
         std::printf("  %d sweeps: E %.9f -> %.9f J, %.1f ms CPU\n", sweeps, e0,
                     e.energy(sc.cloth.state.x, sc.cloth.state.mass), cpu_ms() - cs0);
-      // PROBE_MG_NOCOARSE=1: the sweeps alone (the cycle without its coarse step).
-      const CoarseStats c =
-          env_num("PROBE_MG_NOCOARSE", 0) > 0
-              ? CoarseStats{}
-              : cc.apply(sc.cloth, e, group, sc.cloth.state.x,
-                         k % static_cast<int>(env_num("PROBE_MG_REFRESH", 1)) != 0);
+      // --mg-nocoarse: the sweeps alone (the cycle without its coarse step).
+      const CoarseStats c = kn.mg_nocoarse ? CoarseStats{}
+                                           : cc.apply(sc.cloth, e, group, sc.cloth.state.x,
+                                                      cycle % kn.mg_refresh != 0);
       if (aa_m > 0) {
         const Eigen::VectorXd g = flat(sc.cloth.state.x);
         const Eigen::VectorXd fk = g - xin;
@@ -589,24 +667,24 @@ int probe(int argc, char** argv) {
       std::printf(
           "coarse %d: applied %d alpha %.3g moved %.4f mm residual %.3e N  E %.9f -> %.9f J  "
           "%.1f ms (assemble %.1f, factor %.1f), %d nodes\n",
-          k, c.applied ? 1 : 0, c.alpha, c.max_move * 1e3, c.residual, c.energy_before,
+          cycle, c.applied ? 1 : 0, c.alpha, c.max_move * 1e3, c.residual, c.energy_before,
           c.energy_after, c.total_ms, c.assemble_ms, c.factor_ms, c.nodes);
     }
     sc.cloth.state.x_prev = sc.cloth.state.x;
     if (aa_m > 0) std::printf("anderson steps taken: %d of %d\n", aa_taken, kc);
   }
-  // PROBE_FINISH=k: the static finish (sim/rest/equilibrium_finisher.hpp) of the end state, at most
-  // k cycles (PROBE_FINISH_SWEEPS, PROBE_COARSE_FACTOR, PROBE_COARSE_ROT=0 for translations).
-  if (const int kf = static_cast<int>(env_num("PROBE_FINISH", 0)); kf > 0) {
+  // --finish k: the static finish (sim/rest/equilibrium_finisher.hpp) of the end state, at most
+  // k cycles (--finish-sweeps, --coarse-factor, --no-coarse-rot for translations).
+  if (const int kf = kn.finish; kf > 0) {
     EquilibriumFinisher fin;
     fin.options().cycles = kf;
-    fin.options().sweeps = static_cast<int>(env_num("PROBE_FINISH_SWEEPS", fin.options().sweeps));
-    fin.options().coarse_factor = static_cast<int>(env_num("PROBE_COARSE_FACTOR", 0));
-    fin.options().rotations = env_num("PROBE_COARSE_ROT", 1) > 0;
-    fin.options().extrapolate = env_num("PROBE_FINISH_EXTRA", fin.options().extrapolate);
+    fin.options().sweeps = kn.finish_sweeps;
+    fin.options().coarse_factor = kn.coarse_factor.value_or(0);
+    fin.options().rotations = kn.coarse_rot.value_or(true);
+    fin.options().extrapolate = kn.finish_extra;
     std::vector<int> group(sc.cloth.num_vertices());
     for (int i = 0; i < sc.cloth.num_vertices(); ++i) group[i] = sc.cloth.is_free(i) ? 0 : -1;
-    ThreadPool pool(static_cast<int>(env_num("SOLVERS_THREADS", 1)));
+    ThreadPool pool(kn.threads.value_or(1));
     const FinisherStats fs = fin.run(sc.cloth, sc.objects, group, EnergyOptions{}, &pool);
     std::printf(
         "finish: %d cycles, E %.9f -> %.9f J, moved %.3f mm (last cycle %.4f mm), sweeps %.0f ms, "
@@ -614,18 +692,18 @@ int probe(int argc, char** argv) {
         fs.cycles, fs.energy_before, fs.energy_after, fs.max_move * 1e3, fs.last_move * 1e3,
         fs.sweep_ms, fs.coarse_ms, fs.total_ms);
   }
-  if (path_dependent(scene) && env_num("PROBE_POLISH", 1) > 0) {
+  if (path_dependent(scene) && kn.polish) {
     double res_polish = 0, rms = 0, mx = 0;
     StaticResult pr;
-    const std::vector<Vec3> pol = polished(sc, res_polish, 0, &pr);
-    // PROBE_SAVE_POLISHED=file: the equilibrium itself (velocities zero), e.g. to start a solver
-    // at it and see where the solver's own fixed point lies (PROBE_DRIFT).
-    if (const char* path = std::getenv("PROBE_SAVE_POLISHED")) {
+    const std::vector<Vec3> pol = polished(kn, sc, res_polish, 0, &pr);
+    // --save-polished FILE: the equilibrium itself (velocities zero), e.g. to start a solver at it
+    // and see where the solver's own fixed point lies (--drift).
+    if (!kn.save_polished.empty()) {
       Cloth eq = sc.cloth;
       eq.state.x = pol;
       eq.state.x_prev = pol;
       std::fill(eq.state.v.begin(), eq.state.v.end(), Vec3::Zero());
-      if (!save_state(path, eq)) return 1;
+      if (!save_state(kn.save_polished, eq)) return 1;
     }
     position_error(sc.cloth.state.x, pol, rms, mx);
     std::printf(
@@ -638,30 +716,23 @@ int probe(int argc, char** argv) {
         "error against the equilibrium nearest to the end state: rms %.3f mm, max %.3f mm "
         "(static polish residual %.1e, energy there %.9f J)\n",
         rms * 1e3, mx * 1e3, res_polish, pr.energy);
-    // PROBE_POLISH_STEPS=1,2,4: how close a static solve of k Newton iterations from the end
-    // state gets to that equilibrium, and what it costs (a polish of a piece falling asleep).
-    if (const char* steps = std::getenv("PROBE_POLISH_STEPS")) {
-      for (const char* q = steps; *q;) {
-        const int k = std::atoi(q);
-        if (k > 0) {
-          double rk = 0, e_rms = 0, e_max = 0;
-          const double c0 = cpu_ms();
-          const std::vector<Vec3> xk = polished(sc, rk, k);
-          const double ms = cpu_ms() - c0;
-          position_error(xk, pol, e_rms, e_max);
-          std::printf(
-              "  polish of %d Newton iterations: %.0f ms CPU, residual %.1e, rms %.3f mm, "
-              "max %.3f mm from the equilibrium\n",
-              k, ms, rk, e_rms * 1e3, e_max * 1e3);
-        }
-        while (*q && *q != ',') ++q;
-        if (*q == ',') ++q;
-      }
+    // --polish-steps 1,2,4: how close a static solve of n Newton iterations from the end state
+    // gets to that equilibrium, and what it costs (a polish of a piece falling asleep).
+    for (const int n : kn.polish_steps) {
+      double rk = 0, e_rms = 0, e_max = 0;
+      const double c0 = cpu_ms();
+      const std::vector<Vec3> xk = polished(kn, sc, rk, n);
+      const double ms = cpu_ms() - c0;
+      position_error(xk, pol, e_rms, e_max);
+      std::printf(
+          "  polish of %d Newton iterations: %.0f ms CPU, residual %.1e, rms %.3f mm, "
+          "max %.3f mm from the equilibrium\n",
+          n, ms, rk, e_rms * 1e3, e_max * 1e3);
     }
-    // PROBE_SMOOTH=k: how smooth the error field is: k Jacobi passes of neighbour averaging
-    // (over the triangles' edges) keep its long wavelengths; printed: rms of the smoothed field
-    // and of what the smoothing removed.
-    if (const int ks = static_cast<int>(env_num("PROBE_SMOOTH", 0)); ks > 0) {
+    // --smooth k: how smooth the error field is: k Jacobi passes of neighbour averaging (over
+    // the triangles' edges) keep its long wavelengths; printed: rms of the smoothed field and of
+    // what the smoothing removed.
+    if (const int ks = kn.smooth; ks > 0) {
       const int nv = sc.cloth.num_vertices();
       std::vector<Vec3> e(nv), acc(nv);
       std::vector<int> cnt(nv);
@@ -737,7 +808,7 @@ int probe(int argc, char** argv) {
 // vertices asleep at the end and when the whole panel first slept. With freezing, the static
 // finish of the sleeping drape runs on its own thread (the app's default): its CPU time is not in
 // the rows' (this thread's) and is reported beside them, with how long after 8 s it landed.
-void sleep_rows(int sres) {
+void sleep_rows(const Knobs& kn, int sres) {
   std::ofstream sl("out/bench/solvers_sleep.csv");
   sl << "scene,solver,resolution,freeze,ms_per_frame_drape,ms_per_frame_settling,"
         "ms_per_frame_rest,ms_per_frame_mean,frozen_fraction,all_asleep_s,rms_error_mm,"
@@ -779,9 +850,7 @@ void sleep_rows(int sres) {
     double rms = std::numeric_limits<double>::quiet_NaN(), mx = rms;
     if (fr == 1) {
       double res_polish = 0;
-      position_error(sc.cloth.state.x,
-                     polished(sc, res_polish, static_cast<int>(env_num("SLEEP_REF_ITERS", 100))),
-                     rms, mx);
+      position_error(sc.cloth.state.x, polished(kn, sc, res_polish, kn.sleep_ref_iters), rms, mx);
       rms *= 1e3;
       mx *= 1e3;
       std::printf(
@@ -888,24 +957,221 @@ void thread_rows(int max_res) {
   }
 }
 
+// A flag --name with its negation --no-name (--name=0 works too).
+CLI::Option* switch_flag(CLI::App& app, const std::string& name, bool& value,
+                         const std::string& help) {
+  return app.add_flag("--" + name + ",!--no-" + name, value,
+                      help + (value ? " (default: on)" : " (default: off)"));
+}
+
+// Every knob of the study and the probe as a flag; the environment variables they replace are
+// in the table at the top of this file.
+void add_knobs(CLI::App& app, Knobs& kn, std::string& simd) {
+  const auto count = CLI::Range(0, 1000000);
+  const auto positive = CLI::Range(1, 1000000);
+  const auto non_negative = CLI::Range(0.0, 1e9);
+  app.option_defaults()->always_capture_default();
+  // The study.
+  app.option_defaults()->group("Study");
+  app.add_flag("--quick", kn.quick,
+               "the quick grid (./drape bench solvers' default; a few minutes)");
+  app.add_option("--max-res", kn.max_res,
+                 "the full grid's largest form resolution (64: 64^2 scored; 128: and 128^2 timed, "
+                 "the thread rows; 256: and 256^2 timed)")
+      ->check(CLI::Range(16, 4096));
+  app.add_flag("--sleep-only", kn.sleep_only,
+               "only the sleeping rows (out/bench/solvers_sleep.csv)");
+  app.add_flag("--threads-only", kn.threads_only,
+               "only the thread and precision rows (out/bench/solvers_threads.csv)");
+  app.add_option("--simd", simd,
+                 "the widest SIMD build XPBD's kernels may use: none (portable), avx2, widest "
+                 "(the CPU's widest: avx512 where it has it)")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            return xpbd::parse_simd_limit(v) ? std::string() : "expected none, avx2 or widest";
+          },
+          "none|avx2|widest"));
+  app.add_option("--threads", kn.threads,
+                 "solver threads (default: 1 in the study's grid, 2 in --probe, 1 in the pool of "
+                 "--finish)")
+      ->check(CLI::Range(1, 256));
+  app.add_option("--ref-iters", kn.ref_iters,
+                 "at most so many Newton iterations in the static polish (default 300) and in "
+                 "the contact scenes' static reference after settling (default 150)")
+      ->check(positive);
+  app.add_option("--ref-settle-frames", kn.ref_settle_frames,
+                 "frames VBD settles a contact scene before its static reference")
+      ->check(count);
+  app.add_option("--sleep-ref-iters", kn.sleep_ref_iters,
+                 "Newton iterations of the polish that scores the sleep rows' settled drape")
+      ->check(positive);
+  switch_flag(app, "polish-friction", kn.polish_friction,
+              "the static polish finds the frictional equilibrium (the objects' mu); "
+              "--no-polish-friction: the frictionless one");
+  switch_flag(app, "polish-reuse", kn.polish_reuse,
+              "the static polish reuses a stale factorisation (CG on it)");
+  app.add_option("--polish-cg-max", kn.polish_cg_max,
+                 "CG iterations per system on a stale factorisation in the static polish")
+      ->check(count);
+  app.add_option("--polish-cg-tol", kn.polish_cg_tol,
+                 "relative residual of CG on a stale factorisation in the static polish")
+      ->check(non_negative);
+  // The probe.
+  app.option_defaults()->group("Probe");
+  app.add_option("--probe", kn.probe,
+                 "run one configuration: SCENE (chain, sheet, form, sphere, cantilever), RES "
+                 "(cloth resolution), SOLVER (vbd, xpbd, newton, verlet, default), SUBSTEPS, "
+                 "ITERATIONS; prints wall and CPU time per frame and the error every 0.1 s")
+      ->type_name("SCENE RES SOLVER SUBSTEPS ITERATIONS")
+      ->default_str("");
+  app.add_option("--frames", kn.frames, "frames to step (default: the scene's duration)")
+      ->check(count);
+  switch_flag(app, "ref", kn.ref,
+              "compare the progress lines with the scene's static reference; --no-ref: with "
+              "the start state (skips computing the reference)");
+  switch_flag(app, "polish", kn.polish,
+              "score the end state of a form or sphere drape against the equilibrium nearest "
+              "to it (static polish); --no-polish skips it");
+  app.add_option("--friction", kn.friction,
+                 "the objects' friction coefficient (default: the scene's)")
+      ->check(non_negative);
+  app.add_option("--load", kn.load,
+                 "start from a state --save wrote (same scene and resolution); with --frames 0: "
+                 "only score it")
+      ->check(CLI::ExistingFile);
+  app.add_option("--save", kn.save, "write the end state (positions, velocities) to this file");
+  app.add_option("--save-polished", kn.save_polished,
+                 "write the equilibrium nearest to the end state (velocities zero) to this file");
+  app.add_flag("--drift", kn.drift, "print how far the end state is from the start state");
+  app.add_option("--polish-steps", kn.polish_steps,
+                 "comma-separated Newton iteration counts: how close a polish of so many "
+                 "iterations gets to the equilibrium, and its cost")
+      ->delimiter(',')
+      ->check(positive)
+      ->default_str("");
+  app.add_option("--smooth", kn.smooth,
+                 "passes of neighbour averaging of the error field (its smooth part and the rest "
+                 "are printed)")
+      ->check(count);
+  app.add_option("--coarse-only", kn.coarse_only,
+                 "coarse corrections of the end state alone, contacts detected before each")
+      ->check(count);
+  app.add_option("--coarse-k", kn.coarse_k, "contact stiffness (N/m) of --coarse-only's energy")
+      ->check(non_negative);
+  app.add_option("--coarse-factor", kn.coarse_factor,
+                 "fine edges per coarse lattice cell in --coarse-only (default 4) and --finish "
+                 "(default 0)")
+      ->check(count);
+  app.add_flag_function(
+      "--coarse-rot,!--no-coarse-rot", [&kn](std::int64_t n) { kn.coarse_rot = n > 0; },
+      "rotations in the coarse space of --coarse-only (default off) and --finish (default on)");
+  switch_flag(app, "coarse-mu", kn.coarse_mu,
+              "friction (the objects' mu) in --coarse-only's energy");
+  app.add_option("--mg-aa", kn.mg_aa,
+                 "Anderson acceleration of --coarse-only's cycles over the last so many")
+      ->check(count);
+  app.add_option("--mg-sweeps", kn.mg_sweeps,
+                 "Gauss-Seidel sweeps of per-vertex Newton steps before each coarse correction")
+      ->check(count);
+  app.add_option("--mg-tau", kn.mg_tau, "time step (s) of the inertia term in --mg-sweeps' steps")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--mg-nocoarse", kn.mg_nocoarse, "--mg-sweeps alone, without the coarse step");
+  app.add_option("--mg-refresh", kn.mg_refresh,
+                 "factorise the coarse matrix every so many corrections (reuse it in between)")
+      ->check(positive);
+  app.add_option("--finish", kn.finish,
+                 "the static finish of the end state: at most so many cycles")
+      ->check(count);
+  app.add_option("--finish-sweeps", kn.finish_sweeps, "Gauss-Seidel sweeps per --finish cycle")
+      ->check(count);
+  app.add_option("--finish-extra", kn.finish_extra,
+                 "largest extrapolation along a --finish cycle's displacement (cycles; 0: none)")
+      ->check(non_negative);
+  // The probe's VBD solver.
+  app.option_defaults()->group("Probe: VBD");
+  app.add_option("--vbd-init", kn.vbd_init,
+                 "initial guess: 0 inertia, 1 inertia and gravity, 2 adaptive")
+      ->check(CLI::Range(0, 2));
+  app.add_option("--vbd-rho", kn.vbd_rho, "Chebyshev acceleration's rho (0: off)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--vbd-damp", kn.vbd_damp, "VBD's damping")->check(non_negative);
+  app.add_option("--vbd-air", kn.vbd_air, "air damping (1/s; default: the scene's, else 1)")
+      ->check(non_negative);
+  app.add_flag("--vbd-freeze,!--no-vbd-freeze", kn.vbd_freeze, "freeze vertices at rest");
+  app.add_option("--vbd-tol", kn.vbd_tol, "VBD's tolerance")->check(non_negative);
+  app.add_option("--vbd-ftol", kn.vbd_ftol, "VBD's force tolerance")->check(non_negative);
+  app.add_option("--vbd-threads", kn.vbd_threads, "VBD's threads")->check(CLI::Range(1, 256));
+  // The probe's XPBD solver.
+  app.option_defaults()->group("Probe: XPBD (unset: the solver's own value)");
+  app.add_option("--xpbd-warm", kn.xpbd_warm, "warm start of the constraint multipliers (0-1)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--xpbd-warm-frame", kn.xpbd_warm_frame,
+                 "from this frame on the warm start is --xpbd-warm-late (-1: never)")
+      ->check(CLI::Range(-1, 1000000));
+  app.add_option("--xpbd-warm-late", kn.xpbd_warm_late, "the warm start from --xpbd-warm-frame on")
+      ->check(CLI::Range(0.0, 1.0));
+  switch_flag(app, "xpbd-reuse", kn.xpbd_reuse,
+              "reuse contacts (detect again only after half the margin of motion)");
+  app.add_option("--xpbd-bend-every", kn.xpbd_bend_every, "project bending every so many substeps")
+      ->check(positive);
+  switch_flag(app, "xpbd-retest", kn.xpbd_retest, "test the vertices that moved again");
+  switch_flag(app, "xpbd-settle", kn.xpbd_settle, "settle pieces at rest");
+  switch_flag(app, "xpbd-freeze", kn.xpbd_freeze, "freeze (sleep) pieces at rest");
+  app.add_option("--xpbd-settle-scale", kn.xpbd_settle_scale,
+                 "the largest inertia scale of a settling piece")
+      ->check(CLI::Range(1.0, 1e9));
+  app.add_option("--xpbd-settle-damp", kn.xpbd_settle_damp, "damping of a settled piece (1/s)")
+      ->check(non_negative);
+  app.add_option("--xpbd-snap", kn.xpbd_snap, "contact snap depth (m)")->check(non_negative);
+  app.add_option("--xpbd-sleep-steps", kn.xpbd_sleep_steps,
+                 "substeps at full inertia scale before a settled piece sleeps")
+      ->check(count);
+  app.add_option("--xpbd-settle-speed", kn.xpbd_settle_speed,
+                 "speed (m/s) below which a piece begins to settle")
+      ->check(non_negative);
+  app.add_option("--xpbd-settle-growth", kn.xpbd_settle_growth,
+                 "growth of a settling piece's inertia per step")
+      ->check(CLI::Range(1.0, 1e9));
+  app.add_option("--xpbd-coarse", kn.xpbd_coarse,
+                 "coarse correction of settled pieces: fine edges per coarse cell (0: off)")
+      ->check(count);
+  app.add_option("--xpbd-coarse-frames", kn.xpbd_coarse_frames,
+                 "frames of coarse corrections after a piece has settled")
+      ->check(count);
+  switch_flag(app, "xpbd-coarse-rot", kn.xpbd_coarse_rot, "rotations in the coarse space");
+  switch_flag(app, "xpbd-finish", kn.xpbd_finish, "the static finish of sleeping pieces");
+  app.add_option("--xpbd-finish-cycles", kn.xpbd_finish_cycles, "at most so many finish cycles")
+      ->check(count);
+  switch_flag(app, "xpbd-finish-thread", kn.xpbd_finish_thread,
+              "the static finish on a thread of its own");
+  switch_flag(app, "xpbd-f32", kn.xpbd_f32,
+              "single-precision kernels; --no-xpbd-f32: double precision");
+  app.add_option("--xpbd-kernels", kn.xpbd_kernels,
+                 "the kernels' build by name (default: the fastest this CPU runs)")
+      ->check(CLI::IsMember({"portable", "avx2", "avx512"}));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 1 && !std::strcmp(argv[1], "--probe")) return probe(argc, argv);
-  bool quick = false, sleep_only = false, threads_only = false;
-  int max_res = 64;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--quick")) quick = true;
-    if (!std::strcmp(argv[i], "--max-res") && i + 1 < argc) max_res = std::atoi(argv[++i]);
-    if (!std::strcmp(argv[i], "--sleep-only")) sleep_only = true;
-    if (!std::strcmp(argv[i], "--threads-only")) threads_only = true;
-  }
+  Knobs kn;
+  std::string simd;
+  CLI::App app{
+      "The solver study: solver x substeps x iterations x resolution on the shared scenes "
+      "(out/bench/solvers*.csv, .svg), or one configuration (--probe)."};
+  add_knobs(app, kn, simd);
+  CLI11_PARSE(app, argc, argv);
+  // Before any solver is made (kernels() chooses once).
+  if (!simd.empty()) xpbd::limit_simd(*xpbd::parse_simd_limit(simd));
+  if (app.count("--probe") > 0) return probe(kn);
+  const bool quick = kn.quick;
+  const int max_res = kn.max_res;
   std::filesystem::create_directories("out/bench");
-  if (sleep_only) {  // the sleeping rows alone (out/bench/solvers_sleep.csv)
-    sleep_rows(quick ? 32 : 128);
+  if (kn.sleep_only) {  // the sleeping rows alone (out/bench/solvers_sleep.csv)
+    sleep_rows(kn, quick ? 32 : 128);
     return 0;
   }
-  if (threads_only) {  // the thread and precision rows alone (out/bench/solvers_threads.csv)
+  if (kn.threads_only) {  // the thread and precision rows alone (out/bench/solvers_threads.csv)
     thread_rows(std::max(max_res, 256));
     return 0;
   }
@@ -966,9 +1232,9 @@ int main(int argc, char** argv) {
   csv << "scene,solver,resolution,dt,iterations,ms_per_frame,rms_error_mm,max_error_mm,stable\n";
   for (const auto& j : jobs) {
     const std::vector<Vec3> ref =
-        path_dependent(j.scene) || !j.error ? std::vector<Vec3>{} : reference(j.scene, j.res);
+        path_dependent(j.scene) || !j.error ? std::vector<Vec3>{} : reference(kn, j.scene, j.res);
     for (const auto& c : j.configs) {
-      Row r = run(j.scene, j.res, c, ref, j.error);
+      Row r = run(kn, j.scene, j.res, c, ref, j.error);
       std::printf("%-8s %4d %-7s dt %.5f it %2d: %8.3f ms/frame  rms %8.3f mm  max %8.3f mm %s\n",
                   r.scene.c_str(), r.resolution, r.solver.c_str(), r.dt, r.iterations,
                   r.ms_per_frame, r.rms_mm, r.max_mm, r.stable ? "" : "UNSTABLE");
@@ -1006,7 +1272,7 @@ int main(int argc, char** argv) {
       }
     }
   }
-  sleep_rows(quick ? 32 : 128);
+  sleep_rows(kn, quick ? 32 : 128);
   // Switches of "skip what a scene doesn't need", on and off: XPBD 10x1 on the form scene with
   // contact reuse (detection only after half the margin of motion) on/off, and self-collision
   // (spatial hash) off/on; CPU ms per frame, detections per frame, self pairs at the end.

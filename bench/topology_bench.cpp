@@ -7,6 +7,7 @@
 //  * one self-collision detection with and without the per-entry bounding-sphere test (same
 //    pairs), best of 10.
 // Writes out/bench/topology.csv (one row per resolution) and prints the table.
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -46,7 +47,10 @@ struct Row {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Costs that come with the topology and the scene's layers (out/bench/topology.csv)."};
+  CLI11_PARSE(app, argc, argv);
   std::filesystem::create_directories("out/bench");
   std::vector<Row> rows;
   for (int res : {32, 64, 128}) {

@@ -2,5 +2,6 @@
 # bench/tracking.sh; executables voice_bench and tracking_bench in build/bin).
 foreach(b voice tracking)
   add_executable(${b}_bench ${CMAKE_CURRENT_SOURCE_DIR}/${b}_driver.cpp)
-  target_link_libraries(${b}_bench PRIVATE drape_options drape_tracking nlohmann_json::nlohmann_json)
+  target_link_libraries(${b}_bench PRIVATE drape_options drape_tracking nlohmann_json::nlohmann_json
+                                           CLI11::CLI11)
 endforeach()

@@ -2,10 +2,11 @@
 # ./drape bench tracking: One-Euro jitter vs lag and Kinect pipeline fps on one core.
 set -euo pipefail
 ROOT="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
+shift || true  # the rest: tracking_bench's flags
 cd "$ROOT"
 BUILD="${DRAPE_BUILD_DIR:-build}"
 mkdir -p out/bench
 if command -v taskset > /dev/null; then
-  exec taskset -c 0 "$BUILD/bin/tracking_bench"
+  exec taskset -c 0 "$BUILD/bin/tracking_bench" "$@"
 fi
-exec "$BUILD/bin/tracking_bench"
+exec "$BUILD/bin/tracking_bench" "$@"

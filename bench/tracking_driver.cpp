@@ -1,6 +1,7 @@
 // Tracking benchmark (./drape bench tracking): One-Euro jitter reduction vs added lag on a noisy
 // hand trace (30 Hz, 5 mm Kinect-like noise), and the Kinect depth pipeline's frames per second
 // on 640x480 (run on one core by bench/tracking.sh). Writes out/bench/tracking.json.
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -64,7 +65,11 @@ Score evaluate(const std::vector<double>& ts, const std::vector<Vec3>& y) {
 }
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  CLI::App app{
+      "One-Euro jitter vs lag and the Kinect pipeline's frames per second "
+      "(out/bench/tracking.json)."};
+  CLI11_PARSE(app, argc, argv);
   // Noisy trace (also written as a trace file to exercise record/replay).
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0, 0.005);

@@ -18,19 +18,39 @@
 # speech), the speech allowed outside the phrase words, the word margin and the duration limit.
 # The fixed configuration then decodes every set once -> out/bench/voice.json: the FINAL set's
 # figures at the top level, the others under "tuning", "test", "holdout".
-# VOICE_PHRASES=assets/voice/words.tsv measures the old one-word commands, VOICE_FILLERS=1 the
-# filler-word garbage model, VOICE_SINGLE=1 the single-pass grammar, VOICE_FRONT="--remove-noise 0
-# --comfort-noise 0" the bare pocketsphinx front end; VOICE_TUNE_ONLY=1 only synthesises the
-# tuning/test/held-out sets (no FINAL set, no decoding).
+# Flags (after the root; `./drape bench voice FLAGS`): --phrases assets/voice/words.tsv measures
+# the old one-word commands, --fillers the filler-word garbage model, --single the single-pass
+# grammar, --front "--remove-noise 0 --comfort-noise 0" the bare pocketsphinx front end;
+# --tune-only only synthesises the tuning/test/held-out sets (no FINAL set, no decoding);
+# --noise TYPE sox's noise (default pinknoise), --wip P the word insertion penalty (0.65),
+# --garbage-lws A,B,.. the garbage weights tuned over (6.5,8,10), --out FILE the report
+# (out/bench/voice.json). DRAPE_BUILD_DIR: the build directory (default build).
 # The set arrays are passed to gen_set by name (namerefs), which shellcheck does not follow.
 # shellcheck disable=SC2034
 set -euo pipefail
 ROOT="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
+shift || true
+PHRASES=assets/voice/phrases.tsv NOISE=pinknoise WIP=0.65 LWS=6.5,8,10 OUT=out/bench/voice.json
+TUNE_ONLY='' FILLERS='' SINGLE=''
+FRONT=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --phrases) PHRASES="${2:?--phrases needs a file}"; shift 2 ;;
+    --noise) NOISE="${2:?--noise needs a sox noise type}"; shift 2 ;;
+    --wip) WIP="${2:?--wip needs a value}"; shift 2 ;;
+    --garbage-lws) LWS="${2:?--garbage-lws needs a list}"; shift 2 ;;
+    --out) OUT="${2:?--out needs a file}"; shift 2 ;;
+    --front) read -r -a FRONT <<< "${2:?--front needs voice_bench flags}"; shift 2 ;;
+    --tune-only) TUNE_ONLY=1; shift ;;
+    --fillers) FILLERS=1; shift ;;
+    --single) SINGLE=1; shift ;;
+    -h | --help) sed -n '2,/^# The set arrays/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+    *) echo "bench/voice.sh: unknown flag '$1' (--help lists them)" >&2; exit 2 ;;
+  esac
+done
 cd "$ROOT"
 BUILD="${DRAPE_BUILD_DIR:-build}"
 SET="$BUILD/voice_set2"
-PHRASES="${VOICE_PHRASES:-assets/voice/phrases.tsv}"
-NOISE="${VOICE_NOISE:-pinknoise}"
 mkdir -p "$SET" out/bench
 # One reproducible noise recording (sox -R); the tuning set uses its first half, the test set
 # its second half.
@@ -182,7 +202,7 @@ car_tune3() { CAR=($((3 + (k * 11) % 187)) $((40 + 10 * (k % 3)))); }
 speed_tune3() { S=${TUNE3_SPEEDS[$((k % 3))]}; }
 k=0
 gen_set "$TUNE" tune3 tune3_sent car_tune3 TUNE3_VOICES TUNE3_SPEEDS TUNE3_SENT TUNE3_VOICES speed_tune3
-[ -z "${VOICE_TUNE_ONLY:-}" ] || exit 0
+[ -z "$TUNE_ONLY" ] || exit 0
 # FINAL set (session 4): generated after every decision, evaluated once, the headline of
 # out/bench/voice.json. The test set's voice/speed mix (5 voices x 120/150/180 x the phrases + 20
 # sentences x 5 voices) with new carriers (espeak pitch 35/50/65, 0.5-1.1 s of noise after the
@@ -206,12 +226,11 @@ car_final() {
 }
 k=0
 gen_set "$FINAL" final final_sent car_final TEST_VOICES TEST_SPEEDS FINAL_SENT TEST_VOICES 150
-# Garbage path: the phone loop (default since the session-2 attempt) or the filler words (VOICE_FILLERS=1).
+# Garbage path: the phone loop (default since the session-2 attempt) or the filler words (--fillers).
 GARBAGE=--phones
-[ -z "${VOICE_FILLERS:-}" ] || GARBAGE=--fillers
-# Front end (defaults: noise subtraction on, +-48 LSB comfort noise); VOICE_FRONT overrides, e.g.
-# VOICE_FRONT="--remove-noise 0 --comfort-noise 0".
-FRONT=(${VOICE_FRONT:-})
+[ -z "$FILLERS" ] || GARBAGE=--fillers
+# Front end (defaults: noise subtraction on, +-48 LSB comfort noise); --front overrides, e.g.
+# --front "--remove-noise 0 --comfort-noise 0".
 # 1. VAD hangover: the shortest that keeps every tuning command in one segment.
 HANG=
 for h in 0.25 0.3 0.35 0.4 0.45 0.5 0.6 0.7; do
@@ -221,12 +240,11 @@ done
 HANG=${HANG:-0.7}
 # 2. Rejection thresholds on the tuning set.
 "$BUILD/bin/voice_bench" --tune "$TUNE" "$SET/tuned.txt" --phrases "$PHRASES" --hangover "$HANG" \
-  --wip "${VOICE_WIP:-0.65}" --garbage-lws "${VOICE_GARBAGE_LWS:-6.5,8,10}" $GARBAGE \
-  ${VOICE_SINGLE:+--single} ${FRONT[@]+"${FRONT[@]}"}
+  --wip "$WIP" --garbage-lws "$LWS" $GARBAGE ${SINGLE:+--single} ${FRONT[@]+"${FRONT[@]}"}
 read -r WIP MARGIN WORD MAXS OUTSIDE GLW PERS < "$SET/tuned.txt"
 FIXED=(--phrases "$PHRASES" --hangover "$HANG" --wip "$WIP" --margin "$MARGIN" --word-margin "$WORD"
   --max-s "$MAXS" --max-outside "$OUTSIDE" --per-s "${PERS:-0}" --garbage-lw "$GLW" $GARBAGE
-  ${VOICE_SINGLE:+--single} ${FRONT[@]+"${FRONT[@]}"})
+  ${SINGLE:+--single} ${FRONT[@]+"${FRONT[@]}"})
 # 3. The chosen configuration on every set, each decoded once: the tuning set (its own figures),
 # the old test and held-out sets (seen by earlier sessions' decisions) and, last, the FINAL set
 # that no decision looked at: the headline of out/bench/voice.json.
@@ -234,5 +252,5 @@ for s in tune test holdout; do
   "$BUILD/bin/voice_bench" "$SET/$s.tsv" "$SET/$s.json" "${FIXED[@]}" > "$SET/$s.log"
   grep -E "^accuracy|^latency" "$SET/$s.log" | sed "s/^/$s set: /"
 done
-exec "$BUILD/bin/voice_bench" "$FINAL" "${VOICE_OUT:-out/bench/voice.json}" "${FIXED[@]}" \
+exec "$BUILD/bin/voice_bench" "$FINAL" "$OUT" "${FIXED[@]}" \
   --extra tuning="$SET/tune.json" --extra test="$SET/test.json" --extra holdout="$SET/holdout.json"

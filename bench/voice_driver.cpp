@@ -10,13 +10,14 @@
 //     "wip margin word_margin max_command_s max_outside garbage_lw" to tuned.txt.
 //   voice_bench list.tsv out.json [--margin M] [--max-outside O] [--garbage-lw L] [...]
 //     [--holdout other.json]: evaluates one fixed configuration on a separate set and writes
-//     out/bench/voice.json (with another run's figures embedded under "holdout").
+//     out/bench/voice.json (with another run's figures embedded under "holdout"); --dump FILE
+//     writes the per-utterance scores. `voice_bench --help` lists every option.
 // Latency = end of speech (from the clean synthesised speech, not the end of espeak's file) ->
 // decision: the VAD's hangover plus decoding both passes after the end (decode_ms).
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -158,13 +159,6 @@ void true_speech_end(Item& it) {
   it.speech_end = 0.5 + double(last) / 100.0;
 }
 
-std::vector<double> parse_list(const std::string& s) {
-  std::vector<double> v;
-  std::stringstream ss(s);
-  for (std::string t; std::getline(ss, t, ',');) v.push_back(std::stod(t));
-  return v;
-}
-
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -181,82 +175,83 @@ int main(int argc, char** argv) {
                 cfg.min_word_margin, cfg.max_outside_s, cfg.margin_per_s};
   std::vector<std::pair<std::string, std::string>> extras;  // --extra key=result.json
   std::vector<std::string> pos;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "%s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--tune")
-      tune = true;
-    else if (a == "--vad-only")
-      vad_only = true;
-    else if (a == "--phrases")
-      cfg.phrases = next();
-    else if (a == "--wip")
-      cfg.word_penalty = std::stod(next());
-    else if (a == "--single")
-      cfg.rejection = Rejection::Single;
-    else if (a == "--filler")
-      cfg.filler = next();
-    else if (a == "--phones")
-      cfg.garbage = GarbageModel::Phones;
-    else if (a == "--fillers")
-      cfg.garbage = GarbageModel::Fillers;
-    else if (a == "--remove-noise")
-      cfg.remove_noise = std::stoi(next()) != 0;
-    else if (a == "--comfort-noise")
-      cfg.comfort_noise = std::stod(next());
-    else if (a == "--outside-db")
-      cfg.outside_db = std::stod(next());
-    else if (a == "--holdout")
-      holdout = next();
-    else if (a == "--garbage-lw")
-      cfg.garbage_lw = std::stod(next());
-    else if (a == "--garbage-lws")
-      lws = parse_list(next());
-    else if (a == "--ps")
-      cfg.decoder_args += " " + next();
-    else if (a == "--ps-garbage")
-      cfg.garbage_args += " " + next();
-    else if (a == "--dict")
-      cfg.dict = next();
-    else if (a == "--streaming")
-      cfg.streaming = true;
-    else if (a == "--min-fillers")
-      cfg.min_filler_words = std::stoi(next());
-    else if (a == "--hangover")
-      cfg.hangover_s = std::stod(next());
-    else if (a == "--margin")
-      th.margin = std::stod(next());
-    else if (a == "--word-margin")
-      th.word = std::stod(next());
-    else if (a == "--per-s")
-      th.per_s = std::stod(next());
-    else if (a == "--extra") {
-      const std::string v = next();
-      const auto eq = v.find('=');
-      if (eq == std::string::npos) {
-        std::fprintf(stderr, "--extra needs key=file, got '%s'\n", v.c_str());
-        return 2;
-      }
-      extras.emplace_back(v.substr(0, eq), v.substr(eq + 1));
-    } else if (a == "--max-outside")
-      th.outside = std::stod(next());
-    else if (a == "--max-s")
-      th.max_s = std::stod(next());
-    else
-      pos.push_back(a);
-  }
-  if (pos.size() != 2) {
-    std::fprintf(stderr,
-                 "usage: voice_bench [--tune|--vad-only] list.tsv out [--phrases F] [--wip P] "
-                 "[--phones] [--single] [--hangover H] [--margin M] [--word-margin W] "
-                 "[--max-s D]\n");
-    return 2;
+  std::string dump;  // per-utterance scores for analysis
+  CLI::App app{
+      "Voice benchmark driver: decodes a list of utterances (wav, expected, text, speech end "
+      "[, voice, speed]) through the app's path (VAD, phrases + garbage path, rejection)."};
+  app.option_defaults()->always_capture_default();
+  app.add_option("files", pos,
+                 "the list (TSV) and the output: the JSON report; with --tune the chosen "
+                 "thresholds; with --vad-only the count of split commands")
+      ->expected(2)
+      ->required()
+      ->type_name("LIST OUT")
+      ->default_str("");
+  auto* tune_opt = app.add_flag(
+      "--tune", tune, "grid over the garbage -lw and the thresholds (on the tuning set only)");
+  app.add_flag("--vad-only", vad_only, "segmentation check only")->excludes(tune_opt);
+  app.add_option("--phrases", cfg.phrases, "command phrases (TSV phrase, command)");
+  app.add_option("--dict", cfg.dict, "pronunciation dictionary");
+  app.add_option("--filler", cfg.filler, "filler words (one a line)");
+  app.add_option("--wip", cfg.word_penalty, "word insertion penalty")->check(CLI::Range(0.0, 1e9));
+  app.add_flag_callback(
+      "--single", [&cfg] { cfg.rejection = Rejection::Single; }, "the single-pass grammar");
+  auto* phones = app.add_flag_callback(
+      "--phones", [&cfg] { cfg.garbage = GarbageModel::Phones; }, "garbage path: the phone loop");
+  app.add_flag_callback(
+         "--fillers", [&cfg] { cfg.garbage = GarbageModel::Fillers; },
+         "garbage path: the filler words")
+      ->excludes(phones);
+  app.add_option("--remove-noise", cfg.remove_noise, "pocketsphinx's spectral noise subtraction");
+  app.add_option("--comfort-noise", cfg.comfort_noise, "+- LSB of comfort noise")
+      ->check(CLI::Range(0.0, 32768.0));
+  app.add_option("--outside-db", cfg.outside_db,
+                 "a frame is voiced above the utterance's 10th-percentile energy + this");
+  app.add_option("--holdout", holdout, "a held-out set's result (JSON), embedded as \"holdout\"")
+      ->check(CLI::ExistingFile);
+  app.add_option("--garbage-lw", cfg.garbage_lw, "language weight of the phone loop")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--garbage-lws", lws, "--tune: the garbage weights to try (comma-separated)")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber)
+      ->default_str("");
+  // Extra pocketsphinx arguments ("-name value ..."), appended; repeatable.
+  auto decoder_args = [&app](const std::string& name, std::string& to, const std::string& help) {
+    app.add_option_function<std::vector<std::string>>(
+           name,
+           [&to](const std::vector<std::string>& v) {
+             for (const auto& a : v) to += " " + a;
+           },
+           help)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  };
+  decoder_args("--ps", cfg.decoder_args,
+               "extra pocketsphinx arguments for both decoders (--ps='-name value')");
+  decoder_args("--ps-garbage", cfg.garbage_args,
+               "extra pocketsphinx arguments for the garbage decoder (--ps-garbage='-name value')");
+  app.add_flag("--streaming", cfg.streaming, "decode while the utterance is spoken");
+  app.add_option("--min-fillers", cfg.min_filler_words, "words the filler path needs at least")
+      ->check(CLI::Range(0, 100));
+  app.add_option("--hangover", cfg.hangover_s, "VAD hangover (s)")->check(CLI::Range(0.0, 10.0));
+  app.add_option("--margin", th.margin, "garbage margin per frame");
+  app.add_option("--word-margin", th.word, "weakest command word's margin");
+  app.add_option("--per-s", th.per_s, "margin cost per second of speech");
+  app.add_option("--max-outside", th.outside, "voiced seconds allowed outside the phrase words");
+  app.add_option("--max-s", th.max_s, "longest command (s)")->check(CLI::PositiveNumber);
+  std::vector<std::string> extra_args;
+  app.add_option("--extra", extra_args,
+                 "KEY=FILE: another set's result (same settings) under KEY (repeatable)")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            return v.find('=') == std::string::npos ? "expected KEY=FILE" : std::string();
+          },
+          "KEY=FILE"))
+      ->default_str("");
+  app.add_option("--dump", dump, "write per-utterance scores (TSV) to this file");
+  CLI11_PARSE(app, argc, argv);
+  for (const auto& v : extra_args) {
+    const auto eq = v.find('=');
+    extras.emplace_back(v.substr(0, eq), v.substr(eq + 1));
   }
   std::vector<Item> items;
   std::ifstream in(pos[0]);
@@ -406,7 +401,7 @@ int main(int argc, char** argv) {
   }
 
   const auto out = decode_all(items, cfg);
-  if (const char* dump = std::getenv("VOICE_DUMP")) {  // per-utterance scores for analysis
+  if (!dump.empty()) {  // per-utterance scores for analysis
     std::ofstream d(dump);
     for (size_t i = 0; i < items.size(); ++i)
       d << items[i].wav << '\t' << items[i].expect << '\t' << out[i].command << '\t'
