@@ -232,7 +232,7 @@ Row run(const Knobs& kn, const std::string& scene, int res, const Config& c,
   cfg.iterations = c.iterations;
   cfg.springs_model = sc.springs_model;
   cfg.threads = kn.threads.value_or(1);
-  cfg.air_damping = sc.air_damping;
+  cfg.air_drag = sc.air_drag;
   // "xpbd-nosettle": XPBD without settling pieces at rest (XpbdOptions::settle, on in "xpbd").
   cfg.settle = c.solver != "xpbd-nosettle";
   auto s = make_solver(c.solver == "xpbd-nosettle" ? "xpbd" : c.solver, cfg);
@@ -274,7 +274,7 @@ std::vector<Vec3> reference(const Knobs& kn, const std::string& scene, int res) 
     VbdOptions o;
     o.substeps = 2;
     o.iterations = res > 32 ? 40 : 60;
-    o.air_damping = 3.0;  // settles faster; the static minimum does not depend on it
+    o.air_drag = 3.0;  // settles faster; the static minimum does not depend on it
     o.threads = 1;
     o.tolerance = 1e-9;
     o.force_tolerance = 1e-4;
@@ -409,8 +409,8 @@ int probe(const Knobs& kn) {
     o.init = static_cast<VbdOptions::Init>(kn.vbd_init);
     o.chebyshev_rho = kn.vbd_rho;
     o.chebyshev = o.chebyshev_rho > 0;
-    o.damping = kn.vbd_damp;
-    o.air_damping = kn.vbd_air.value_or(sc.air_damping >= 0 ? sc.air_damping : 1.0);
+    o.rayleigh_damping = kn.vbd_damp;
+    o.air_drag = kn.vbd_air.value_or(sc.air_drag >= 0 ? sc.air_drag : 1.0);
     o.freeze = kn.vbd_freeze;
     o.tolerance = kn.vbd_tol;
     o.force_tolerance = kn.vbd_ftol;
@@ -424,7 +424,7 @@ int probe(const Knobs& kn) {
     cfg.iterations = it;
     cfg.springs_model = sc.springs_model;
     cfg.threads = kn.threads.value_or(2);
-    cfg.air_damping = sc.air_damping;
+    cfg.air_drag = sc.air_drag;
     auto made = make_solver(solver, cfg);
     if (!made) {
       std::fprintf(stderr, "--probe: %s\n", made.error().c_str());
@@ -440,7 +440,7 @@ int probe(const Knobs& kn) {
       o.settle = kn.xpbd_settle;
       o.freeze = kn.xpbd_freeze;
       o.settle_mass_scale = kn.xpbd_settle_scale;
-      o.settle_damping = kn.xpbd_settle_damp.value_or(o.settle_damping);
+      o.settle_air_drag = kn.xpbd_settle_damp.value_or(o.settle_air_drag);
       o.contact_snap_depth = kn.xpbd_snap.value_or(o.contact_snap_depth);
       o.settle_sleep_steps = kn.xpbd_sleep_steps.value_or(o.settle_sleep_steps);
       o.settle_speed = kn.xpbd_settle_speed.value_or(o.settle_speed);
@@ -819,7 +819,7 @@ void sleep_rows(const Knobs& kn, int sres) {
     SolverConfig cfg;
     cfg.freeze = fr == 1;
     cfg.threads = 1;
-    cfg.air_damping = sc.air_damping;
+    cfg.air_drag = sc.air_drag;
     auto s = make_solver("default", cfg);
     const int marks[4] = {0, 270, 540, 720};
     double ms[3] = {0, 0, 0}, asleep_at = -1;
@@ -905,7 +905,7 @@ void thread_rows(int max_res) {
           SolverConfig cfg;
           cfg.substeps = 10;
           cfg.threads = threads;
-          cfg.air_damping = sc.air_damping;
+          cfg.air_drag = sc.air_drag;
           auto s = make_solver("default", cfg);
           if (auto* xp = xpbd_of(s->get())) {
             xp->options().single_precision = !configs[c].dbl;
@@ -1292,7 +1292,7 @@ int main(int argc, char** argv) {
       XpbdOptions o;
       o.substeps = 10;
       o.threads = 1;
-      o.damping = sc.air_damping;
+      o.air_drag = sc.air_drag;
       o.reuse_contacts = sw.reuse;
       XpbdSolver s(o);
       const int frames = static_cast<int>(std::lround(sc.duration * 90));
