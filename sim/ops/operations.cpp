@@ -436,7 +436,7 @@ bool ops_map(World& w, OperationsState& s) {
   if (!w.scene.form || w.scene.form->num_sections() < 2)
     return w.report("map: no dress form in the scene: ignored"), false;
   if (s.pinched[0] >= 0 || s.pinched[1] >= 0 || s.moving)
-    return w.report("map: not while pinching or moving (the study: map does not combine)"), false;
+    return w.report("map: not while pinching or moving (map does not combine with them)"), false;
   Cloth& c = w.cloth;
   std::vector<char> used;
   in_any_triangle(c, used);
