@@ -1,5 +1,5 @@
-// Baseline benchmark (issue 2): the study's mass-spring + damped Verlet with dress-form collision
-// at the study's sizes 21^2, 42^2, 81^2 and at 128^2. Measures ms of compute per 1/90 s frame,
+// Baseline benchmark: the explicit mass-spring + damped Verlet with dress-form collision at
+// 21^2, 42^2, 81^2 and 128^2. Measures ms of compute per 1/90 s frame,
 // the largest stable dt at muslin stiffness (bisection) and the substeps per frame it implies,
 // and the section-lookup collision cost per vertex. Writes out/bench/baseline.csv.
 #include <benchmark/benchmark.h>

@@ -1,4 +1,4 @@
-// The peer of the solver study (issue 3, item 6): Bullet's soft body (Debian libbullet-dev,
+// The peer of the solver benchmark (solvers_bench): Bullet's soft body (Debian libbullet-dev,
 // btSoftBody position-based links) on the hanging-sheet scene of sim/testbeds/testbed.hpp, with the
 // same vertices, triangles, lumped masses, pins, gravity and frame length as our solvers. Matching
 // (docs/solvers.md, "Bullet peer"): one Bullet link per triangle edge of the cloth; each link's
@@ -7,7 +7,7 @@
 //   s = k h^2 / (m_ab + k h^2)  (the fraction of the violation an implicit spring removes in
 //   one step), kLST = 1 - (1 - s)^(1/iterations) (so `iterations` passes remove the same).
 // No damping (fabric damping 0 -> kDP 0), no aerodynamics (kLF = kDG = 0, air density 0), no
-// self-collision, no bending constraints (see the report for the measured effect).
+// self-collision, no bending constraints (bullet_peer_bench --bending measures their effect).
 #pragma once
 
 #include <Eigen/Core>
@@ -31,7 +31,7 @@ struct PeerRow {
 // 50 m of the start. Without Bullet at build time: stable = false, positions empty.
 PeerRow run_bullet_sheet(int res, int substeps, int iterations);
 
-// Options for studying the matching (the driver uses them; run_bullet_sheet uses defaults).
+// Options for exploring the matching (the driver uses them; run_bullet_sheet uses defaults).
 struct PeerOptions {
   double klst_scale = 1.0;  // multiplies the derived per-link kLST (clamped to [0, 1])
   double klst_fixed = 0.0;  // > 0: every link gets this kLST instead of the derived one

@@ -1,7 +1,8 @@
 // Standalone driver of the Bullet peer (bench/bullet_peer.hpp): runs Bullet's soft body on the
 // hanging sheet for a few substep x iteration settings and prints ms per 1/90 s frame and the
-// error against the static Newton minimum of the same scene (the study's reference). The
-// study itself (solvers_bench) writes the solver=bullet rows; this driver is for the matching.
+// error against the static Newton minimum of the same scene (the solver benchmark's
+// reference). The solver benchmark itself (solvers_bench) writes the solver=bullet rows; this
+// driver is for the matching.
 // Usage: bullet_peer_bench [--res N] [--check-rms MM] [--scale S] [--fixed K] [--bending] [--kdp D]
 //                          [--runs SUBSTEPSxITER,...] [--ours SOLVER:SUBSTEPSxITER,...]
 // --ours runs our solvers (sim/solvers/solver_factory.hpp) on the same scene in the same process,

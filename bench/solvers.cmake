@@ -1,6 +1,6 @@
-# Solver study (issue 3): the Bullet soft-body peer (bench/bullet_peer.cpp) is linked into
+# Solver benchmark: the Bullet soft-body peer (bench/bullet_peer.cpp) is linked into
 # solvers_bench and into its standalone driver bullet_peer_bench. Bullet (libbullet-dev) is
-# required: `./drape setup` installs it, and a study without its peer would be incomplete.
+# required: `./drape setup` installs it, and the solver benchmark compares against it.
 find_path(DRAPE_BULLET_INCLUDE btSoftBody.h PATHS /usr/include/bullet/BulletSoftBody
           NO_DEFAULT_PATH)
 find_library(DRAPE_BULLET_SOFT BulletSoftBody)

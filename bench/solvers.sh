@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# ./drape bench solvers: the solver study, quick version by default (a few minutes);
+# ./drape bench solvers: the solver benchmark, quick version by default (a few minutes);
 # ./drape bench solvers --full runs the full grid up to 128^2 scored, 256^2 timed (about 45 min).
 # Other flags go to solvers_bench (`build/bin/solvers_bench --help`).
 set -euo pipefail

@@ -1,6 +1,6 @@
-// The solver study (issue 3, item 5): solver x substeps (dt) x iterations x resolution on the
-// shared scenes; CPU time per 1/90 s frame and error against the converged reference (the
-// static minimum of the same scene), plus the Bullet peer (bench/bullet_peer.hpp) on the
+// The solver benchmark: solver x substeps (dt) x iterations x resolution on the shared scenes;
+// CPU time per 1/90 s frame and error against the converged reference (the static minimum of
+// the same scene), plus the Bullet peer (bench/bullet_peer.hpp) on the
 // sheet. Writes out/bench/solvers.csv and Pareto charts out/bench/solvers.svg (form) and
 // solvers_sheet.svg (error vs time, log axes, one curve per solver), prints time-at-equal-
 // error ratios of the default solver against the explicit baseline, Bullet and XPBD.
@@ -96,14 +96,14 @@ double cpu_ms() {
   return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-// The study's and the probe's knobs (command-line flags; `solvers_bench --help` lists them).
-// Unset optionals take the default named in their help: the solver's own or the scene's value,
-// or one that depends on where the knob is used.
+// The benchmark grid's and the probe's knobs (command-line flags; `solvers_bench --help` lists
+// them). Unset optionals take the default named in their help: the solver's own or the scene's
+// value, or one that depends on where the knob is used.
 struct Knobs {
-  // The study (and the probe, where they apply).
+  // The benchmark grid (and the probe, where they apply).
   bool quick = false, sleep_only = false, threads_only = false;
   int max_res = 64;
-  std::optional<int> threads;    // solver threads: study 1, probe 2, the probe's --finish pool 1
+  std::optional<int> threads;    // solver threads: grid 1, probe 2, the probe's --finish pool 1
   std::optional<int> ref_iters;  // Newton iterations: polish 300, contact scenes' reference 150
   int ref_settle_frames = 360;
   int sleep_ref_iters = 100;
@@ -211,7 +211,7 @@ std::vector<Vec3> polished(const Knobs& kn, const Testbed& end, double& residual
   StaticOptions so;
   so.tolerance = 1e-8;
   // The frictional equilibrium nearest to it (the scene's objects' mu); --no-polish-friction:
-  // the frictionless one (a probe study).
+  // the frictionless one (for probing).
   so.friction = kn.polish_friction;
   so.reuse_factorisation = kn.polish_reuse;
   so.reuse_max_cg = kn.polish_cg_max;
@@ -462,7 +462,7 @@ int probe(const Knobs& kn) {
   int max_frame = -1;
   long iters = 0;
   // --load FILE: start from a state --save FILE wrote (positions and velocities of the same
-  // scene and resolution), e.g. to study the polish of one end state without re-running the
+  // scene and resolution), e.g. to examine the polish of one end state without re-running the
   // drape (--frames 0).
   if (!kn.load.empty() && !load_state(kn.load, sc.cloth)) return 1;
   const std::vector<Vec3> start_x = sc.cloth.state.x;
@@ -565,8 +565,8 @@ int probe(const Knobs& kn) {
     }
   }
   // --coarse-only k: k coarse corrections (sim/rest/coarse_correction.hpp, lattice
-  // --coarse-factor) of the end state alone, contacts re-detected before each (a study of
-  // the correction without the solver's sweeps).
+  // --coarse-factor) of the end state alone, contacts re-detected before each (the
+  // correction alone, without the solver's sweeps).
   CoarseCorrection probe_cc;
   bool probe_cc_used = false;
   if (const int kc = kn.coarse_only; kc > 0) {
@@ -872,14 +872,14 @@ void sleep_rows(const Knobs& kn, int sres) {
 }
 
 void thread_rows(int max_res) {
-  // Both cores: the default solver 10x1 on the form scene with 1 and 2 threads (colour-parallel,
-  // same result), wall and CPU ms per frame at 128^2 and 256^2, with XPBD's kernels in single
-  // precision (the default) and in double, side by side; on a CPU with AVX-512 also the single
-  // precision kernels of the AVX2 build (what a CPU without AVX-512 runs). The study's other rows
-  // are CPU time of one thread (the machine is shared); this is what one frame takes on this
-  // 2-core machine. The host's speed drifts by tens of % within minutes: at 128^2 the
-  // configurations run interleaved in three rounds and each row is the median of its three
-  // (256^2: one round).
+  // Threads and precision: the default solver 10x1 on the form scene with 1 and 2 threads
+  // (colour-parallel, same result), wall and CPU ms per frame at 128^2 and 256^2, with XPBD's
+  // kernels in single precision (the default) and in double, side by side; on a CPU with AVX-512
+  // also the single precision kernels of the AVX2 build (what a CPU without AVX-512 runs). The
+  // benchmark's other rows are CPU time of one thread (the machine may be shared); these are the
+  // wall time one frame takes on one and two cores. A shared host's speed drifts by tens of %
+  // within minutes, so at 128^2 the configurations run interleaved in three rounds and each row is
+  // the median of its three (256^2: one round).
   std::ofstream tc("out/bench/solvers_threads.csv");
   tc << "scene,solver,resolution,substeps,threads,precision,kernels,runs,wall_ms_per_frame,"
         "cpu_ms_per_frame,steady_wall_ms_per_frame,first_frame_ms\n";
@@ -964,14 +964,14 @@ CLI::Option* switch_flag(CLI::App& app, const std::string& name, bool& value,
                       help + (value ? " (default: on)" : " (default: off)"));
 }
 
-// Every knob of the study and the probe as a flag; the environment variables they replace are
-// in the table at the top of this file.
+// Every knob of the benchmark grid and the probe as a flag; the environment variables they replace
+// are in the table at the top of this file.
 void add_knobs(CLI::App& app, Knobs& kn, std::string& simd) {
   const auto count = CLI::Range(0, 1000000);
   const auto positive = CLI::Range(1, 1000000);
   const auto non_negative = CLI::Range(0.0, 1e9);
   app.option_defaults()->always_capture_default();
-  // The study.
+  // The benchmark grid.
   app.option_defaults()->group("Study");
   app.add_flag("--quick", kn.quick,
                "the quick grid (./drape bench solvers' default; a few minutes)");
@@ -1182,8 +1182,8 @@ int main(int argc, char** argv) {
     std::vector<Config> configs;
     bool error = true;  // false: time only (256^2)
   };
-  // "xpbd" settles pieces at rest (the default since session 5); "xpbd-nosettle" is the same
-  // solver without it, side by side.
+  // "xpbd" settles pieces at rest (the default); "xpbd-nosettle" is the same solver without it,
+  // side by side.
   std::vector<Config> full{{"vbd", 1, 5},
                            {"vbd", 1, 10},
                            {"vbd", 2, 10},
@@ -1212,8 +1212,8 @@ int main(int argc, char** argv) {
   } else {
     jobs = {{"chain", 20, full}, {"sheet", 16, full}, {"form", 16, full},
             {"sheet", 32, full}, {"form", 32, full},  {"sphere", 32, full}};
-    // 64^2 scored since session 4 (the static polish takes ~30 s per state there, docs/
-    // solvers.md "Static solver speed"), with the explicit baseline (~50 s of stepping).
+    // 64^2 scored (the static polish takes ~30 s per state there, docs/solvers.md "Static
+    // solver speed"), with the explicit baseline (~50 s of stepping).
     const std::vector<Config> big{{"vbd", 1, 5}, {"xpbd", 10, 1}, {"xpbd", 20, 1}};
     std::vector<Config> b64 = big;
     b64.push_back({"xpbd", 5, 1});

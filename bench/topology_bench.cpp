@@ -1,8 +1,8 @@
-// Costs that come with the topology and the scene's layers rather than with a step (issue 3,
-// "nothing computed that a scene doesn't need"), on the settled form drape (XPBD 10x1, one
-// thread, 120 frames) at 32^2, 64^2 and 128^2, each side by side in one run:
+// Costs that come with the topology and the scene's layers rather than with a step (nothing is
+// computed that a scene doesn't need), on the settled form drape (XPBD 10x1, one thread, 120
+// frames) at 32^2, 64^2 and 128^2, each side by side in one run:
 //  * rebuilding the cloth energy after a cut, with the bending vertex matrix P (VBD, Newton,
-//    Verlet need it) and rows only (what XPBD builds since session 5), best of 3;
+//    Verlet need it) and rows only (what XPBD builds), best of 3;
 //  * the first XPBD step after a slit is cut (re-cook + one frame) against a plain frame;
 //  * one self-collision detection with and without the per-entry bounding-sphere test (same
 //    pairs), best of 10.

@@ -3,15 +3,15 @@
 # 10 dB SNR (measured on the speech):
 #   TUNING set: 4 voices x speeds 110/130/170 x the command phrases + 2 more accents (Scottish,
 #               West Midlands) x 130/170 x the phrases; 16 non-command sentences x 5 voices and
-#               (session 3) 24 more x 4 voices; (session 4) 4 more voices (en-029+f3, en-029+m3,
-#               en-us-nyc+f3, en-gb+f3) x 115/145/175 x the phrases at pitch 40/50/60 + 24 more
-#               sentences x those voices; noise from the first half of the recording;
+#               24 more x 4 voices; 4 more voices (en-029+f3, en-029+m3, en-us-nyc+f3, en-gb+f3)
+#               x 115/145/175 x the phrases at pitch 40/50/60 + 24 more sentences x those voices;
+#               noise from the first half of the recording;
 #   TEST set:   5 OTHER voices x 3 other speeds (120/150/180) x the phrases + 20 other sentences
-#               x 5 voices, noise from the second half (design unchanged since session 2);
-#   HOLDOUT:    4 voices used nowhere else x 140/165 x the phrases + 20 more sentences x 4 voices
-#               (session 3), noise from the second half, other offsets.
-#   The test and held-out sets were looked at by earlier sessions' decisions: "seen".
-#   FINAL set (session 4): the test set's voice/speed mix with new sentences, new carriers (pitch,
+#               x 5 voices, noise from the second half;
+#   HOLDOUT:    4 voices used nowhere else x 140/165 x the phrases + 20 more sentences x 4 voices,
+#               noise from the second half, other offsets.
+#   Tuning decisions also looked at the test and held-out sets' figures: they are "seen".
+#   FINAL set:  the test set's voice/speed mix with new sentences, new carriers (pitch,
 #               trailing pad) and a new noise recording; no decision looked at it. HEADLINE.
 # On the tuning set only: the VAD hangover (shortest whose decoded audio covers every command),
 # then voice_bench --tune picks the garbage -lw, the garbage margin (and its cost per second of
@@ -139,17 +139,17 @@ car_tune() { CAR=($((k % 190))); }
 k=0
 TUNE_SENT_VOICES=(en-us en-us+f3 en-gb-x-rp)
 gen_set "$TUNE" tune tune_sent car_tune TUNE_VOICES TUNE_SPEEDS TUNE_SENT TUNE_SENT_VOICES 150
-# Slow speech (added by the session-2 attempt): espeak-ng pauses longer between words below ~130 wpm, which
-# the VAD hangover must bridge; its own noise offsets, so the sets above are unchanged.
+# Slow speech: espeak-ng pauses longer between words below ~130 wpm, which the VAD hangover
+# must bridge; its own noise offsets, so the other tuning files keep theirs.
 TUNE_SLOW_SPEEDS=("$TUNE_SLOW")
 gen_set "$TUNE" tune - car_tune TUNE_VOICES TUNE_SLOW_SPEEDS NONE NONE 150
-# More accents in the tuning set (session-2 attempt; none of them is a test voice).
+# More accents in the tuning set (none of them is a test voice).
 for accent in "${TUNE_ACCENTS[@]}"; do
   ACCENT=("$accent")
   gen_set "$TUNE" tune tune_sent car_tune ACCENT TUNE_SPEEDS TUNE_SENT ACCENT 150
 done
-# More non-command sentences (session 3): 16 sentences gave too few false-trigger candidates to
-# place the thresholds (the chosen margin let 5 % of the test sentences through). None of them is
+# More non-command sentences: 16 alone give too few false-trigger candidates to place the
+# thresholds (the margin chosen on them let 5 % of the test sentences through). None of them is
 # a test sentence; like the test set, some contain command words.
 TUNE_SENT2=("could you pass the pins please" "the hem is uneven on the left"
   "I will cut the lining tomorrow" "stop the machine for a moment" "move the lamp a bit closer"
@@ -164,9 +164,9 @@ K2_BASE=$k # the n-th of these files (from 1) is spoken at 130 wpm if n is odd, 
 speed_sent2() { S=$(((k - K2_BASE) % 2 ? 130 : 170)); }
 gen_set "$TUNE" tune tune_sent2 car_tune NONE NONE TUNE_SENT2 TUNE_SENT2_VOICES speed_sent2
 car_test() { CAR=($((200 + k % 190))); }
-k=120 # the test set's noise offsets as in session 2
+k=120 # the test set's noise offsets (fixed, so the set stays the same)
 gen_set "$TEST" test test_sent car_test TEST_VOICES TEST_SPEEDS TEST_SENT TEST_VOICES 150
-# HOLDOUT set (session 3): made after the phrases were changed, never used for any decision:
+# HOLDOUT set, never used for any decision:
 # 9 phrases x 4 voices used nowhere else (en-us+m2, en-us+f4, en-gb-x-gbclan, en-gb+m4) x speeds
 # 140/165 + 20 more sentences x 4 voices; noise from the test half at other offsets.
 HOLD_VOICES=(en-us+m2 en-us+f4 en-gb-x-gbclan en-gb+m4)
@@ -183,10 +183,10 @@ HOLD="$SET/holdout.tsv"
 car_hold() { CAR=($((205 + (k * 7) % 185))); }
 k=0
 gen_set "$HOLD" hold hold_sent car_hold HOLD_VOICES HOLD_SPEEDS HOLD_SENT HOLD_VOICES 155
-# TUNING extension (session 4): the remaining errors were accented and slow voices, so the tuning
-# set gets 4 more voices (variants of the Caribbean, New York and British accents; none is a test,
-# held-out or FINAL voice) x speeds 115/145/175 x the phrases with espeak pitch 40/50/60, and 24
-# more non-command sentences x the same 4 voices; noise from the first half, other offsets.
+# TUNING extension for accented and slow voices (where the other tuning files leave errors): 4
+# more voices (variants of the Caribbean, New York and British accents; none is a test, held-out
+# or FINAL voice) x speeds 115/145/175 x the phrases with espeak pitch 40/50/60, and 24 more
+# non-command sentences x the same 4 voices; noise from the first half, other offsets.
 TUNE3_VOICES=(en-029+f3 en-029+m3 en-us-nyc+f3 en-gb+f3)
 TUNE3_SPEEDS=(115 145 175)
 TUNE3_SENT=("the tailor is coming at noon" "could you fetch the measuring tape"
@@ -203,7 +203,7 @@ speed_tune3() { S=${TUNE3_SPEEDS[$((k % 3))]}; }
 k=0
 gen_set "$TUNE" tune3 tune3_sent car_tune3 TUNE3_VOICES TUNE3_SPEEDS TUNE3_SENT TUNE3_VOICES speed_tune3
 [ -z "$TUNE_ONLY" ] || exit 0
-# FINAL set (session 4): generated after every decision, evaluated once, the headline of
+# FINAL set: no decision depends on it; evaluated once, the headline of
 # out/bench/voice.json. The test set's voice/speed mix (5 voices x 120/150/180 x the phrases + 20
 # sentences x 5 voices) with new carriers (espeak pitch 35/50/65, 0.5-1.1 s of noise after the
 # speech), 20 new sentences, and a NEW noise recording (the second channel of a seeded stereo
@@ -226,7 +226,7 @@ car_final() {
 }
 k=0
 gen_set "$FINAL" final final_sent car_final TEST_VOICES TEST_SPEEDS FINAL_SENT TEST_VOICES 150
-# Garbage path: the phone loop (default since the session-2 attempt) or the filler words (--fillers).
+# Garbage path: the phone loop (the default) or the filler words (--fillers).
 GARBAGE=--phones
 [ -z "$FILLERS" ] || GARBAGE=--fillers
 # Front end (defaults: noise subtraction on, +-48 LSB comfort noise); --front overrides, e.g.
@@ -246,7 +246,7 @@ FIXED=(--phrases "$PHRASES" --hangover "$HANG" --wip "$WIP" --margin "$MARGIN" -
   --max-s "$MAXS" --max-outside "$OUTSIDE" --per-s "${PERS:-0}" --garbage-lw "$GLW" $GARBAGE
   ${SINGLE:+--single} ${FRONT[@]+"${FRONT[@]}"})
 # 3. The chosen configuration on every set, each decoded once: the tuning set (its own figures),
-# the old test and held-out sets (seen by earlier sessions' decisions) and, last, the FINAL set
+# the test and held-out sets ("seen", see the header) and, last, the FINAL set
 # that no decision looked at: the headline of out/bench/voice.json.
 for s in tune test holdout; do
   "$BUILD/bin/voice_bench" "$SET/$s.tsv" "$SET/$s.json" "${FIXED[@]}" > "$SET/$s.log"
