@@ -222,7 +222,7 @@ int main(int argc, char** argv) {
   std::ofstream csv("out/bench/baseline.csv");
   csv << "resolution,ms_per_frame,max_stable_dt,substeps_per_frame,collision_ns_per_vertex\n";
   std::printf(
-      "\nbaseline (study's mass-spring + damped Verlet, 9AR form collision), 1/90 s frames\n"
+      "\nbaseline (explicit mass-spring + damped Verlet, 9AR form collision), 1/90 s frames\n"
       "(ms/frame and collision: CPU time of the thread; wall ms under the machine's load beside)\n"
       "%-10s %12s %12s %10s %14s %10s %12s %14s %10s\n",
       "resolution", "ms/frame", "wall ms", "x 21^2", "max stable dt", "substeps", "auto substeps",

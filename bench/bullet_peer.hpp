@@ -1,9 +1,9 @@
 // The peer of the solver benchmark (solvers_bench): Bullet's soft body (Debian libbullet-dev,
 // btSoftBody position-based links) on the hanging-sheet scene of sim/testbeds/testbed.hpp, with the
 // same vertices, triangles, lumped masses, pins, gravity and frame length as our solvers. Matching
-// (docs/solvers.md, "Bullet peer"): one Bullet link per triangle edge of the cloth; each link's
-// kLST is derived from the FEM's stiffness along that edge (warp, weft, or the diagonal's shear
-// stiffness 2G), the substep h and the link's reduced mass:
+// (docs/solvers.md, "Measured figures"): one Bullet link per triangle edge of the cloth; each
+// link's kLST is derived from the FEM's stiffness along that edge (warp, weft, or the diagonal's
+// shear stiffness 2G), the substep h and the link's reduced mass:
 //   s = k h^2 / (m_ab + k h^2)  (the fraction of the violation an implicit spring removes in
 //   one step), kLST = 1 - (1 - s)^(1/iterations) (so `iterations` passes remove the same).
 // No damping (fabric damping 0 -> kDP 0), no aerodynamics (kLF = kDG = 0, air density 0), no

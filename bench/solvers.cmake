@@ -10,7 +10,7 @@ find_library(DRAPE_BULLET_MATH LinearMath)
 if(NOT (DRAPE_BULLET_INCLUDE AND DRAPE_BULLET_SOFT AND DRAPE_BULLET_DYN AND DRAPE_BULLET_COLL
         AND DRAPE_BULLET_MATH))
   message(FATAL_ERROR "Bullet soft body not found (Debian package libbullet-dev; `./drape setup` "
-                      "installs it), needed by the solver study's peer (bench/bullet_peer.cpp)")
+                      "installs it), needed by the solver benchmark's peer (bench/bullet_peer.cpp)")
 endif()
 foreach(tgt solvers_bench bullet_peer_bench)
   if(TARGET ${tgt})

@@ -972,7 +972,7 @@ void add_knobs(CLI::App& app, Knobs& kn, std::string& simd) {
   const auto non_negative = CLI::Range(0.0, 1e9);
   app.option_defaults()->always_capture_default();
   // The benchmark grid.
-  app.option_defaults()->group("Study");
+  app.option_defaults()->group("Benchmark grid");
   app.add_flag("--quick", kn.quick,
                "the quick grid (./drape bench solvers' default; a few minutes)");
   app.add_option("--max-res", kn.max_res,
@@ -992,7 +992,7 @@ void add_knobs(CLI::App& app, Knobs& kn, std::string& simd) {
           },
           "none|avx2|widest"));
   app.add_option("--threads", kn.threads,
-                 "solver threads (default: 1 in the study's grid, 2 in --probe, 1 in the pool of "
+                 "solver threads (default: 1 in the benchmark grid, 2 in --probe, 1 in the pool of "
                  "--finish)")
       ->check(CLI::Range(1, 256));
   app.add_option("--ref-iters", kn.ref_iters,
@@ -1157,7 +1157,7 @@ int main(int argc, char** argv) {
   Knobs kn;
   std::string simd;
   CLI::App app{
-      "The solver study: solver x substeps x iterations x resolution on the shared scenes "
+      "The solver benchmark: solver x substeps x iterations x resolution on the shared scenes "
       "(out/bench/solvers*.csv, .svg), or one configuration (--probe)."};
   add_knobs(app, kn, simd);
   CLI11_PARSE(app, argc, argv);
