@@ -10,6 +10,7 @@
 
 #include "sim/core/cloth.hpp"
 #include "sim/core/fabric.hpp"
+#include "sim/core/scene_objects.hpp"
 #include "sim/draping/mapping.hpp"
 #include "sim/draping/panel.hpp"
 #include "sim/form/dress_form.hpp"
@@ -206,6 +207,10 @@ void parse_cloth(const json& c, const std::string& base, sim::SceneSnapshot& sna
       if (!s) bad("cloth.drape.solver", s.error());
       sim::SceneObjects objs;
       objs.form = snap.form;
+      // Muslin on the form's linen cover does not slide (Coulomb friction, every solver).
+      objs.friction = d.contains("friction") ? number(d["friction"], "cloth.drape.friction")
+                                             : sim::kFormFriction;
+      if (objs.friction < 0 || objs.friction > 2) bad("cloth.drape.friction", "outside [0, 2]");
       for (const auto& p : snap.plates) objs.plates.push_back(p);
       for (const auto& b : snap.boxes) objs.boxes.push_back(b);
       for (const auto& sp : snap.spheres) objs.spheres.push_back(sp);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 
 namespace drape::app {
@@ -90,6 +92,29 @@ TEST(SceneFile, BadInputNamesTheField) {
   expect_error(R"({"candidates": [{"hand": 0, "vertex": 3}]})", "candidates[0].vertex");
   expect_error(R"({"form": {"size": "99XX"}})", "form.size");
   expect_error(R"({"form": {"colour": 1}})", "form");
+}
+
+// The default scene of `drape render` drapes with the app's solver (XPBD) and friction on the
+// form: the muslin hangs from the shoulders instead of sliding off (without friction it slid
+// down the form and off its hips within 1.5 s).
+TEST(SceneFile, DefaultSceneHangsOnTheForm) {
+  auto d = default_scene(2.5, "xpbd", 41);
+  ASSERT_TRUE(d) << d.error();
+  const auto& x = d->snapshot.positions;
+  ASSERT_EQ(x.size(), 41u * 41u);
+  float top = -1e9f, bottom = 1e9f, r2max = 0;
+  for (const auto& p : x) {
+    ASSERT_TRUE(std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()));
+    top = std::max(top, p.y());
+    bottom = std::min(bottom, p.y());
+    r2max = std::max(r2max, p.x() * p.x() + p.z() * p.z());
+  }
+  // The 9AR form's neck base is at 1.35 m, its shoulders ~1.3 m: the panel rests there.
+  EXPECT_GT(top, 1.25f);
+  // A 1 m square hanging from the shoulders reaches no lower than ~0.7 m and stays within
+  // ~0.8 m of the form's axis.
+  EXPECT_GT(bottom, 0.5f);
+  EXPECT_LT(std::sqrt(r2max), 0.8f);
 }
 
 TEST(SceneFile, MissingFileIsAnError) {
