@@ -47,12 +47,18 @@ struct TargetKey {
   VkFormat format;
   int samples;
   VkImageLayout final_layout;
-  auto tie() const { return std::tie(image, layer, width, height, format, samples, final_layout); }
+  VkImage depth_image;
+  VkFormat depth_format;
+  auto tie() const {
+    return std::tie(image, layer, width, height, format, samples, final_layout, depth_image,
+                    depth_format);
+  }
   bool operator<(const TargetKey& o) const { return tie() < o.tie(); }
 };
 
 struct TargetFb {
   VkImageView view = VK_NULL_HANDLE;
+  VkImageView depth_view = VK_NULL_HANDLE;  // of the caller's depth image
   VkFramebuffer framebuffer = VK_NULL_HANDLE;
 };
 
@@ -99,8 +105,10 @@ struct Renderer::Impl {
   VkFence fence = VK_NULL_HANDLE;
   VkShaderModule vs = VK_NULL_HANDLE, fs = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  std::map<std::tuple<VkFormat, int, VkImageLayout>, VkRenderPass> passes;
-  std::map<std::tuple<VkFormat, int, uint32_t>, VkPipeline> pipelines;  // + modes mask
+  // (colour format, samples, final layout, depth format, depth stored)
+  std::map<std::tuple<VkFormat, int, VkImageLayout, VkFormat, bool>, VkRenderPass> passes;
+  std::map<std::tuple<VkFormat, int, uint32_t, VkFormat, bool>, VkPipeline>
+      pipelines;  // + modes mask, depth format, depth write
   std::map<std::tuple<uint32_t, uint32_t, VkFormat, int>, std::pair<Attachment, Attachment>>
       attachments;  // (depth, msaa colour) per size/format/samples
   std::map<TargetKey, TargetFb> targets;
@@ -305,12 +313,15 @@ struct Renderer::Impl {
     for (auto& [k, t] : targets) {
       if (t.framebuffer) vkDestroyFramebuffer(dev(), t.framebuffer, nullptr);
       if (t.view) vkDestroyImageView(dev(), t.view, nullptr);
+      if (t.depth_view) vkDestroyImageView(dev(), t.depth_view, nullptr);
     }
     targets.clear();
   }
 
-  sim::Result<VkRenderPass> pass_for(VkFormat fmt, VkImageLayout final_layout) {
-    const auto key = std::make_tuple(fmt, samples, final_layout);
+  // store_depth: the depth attachment is the caller's (depth_fmt), stored.
+  sim::Result<VkRenderPass> pass_for(VkFormat fmt, VkImageLayout final_layout, VkFormat depth_fmt,
+                                     bool store_depth) {
+    const auto key = std::make_tuple(fmt, samples, final_layout, depth_fmt, store_depth);
     if (auto it = passes.find(key); it != passes.end()) return it->second;
     const auto s = static_cast<VkSampleCountFlagBits>(samples);
     std::vector<VkAttachmentDescription> att;
@@ -325,8 +336,8 @@ struct Renderer::Impl {
     color.finalLayout = samples > 1 ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : final_layout;
     att.push_back(color);
     VkAttachmentDescription depth = color;
-    depth.format = VK_FORMAT_D32_SFLOAT;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    depth.format = depth_fmt;
+    depth.storeOp = store_depth ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE;
     depth.finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
     att.push_back(depth);
     if (samples > 1) {
@@ -381,8 +392,9 @@ struct Renderer::Impl {
 
   // One pipeline per (format, samples, shading modes of the draw): the fragment shader is
   // specialised to the modes present (scene.frag kModes).
-  sim::Result<VkPipeline> pipeline_for(VkFormat fmt, VkRenderPass rp, uint32_t modes) {
-    const auto key = std::make_tuple(fmt, samples, modes);
+  sim::Result<VkPipeline> pipeline_for(VkFormat fmt, VkRenderPass rp, uint32_t modes,
+                                       VkFormat depth_fmt, bool depth_write = true) {
+    const auto key = std::make_tuple(fmt, samples, modes, depth_fmt, depth_write);
     if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
     const auto spec_value = static_cast<int32_t>(modes);
     const VkSpecializationMapEntry spec_entry{0, 0, sizeof(int32_t)};
@@ -431,7 +443,7 @@ struct Renderer::Impl {
     VkPipelineDepthStencilStateCreateInfo ds{
         VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
     ds.depthTestEnable = VK_TRUE;
-    ds.depthWriteEnable = VK_TRUE;
+    ds.depthWriteEnable = depth_write ? VK_TRUE : VK_FALSE;
     ds.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
     VkPipelineColorBlendAttachmentState cba{};
     cba.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
@@ -486,8 +498,8 @@ struct Renderer::Impl {
   }
 
   sim::Result<VkFramebuffer> framebuffer_for(const ColorTarget& t, VkRenderPass rp) {
-    const TargetKey key{t.image,  t.array_layer, t.width,       t.height,
-                        t.format, samples,       t.final_layout};
+    const TargetKey key{t.image, t.array_layer,  t.width,       t.height,      t.format,
+                        samples, t.final_layout, t.depth_image, t.depth_format};
     if (auto it = targets.find(key); it != targets.end()) return it->second.framebuffer;
     auto att = attachments_for(t.width, t.height, t.format);
     if (!att) return sim::Error{att.error()};
@@ -499,11 +511,22 @@ struct Renderer::Impl {
     vi.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, t.array_layer, 1};
     if (VkResult r = vkCreateImageView(dev(), &vi, nullptr, &fb.view); r != VK_SUCCESS)
       return sim::Error{fail("vkCreateImageView (target)", r).error};
+    VkImageView depth_view = (*att)->first.view;
+    if (t.depth_image) {
+      vi.image = t.depth_image;
+      vi.format = t.depth_format;
+      vi.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, t.array_layer, 1};
+      if (VkResult r = vkCreateImageView(dev(), &vi, nullptr, &fb.depth_view); r != VK_SUCCESS) {
+        vkDestroyImageView(dev(), fb.view, nullptr);
+        return sim::Error{fail("vkCreateImageView (depth target)", r).error};
+      }
+      depth_view = fb.depth_view;
+    }
     std::vector<VkImageView> views;
     if (samples > 1)
-      views = {(*att)->second.view, (*att)->first.view, fb.view};
+      views = {(*att)->second.view, depth_view, fb.view};
     else
-      views = {fb.view, (*att)->first.view};
+      views = {fb.view, depth_view};
     VkFramebufferCreateInfo fi{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
     fi.renderPass = rp;
     fi.attachmentCount = static_cast<uint32_t>(views.size());
@@ -513,6 +536,7 @@ struct Renderer::Impl {
     fi.layers = 1;
     if (VkResult r = vkCreateFramebuffer(dev(), &fi, nullptr, &fb.framebuffer); r != VK_SUCCESS) {
       vkDestroyImageView(dev(), fb.view, nullptr);
+      if (fb.depth_view) vkDestroyImageView(dev(), fb.depth_view, nullptr);
       return sim::Error{fail("vkCreateFramebuffer", r).error};
     }
     targets[key] = fb;
@@ -618,6 +642,11 @@ struct Renderer::Impl {
       const ColorTarget& t = views[i].target;
       if (!t.image || t.width == 0 || t.height == 0)
         return Status{"render: target image is null or has zero size"};
+      if (t.depth_image && samples > 1)
+        return Status{"render: a caller's depth image needs samples 1"};
+      if (t.depth_image && t.depth_format != VK_FORMAT_D32_SFLOAT &&
+          t.depth_format != VK_FORMAT_D16_UNORM)
+        return Status{"render: the depth image must be D32_SFLOAT or D16_UNORM"};
     }
     const double cpu0 = thread_cpu_ms();
     auto t0 = Clock::now();
@@ -659,7 +688,8 @@ struct Renderer::Impl {
     for (int i = 0; i < count; ++i) {
       const View& view = views[i].view;
       const ColorTarget& t = views[i].target;
-      auto rp = pass_for(t.format, t.final_layout);
+      const VkFormat depth_fmt = t.depth_image ? t.depth_format : VK_FORMAT_D32_SFLOAT;
+      auto rp = pass_for(t.format, t.final_layout, depth_fmt, t.depth_image != VK_NULL_HANDLE);
       if (!rp) return Status{rp.error()};
       auto fb = framebuffer_for(t, *rp);
       if (!fb) return Status{fb.error()};
@@ -709,9 +739,15 @@ struct Renderer::Impl {
       const VkDeviceSize zero = 0;
       VkPipeline bound = VK_NULL_HANDLE;
       const Buffer* bound_vb = nullptr;
-      for (const DrawRange& d : ranges) {
+      // A stored (submitted) depth holds the scene only: the hands and markers are drawn last,
+      // depth-tested but not written, so the depth under a hand is the surface it is over, not
+      // its own pointer (a compositor reprojecting, or a desk runtime placing the hand on it).
+      const bool stored = t.depth_image != VK_NULL_HANDLE;
+      static constexpr int kSceneOrder[4] = {0, 1, 2, 3}, kStoredOrder[4] = {1, 2, 3, 0};
+      for (int k : stored ? kStoredOrder : kSceneOrder) {
+        const DrawRange& d = ranges[k];
         if (!d.count) continue;
-        auto pipe = pipeline_for(t.format, *rp, d.modes);
+        auto pipe = pipeline_for(t.format, *rp, d.modes, depth_fmt, !(stored && k == 0));
         if (!pipe) {
           vkCmdEndRenderPass(cmd);
           vkEndCommandBuffer(cmd);
