@@ -185,5 +185,5 @@ m = re.search(r"pinched_frames (\d+)", text)
 assert m and int(m.group(1)) > 10, "too few frames with the particle held"
 PY
 echo "ok: the pinch took a cloth particle at the hand and the drag moved it"
-grep "frame p50" "$OUT/stdout"
+grep "fps (frame work p50" "$OUT/stdout"
 echo PASS

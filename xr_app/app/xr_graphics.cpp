@@ -140,8 +140,10 @@ bool XrGraphics::create_swapchains(XrInstance instance, XrSystemId system, XrSes
                       eye.width, eye.height, eye.chain, eye.images))
       return false;
     if (depth_format_ != VK_FORMAT_UNDEFINED &&
-        !create_chain(session, depth_format_, XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
-                      eye.width, eye.height, eye.depth_chain, eye.depth_images))
+        !create_chain(
+            session, depth_format_,
+            XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT,
+            eye.width, eye.height, eye.depth_chain, eye.depth_images))
       return false;
   }
   if (depth_format_ != VK_FORMAT_UNDEFINED)
