@@ -47,12 +47,19 @@ struct TargetKey {
   VkFormat format;
   int samples;
   VkImageLayout final_layout;
-  auto tie() const { return std::tie(image, layer, width, height, format, samples, final_layout); }
+  VkImage depth_image;
+  VkFormat depth_format;
+  auto tie() const {
+    return std::tie(image, layer, width, height, format, samples, final_layout, depth_image,
+                    depth_format);
+  }
   bool operator<(const TargetKey& o) const { return tie() < o.tie(); }
 };
 
 struct TargetFb {
   VkImageView view = VK_NULL_HANDLE;
+  VkImageView depth_view = VK_NULL_HANDLE;             // of the caller's depth image
+  VkFramebuffer overlay_framebuffer = VK_NULL_HANDLE;  // colour + the renderer's depth
   VkFramebuffer framebuffer = VK_NULL_HANDLE;
 };
 
@@ -99,10 +106,17 @@ struct Renderer::Impl {
   VkFence fence = VK_NULL_HANDLE;
   VkShaderModule vs = VK_NULL_HANDLE, fs = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  std::map<std::tuple<VkFormat, int, VkImageLayout>, VkRenderPass> passes;
-  std::map<std::tuple<VkFormat, int, uint32_t>, VkPipeline> pipelines;  // + modes mask
-  std::map<std::tuple<uint32_t, uint32_t, VkFormat, int>, std::pair<Attachment, Attachment>>
-      attachments;  // (depth, msaa colour) per size/format/samples
+  // With a caller's depth image a view is drawn in two passes: kScene (cloth, form, floor into
+  // the colour and the caller's depth, stored), then the depth is copied into the renderer's
+  // own and kOverlay (hands and markers, the colour and that copy loaded) draws over it.
+  enum PassKind { kWhole = 0, kScene = 1, kOverlay = 2 };
+  // (colour format, samples, final layout, depth format, kind)
+  std::map<std::tuple<VkFormat, int, VkImageLayout, VkFormat, int>, VkRenderPass> passes;
+  std::map<std::tuple<VkFormat, int, uint32_t, VkFormat>, VkPipeline>
+      pipelines;  // + modes mask, depth format
+  std::map<std::tuple<uint32_t, uint32_t, VkFormat, int, VkFormat>,
+           std::pair<Attachment, Attachment>>
+      attachments;  // (depth, msaa colour) per size/format/samples/depth format
   std::map<TargetKey, TargetFb> targets;
 
   // Offscreen target + readback.
@@ -305,12 +319,15 @@ struct Renderer::Impl {
     for (auto& [k, t] : targets) {
       if (t.framebuffer) vkDestroyFramebuffer(dev(), t.framebuffer, nullptr);
       if (t.view) vkDestroyImageView(dev(), t.view, nullptr);
+      if (t.depth_view) vkDestroyImageView(dev(), t.depth_view, nullptr);
+      if (t.overlay_framebuffer) vkDestroyFramebuffer(dev(), t.overlay_framebuffer, nullptr);
     }
     targets.clear();
   }
 
-  sim::Result<VkRenderPass> pass_for(VkFormat fmt, VkImageLayout final_layout) {
-    const auto key = std::make_tuple(fmt, samples, final_layout);
+  sim::Result<VkRenderPass> pass_for(VkFormat fmt, VkImageLayout final_layout, VkFormat depth_fmt,
+                                     PassKind kind) {
+    const auto key = std::make_tuple(fmt, samples, final_layout, depth_fmt, static_cast<int>(kind));
     if (auto it = passes.find(key); it != passes.end()) return it->second;
     const auto s = static_cast<VkSampleCountFlagBits>(samples);
     std::vector<VkAttachmentDescription> att;
@@ -323,11 +340,21 @@ struct Renderer::Impl {
     color.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
     color.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     color.finalLayout = samples > 1 ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : final_layout;
+    if (kind == kScene) color.finalLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    if (kind == kOverlay) {
+      color.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+      color.initialLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    }
     att.push_back(color);
     VkAttachmentDescription depth = color;
-    depth.format = VK_FORMAT_D32_SFLOAT;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-    depth.finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    depth.format = depth_fmt;
+    depth.storeOp =
+        kind == kScene ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    depth.initialLayout = kind == kOverlay ? VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL
+                                           : VK_IMAGE_LAYOUT_UNDEFINED;
+    // kScene: copied from next (then left for the caller in DEPTH_STENCIL_ATTACHMENT_OPTIMAL).
+    depth.finalLayout = kind == kScene ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL
+                                       : VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
     att.push_back(depth);
     if (samples > 1) {
       VkAttachmentDescription resolve = color;
@@ -381,8 +408,11 @@ struct Renderer::Impl {
 
   // One pipeline per (format, samples, shading modes of the draw): the fragment shader is
   // specialised to the modes present (scene.frag kModes).
-  sim::Result<VkPipeline> pipeline_for(VkFormat fmt, VkRenderPass rp, uint32_t modes) {
-    const auto key = std::make_tuple(fmt, samples, modes);
+  // The render passes of one (format, samples, depth format) are compatible: any of them
+  // makes the pipeline.
+  sim::Result<VkPipeline> pipeline_for(VkFormat fmt, VkRenderPass rp, uint32_t modes,
+                                       VkFormat depth_fmt) {
+    const auto key = std::make_tuple(fmt, samples, modes, depth_fmt);
     if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
     const auto spec_value = static_cast<int32_t>(modes);
     const VkSpecializationMapEntry spec_entry{0, 0, sizeof(int32_t)};
@@ -465,13 +495,16 @@ struct Renderer::Impl {
     return p;
   }
 
-  sim::Result<std::pair<Attachment, Attachment>*> attachments_for(uint32_t w, uint32_t h,
-                                                                  VkFormat fmt) {
-    const auto key = std::make_tuple(w, h, fmt, samples);
+  // The renderer's depth (depth_fmt: that of a caller's depth image it is copied from) and MSAA
+  // colour.
+  sim::Result<std::pair<Attachment, Attachment>*> attachments_for(
+      uint32_t w, uint32_t h, VkFormat fmt, VkFormat depth_fmt = VK_FORMAT_D32_SFLOAT) {
+    const auto key = std::make_tuple(w, h, fmt, samples, depth_fmt);
     if (auto it = attachments.find(key); it != attachments.end()) return &it->second;
     std::pair<Attachment, Attachment> a;
     Status st =
-        make_image(a.first, w, h, VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
+        make_image(a.first, w, h, depth_fmt,
+                   VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
                    VK_IMAGE_ASPECT_DEPTH_BIT, samples);
     if (st && samples > 1)
       st = make_image(a.second, w, h, fmt,
@@ -485,11 +518,15 @@ struct Renderer::Impl {
     return &(attachments[key] = a);
   }
 
-  sim::Result<VkFramebuffer> framebuffer_for(const ColorTarget& t, VkRenderPass rp) {
-    const TargetKey key{t.image,  t.array_layer, t.width,       t.height,
-                        t.format, samples,       t.final_layout};
-    if (auto it = targets.find(key); it != targets.end()) return it->second.framebuffer;
-    auto att = attachments_for(t.width, t.height, t.format);
+  // The target's framebuffer for rp; with a caller's depth image (rp kScene) also the kOverlay
+  // framebuffer for overlay_rp (fb.overlay_framebuffer).
+  sim::Result<TargetFb> framebuffer_for(const ColorTarget& t, VkRenderPass rp,
+                                        VkRenderPass overlay_rp = VK_NULL_HANDLE) {
+    const TargetKey key{t.image, t.array_layer,  t.width,       t.height,      t.format,
+                        samples, t.final_layout, t.depth_image, t.depth_format};
+    if (auto it = targets.find(key); it != targets.end()) return it->second;
+    auto att = attachments_for(t.width, t.height, t.format,
+                               t.depth_image ? t.depth_format : VK_FORMAT_D32_SFLOAT);
     if (!att) return sim::Error{att.error()};
     TargetFb fb;
     VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
@@ -499,11 +536,22 @@ struct Renderer::Impl {
     vi.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, t.array_layer, 1};
     if (VkResult r = vkCreateImageView(dev(), &vi, nullptr, &fb.view); r != VK_SUCCESS)
       return sim::Error{fail("vkCreateImageView (target)", r).error};
+    VkImageView depth_view = (*att)->first.view;
+    if (t.depth_image) {
+      vi.image = t.depth_image;
+      vi.format = t.depth_format;
+      vi.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, t.array_layer, 1};
+      if (VkResult r = vkCreateImageView(dev(), &vi, nullptr, &fb.depth_view); r != VK_SUCCESS) {
+        vkDestroyImageView(dev(), fb.view, nullptr);
+        return sim::Error{fail("vkCreateImageView (depth target)", r).error};
+      }
+      depth_view = fb.depth_view;
+    }
     std::vector<VkImageView> views;
     if (samples > 1)
-      views = {(*att)->second.view, (*att)->first.view, fb.view};
+      views = {(*att)->second.view, depth_view, fb.view};
     else
-      views = {fb.view, (*att)->first.view};
+      views = {fb.view, depth_view};
     VkFramebufferCreateInfo fi{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
     fi.renderPass = rp;
     fi.attachmentCount = static_cast<uint32_t>(views.size());
@@ -513,10 +561,23 @@ struct Renderer::Impl {
     fi.layers = 1;
     if (VkResult r = vkCreateFramebuffer(dev(), &fi, nullptr, &fb.framebuffer); r != VK_SUCCESS) {
       vkDestroyImageView(dev(), fb.view, nullptr);
+      if (fb.depth_view) vkDestroyImageView(dev(), fb.depth_view, nullptr);
       return sim::Error{fail("vkCreateFramebuffer", r).error};
     }
+    if (t.depth_image) {
+      const VkImageView ov[2] = {fb.view, (*att)->first.view};
+      fi.renderPass = overlay_rp;
+      fi.pAttachments = ov;
+      if (VkResult r = vkCreateFramebuffer(dev(), &fi, nullptr, &fb.overlay_framebuffer);
+          r != VK_SUCCESS) {
+        vkDestroyFramebuffer(dev(), fb.framebuffer, nullptr);
+        vkDestroyImageView(dev(), fb.view, nullptr);
+        vkDestroyImageView(dev(), fb.depth_view, nullptr);
+        return sim::Error{fail("vkCreateFramebuffer (overlay)", r).error};
+      }
+    }
     targets[key] = fb;
-    return fb.framebuffer;
+    return fb;
   }
 
   Status upload(const Mesh& m, Buffer& vb, Buffer& ib) {
@@ -607,6 +668,45 @@ struct Renderer::Impl {
     return true;
   }
 
+  // Between the kScene and kOverlay passes: the caller's depth (TRANSFER_SRC_OPTIMAL) into the
+  // renderer's `own` depth image; both then in DEPTH_STENCIL_ATTACHMENT_OPTIMAL.
+  void copy_depth(const ColorTarget& t, VkImage own) {
+    auto barrier = [&](VkImage image, uint32_t layer, VkImageLayout from, VkImageLayout to,
+                       VkAccessFlags src, VkAccessFlags dst, VkPipelineStageFlags src_stage,
+                       VkPipelineStageFlags dst_stage) {
+      VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+      b.oldLayout = from;
+      b.newLayout = to;
+      b.srcAccessMask = src;
+      b.dstAccessMask = dst;
+      b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+      b.image = image;
+      b.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, layer, 1};
+      vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 0, nullptr, 0, nullptr, 1, &b);
+    };
+    const VkAccessFlags depth_rw =
+        VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+    const VkPipelineStageFlags tests =
+        VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
+    barrier(t.depth_image, t.array_layer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+            VK_ACCESS_TRANSFER_READ_BIT, tests, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    barrier(own, 0, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+            VK_ACCESS_TRANSFER_WRITE_BIT, tests, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkImageCopy region{};
+    region.srcSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, t.array_layer, 1};
+    region.dstSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+    region.extent = {t.width, t.height, 1};
+    vkCmdCopyImage(cmd, t.depth_image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, own,
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    barrier(t.depth_image, t.array_layer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, VK_ACCESS_TRANSFER_READ_BIT, 0,
+            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+    barrier(own, 0, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+            VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+            depth_rw, VK_PIPELINE_STAGE_TRANSFER_BIT, tests);
+  }
+
   // Records and submits one frame into every target of `views` (the geometry is built and
   // uploaded once); with `readback_copy` (one view) also copies the result into the readback
   // buffer. Waits for completion.
@@ -618,6 +718,11 @@ struct Renderer::Impl {
       const ColorTarget& t = views[i].target;
       if (!t.image || t.width == 0 || t.height == 0)
         return Status{"render: target image is null or has zero size"};
+      if (t.depth_image && samples > 1)
+        return Status{"render: a caller's depth image needs samples 1"};
+      if (t.depth_image && t.depth_format != VK_FORMAT_D32_SFLOAT &&
+          t.depth_format != VK_FORMAT_D16_UNORM)
+        return Status{"render: the depth image must be D32_SFLOAT or D16_UNORM"};
     }
     const double cpu0 = thread_cpu_ms();
     auto t0 = Clock::now();
@@ -659,9 +764,14 @@ struct Renderer::Impl {
     for (int i = 0; i < count; ++i) {
       const View& view = views[i].view;
       const ColorTarget& t = views[i].target;
-      auto rp = pass_for(t.format, t.final_layout);
+      const bool stored = t.depth_image != VK_NULL_HANDLE;
+      const VkFormat depth_fmt = stored ? t.depth_format : VK_FORMAT_D32_SFLOAT;
+      auto rp = pass_for(t.format, t.final_layout, depth_fmt, stored ? kScene : kWhole);
       if (!rp) return Status{rp.error()};
-      auto fb = framebuffer_for(t, *rp);
+      sim::Result<VkRenderPass> overlay_rp = VkRenderPass{VK_NULL_HANDLE};
+      if (stored) overlay_rp = pass_for(t.format, t.final_layout, depth_fmt, kOverlay);
+      if (!overlay_rp) return Status{overlay_rp.error()};
+      auto fb = framebuffer_for(t, *rp, *overlay_rp);
       if (!fb) return Status{fb.error()};
 
       PushConstants pc{};
@@ -695,7 +805,7 @@ struct Renderer::Impl {
       clears[2] = clears[0];
       VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
       rbi.renderPass = *rp;
-      rbi.framebuffer = *fb;
+      rbi.framebuffer = fb->framebuffer;
       rbi.renderArea = {{0, 0}, {t.width, t.height}};
       rbi.clearValueCount = samples > 1 ? 3 : 2;
       rbi.pClearValues = clears;
@@ -709,24 +819,50 @@ struct Renderer::Impl {
       const VkDeviceSize zero = 0;
       VkPipeline bound = VK_NULL_HANDLE;
       const Buffer* bound_vb = nullptr;
-      for (const DrawRange& d : ranges) {
-        if (!d.count) continue;
-        auto pipe = pipeline_for(t.format, *rp, d.modes);
-        if (!pipe) {
-          vkCmdEndRenderPass(cmd);
-          vkEndCommandBuffer(cmd);
-          return Status{pipe.error()};
+      auto draw_ranges = [&](std::initializer_list<int> which) -> Status {
+        for (int k : which) {
+          const DrawRange& d = ranges[k];
+          if (!d.count) continue;
+          auto pipe = pipeline_for(t.format, *rp, d.modes, depth_fmt);
+          if (!pipe) return Status{pipe.error()};
+          if (*pipe != bound) {
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, *pipe);
+            bound = *pipe;
+          }
+          if (d.vb != bound_vb) {
+            vkCmdBindVertexBuffers(cmd, 0, 1, &d.vb->buffer, &zero);
+            vkCmdBindIndexBuffer(cmd, d.ib->buffer, 0, VK_INDEX_TYPE_UINT32);
+            bound_vb = d.vb;
+          }
+          vkCmdDrawIndexed(cmd, d.count, 1, d.first, 0, 0);
         }
-        if (*pipe != bound) {
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, *pipe);
-          bound = *pipe;
-        }
-        if (d.vb != bound_vb) {
-          vkCmdBindVertexBuffers(cmd, 0, 1, &d.vb->buffer, &zero);
-          vkCmdBindIndexBuffer(cmd, d.ib->buffer, 0, VK_INDEX_TYPE_UINT32);
-          bound_vb = d.vb;
-        }
-        vkCmdDrawIndexed(cmd, d.count, 1, d.first, 0, 0);
+        return Status{};
+      };
+      // A caller's depth holds the scene only (cloth, form, floor): the hands and markers are
+      // drawn in a second pass over a copy of it, so the depth under a hand is the surface it
+      // is over, not its own pointer (a compositor reprojecting the scene, a desk runtime
+      // placing the hand on it). The colour is the same as in one pass.
+      Status drawn = stored ? draw_ranges({1, 2, 3}) : draw_ranges({0, 1, 2, 3});
+      if (drawn && stored) {
+        vkCmdEndRenderPass(cmd);
+        copy_depth(t, (*attachments_for(t.width, t.height, t.format, depth_fmt))->first.image);
+        rbi.renderPass = *overlay_rp;
+        rbi.framebuffer = fb->overlay_framebuffer;
+        rbi.clearValueCount = 0;
+        rbi.pClearValues = nullptr;
+        vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+        vkCmdSetViewport(cmd, 0, 1, &viewport);
+        vkCmdSetScissor(cmd, 0, 1, &scissor);
+        vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                           0, sizeof(pc), &pc);
+        bound = VK_NULL_HANDLE;
+        bound_vb = nullptr;
+        drawn = draw_ranges({0});
+      }
+      if (!drawn) {
+        vkCmdEndRenderPass(cmd);
+        vkEndCommandBuffer(cmd);
+        return drawn;
       }
       vkCmdEndRenderPass(cmd);
       if (readback_copy && i == 0) {

@@ -30,6 +30,14 @@ struct ColorTarget {
   uint32_t width = 0, height = 0;
   uint32_t array_layer = 0;
   VkImageLayout final_layout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;  // what XR expects
+  // Optional: the caller's depth image (an XR depth swapchain image, same size, same array layer;
+  // D32_SFLOAT or D16_UNORM; depth-attachment and transfer-source usage). The scene's depth
+  // (cloth, form, floor; not the hands and markers drawn over it) is stored into it (storeOp
+  // STORE: 0 at the view's near plane, 1 at its far plane) and it is left in
+  // DEPTH_STENCIL_ATTACHMENT_OPTIMAL. Needs samples 1. Null: the renderer's own depth buffer,
+  // not stored.
+  VkImage depth_image = VK_NULL_HANDLE;
+  VkFormat depth_format = VK_FORMAT_D32_SFLOAT;
 };
 
 // 8-bit RGBA pixels, rows top to bottom, sRGB-encoded.

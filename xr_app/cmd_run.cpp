@@ -1,10 +1,11 @@
 // `drape run`: the main job. With an OpenXR runtime (a headset, or else the headless simulated
 // runtime built next to the executable) it runs the XR app on the default draping scenario
 // (assets/scenarios/default.json) and writes screenshots, the session log, the draped cloth and
-// the pattern to out/ (see docs/xr.md). `drape run --headless` (or no XR build) is the sim-core
-// job: builds the 9AR form, drops a muslin panel over its shoulders on the simulation thread
-// (lock step, or real time), then writes the draped cloth and the form as glTF and prints where,
-// with the max penetration.
+// the pattern to out/ (see docs/xr.md). At a desk (a display, no headset runtime, no --scenario)
+// the simulated runtime opens its window instead and the person drapes live until Escape. `drape
+// run --headless` (or no XR build) is the sim-core job: builds the 9AR form, drops a muslin panel
+// over its shoulders on the simulation thread (lock step, or real time), then writes the draped
+// cloth and the form as glTF and prints where, with the max penetration.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -39,6 +40,16 @@ std::string fabrics_path() {
   return drape::app::user_or_asset("assets/fabrics.json").string();
 }
 
+// Creates `dir` (and its parents); else says why on stderr and returns false.
+bool make_dir(const std::string& dir, const std::string& shown) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec)
+    std::fprintf(stderr, "drape run: cannot create '%s': %s\n", shown.c_str(),
+                 ec.message().c_str());
+  return !ec;
+}
+
 // The headless job's options.
 struct HeadlessOptions {
   double seconds = 3.0, stiffness_scale = 1.0;
@@ -64,13 +75,7 @@ int write_headless(const HeadlessOptions& o, const World& w, const DressForm& f,
     return 1;
   }
 
-  std::error_code ec;
-  std::filesystem::create_directories(o.out, ec);
-  if (ec) {
-    std::fprintf(stderr, "drape run: cannot create '%s': %s\n", o.out.c_str(),
-                 ec.message().c_str());
-    return 1;
-  }
+  if (!make_dir(o.out, o.out)) return 1;
   const std::string cloth_path = o.out + "/drape_cloth.gltf",
                     form_path = o.out + "/dress_form.gltf";
   if (std::string e = write_meshes(cloth_path, {cloth_to_mesh(w.cloth, "cloth")}); !e.empty()) {
@@ -213,7 +218,71 @@ struct XrRunOptions {
   std::string scenario = "assets/scenarios/default.json", out = "out";
   bool pattern = true;
   int every = 30;
+  bool scenario_given = false;   // --scenario: always the scripted run
+  bool cloth_res_given = false;  // --cloth-res: also live
 };
+
+int export_pattern(const std::string& out);
+
+// The cloth resolution of a live session unless --cloth-res says otherwise.
+constexpr int kLiveClothRes = 12;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Live at a desk: the simulated runtime's window (DRAPE_MOCK_WINDOW, docs/mock-window.md) is the
+// headset; the person drives the head and hands with mouse and keyboard, no scenario, the sim
+// on its own 90 Hz clock, until Escape or the window is closed (or --frames).
+int run_live(XrRunOptions& o, const std::string& manifest) {
+  namespace app = drape::app;
+  const auto wall0 = std::chrono::steady_clock::now();
+  if (!make_dir(o.out, o.out)) return 1;
+  app::set_mock_window();
+  o.app.out_dir = o.out;
+  o.app.scenario_path.clear();
+  o.app.voice = false;  // no scenario: no audio cues
+  o.app.sim_lock_step = false;
+  if (!o.cloth_res_given) o.app.cloth_res = kLiveClothRes;
+  o.app.commands_path = app::commands_file("");
+  o.app.api_layers = app::loader_api_layers();
+  std::printf(
+      "drape run: live in the simulated runtime's window (%s): the mouse moves the right hand, "
+      "the left button pinches, right-drag looks, W/A/S/D/Q/E move the head; Escape or closing "
+      "the window ends the session (docs/mock-window.md)\n",
+      manifest.c_str());
+  std::fflush(stdout);
+  auto r = app::run_xr_app(o.app);
+  for (const auto& l : r.log)
+    if (l.rfind("pinch:", 0) == 0 || l.rfind("depth:", 0) == 0 || l.rfind("cut", 0) == 0)
+      std::printf("  %s\n", l.c_str());
+  for (const auto& t : r.triggers) std::printf("  trigger %s\n", t.c_str());
+  const double secs =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  // Frames per second as shown: the frames over the loop's time (waits included); the frame's
+  // own work (xrWaitFrame's return to xrEndFrame's) as its median.
+  const double p50 = median(r.frame_ms);
+  double loop_ms = 0;
+  for (double ms : r.frame_ms) loop_ms += ms;
+  for (double ms : r.profile_ms["xr.wait_frame"]) loop_ms += ms;
+  const double fps = loop_ms > 0 ? 1000.0 * static_cast<double>(r.frames) / loop_ms : 0.0;
+  std::printf(
+      "drape run: %s, runtime '%s', %lld frames (%lld rendered), %.1f fps (frame work p50 %.1f "
+      "ms), "
+      "sim step p50 %.1f ms, pinched in %lld frames, %d vertices pinned, cloth %d x %d\n",
+      app::to_string(r.final_state), r.runtime_name.c_str(), static_cast<long long>(r.frames),
+      static_cast<long long>(r.frames_rendered), fps, p50, median(r.profile_ms["sim.step_wall"]),
+      static_cast<long long>(r.frames_pinched), r.pinned_added, o.app.cloth_res, o.app.cloth_res);
+  if (!r.error.empty()) std::fprintf(stderr, "drape run: error: %s\n", r.error.c_str());
+  if (r.exit_code != 0) return r.exit_code;
+  for (const auto& w : r.written) std::printf("wrote %s\n", std::filesystem::absolute(w).c_str());
+  if (o.pattern)
+    if (int rc = export_pattern(o.out); rc != 0) return rc;
+  std::printf("drape run: done in %.1f s\n", secs);
+  return 0;
+}
 
 // The scenario with its audio cues generated: every cue's "text" (or "say") is spoken by
 // espeak-ng into DIR/voice/ and the copy DIR/scenario.json points at those WAVs. Returns that
@@ -287,14 +356,14 @@ int export_pattern(const std::string& out) {
 
 int run_xr(XrRunOptions& o) {
   namespace app = drape::app;
+  bool simulated = false;
+  const std::string manifest = app::select_runtime(&simulated);
+  // At a desk without a headset: live in the simulated runtime's window. Otherwise (a headset,
+  // no display, or --scenario) the scripted run.
+  if (simulated && app::has_display() && !o.scenario_given) return run_live(o, manifest);
   const auto wall0 = std::chrono::steady_clock::now();
+  if (!make_dir(o.out + "/frames", o.out)) return 1;
   std::error_code ec;
-  std::filesystem::create_directories(o.out + "/frames", ec);
-  if (ec) {
-    std::fprintf(stderr, "drape run: cannot create '%s': %s\n", o.out.c_str(),
-                 ec.message().c_str());
-    return 1;
-  }
   const std::string sc_path = prepare_scenario(o);
   if (sc_path.empty()) return 1;
   // The simulated runtime plays the scenario and writes every K-th frame's screenshot.
@@ -306,7 +375,6 @@ int run_xr(XrRunOptions& o) {
   o.app.scenario_path = sc_path;
   o.app.commands_path = app::commands_file("");
   o.app.api_layers = app::loader_api_layers();
-  const std::string manifest = app::select_runtime();
   std::printf("drape run: runtime manifest %s, scenario %s\n",
               manifest.empty() ? "(system active runtime)" : manifest.c_str(), o.scenario.c_str());
   auto r = app::run_xr_app(o.app);
@@ -337,7 +405,9 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
   o.app.eye_size = 256;
   o.app.cloth_res = 12;
   drape::app::add_app_options(cli, o.app);
-  cli.add_option("--scenario", o.scenario, "the draping scenario the simulated runtime plays");
+  cli.add_option("--scenario", o.scenario,
+                 "the draping scenario the simulated runtime plays (given: the scripted run even "
+                 "with a display)");
   drape::app::add_off_switches(cli, {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
                                      {"--no-pattern", &o.pattern, "skip the pattern export"}});
   cli.add_option("--every", o.every, "write every K-th frame's screenshot")
@@ -383,6 +453,9 @@ int run(int argc, char** argv) {
       "draping scenario: pinch, pin (a spoken 'pin here' made with espeak-ng), a cut stroke; "
       "then the pattern export. Writes DIR/frames/*.png, DIR/session_log.json, "
       "DIR/xr_session.txt, DIR/drape_cloth.gltf, DIR/pattern/.\n"
+      "At a desk (DISPLAY or WAYLAND_DISPLAY set, no headset runtime configured, no --scenario): "
+      "the simulated runtime's window instead; drape live with mouse and keyboard until Escape "
+      "(docs/mock-window.md). Writes the session log, xr_session.txt, the cloth, the pattern.\n"
       "With --headless: drops a 0.6 m x 0.7 m panel over the dress form's shoulders, its centre "
       "pinned above the neck, and simulates it with the baseline solver (mass-spring + damped "
       "Verlet, substeps chosen for stability) on the 90 Hz simulation thread. Writes "
@@ -409,6 +482,8 @@ int run(int argc, char** argv) {
 #ifdef DRAPE_HAVE_XR_APP
   if (!headless_job) {
     xo.out = out;
+    xo.scenario_given = cli.get_option("--scenario")->count() > 0;
+    xo.cloth_res_given = cli.get_option("--cloth-res")->count() > 0;
     if (!drape::app::resolve_input_file("drape run", "--scenario", xo.scenario)) return 2;
     return run_xr(xo);
   }

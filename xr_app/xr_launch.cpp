@@ -30,7 +30,8 @@ std::vector<std::string> split(const std::string& s, const char* separators) {
 }
 }  // namespace
 
-std::string select_runtime() {
+std::string select_runtime(bool* simulated) {
+  if (simulated) *simulated = false;
   if (std::string j = env("XR_RUNTIME_JSON"); !j.empty()) return j;
   std::vector<fs::path> dirs;
   if (std::string x = env("XDG_CONFIG_HOME"); !x.empty()) dirs.emplace_back(x);
@@ -44,7 +45,16 @@ std::string select_runtime() {
   const fs::path mock = mock_runtime_manifest();
   if (mock.empty()) return "";
   setenv("XR_RUNTIME_JSON", mock.c_str(), 1);
+  if (simulated) *simulated = true;
   return mock.string();
+}
+
+bool has_display() {
+  return !env("DISPLAY").empty() || !env("WAYLAND_DISPLAY").empty();
+}
+
+void set_mock_window() {
+  setenv("DRAPE_MOCK_WINDOW", "1", 1);
 }
 
 std::vector<std::string> loader_api_layers() {

@@ -16,8 +16,16 @@ namespace drape::app {
 // The runtime the loader will load: XR_RUNTIME_JSON when set; else the system's active runtime
 // (openxr/1/active_runtime.json below $XDG_CONFIG_HOME, ~/.config, $XDG_CONFIG_DIRS or
 // /etc/xdg); else the simulated runtime (paths.hpp), which XR_RUNTIME_JSON is then pointed at.
-// Returns the manifest ("" = the system's active runtime).
-std::string select_runtime();
+// Returns the manifest ("" = the system's active runtime); *simulated (when given) says whether
+// it fell back to the simulated runtime (no runtime configured).
+std::string select_runtime(bool* simulated = nullptr);
+
+// Whether there is a desktop to open a window on (DISPLAY or WAYLAND_DISPLAY set).
+bool has_display();
+
+// The simulated runtime opens its desktop window (DRAPE_MOCK_WINDOW=1, docs/mock-window.md):
+// the person at the desk is the headset's wearer.
+void set_mock_window();
 
 // The API layers the loader enables from XR_ENABLE_API_LAYERS (':' or ';' separated).
 std::vector<std::string> loader_api_layers();

@@ -208,12 +208,14 @@ void DrapingSession::draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& 
         Eigen::Quaternionf(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z);
     pose.position = {p.position.x, p.position.y, p.position.z};
     const XrFovf& f = eyes[e].view.fov;
-    vt[e].view =
-        render::make_view(pose, render::Fov{f.angleLeft, f.angleRight, f.angleUp, f.angleDown});
+    vt[e].view = render::make_view(
+        pose, render::Fov{f.angleLeft, f.angleRight, f.angleUp, f.angleDown}, kNearZ, kFarZ);
     vt[e].target.image = eyes[e].image;
     vt[e].target.format = eyes[e].format;
     vt[e].target.width = eyes[e].width;
     vt[e].target.height = eyes[e].height;
+    vt[e].target.depth_image = eyes[e].depth_image;  // stored for the runtime when handed one
+    vt[e].target.depth_format = eyes[e].depth_format;
   }
   render::DrawOptions dopt;
   dopt.hands = overlays_;
@@ -249,6 +251,7 @@ void DrapingSession::finish() {
   if (!sim_) return;
   rep_.r.thread_cpu_s = threads_.seconds();  // before the sim's threads end
   sim_->stop();
+  if (ops_ && !opt_.sim_lock_step) drain_free_outcomes();
   sim::World& w = sim_->world();
   rep_.r.pinned_added = count_pinned(w.cloth) - pinned_at_start_;
   for (const auto& m : w.messages) rep_.r.sim_messages.push_back(m);

@@ -6,7 +6,9 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -64,6 +66,18 @@ class DrapingSession : public SessionContent {
   void hear_cues(int64_t frame, double t, std::vector<tracking::Trigger>& trig);
   std::vector<Op> map_triggers(int64_t frame, const std::vector<tracking::Trigger>& trig);
   void note_lock_step_outcomes(bool cut_trigger);
+  // Free-running sim: what the sim thread saw of the pinches, read by the frame loop.
+  struct FreeOutcomes {
+    std::atomic<int64_t> frames_pinched{0};      // posted frames after which a hand held a particle
+    std::atomic<bool> busy[2] = {false, false};  // pinching (the hand's overlay is drawn active)
+    int pinched[2] = {-1, -1};                   // sim thread only
+    sim::Vec3 taken_at[2];                       // sim thread only
+    std::mutex m;
+    std::vector<std::string> lines;  // "pinch: ..." for the log, under m
+  };
+  static void note_free_outcomes(const sim::World& w, const sim::OperationsState& st,
+                                 FreeOutcomes& out);
+  void drain_free_outcomes();
   void record_pointer_probe(int64_t frame, const render::ViewTarget& left_eye);
   void write_outputs(sim::World& w);
 
@@ -80,6 +94,7 @@ class DrapingSession : public SessionContent {
   tracking::CommandMap commands_;              // triggers -> operations (assets/commands.json)
   std::vector<render::HandOverlay> overlays_;  // this frame's hands, drawn from its own pose
   bool ops_busy_[2] = {false, false}, cutting_[2] = {false, false};
+  std::shared_ptr<FreeOutcomes> free_ = std::make_shared<FreeOutcomes>();
   int pinned_at_start_ = 0;
   std::vector<Posted> posted_;                // right-hand pose posted per frame
   const sim::SceneSnapshot* snap_ = nullptr;  // the snapshot this frame draws

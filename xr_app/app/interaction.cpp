@@ -2,6 +2,8 @@
 // (tracking::XrHandSource: the joints of XR_EXT_hand_tracking and the controller's grip pose,
 // trigger, squeeze and a/b buttons); its triggers, the gestures' and the voice cues' go through
 // the command map to the sim's operations.
+#include <cstdio>
+
 #include "xr_app/app/draping_session.hpp"
 
 namespace drape::app {
@@ -45,16 +47,67 @@ void DrapingSession::interact(int64_t frame, const HandInput& in) {
   for (const auto& op : use) cut_trigger = cut_trigger || op.name == "cut" || op.name == "stop";
   if (ops_) {
     auto ops = ops_;
-    sim_->post([ops, hands, use](sim::World& w) {
+    std::shared_ptr<FreeOutcomes> free = opt_.sim_lock_step ? nullptr : free_;
+    sim_->post([ops, hands, use, free](sim::World& w) {
       ops->set_hands(w, hands);
       w.scene.hands.assign(hands.begin(), hands.end());  // into the snapshot (latency probe)
       for (const auto& op : use) ops->trigger(w, op.name, op.phase, op.hand);
+      if (free) note_free_outcomes(w, ops->state(), *free);
     });
   }
   if (opt_.sim_lock_step) {
     sim_->advance(1);  // orders the sim's writes before these reads (sim_thread.hpp)
     if (ops_) note_lock_step_outcomes(cut_trigger);
+  } else if (ops_) {
+    drain_free_outcomes();
   }
+}
+
+// On the sim thread, after a frame's hands and triggers: pinches taken and let go (with how far
+// the particle moved while held) and the frames spent holding one.
+void DrapingSession::note_free_outcomes(const sim::World& w, const sim::OperationsState& st,
+                                        FreeOutcomes& out) {
+  auto at = [](const sim::Vec3& p) {
+    char b[96];
+    std::snprintf(b, sizeof b, "(%.3f, %.3f, %.3f)", p.x(), p.y(), p.z());
+    return std::string(b);
+  };
+  std::vector<std::string> lines;
+  for (int h = 0; h < 2; ++h) {
+    const int32_t v = st.pinched[h], was = out.pinched[h];
+    if (v == was) continue;
+    const std::string hand = tracking::hand_name(static_cast<tracking::Hand>(h));
+    if (was >= 0 && was < w.cloth.num_vertices()) {
+      const sim::Vec3& p = w.cloth.state.x[was];
+      char b[64];
+      std::snprintf(b, sizeof b, " (moved %.1f mm)", (p - out.taken_at[h]).norm() * 1e3);
+      lines.push_back("pinch: " + hand + " hand let particle " + std::to_string(was) + " go at " +
+                      at(p) + b);
+    }
+    if (v >= 0 && v < w.cloth.num_vertices()) {
+      out.taken_at[h] = w.cloth.state.x[v];
+      lines.push_back("pinch: " + hand + " hand took particle " + std::to_string(v) + " at " +
+                      at(out.taken_at[h]));
+    }
+    out.pinched[h] = v;
+  }
+  for (int h = 0; h < 2; ++h) out.busy[h] = st.pinched[h] >= 0 || st.cutting[h];
+  if (st.pinched[0] >= 0 || st.pinched[1] >= 0) ++out.frames_pinched;
+  if (lines.empty()) return;
+  std::lock_guard lock(out.m);
+  for (auto& l : lines) out.lines.push_back(std::move(l));
+}
+
+// On the frame loop: the sim thread's pinch outcomes into the result and the log.
+void DrapingSession::drain_free_outcomes() {
+  rep_.r.frames_pinched = free_->frames_pinched;
+  for (int h = 0; h < 2; ++h) ops_busy_[h] = free_->busy[h];
+  std::vector<std::string> lines;
+  {
+    std::lock_guard lock(free_->m);
+    lines.swap(free_->lines);
+  }
+  for (const auto& l : lines) rep_.note(l);
 }
 
 void DrapingSession::read_hand(int h, double t, const HandInput& in, sim::HandProxy& hand,

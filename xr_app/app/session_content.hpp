@@ -13,12 +13,20 @@
 
 namespace drape::app {
 
-// One eye of a frame: its located view and the swapchain image to draw into.
+// The eyes' clip planes (m): what the depth images hold, 0 at kNearZ to 1 at kFarZ
+// (XrCompositionLayerDepthInfoKHR).
+constexpr float kNearZ = 0.05f, kFarZ = 50.0f;
+
+// One eye of a frame: its located view, the swapchain image to draw into and, where the
+// runtime takes depth (XR_KHR_composition_layer_depth), the depth swapchain image to store the
+// depth into (else null).
 struct EyeTarget {
   XrView view{XR_TYPE_VIEW};
   VkImage image = VK_NULL_HANDLE;
   VkFormat format = VK_FORMAT_UNDEFINED;
   uint32_t width = 0, height = 0;
+  VkImage depth_image = VK_NULL_HANDLE;
+  VkFormat depth_format = VK_FORMAT_UNDEFINED;
 };
 
 class SessionContent {

@@ -1,6 +1,8 @@
 // The OpenXR app's graphics: Vulkan handover and swapchains (see xr_graphics.hpp).
 #include "xr_app/app/xr_graphics.hpp"
 
+#include <algorithm>
+
 namespace drape::app {
 
 bool XrGraphics::create_vk_instance(XrInstance instance, XrSystemId system) {
@@ -96,7 +98,7 @@ void XrGraphics::destroy_device() {
 }
 
 bool XrGraphics::create_swapchains(XrInstance instance, XrSystemId system, XrSession session,
-                                   int eye_size) {
+                                   int eye_size, bool depth) {
   // sRGB colour: the first of these the runtime offers, else its first format.
   uint32_t nf = 0;
   xrEnumerateSwapchainFormats(session, 0, &nf, nullptr);
@@ -121,54 +123,88 @@ bool XrGraphics::create_swapchains(XrInstance instance, XrSystemId system, XrSes
     rep_.r.error = "the system has no stereo view configuration";
     return false;
   }
+  depth_format_ = VK_FORMAT_UNDEFINED;
+  if (depth)
+    for (int64_t want : {int64_t{VK_FORMAT_D32_SFLOAT}, int64_t{VK_FORMAT_D16_UNORM}})
+      if (depth_format_ == VK_FORMAT_UNDEFINED &&
+          std::find(formats.begin(), formats.end(), want) != formats.end())
+        depth_format_ = want;
+  if (depth && depth_format_ == VK_FORMAT_UNDEFINED)
+    rep_.note("depth: the runtime offers neither D32_SFLOAT nor D16_UNORM swapchains; no depth");
   for (int e = 0; e < 2; ++e) {
-    XrSwapchainCreateInfo sc{XR_TYPE_SWAPCHAIN_CREATE_INFO};
-    sc.usageFlags = XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_SAMPLED_BIT;
-    sc.format = format_;
-    sc.sampleCount = 1;
-    sc.width = eye_size > 0 ? static_cast<uint32_t>(eye_size) : vcv[e].recommendedImageRectWidth;
-    sc.height = eye_size > 0 ? static_cast<uint32_t>(eye_size) : vcv[e].recommendedImageRectHeight;
-    sc.faceCount = sc.arraySize = sc.mipCount = 1;
     Eye& eye = eyes_[e];
-    if (!rep_.ok(xrCreateSwapchain(session, &sc, &eye.chain), "xrCreateSwapchain")) return false;
-    eye.width = sc.width;
-    eye.height = sc.height;
-    uint32_t ni = 0;
-    xrEnumerateSwapchainImages(eye.chain, 0, &ni, nullptr);
-    eye.images.assign(ni, {XR_TYPE_SWAPCHAIN_IMAGE_VULKAN2_KHR});
-    if (!rep_.ok(xrEnumerateSwapchainImages(
-                     eye.chain, ni, &ni,
-                     reinterpret_cast<XrSwapchainImageBaseHeader*>(eye.images.data())),
-                 "xrEnumerateSwapchainImages"))
+    eye.width = eye_size > 0 ? static_cast<uint32_t>(eye_size) : vcv[e].recommendedImageRectWidth;
+    eye.height = eye_size > 0 ? static_cast<uint32_t>(eye_size) : vcv[e].recommendedImageRectHeight;
+    if (!create_chain(session, format_,
+                      XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_SAMPLED_BIT,
+                      eye.width, eye.height, eye.chain, eye.images))
+      return false;
+    if (depth_format_ != VK_FORMAT_UNDEFINED &&
+        !create_chain(
+            session, depth_format_,
+            XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT,
+            eye.width, eye.height, eye.depth_chain, eye.depth_images))
       return false;
   }
+  if (depth_format_ != VK_FORMAT_UNDEFINED)
+    rep_.note(std::string("depth: ") +
+              (depth_format_ == VK_FORMAT_D32_SFLOAT ? "D32_SFLOAT" : "D16_UNORM") +
+              " swapchain per eye");
   return true;
+}
+
+bool XrGraphics::create_chain(XrSession session, int64_t format, uint64_t usage, uint32_t w,
+                              uint32_t h, XrSwapchain& chain,
+                              std::vector<XrSwapchainImageVulkan2KHR>& images) {
+  XrSwapchainCreateInfo sc{XR_TYPE_SWAPCHAIN_CREATE_INFO};
+  sc.usageFlags = usage;
+  sc.format = format;
+  sc.sampleCount = 1;
+  sc.width = w;
+  sc.height = h;
+  sc.faceCount = sc.arraySize = sc.mipCount = 1;
+  if (!rep_.ok(xrCreateSwapchain(session, &sc, &chain), "xrCreateSwapchain")) return false;
+  uint32_t ni = 0;
+  xrEnumerateSwapchainImages(chain, 0, &ni, nullptr);
+  images.assign(ni, {XR_TYPE_SWAPCHAIN_IMAGE_VULKAN2_KHR});
+  return rep_.ok(xrEnumerateSwapchainImages(
+                     chain, ni, &ni, reinterpret_cast<XrSwapchainImageBaseHeader*>(images.data())),
+                 "xrEnumerateSwapchainImages");
 }
 
 void XrGraphics::destroy_swapchains() {
   if (vk_.device != VK_NULL_HANDLE) vkDeviceWaitIdle(vk_.device);
   for (auto& e : eyes_) {
     if (e.chain != XR_NULL_HANDLE) xrDestroySwapchain(e.chain);
+    if (e.depth_chain != XR_NULL_HANDLE) xrDestroySwapchain(e.depth_chain);
     e = Eye{};
   }
 }
 
-bool XrGraphics::acquire(uint32_t idx[2]) {
+bool XrGraphics::acquire_one(Report& rep, XrSwapchain chain, uint32_t& idx) {
+  if (!rep.ok(xrAcquireSwapchainImage(chain, nullptr, &idx), "xrAcquireSwapchainImage"))
+    return false;
+  XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
+  wi.timeout = XR_INFINITE_DURATION;
+  return rep.ok(xrWaitSwapchainImage(chain, &wi), "xrWaitSwapchainImage");
+}
+
+bool XrGraphics::acquire(uint32_t idx[2], uint32_t didx[2]) {
   for (int e = 0; e < 2; ++e) {
-    if (!rep_.ok(xrAcquireSwapchainImage(eyes_[e].chain, nullptr, &idx[e]),
-                 "xrAcquireSwapchainImage"))
+    if (!acquire_one(rep_, eyes_[e].chain, idx[e])) return false;
+    didx[e] = 0;
+    if (eyes_[e].depth_chain != XR_NULL_HANDLE && !acquire_one(rep_, eyes_[e].depth_chain, didx[e]))
       return false;
-    XrSwapchainImageWaitInfo wi{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
-    wi.timeout = XR_INFINITE_DURATION;
-    if (!rep_.ok(xrWaitSwapchainImage(eyes_[e].chain, &wi), "xrWaitSwapchainImage")) return false;
   }
   return true;
 }
 
 bool XrGraphics::release() {
   for (auto& eye : eyes_)
-    if (!rep_.ok(xrReleaseSwapchainImage(eye.chain, nullptr), "xrReleaseSwapchainImage"))
-      return false;
+    for (XrSwapchain chain : {eye.chain, eye.depth_chain})
+      if (chain != XR_NULL_HANDLE &&
+          !rep_.ok(xrReleaseSwapchainImage(chain, nullptr), "xrReleaseSwapchainImage"))
+        return false;
   return true;
 }
 

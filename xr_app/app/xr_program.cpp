@@ -74,6 +74,7 @@ bool XrProgram::create_instance() {
   const auto props = instance_extensions(nullptr);
   const bool has_vk2 = has_extension(props, XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME);
   has_hands_ext_ = has_extension(props, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
+  has_depth_ext_ = has_extension(props, XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME);
   has_debug_ext_ = has_extension(props, XR_EXT_DEBUG_UTILS_EXTENSION_NAME) ||
                    offers_debug_utils_through_layers();
   if (!has_vk2) {
@@ -83,6 +84,7 @@ bool XrProgram::create_instance() {
   }
   std::vector<const char*> exts = {XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME};
   if (has_hands_ext_) exts.push_back(XR_EXT_HAND_TRACKING_EXTENSION_NAME);
+  if (has_depth_ext_) exts.push_back(XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME);
   if (has_debug_ext_) exts.push_back(XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
   XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
   std::snprintf(ci.applicationInfo.applicationName, XR_MAX_APPLICATION_NAME_SIZE, "drape");
@@ -175,7 +177,8 @@ bool XrProgram::create_session() {
   rep_.note(stage ? "space: STAGE" : "space: LOCAL (no STAGE)");
   if (!input_.has_actions()) input_.create_actions(instance_);
   input_.attach(instance_, session_, rep_.r.hand_tracking);
-  return graphics_.create_swapchains(instance_, system_, session_, opt_.eye_size);
+  return graphics_.create_swapchains(instance_, system_, session_, opt_.eye_size,
+                                     has_depth_ext_ && content_ != nullptr);
 }
 
 void XrProgram::destroy_session() {
@@ -276,14 +279,18 @@ bool XrProgram::render_layer(const XrFrameState& fs, int64_t frame, FrameLaps& l
   laps.lap("probes");
   // Both eyes: acquire and wait both swapchain images, draw them with one geometry build and
   // one submission, release both.
-  uint32_t idx[2] = {0, 0};
-  if (!graphics_.acquire(idx)) return false;
+  uint32_t idx[2] = {0, 0}, didx[2] = {0, 0};
+  if (!graphics_.acquire(idx, didx)) return false;
   laps.lap("xr.acquire");
   if (content_) {
     EyeTarget eyes[2];
     for (int e = 0; e < 2; ++e) {
       const Eye& eye = graphics_.eye(e);
       eyes[e] = {views[e], eye.images[idx[e]].image, graphics_.format(), eye.width, eye.height};
+      if (graphics_.has_depth()) {
+        eyes[e].depth_image = eye.depth_images[didx[e]].image;
+        eyes[e].depth_format = graphics_.depth_format();
+      }
     }
     content_->draw(frame, eyes, laps);
   }
@@ -295,6 +302,17 @@ bool XrProgram::render_layer(const XrFrameState& fs, int64_t frame, FrameLaps& l
     views_[e].subImage.swapchain = eye.chain;
     views_[e].subImage.imageRect = {
         {0, 0}, {static_cast<int32_t>(eye.width), static_cast<int32_t>(eye.height)}};
+    // The depth drawn with this eye (0 at kNearZ, 1 at kFarZ) for the compositor.
+    views_[e].next = nullptr;
+    if (content_ && graphics_.has_depth()) {
+      depth_[e].subImage.swapchain = eye.depth_chain;
+      depth_[e].subImage.imageRect = views_[e].subImage.imageRect;
+      depth_[e].minDepth = 0.0f;
+      depth_[e].maxDepth = 1.0f;
+      depth_[e].nearZ = kNearZ;
+      depth_[e].farZ = kFarZ;
+      views_[e].next = &depth_[e];
+    }
   }
   laps.lap("xr.release");
   layer_.space = space_;

@@ -45,6 +45,7 @@ class XrProgram {
   XrSystemId system_ = XR_NULL_SYSTEM_ID;
   XrDebugUtilsMessengerEXT messenger_ = XR_NULL_HANDLE;
   bool has_hands_ext_ = false, has_debug_ext_ = false;
+  bool has_depth_ext_ = false;  // XR_KHR_composition_layer_depth: the eyes' depth is submitted
   XrGraphics graphics_;
   XrInput input_;
   std::unique_ptr<SessionContent> content_;
@@ -55,6 +56,8 @@ class XrProgram {
   int64_t session_frame_ = 0;  // xrWaitFrame calls in this session (the scenario's frame index)
   XrCompositionLayerProjectionView views_[2] = {{XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW},
                                                 {XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW}};
+  XrCompositionLayerDepthInfoKHR depth_[2] = {{XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR},
+                                              {XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR}};
   XrCompositionLayerProjection layer_{XR_TYPE_COMPOSITION_LAYER_PROJECTION};
 };
 
