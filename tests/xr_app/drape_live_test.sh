@@ -12,30 +12,8 @@
 set -uo pipefail
 EXE="$1" OUT="$2"
 rm -rf "$OUT" && mkdir -p "$OUT/home"
-LOG="$OUT/window.log"
-XVFB_PID="" APP_PID=""
-cleanup() {
-  [ -n "$APP_PID" ] && kill "$APP_PID" 2>/dev/null
-  [ -n "$XVFB_PID" ] && kill "$XVFB_PID" 2>/dev/null
-  wait 2>/dev/null
-}
-trap cleanup EXIT
-fail() {
-  echo "FAIL: $*"
-  echo "--- window log (tail)"; tail -3 "$LOG" 2>/dev/null
-  echo "--- drape stdout (tail)"; tail -15 "$OUT/stdout" 2>/dev/null
-  echo "--- drape stderr (tail)"; tail -15 "$OUT/stderr" 2>/dev/null
-  exit 1
-}
-for tool in Xvfb xdotool xwd python3; do command -v $tool >/dev/null || fail "$tool is not installed (./drape setup)"; done
-
-Xvfb -displayfd 3 -screen 0 1024x768x24 -nolisten tcp 3>"$OUT/display" 2>"$OUT/xvfb.log" &
-XVFB_PID=$!
-for _ in $(seq 100); do [ -s "$OUT/display" ] && break; sleep 0.1; done
-[ -s "$OUT/display" ] || fail "Xvfb did not start"
-export DISPLAY=":$(head -1 "$OUT/display")"
-unset WAYLAND_DISPLAY
-echo "Xvfb on $DISPLAY"
+source "$(dirname "$0")/window_test_lib.sh"
+start_xvfb
 
 # No runtime configured: the launch falls back to the simulated runtime and, with a display,
 # opens its window. The window's size and log are the runtime's own variables.
@@ -44,42 +22,10 @@ unset XR_RUNTIME_JSON XR_ENABLE_API_LAYERS DRAPE_MOCK_WINDOW DRAPE_MOCK_SCENARIO
 export HOME="$OUT/home" XDG_CONFIG_HOME="$OUT/home/.config" XDG_CONFIG_DIRS="$OUT/home/xdg"
 export DRAPE_MOCK_WINDOW_SIZE=800x600 DRAPE_MOCK_WINDOW_LOG="$LOG"
 "$EXE" run --out "$OUT/out" --no-pattern >"$OUT/stdout" 2>"$OUT/stderr" &
-APP_PID=$!
+CLIENT_PID=$!
 
-lines() { [ -f "$LOG" ] && wc -l <"$LOG" || echo 0; }
-frames() {
-  local want=$(( $(lines) + $1 ))
-  for _ in $(seq 600); do [ "$(lines)" -ge "$want" ] && return 0; sleep 0.05; done
-  fail "the runtime logged no frames for 30 s"
-}
-# expect "description" EXPR: polls the last log line (up to 20 s) until the Python expression
-# EXPR holds; f(NAME) is a field as text, v(NAME, I) the I-th (1-based) number of it.
-expect() {
-  python3 - "$LOG" "$2" <<'PY' || fail "$1 ($2)"
-import sys, time
-log, expr = sys.argv[1], sys.argv[2]
-deadline = time.time() + 20
-while True:
-    with open(log) as fh:
-        lines = fh.read().splitlines()
-    d = dict(kv.split("=", 1) for kv in lines[-1].split() if "=" in kv) if lines else {}
-    f = lambda name: d[name]
-    v = lambda name, i=1: float(d[name].split(",")[i - 1])
-    try:
-        if eval(expr):
-            sys.exit(0)
-    except (KeyError, ValueError, IndexError):
-        pass
-    if time.time() > deadline:
-        print("last line:", lines[-1] if lines else "(none)")
-        sys.exit(1)
-    time.sleep(0.02)
-PY
-  echo "ok: $1"
-}
-field() { tail -1 "$LOG" | tr ' ' '\n' | sed -n "s/^$1=//p"; }
 
-for _ in $(seq 1200); do [ "$(lines)" -ge 5 ] && break; kill -0 $APP_PID 2>/dev/null || break; sleep 0.05; done
+for _ in $(seq 1200); do [ "$(lines)" -ge 5 ] && break; kill -0 $CLIENT_PID 2>/dev/null || break; sleep 0.05; done
 [ "$(lines)" -ge 5 ] || fail "no window frames logged (did the window open?)"
 grep -q "live in the simulated runtime's window" "$OUT/stdout" || fail "drape run did not go live"
 WID=$(xdotool search --name "drape mock runtime" | head -1)
@@ -117,36 +63,13 @@ expect "the release opens the hand" "v('pinch', 2) == 0"
 frames 20
 
 frames 4  # the last image drawn in the window
-xwd -root -silent >"$OUT/screen.xwd" || fail "xwd"
-python3 - "$OUT/screen.xwd" "$OUT/window.png" <<'PY' || fail "screenshot"
-import struct, sys, zlib
-d = open(sys.argv[1], "rb").read()
-f = struct.unpack(">25I", d[:100])
-hsize, fmt, w, h, byte_order, bpp, bpl, ncolors = f[0], f[2], f[4], f[5], f[7], f[11], f[12], f[19]
-assert fmt == 2 and bpp in (24, 32), (fmt, bpp)
-px, n = d[hsize + 12 * ncolors:], bpp // 8
-order = "little" if byte_order == 0 else "big"
-rows = []
-for y in range(600):  # the window: 800x600 at (0, 0)
-    row = bytearray()
-    for x in range(800):
-        v = int.from_bytes(px[y * bpl + n * x:y * bpl + n * x + n], order)
-        row += bytes(((v >> 16) & 255, (v >> 8) & 255, v & 255))
-    rows.append(bytes(row))
-raw = b"".join(b"\0" + r for r in rows)
-def chunk(t, b): return struct.pack(">I", len(b)) + t + b + struct.pack(">I", zlib.crc32(t + b))
-open(sys.argv[2], "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 800, 600, 8, 2, 0, 0, 0))
-                              + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
-view = {rows[y][3 * x:3 * x + 3] for y in range(0, 600, 4) for x in range(100, 700, 4)}
-assert len(view) >= 3, "the view is blank"
-PY
-echo "ok: screenshot $OUT/window.png"
+screenshot
 
 # --- Escape ends the session; the app writes its outputs and exits 0
 xdotool key Escape
-for _ in $(seq 600); do kill -0 $APP_PID 2>/dev/null || break; sleep 0.1; done
-kill -0 $APP_PID 2>/dev/null && fail "drape run did not exit within 60 s of Escape"
-wait $APP_PID; rc=$?; APP_PID=""
+for _ in $(seq 600); do kill -0 $CLIENT_PID 2>/dev/null || break; sleep 0.1; done
+kill -0 $CLIENT_PID 2>/dev/null && fail "drape run did not exit within 60 s of Escape"
+wait $CLIENT_PID; rc=$?; CLIENT_PID=""
 [ "$rc" -eq 0 ] || fail "drape run exited with $rc"
 grep -q "closed or Escape: ending the session" "$OUT/stderr" || fail "the runtime did not log the quit"
 grep -q "^drape run: exiting" "$OUT/stdout" || fail "the session did not end in EXITING"
