@@ -1,4 +1,4 @@
-// Scene files and the default scene (render/scene_file.hpp).
+// Scene files and the default scene of `drape render` (xr_app/scene_file.hpp).
 #include "xr_app/scene_file.hpp"
 
 #include <algorithm>
