@@ -54,11 +54,11 @@ case $mode in
     n=$(ls "$work/out/frames"/frame_*.png 2>/dev/null | wc -l)
     echo "$n screenshots"
     [ "$n" -ge 5 ] || fail "only $n screenshots"
-    # The pattern export (sim/pattern_pipeline) either writes its files or its failure is
-    # reported (it is another engineer's module); either way drape run exits 0.
-    grep -q "wrote .*/pattern/\|pattern export failed (skipped)" "$log" || fail "no pattern outcome"
-    grep "pattern export failed" "$log" || true
-    grep -q "vertices pinned" <<<"$(grep '^drape run: exiting' "$log")" || true
+    # The pattern export writes every file it names.
+    grep -q "pattern export failed" "$log" && fail "the pattern export failed"
+    for f in pattern.svg pattern.dxf pattern_a4.pdf report.json; do
+      grep -q "wrote .*/pattern/$f" "$log" && [ -s "$work/out/pattern/$f" ] || fail "no pattern/$f"
+    done
     summary=$(grep "^drape run: exiting" "$log") || fail "no summary"
     echo "$summary"
     grep -q "voice commands 1" <<<"$summary" || fail "voice pin not heard"
