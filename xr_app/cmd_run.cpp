@@ -23,6 +23,7 @@
 #include "sim/io/mesh_io.hpp"
 #include "sim/runtime/sim_thread.hpp"
 #include "sim/solvers/verlet_solver.hpp"
+#include "tracking/command_map.hpp"
 #include "xr_app/command.hpp"
 #include "xr_app/paths.hpp"
 #ifdef DRAPE_HAVE_XR_APP
@@ -447,6 +448,27 @@ void add_headless_options(CLI::App& cli, HeadlessOptions& o, CLI::Option* headle
       ->needs(headless);
 }
 
+// The bindings of the command map the app loads (assets/commands.json, else the built-in
+// defaults), one line each, for the end of --help: which trigger starts or ends which operation.
+std::string bindings_help() {
+  std::string error;
+  const std::string path = drape::app::user_or_asset("assets/commands.json").string();
+  auto map = drape::tracking::CommandMap::load(path, &error);
+  std::string out = "Bindings (" + (map ? path : std::string("built-in defaults")) +
+                    "; any source can start any operation):\n";
+  if (!map) map = drape::tracking::CommandMap::defaults();
+  for (const drape::tracking::Binding& b : map->bindings()) {
+    char line[160];
+    std::snprintf(line, sizeof line, "  %-10s %-22s %-5s -> %s %s\n", b.source.c_str(),
+                  b.command.c_str(), b.edge.c_str(), b.action.operation.c_str(),
+                  drape::tracking::phase_name(b.action.phase));
+    out += line;
+  }
+  return out +
+         "The simulated runtime's window turns mouse and keys into these hands and buttons: "
+         "docs/mock-window.md.";
+}
+
 int run(int argc, char** argv) {
   CLI::App cli(
       "Runs the OpenXR app (headset, or the simulated runtime when none is configured) on a "
@@ -462,6 +484,7 @@ int run(int argc, char** argv) {
       "DIR/drape_cloth.gltf and DIR/dress_form.gltf.",
       "drape run");
   cli.option_defaults()->always_capture_default();
+  cli.footer(bindings_help);
   HeadlessOptions ho;
   std::string out = "out";
   bool headless_job = false;

@@ -6,7 +6,8 @@
 #   run        `drape run` (the default draping scenario) writes frames, the session log, the
 #              cloth glTF and the pattern to its out dir, exits 0, well under 2 minutes.
 #   args       out-of-range and misplaced arguments of `drape xr` and `drape run` exit 2 with a
-#              message naming the option; --help exits 0 and lists every option.
+#              message naming the option; --help exits 0 and lists every option (drape run's
+#              also the command map's bindings).
 # usage: drape_cli_test.sh DRAPE_EXE MODE WORKDIR
 set -u
 exe=$1 mode=$2 work=$3
@@ -109,6 +110,13 @@ case $mode in
       done
       echo "drape $cmd --help lists ${#opts[@]} options"
     done
+    # drape run --help ends with the command map's bindings (the bundled assets/commands.json).
+    grep -q "^Bindings (.*commands.json" "$work/help.txt" || fail "drape run --help lists no bindings"
+    for b in "gesture +pinch +begin -> pinch begin" "voice +pin +any +-> pin once" \
+             "controller button.trigger +begin -> pinch begin" "controller button.a +begin -> cut toggle"; do
+      grep -Eq "^  $b" "$work/help.txt" || fail "drape run --help does not list the binding '$b'"
+    done
+    echo "drape run --help lists $(grep -c ' -> ' "$work/help.txt") bindings"
     ;;
   *) echo "unknown mode $mode"; exit 2 ;;
 esac
