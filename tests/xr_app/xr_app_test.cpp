@@ -1,18 +1,22 @@
 // End-to-end runs of the drape OpenXR app on the mock runtime: the lifecycle to EXITING, the
 // core validation layer with zero messages, hand tracking and controller input from a
-// scenario, a scripted session loss (the session is re-created), and a missing runtime.
-// The test plays the executable's part: it sets the loader's and the simulated runtime's
-// variables and passes the scenario, the layers and the command map in the app's options.
+// scenario, each binding of each controller profile, a scripted session loss (the session is
+// re-created), and a missing runtime. The test plays the executable's part: it sets the loader's
+// and the simulated runtime's variables and passes the scenario, the layers and the command map in
+// the app's options.
 #include "xr_app/app/xr_app.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -334,6 +338,221 @@ TEST(XrApp, HandMarkerIsDrawnAtTheFramesOwnPose) {
   EXPECT_LT(median, 1.0);
 }
 #endif
+
+// Each binding of each controller profile the app suggests bindings for (xr_input.cpp), on
+// the simulated runtime in lock step: a short scenario selects the profile and, with both
+// controllers held over the cloth, pulls and lets go of the trigger (select), squeezes, and
+// presses the primary and the secondary button, one at a time, each with the right controller
+// and then the left one. Every press must reach the command map as the controller trigger its
+// binding names and be mapped to that trigger's operation (assets/commands.json: trigger ->
+// pinch begin/end, squeeze -> move begin/end, button.a -> cut toggle, button.b -> undo), in
+// the frame of the press (release) or the next, and the pinches must take hold; a
+// profile lacking a button (khr/simple: select and menu only) has its other buttons' inputs
+// pressed too and must produce nothing for them.
+struct ProfileButtons {
+  const char* profile;  // after "/interaction_profiles/"
+  // The scenario's input names ("input/" stripped) pressed for each step, per hand (left,
+  // right); `bound` false: the profile has no such button, so no trigger may come of it.
+  const char* trigger;
+  std::vector<std::string> squeeze;
+  bool squeeze_bound;
+  std::vector<std::string> primary[2];
+  bool primary_bound;
+  std::vector<std::string> secondary[2];
+};
+
+std::ostream& operator<<(std::ostream& os, const ProfileButtons& p) {
+  return os << p.profile;
+}
+
+const ProfileButtons kProfileButtons[] = {
+    {"khr/simple_controller",
+     "select/click",
+     {"squeeze/value", "squeeze/click"},
+     false,
+     {{"a/click", "x/click", "trackpad/click", "b/click", "y/click", "thumbstick/click"},
+      {"a/click", "x/click", "trackpad/click", "b/click", "y/click", "thumbstick/click"}},
+     false,
+     {{"menu/click"}, {"menu/click"}}},
+    {"oculus/touch_controller",
+     "trigger/value",
+     {"squeeze/value"},
+     true,
+     {{"x/click"}, {"a/click"}},
+     true,
+     {{"y/click"}, {"b/click"}}},
+    {"valve/index_controller",
+     "trigger/value",
+     {"squeeze/value"},
+     true,
+     {{"a/click"}, {"a/click"}},
+     true,
+     {{"b/click"}, {"b/click"}}},
+    {"htc/vive_controller",
+     "trigger/value",
+     {"squeeze/click"},
+     true,
+     {{"trackpad/click"}, {"trackpad/click"}},
+     true,
+     {{"menu/click"}, {"menu/click"}}},
+    {"microsoft/motion_controller",
+     "trigger/value",
+     {"squeeze/click"},
+     true,
+     {{"trackpad/click"}, {"trackpad/click"}},
+     true,
+     {{"menu/click"}, {"menu/click"}}},
+};
+
+class XrAppProfileBindings : public ::testing::TestWithParam<ProfileButtons> {};
+
+TEST_P(XrAppProfileBindings, EachButtonReachesItsCommand) {
+  const ProfileButtons& p = GetParam();
+  base_env();
+  std::string name = std::string("app_profile_") + p.profile;
+  std::replace(name.begin(), name.end(), '/', '_');
+  const fs::path dir = fresh_out_dir(name.c_str());
+  // Steps (4 frames pressed, 3 released): trigger, squeeze, primary, secondary, each with the
+  // right hand and then the left (both pinches come before any move or undo). Both controllers are
+  // held over the cloth (the right one where the default scenario's hand pinches it, the left one
+  // mirrored).
+  struct Step {
+    int hand;
+    std::vector<std::string> inputs;
+    std::vector<std::string> expect;  // the mapped lines, without "frame F: "
+    int press = 0, release = 0;
+  };
+  std::vector<Step> steps;
+  std::vector<std::string> all_inputs;
+  const char* side_name[2] = {"left", "right"};
+  std::vector<Step> per_hand[2];
+  for (int h : {1, 0}) {
+    auto& hand_steps = per_hand[h];
+    const std::string hs = std::string(" hand ") + side_name[h] + " -> ";
+    hand_steps.push_back({h,
+                          {p.trigger},
+                          {"controller button.trigger begin" + hs + "pinch begin",
+                           "controller button.trigger end" + hs + "pinch end"}});
+    hand_steps.push_back(
+        {h, p.squeeze,
+         p.squeeze_bound
+             ? std::vector<std::string>{"controller button.squeeze begin" + hs + "move begin",
+                                        "controller button.squeeze end" + hs + "move end"}
+             : std::vector<std::string>{}});
+    hand_steps.push_back(
+        {h, p.primary[h],
+         p.primary_bound ? std::vector<std::string>{"controller button.a begin" + hs + "cut toggle"}
+                         : std::vector<std::string>{}});
+    hand_steps.push_back({h, p.secondary[h], {"controller button.b begin" + hs + "undo once"}});
+  }
+  for (size_t k = 0; k < per_hand[1].size(); ++k)
+    for (int h : {1, 0}) steps.push_back(per_hand[h][k]);
+  for (const auto& s : steps)
+    for (const auto& i : s.inputs)
+      if (std::find(all_inputs.begin(), all_inputs.end(), i) == all_inputs.end())
+        all_inputs.push_back(i);
+  int frame = 4;
+  for (auto& s : steps) {
+    s.press = frame;
+    s.release = frame + 4;
+    frame += 7;
+  }
+  const int end_frame = frame + 3;
+  // Keys: each press and release (the pressed inputs of the step; all others released).
+  auto keys = [&](int h) {
+    // Both controllers stay over the cloth, either side of its middle, all the time.
+    const char* over = h == 1 ? "[0.12, 1.02, 0.21]" : "[-0.12, 1.02, 0.21]";
+    std::string out;
+    auto key = [&](int f, const std::vector<std::string>& pressed) {
+      std::string k = std::string(out.empty() ? "" : ",\n") + "{\"frame\": " + std::to_string(f) +
+                      ", \"grip\": {\"position\": " + over + "}, \"inputs\": {";
+      for (size_t i = 0; i < all_inputs.size(); ++i) {
+        const bool on = std::find(pressed.begin(), pressed.end(), all_inputs[i]) != pressed.end();
+        const bool value = all_inputs[i].find("/value") != std::string::npos;
+        k += (i ? ", " : "") + ("\"" + all_inputs[i] + "\": ") +
+             (value ? (on ? "1.0" : "0.0") : (on ? "true" : "false"));
+      }
+      out += k + "}}";
+    };
+    key(0, {});
+    for (const auto& s : steps) {
+      if (s.hand != h) continue;
+      // Values are interpolated between keys: a key each side of an edge makes it a step.
+      key(s.press - 2, {});  // moves to / stays over the cloth before the first press
+      key(s.press - 1, {});
+      key(s.press, s.inputs);
+      key(s.release - 1, s.inputs);
+      key(s.release, {});
+    }
+    key(end_frame, {});
+    return out;
+  };
+  const std::string sc = (dir / "scenario.json").string();
+  std::ofstream(sc) << "{\"name\": \"" << name << "\", \"end_after_frames\": " << end_frame
+                    << ", \"fast\": true, \"interaction_profile\": \"/interaction_profiles/"
+                    << p.profile
+                    << "\",\n\"head\": [{\"frame\": 0, \"position\": [0.0, 1.3, 1.2]}],\n"
+                       "\"controllers\": {\"right\": [\n"
+                    << keys(1) << "],\n\"left\": [\n"
+                    << keys(0) << "]}}\n";
+  auto o = small();
+  play_scenario(o, sc);
+  o.eye_size = 64;
+  o.cloth_res = 8;
+  o.voice = false;
+  o.verbose = true;
+  auto r = drape::app::run_xr_app(o);
+  print(r);
+  for (const auto& m : r.sim_messages) std::printf("sim: %s\n", m.c_str());
+  std::printf("pinched in %lld frames\n", static_cast<long long>(r.frames_pinched));
+  ASSERT_EQ(r.exit_code, 0) << r.error;
+  EXPECT_EQ(r.frames, end_frame);
+  // The controller triggers, in order, each in the frame of its press (release) or the next.
+  std::vector<long long> got_frame;
+  std::vector<std::string> got, want;
+  std::vector<int> want_frame;
+  for (const auto& t : r.triggers) {
+    long long f = -1;
+    char rest[256] = {};
+    if (std::sscanf(t.c_str(), "frame %lld: %255[^\n]", &f, rest) == 2 &&
+        std::string(rest).rfind("controller ", 0) == 0) {
+      got_frame.push_back(f);
+      got.push_back(rest);
+    }
+  }
+  for (const auto& s : steps)
+    for (size_t i = 0; i < s.expect.size(); ++i) {
+      want_frame.push_back(i == 0 ? s.press : s.release);
+      want.push_back(s.expect[i]);
+    }
+  EXPECT_EQ(got, want) << p.profile;
+  for (size_t i = 0; i < want.size() && got == want; ++i) {
+    EXPECT_GE(got_frame[i], want_frame[i]) << got[i];
+    EXPECT_LE(got_frame[i], want_frame[i] + 1) << got[i];
+  }
+  // Nothing at all (mapped or not: the verbose log notes unmapped triggers too) of the buttons
+  // the profile lacks.
+  std::vector<std::string> absent;
+  if (!p.squeeze_bound) absent.push_back("button.squeeze");
+  if (!p.primary_bound) absent.push_back("button.a");
+  for (const auto& c : absent) {
+    for (const auto& l : r.log) EXPECT_EQ(l.find(c), std::string::npos) << p.profile << ": " << l;
+    for (const auto& t : r.triggers)
+      EXPECT_EQ(t.find(c), std::string::npos) << p.profile << ": " << t;
+  }
+  // The trigger, pulled over the cloth, took hold of it with each hand: 4 frames each (more
+  // where an undo re-takes a pinch that was let go).
+  EXPECT_GE(r.frames_pinched, 8);
+  for (const auto& m : r.sim_messages) EXPECT_EQ(m.rfind("pinch", 0), std::string::npos) << m;
+}
+
+INSTANTIATE_TEST_SUITE_P(XrApp, XrAppProfileBindings, ::testing::ValuesIn(kProfileButtons),
+                         [](const ::testing::TestParamInfo<ProfileButtons>& i) {
+                           std::string n = i.param.profile;
+                           for (char& c : n)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return n;
+                         });
 
 TEST(XrApp, SessionLossIsAnOrdinaryState) {
   base_env();
