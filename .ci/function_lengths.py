@@ -155,15 +155,15 @@ def per_step(funcs):
     for f in funcs:
         by_short.setdefault(f[0].split("::")[-1], []).append(f)
     roots = [f for f in funcs if f[0] == "XpbdSolver::step"]
-    seen, todo = set(), list(roots)
-    while todo:
-        f = todo.pop()
+    seen, frontier = set(), list(roots)
+    while frontier:
+        f = frontier.pop()
         key = (f[0], f[4], f[1])
         if key in seen:
             continue
         seen.add(key)
         for callee in set(CALL.findall(f[3])):
-            todo.extend(by_short.get(callee, []))
+            frontier.extend(by_short.get(callee, []))
     return [f for f in funcs if (f[0], f[4], f[1]) in seen], bool(roots)
 
 
