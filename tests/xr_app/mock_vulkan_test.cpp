@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "xr_vulkan_handover.hpp"
+
 namespace {
 
 const std::string kManifest = std::string(DRAPE_BINARY_DIR) + "/bin/drape_mock_runtime.json";
@@ -93,58 +95,16 @@ TEST(MockVulkan, SwapchainFramesAreReadBackToPng) {
   XrSystemId sys;
   ASSERT_EQ(xrGetSystem(inst, &gi, &sys), XR_SUCCESS);
 
-  auto reqs =
-      proc<PFN_xrGetVulkanGraphicsRequirements2KHR>(inst, "xrGetVulkanGraphicsRequirements2KHR");
-  auto mk_inst = proc<PFN_xrCreateVulkanInstanceKHR>(inst, "xrCreateVulkanInstanceKHR");
-  auto get_dev = proc<PFN_xrGetVulkanGraphicsDevice2KHR>(inst, "xrGetVulkanGraphicsDevice2KHR");
-  auto mk_dev = proc<PFN_xrCreateVulkanDeviceKHR>(inst, "xrCreateVulkanDeviceKHR");
-  XrGraphicsRequirementsVulkan2KHR rq{XR_TYPE_GRAPHICS_REQUIREMENTS_VULKAN2_KHR};
-  ASSERT_EQ(reqs(inst, sys, &rq), XR_SUCCESS);
-  EXPECT_LE(rq.minApiVersionSupported, XR_MAKE_VERSION(1, 1, 0));
-
-  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
-  app.apiVersion = VK_API_VERSION_1_1;
-  VkInstanceCreateInfo vci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-  vci.pApplicationInfo = &app;
-  XrVulkanInstanceCreateInfoKHR xvci{XR_TYPE_VULKAN_INSTANCE_CREATE_INFO_KHR};
-  xvci.systemId = sys;
-  xvci.pfnGetInstanceProcAddr = &vkGetInstanceProcAddr;
-  xvci.vulkanCreateInfo = &vci;
-  VkInstance vk = VK_NULL_HANDLE;
-  VkResult vr;
-  ASSERT_EQ(mk_inst(inst, &xvci, &vk, &vr), XR_SUCCESS);
-  ASSERT_EQ(vr, VK_SUCCESS);
-  XrVulkanGraphicsDeviceGetInfoKHR dgi{XR_TYPE_VULKAN_GRAPHICS_DEVICE_GET_INFO_KHR};
-  dgi.systemId = sys;
-  dgi.vulkanInstance = vk;
-  VkPhysicalDevice phys;
-  ASSERT_EQ(get_dev(inst, &dgi, &phys), XR_SUCCESS);
+  XrVulkanHandover h;
+  ASSERT_EQ(create_vulkan_through_xr(inst, sys, h), "");
+  EXPECT_LE(h.requirements.minApiVersionSupported, XR_MAKE_VERSION(1, 1, 0));
+  VkInstance vk = h.instance;
+  VkPhysicalDevice phys = h.phys;
+  VkDevice dev = h.device;
+  const uint32_t family = h.family;
   VkPhysicalDeviceProperties pp;
   vkGetPhysicalDeviceProperties(phys, &pp);
   std::printf("runtime chose Vulkan device: %s\n", pp.deviceName);
-  uint32_t nq = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(phys, &nq, nullptr);
-  std::vector<VkQueueFamilyProperties> qf(nq);
-  vkGetPhysicalDeviceQueueFamilyProperties(phys, &nq, qf.data());
-  uint32_t family = 0;
-  while (family < nq && !(qf[family].queueFlags & VK_QUEUE_GRAPHICS_BIT)) ++family;
-  ASSERT_LT(family, nq);
-  float prio = 1;
-  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  qci.queueFamilyIndex = family;
-  qci.queueCount = 1;
-  qci.pQueuePriorities = &prio;
-  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-  dci.queueCreateInfoCount = 1;
-  dci.pQueueCreateInfos = &qci;
-  XrVulkanDeviceCreateInfoKHR xdci{XR_TYPE_VULKAN_DEVICE_CREATE_INFO_KHR};
-  xdci.systemId = sys;
-  xdci.pfnGetInstanceProcAddr = &vkGetInstanceProcAddr;
-  xdci.vulkanPhysicalDevice = phys;
-  xdci.vulkanCreateInfo = &dci;
-  VkDevice dev;
-  ASSERT_EQ(mk_dev(inst, &xdci, &dev, &vr), XR_SUCCESS);
-  ASSERT_EQ(vr, VK_SUCCESS);
 
   XrGraphicsBindingVulkan2KHR bind{XR_TYPE_GRAPHICS_BINDING_VULKAN2_KHR};
   bind.instance = vk;

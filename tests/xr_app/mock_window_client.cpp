@@ -14,7 +14,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 #include <vector>
+
+#include "xr_vulkan_handover.hpp"
 
 namespace {
 
@@ -198,49 +201,16 @@ int main() {
   XR(xrGetSystem(inst, &gi, &sys));
 
   // Vulkan through XR_KHR_vulkan_enable2.
-  XrGraphicsRequirementsVulkan2KHR rq{XR_TYPE_GRAPHICS_REQUIREMENTS_VULKAN2_KHR};
-  XR(proc<PFN_xrGetVulkanGraphicsRequirements2KHR>(inst, "xrGetVulkanGraphicsRequirements2KHR")(
-      inst, sys, &rq));
-  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
-  app.apiVersion = VK_API_VERSION_1_1;
-  VkInstanceCreateInfo vci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-  vci.pApplicationInfo = &app;
-  XrVulkanInstanceCreateInfoKHR xvci{XR_TYPE_VULKAN_INSTANCE_CREATE_INFO_KHR};
-  xvci.systemId = sys;
-  xvci.pfnGetInstanceProcAddr = &vkGetInstanceProcAddr;
-  xvci.vulkanCreateInfo = &vci;
-  VkInstance vk;
-  VkResult vr;
-  XR(proc<PFN_xrCreateVulkanInstanceKHR>(inst, "xrCreateVulkanInstanceKHR")(inst, &xvci, &vk, &vr));
-  CHECK(vr == VK_SUCCESS);
-  XrVulkanGraphicsDeviceGetInfoKHR dgi{XR_TYPE_VULKAN_GRAPHICS_DEVICE_GET_INFO_KHR};
-  dgi.systemId = sys;
-  dgi.vulkanInstance = vk;
+  XrVulkanHandover h;
+  if (std::string e = create_vulkan_through_xr(inst, sys, h); !e.empty()) {
+    std::fprintf(stderr, "Vulkan through the runtime: %s failed\n", e.c_str());
+    return 1;
+  }
+  VkInstance vk = h.instance;
+  const uint32_t family = h.family;
   Gpu g{};
-  XR(proc<PFN_xrGetVulkanGraphicsDevice2KHR>(inst, "xrGetVulkanGraphicsDevice2KHR")(inst, &dgi,
-                                                                                    &g.phys));
-  uint32_t nq = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(g.phys, &nq, nullptr);
-  std::vector<VkQueueFamilyProperties> qf(nq);
-  vkGetPhysicalDeviceQueueFamilyProperties(g.phys, &nq, qf.data());
-  uint32_t family = 0;
-  while (family < nq && !(qf[family].queueFlags & VK_QUEUE_GRAPHICS_BIT)) ++family;
-  CHECK(family < nq);
-  float prio = 1;
-  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  qci.queueFamilyIndex = family;
-  qci.queueCount = 1;
-  qci.pQueuePriorities = &prio;
-  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-  dci.queueCreateInfoCount = 1;
-  dci.pQueueCreateInfos = &qci;
-  XrVulkanDeviceCreateInfoKHR xdci{XR_TYPE_VULKAN_DEVICE_CREATE_INFO_KHR};
-  xdci.systemId = sys;
-  xdci.pfnGetInstanceProcAddr = &vkGetInstanceProcAddr;
-  xdci.vulkanPhysicalDevice = g.phys;
-  xdci.vulkanCreateInfo = &dci;
-  XR(proc<PFN_xrCreateVulkanDeviceKHR>(inst, "xrCreateVulkanDeviceKHR")(inst, &xdci, &g.dev, &vr));
-  CHECK(vr == VK_SUCCESS);
+  g.phys = h.phys;
+  g.dev = h.device;
   vkGetDeviceQueue(g.dev, family, 0, &g.queue);
   VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pci.queueFamilyIndex = family;
