@@ -19,6 +19,7 @@
 #include "tracking/gestures.hpp"
 #include "tracking/hand_source.hpp"
 #include "tracking/voice.hpp"
+#include "xr_app/app/feedback.hpp"
 #include "xr_app/app/session_content.hpp"
 
 namespace drape::app {
@@ -100,6 +101,7 @@ class DrapingSession : public SessionContent {
   const sim::SceneSnapshot* snap_ = nullptr;  // the snapshot this frame draws
   bool cloth_matched_ = false;           // the drawn snapshot holds a posted right-hand pose ...
   Clock::time_point cloth_posted_at_{};  // ... posted then
+  Feedback feedback_;  // the text panel's content (feedback.hpp)
   TickProfile ticks_;
   ThreadGroups threads_;
 };

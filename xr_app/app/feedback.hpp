@@ -1,0 +1,56 @@
+// What the user sees in view about the session (the text panel): per hand the operation in
+// progress, the last voice command heard, each refusal with its reason, lasting states (a
+// missing microphone, a lost hand) and, on request, the help (every binding). Written by the
+// frame loop (interaction, voice, the sim's reports as they are drained); read by the drawing of
+// the same frame. Not thread-safe: the frame loop owns it.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace drape::app {
+
+class Feedback {
+ public:
+  // The operation the hand (0 left, 1 right) is doing now; "" when none.
+  void set_operation(int hand, const std::string& op);
+  // A voice command recognised: the phrase heard and the command it gave ("" when rejected).
+  void heard(int64_t frame, const std::string& phrase, const std::string& command);
+  // An operation refused, with its reason ("pinch: nothing within 3 cm to pinch"); shown for a
+  // few seconds.
+  void refused(int64_t frame, const std::string& reason);
+  // A state that lasts until cleared (key: "voice", "hands", ...; "" message clears it).
+  void set_status(const std::string& key, const std::string& message);
+  // The help: every binding, one line each (set once from the command map).
+  void set_help(std::vector<std::string> lines) { help_ = std::move(lines); }
+  void toggle_help() { show_help_ = !show_help_; }
+  void show_help(bool on) { show_help_ = on; }
+  bool help_shown() const { return show_help_; }
+
+  // The panel's lines at `frame` (90 frames a second): statuses, the hands, the voice, the
+  // refusals of the last kRefusalFrames frames, then the help when shown.
+  std::vector<std::string> lines(int64_t frame) const;
+  // Bumped on every change, so a renderer rebuilds its text only when it changed.
+  uint64_t version() const { return version_; }
+
+  static constexpr int64_t kRefusalFrames = 4 * 90;
+  static constexpr size_t kMaxRefusals = 3;
+
+ private:
+  struct Refusal {
+    int64_t frame;
+    std::string text;
+  };
+  std::string op_[2];
+  std::string heard_;
+  int64_t heard_frame_ = -1;
+  std::vector<Refusal> refusals_;
+  std::map<std::string, std::string> status_;
+  std::vector<std::string> help_;
+  bool show_help_ = false;
+  uint64_t version_ = 0;
+};
+
+}  // namespace drape::app
