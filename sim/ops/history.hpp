@@ -50,6 +50,9 @@ class History {
   std::string undo(Cloth& cloth, OperationsState& ops);
   std::string redo(Cloth& cloth, OperationsState& ops);
   void clear() { undo_.clear(), redo_.clear(); }
+  // A change that needs no undo point of its own (the end of a pinch or move: the entry taken
+  // at its begin covers it) still makes the redo stack stale.
+  void drop_redo() { redo_.clear(); }
   size_t undo_size() const { return undo_.size(); }
   size_t redo_size() const { return redo_.size(); }
   const HistoryEntry* last() const { return undo_.empty() ? nullptr : &undo_.back(); }

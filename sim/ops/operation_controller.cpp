@@ -143,7 +143,11 @@ void OperationController::apply_trigger(World& w, const std::string& name, Trigg
     done = begin ? ops_smooth_begin(w, state_, hand) : ops_smooth_end(w, state_, hand);
     if (!begin) done = false;  // the state before smoothing began is the undo point
   }
-  if (done) history_.push(name, std::move(before), ops_before);
+  // The end of a pinch or move keeps no undo point: the state before its begin is the one to
+  // return to (undo then leaves nothing in progress), as for smoothing.
+  const bool ends_held = !begin && (name == "pinch" || name == "move");
+  if (done && ends_held) history_.drop_redo();
+  if (done && !ends_held) history_.push(name, std::move(before), ops_before);
 }
 
 void OperationController::start_recording(const World& w) {

@@ -95,6 +95,45 @@ TEST(History, ChainOfOperationsThroughTheController) {
   }
 }
 
+// Undo after a finished pinch or move returns to the state before it began, with nothing in
+// progress (not to the held state just before its end), and redo brings back the finished one.
+TEST(History, UndoAfterAFinishedPinchOrMoveRestoresTheStateBeforeItsBegin) {
+  for (const char* name : {"pinch", "move"}) {
+    World w = testing::make_world(Initial::kSpread, 2);
+    OperationController c;
+    c.install(w);
+    std::array<HandProxy, 2> hands{hand_at(0, w.cloth.state.x[72]),
+                                   hand_at(1, w.cloth.state.x[40])};
+    c.set_hands(w, hands);
+    tick(w, 2);
+    const uint64_t before = state_hash(w.cloth);
+    c.trigger(w, name, TriggerPhase::kBegin, 1);
+    ASSERT_TRUE(c.state().pinched[1] >= 0 || c.state().moving) << name;
+    for (auto& hp : hands) hp.position += Vec3(0.05, 0.03, 0);
+    for (int k = 0; k < 6; ++k) {
+      c.set_hands(w, hands);
+      tick(w, 1);
+    }
+    c.trigger(w, name, TriggerPhase::kEnd, 1);
+    tick(w, 2);
+    const uint64_t after = state_hash(w.cloth);
+    ASSERT_NE(after, before) << name;
+    EXPECT_EQ(c.history().undo_size(), 1u) << name;
+    c.trigger(w, "undo", TriggerPhase::kBegin, 1);
+    EXPECT_EQ(state_hash(w.cloth), before) << name;
+    EXPECT_EQ(c.state().pinched[0], -1) << name;
+    EXPECT_EQ(c.state().pinched[1], -1) << name;
+    EXPECT_FALSE(c.state().moving) << name;
+    tick(w, 3);  // nothing in progress drags the cloth back toward the hands
+    EXPECT_EQ(c.state().pinched[1], -1) << name;
+    EXPECT_FALSE(c.state().moving) << name;
+    c.trigger(w, "redo", TriggerPhase::kBegin, 1);
+    EXPECT_EQ(state_hash(w.cloth), after) << name;
+    EXPECT_EQ(c.state().pinched[1], -1) << name;
+    EXPECT_FALSE(c.state().moving) << name;
+  }
+}
+
 TEST(History, IsBounded) {
   World w = testing::make_world(Initial::kSpread, 2);
   OperationsState ops;
