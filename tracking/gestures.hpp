@@ -1,5 +1,10 @@
-// Gestures -> triggers: pinch (thumb tip - index tip distance with hysteresis and a minimum
-// duration), grab (fist), open palm; dwell and push for palm-only sources; controller buttons.
+// Gestures -> triggers. From XR_EXT_hand_tracking joints: the thumb's pinches with each finger
+// ("pinch" = index, "pinch_middle", "pinch_ring", "pinch_little"; tip distance with hysteresis,
+// the finger clearly the thumb's nearest), the fist ("grab"), the flat hand with the fingers
+// together and the palm down ("flat"), the open hand with the palm up ("palm_up") and the open
+// palm thrust forward ("push"); every held one debounced by a minimum duration, and a resting
+// open hand fires nothing. From palm-only sources (Kinect, UDP): "dwell" and "palm_push".
+// Controller buttons: ButtonMapper.
 #pragma once
 #include <deque>
 #include <string>
@@ -10,16 +15,21 @@
 namespace drape::tracking {
 
 struct GestureParams {
-  double pinch_enter = 0.025;   // m: thumb-index tip distance to start a pinch
+  double pinch_enter = 0.025;   // m: thumb-finger tip distance to start a pinch
   double pinch_leave = 0.040;   // m: distance to end it (hysteresis)
+  double pinch_nearest = 0.6;   // a pinch starts only below this fraction of the next finger's
   double min_duration = 0.08;   // s: a state must hold this long before a trigger fires
   double grab_curl = 0.07;      // m: mean fingertip-to-palm distance below = fist
-  double open_extend = 0.14;    // m: mean fingertip-to-palm distance above = open palm
+  double extend_curl = 0.10;    // m: mean fingertip-to-palm distance above = fingers extended
+  double together = 0.85;       // fingertips' spread across the palm below this fraction of
+                                // the knuckles' = fingers together
+  double facing_cos = 0.75;     // palm normal within ~40 degrees of up / down / its push
   double dwell_radius = 0.03;   // m: palm-only: hand stays within this radius ...
   double dwell_time = 1.0;      // s: ... this long -> "dwell"
-  double push_distance = 0.12;  // m: palm-only: forward (toward -z of the source) motion ...
-  double push_time = 0.35;      // s: ... within this time -> "push"
+  double push_distance = 0.12;  // m: forward motion (palm-only: along push_axis; joints: along
+  double push_time = 0.35;      // s: the palm's normal) within this time -> "push"
   Vec3 push_axis = Vec3(0, 0, -1);
+  Vec3 up = Vec3(0, 1, 0);  // the source's up (OpenXR reference spaces: +y)
 };
 
 // A boolean state with hysteresis already applied, debounced by a minimum duration.
@@ -34,22 +44,35 @@ class Debounced {
   double since_ = 0;
 };
 
+// The shape of a hand from its joints (exposed for tests and the help text).
+struct HandShape {
+  double tip_distance[4] = {};  // thumb tip to the index, middle, ring, little tips
+  double curl = 0;              // mean fingertip-to-palm distance
+  double spread = 1;            // the fingertips' extent across the palm / the knuckles'
+  Vec3 normal = Vec3::Zero();   // out of the palm (the palm joint's -y)
+};
+HandShape hand_shape(const HandFrame& f);
+
 class GestureRecognizer {
  public:
   explicit GestureRecognizer(GestureParams p = {}) : p_(p) {}
-  // Feed one filtered frame of one hand; appends triggers ("pinch", "grab", "open_palm",
-  // "dwell", "push") with begin=true/false.
+  // Feed one filtered frame of one hand; appends triggers with begin=true/false.
   void update(const HandFrame& f, std::vector<Trigger>& out);
-  bool pinching(Hand h) const { return st_[static_cast<int>(h)].pinch.on(); }
+  bool pinching(Hand h) const { return st_[static_cast<int>(h)].pinch[0].on(); }
 
  private:
   struct State {
-    bool pinch_raw = false;
-    Debounced pinch, grab, open;
+    int pinch_finger = -1;  // the finger the thumb touches (0 index .. 3 little), -1 none
+    Debounced pinch[4], grab, flat, palm_up;
     std::deque<std::pair<double, Vec3>> history;  // palm positions for dwell/push
     bool dwell_fired = false;
     double push_block_until = -1;
   };
+  void update_joints(const HandFrame& f, State& s, std::vector<Trigger>& out);
+  void update_pinch_finger(const HandShape& shape, State& s) const;
+  bool joint_push(const HandFrame& f, const HandShape& shape, State& s) const;
+  void update_palm_only(const HandFrame& f, State& s, std::vector<Trigger>& out);
+  void lose(const HandFrame& f, State& s, std::vector<Trigger>& out);
   void emit(int edge, const char* name, const HandFrame& f, std::vector<Trigger>& out);
   GestureParams p_;
   State st_[2];

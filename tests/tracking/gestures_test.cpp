@@ -1,27 +1,103 @@
+// Gestures (tracking/gestures.cpp) on synthetic joint frames: the thumb's pinch with each
+// finger, the fist, the flat hand palm down, the palm up and the push, each with its hysteresis
+// and minimum duration; the resting open hand fires nothing and each gesture's neighbours do
+// not cross-fire. Palm-only sources' dwell and push; controller button edges.
 #include "tracking/gestures.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 using namespace drape::tracking;
 
 namespace {
-HandFrame hand_with_pinch(double d, double t, double curl = 0.1) {
+// The right hand in its palm frame (the mock runtime's skeleton): +x toward the little finger,
+// +y out of the back of the hand, the fingers along -z.
+const double kHand[kJointCount][3] = {
+    {0, 0, 0},
+    {0, 0, 0.045},
+    {-0.025, -0.01, 0.03},
+    {-0.045, -0.015, 0.005},
+    {-0.055, -0.02, -0.025},
+    {-0.06, -0.022, -0.045},
+    {-0.02, 0, 0.035},
+    {-0.022, 0, -0.03},
+    {-0.023, 0, -0.07},
+    {-0.024, 0, -0.095},
+    {-0.024, 0, -0.115},
+    {0, 0, 0.035},
+    {0, 0, -0.035},
+    {0, 0, -0.08},
+    {0, 0, -0.108},
+    {0, 0, -0.13},
+    {0.018, 0, 0.035},
+    {0.02, 0, -0.03},
+    {0.021, 0, -0.07},
+    {0.022, 0, -0.095},
+    {0.022, 0, -0.115},
+    {0.03, 0, 0.035},
+    {0.038, 0, -0.02},
+    {0.04, 0, -0.05},
+    {0.041, 0, -0.068},
+    {0.042, 0, -0.085},
+};
+constexpr int kTip[4] = {int(Joint::IndexTip), int(Joint::MiddleTip), int(Joint::RingTip),
+                         int(Joint::LittleTip)};
+
+enum class Shape { Relaxed, Pinch, Fist, Together, ThumbBetween };
+
+// Palm orientations: down (identity: the palm's normal -y), up, sideways, forward (-z).
+const Quat kDown = Quat::Identity();
+const Quat kUp(Eigen::AngleAxisd(M_PI, Vec3::UnitZ()));
+const Quat kSideways(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()));
+const Quat kForward(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX()));
+
+// A hand of `shape` (Pinch: the thumb tip `d` from finger `finger`'s tip) with its palm at `at`
+// turned by `q`, at time t.
+HandFrame hand(Shape shape, const Quat& q, double t, Hand side = Hand::Right, int finger = 0,
+               double d = 0.005, Vec3 at = Vec3(0, 1.2, -0.3)) {
+  Vec3 p[kJointCount];
+  for (int j = 0; j < kJointCount; ++j) p[j] = Vec3(kHand[j][0], kHand[j][1], kHand[j][2]);
+  const int thumb = int(Joint::ThumbTip);
+  // The index's thumb on the thumb's side of its tip, the others' under theirs.
+  if (shape == Shape::Pinch)
+    p[thumb] = p[kTip[finger]] + (finger ? Vec3(0, -d, 0) : Vec3(-d, 0, 0));
+  if (shape == Shape::ThumbBetween) p[thumb] = 0.5 * (p[kTip[0]] + p[kTip[1]]) + Vec3(0, -0.01, 0);
+  for (int k = 0; k < 4; ++k) {
+    Vec3& tip = p[kTip[k]];
+    if (shape == Shape::Fist) tip = Vec3(tip.x(), -0.03, -0.02);
+    if (shape == Shape::Together) tip.x() *= 0.55;
+  }
   HandFrame f;
+  f.hand = side;
   f.time = t;
   f.tracked = true;
   f.confidence = 1;
   f.has_joints = true;
-  for (auto& j : f.joints) j = Vec3(0, 0, 0);
-  f.joints[int(Joint::ThumbTip)] = Vec3(0, curl, 0);
-  f.joints[int(Joint::IndexTip)] = Vec3(d, curl, 0);
-  for (Joint tip : {Joint::MiddleTip, Joint::RingTip, Joint::LittleTip})
-    f.joints[int(tip)] = Vec3(0, curl, 0);
+  for (int j = 0; j < kJointCount; ++j) {
+    if (side == Hand::Left) p[j].x() = -p[j].x();
+    f.joints[j] = at + q * p[j];
+  }
+  f.palm.position = f.joints[0];
+  f.palm.orientation = q;
   return f;
 }
+
 int count(const std::vector<Trigger>& v, const std::string& c, bool begin) {
   int n = 0;
   for (auto& t : v) n += (t.command == c && t.begin == begin);
   return n;
+}
+std::string names(const std::vector<Trigger>& v) {
+  std::string s;
+  for (auto& t : v) s += t.command + (t.begin ? "+ " : "- ");
+  return s;
+}
+
+// Feeds `frames` frames at 100 Hz of make(t) from time t.
+template <class Make>
+void feed(GestureRecognizer& g, double& t, int frames, Make make, std::vector<Trigger>& out) {
+  for (int i = 0; i < frames; ++i, t += 0.01) g.update(make(t), out);
 }
 }  // namespace
 
@@ -29,45 +105,148 @@ TEST(Gestures, PinchHysteresisAndMinimumDuration) {
   GestureRecognizer g;  // enter < 2.5 cm, leave > 4 cm, 80 ms
   std::vector<Trigger> out;
   double t = 0;
-  auto feed = [&](double d, int frames) {
-    for (int i = 0; i < frames; ++i, t += 0.01) g.update(hand_with_pinch(d, t), out);
+  auto at = [&](double d, int frames) {
+    feed(
+        g, t, frames,
+        [&](double tt) { return hand(Shape::Pinch, kSideways, tt, Hand::Right, 0, d); }, out);
   };
-  feed(0.06, 10);
-  feed(0.02, 5);  // 50 ms below: shorter than min duration -> nothing
-  feed(0.06, 10);
+  at(0.06, 10);
+  at(0.02, 5);  // 50 ms below: shorter than min duration -> nothing
+  at(0.06, 10);
   EXPECT_EQ(count(out, "pinch", true), 0);
-  feed(0.02, 12);  // 120 ms -> begins
+  at(0.02, 12);  // 120 ms -> begins
   EXPECT_EQ(count(out, "pinch", true), 1);
-  feed(0.035, 30);  // between thresholds: still pinching
+  at(0.035, 30);  // between thresholds: still pinching
   EXPECT_EQ(count(out, "pinch", false), 0);
   EXPECT_TRUE(g.pinching(Hand::Right));
-  feed(0.045, 12);  // above 4 cm for 120 ms -> ends
+  at(0.045, 12);  // above 4 cm for 120 ms -> ends
   EXPECT_EQ(count(out, "pinch", false), 1);
   // Chatter around 3 cm never re-triggers (hysteresis).
-  for (int i = 0; i < 50; ++i) feed(i % 2 ? 0.028 : 0.034, 1);
+  for (int i = 0; i < 50; ++i) at(i % 2 ? 0.028 : 0.034, 1);
   EXPECT_EQ(count(out, "pinch", true), 1);
+  EXPECT_EQ(names(out), "pinch+ pinch- ");
 }
 
-TEST(Gestures, GrabAndOpenPalm) {
+TEST(Gestures, EachFingerPinchFiresOnlyItselfWithEitherHand) {
+  const char* name[4] = {"pinch", "pinch_middle", "pinch_ring", "pinch_little"};
+  for (Hand side : {Hand::Right, Hand::Left}) {
+    for (int k = 0; k < 4; ++k) {
+      GestureRecognizer g;
+      std::vector<Trigger> out;
+      double t = 0;
+      feed(
+          g, t, 10, [&](double tt) { return hand(Shape::Relaxed, kSideways, tt, side); }, out);
+      feed(
+          g, t, 5, [&](double tt) { return hand(Shape::Pinch, kSideways, tt, side, k); }, out);
+      EXPECT_TRUE(out.empty()) << name[k] << ": 50 ms is shorter than the minimum duration";
+      feed(
+          g, t, 20, [&](double tt) { return hand(Shape::Pinch, kSideways, tt, side, k); }, out);
+      feed(
+          g, t, 20, [&](double tt) { return hand(Shape::Relaxed, kSideways, tt, side); }, out);
+      EXPECT_EQ(names(out), std::string(name[k]) + "+ " + name[k] + "- ") << hand_name(side);
+      for (const auto& tr : out) EXPECT_EQ(tr.hand, side);
+    }
+  }
+}
+
+TEST(Gestures, ThumbBetweenTwoFingertipsPinchesNeither) {
   GestureRecognizer g;
   std::vector<Trigger> out;
   double t = 0;
-  for (int i = 0; i < 20; ++i, t += 0.01) g.update(hand_with_pinch(0.06, t, 0.03), out);
-  EXPECT_EQ(count(out, "grab", true), 1);
-  for (int i = 0; i < 20; ++i, t += 0.01) g.update(hand_with_pinch(0.06, t, 0.18), out);
-  EXPECT_EQ(count(out, "grab", false), 1);
-  EXPECT_EQ(count(out, "open_palm", true), 1);
+  feed(
+      g, t, 50, [&](double tt) { return hand(Shape::ThumbBetween, kSideways, tt); }, out);
+  EXPECT_EQ(names(out), "");
 }
 
-TEST(Gestures, LostHandEndsPinch) {
+TEST(Gestures, RestingOpenHandFiresNothing) {
+  for (const Quat& q : {kSideways, kDown, kForward}) {
+    GestureRecognizer g;
+    std::vector<Trigger> out;
+    double t = 0;
+    // Two seconds of a relaxed hand with a slow drift and a 3 mm tremor.
+    feed(
+        g, t, 200,
+        [&](double tt) {
+          auto f = hand(Shape::Relaxed, q, tt);
+          const Vec3 drift(0.02 * tt, 0.003 * std::sin(40 * tt), -0.01 * tt);
+          for (auto& j : f.joints) j += drift;
+          f.palm.position += drift;
+          return f;
+        },
+        out);
+    EXPECT_EQ(names(out), "") << q.coeffs().transpose();
+  }
+}
+
+TEST(Gestures, FistIsGrabAndNoPinch) {
   GestureRecognizer g;
   std::vector<Trigger> out;
   double t = 0;
-  for (int i = 0; i < 20; ++i, t += 0.01) g.update(hand_with_pinch(0.01, t), out);
+  feed(
+      g, t, 20, [&](double tt) { return hand(Shape::Fist, kSideways, tt); }, out);
+  feed(
+      g, t, 20, [&](double tt) { return hand(Shape::Relaxed, kSideways, tt); }, out);
+  EXPECT_EQ(names(out), "grab+ grab- ");
+}
+
+TEST(Gestures, FlatHandPalmDownIsFlatAndItsNeighboursAreNot) {
+  auto run = [](Shape shape, const Quat& q) {
+    GestureRecognizer g;
+    std::vector<Trigger> out;
+    double t = 0;
+    feed(
+        g, t, 20, [&](double tt) { return hand(shape, q, tt); }, out);
+    feed(
+        g, t, 20, [&](double tt) { return hand(Shape::Relaxed, kSideways, tt); }, out);
+    return names(out);
+  };
+  EXPECT_EQ(run(Shape::Together, kDown), "flat+ flat- ");
+  EXPECT_EQ(run(Shape::Relaxed, kDown), "");                   // fingers apart: resting on a table
+  EXPECT_EQ(run(Shape::Together, kSideways), "");              // a karate chop, not palm down
+  EXPECT_EQ(run(Shape::Together, kUp), "palm_up+ palm_up- ");  // palm up, not flat
+  EXPECT_EQ(run(Shape::Relaxed, kUp), "palm_up+ palm_up- ");
+  EXPECT_EQ(run(Shape::Fist, kUp), "grab+ grab- ");  // a fist turned up is no palm up
+  EXPECT_EQ(run(Shape::Pinch, kUp), "pinch+ pinch- ");
+}
+
+TEST(Gestures, PushIsTheOpenPalmThrustForward) {
+  auto run = [](const Quat& q, Vec3 dir, double dist, Shape shape = Shape::Relaxed) {
+    GestureRecognizer g;
+    std::vector<Trigger> out;
+    double t = 0;
+    const Vec3 start(0, 1.2, -0.3);
+    feed(
+        g, t, 20, [&](double tt) { return hand(shape, q, tt, Hand::Right, 0, 0.005, start); }, out);
+    // `dist` along `dir` in 0.2 s, then held there.
+    for (int i = 1; i <= 40; ++i, t += 0.01) {
+      const double s = std::min(1.0, i / 20.0);
+      g.update(hand(shape, q, t, Hand::Right, 0, 0.005, start + dir * dist * s), out);
+    }
+    return names(out);
+  };
+  const Vec3 fwd(0, 0, -1);
+  EXPECT_EQ(run(kForward, fwd, 0.2), "push+ ");
+  EXPECT_EQ(run(kForward, fwd, 0.08), "");                     // too short
+  EXPECT_EQ(run(kSideways, fwd, 0.2), "");                     // the palm does not lead
+  EXPECT_EQ(run(kDown, Vec3(0, -1, 0), 0.2, Shape::Together),  // smoothing pressed down
+            "flat+ ");
+  EXPECT_EQ(run(kForward, fwd, 0.2, Shape::Fist), "grab+ ");  // a punch is no push
+}
+
+TEST(Gestures, LostHandEndsWhatIsHeld) {
+  GestureRecognizer g;
+  std::vector<Trigger> out;
+  double t = 0;
+  feed(
+      g, t, 20, [&](double tt) { return hand(Shape::Pinch, kSideways, tt); }, out);
+  feed(
+      g, t, 20, [&](double tt) { return hand(Shape::Together, kDown, tt, Hand::Left); }, out);
   HandFrame lost;
   lost.time = t;
   g.update(lost, out);
-  EXPECT_EQ(count(out, "pinch", false), 1);
+  lost.hand = Hand::Left;
+  g.update(lost, out);
+  EXPECT_EQ(names(out), "pinch+ flat+ pinch- flat- ");
 }
 
 TEST(Gestures, DwellAndPushForPalmOnlySources) {
@@ -88,7 +267,7 @@ TEST(Gestures, DwellAndPushForPalmOnlySources) {
     f.palm.position = Vec3(0, 1, -1 - 0.2 * (i + 1) / 9.0);
     g.update(f, out);
   }
-  EXPECT_EQ(count(out, "push", true), 1);
+  EXPECT_EQ(count(out, "palm_push", true), 1);
   EXPECT_EQ(count(out, "dwell", true), 1);
 }
 
