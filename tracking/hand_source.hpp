@@ -36,13 +36,23 @@ struct XrControllerInput {
   Pose grip;
   double trigger = 0;  // 0..1 analog value
   bool a = false, b = false, squeeze = false;
+  bool menu = false;
+  double stick_x = 0, stick_y = 0;  // thumbstick, -1..1 (+y up, +x right)
+  bool stick_click = false;
+  double pad_x = 0, pad_y = 0;  // trackpad position, -1..1
+  bool pad_click = false;
 };
 
 class XrHandSource : public HandSource {
  public:
   std::string name() const override { return "xr"; }
   void feed_joints(Hand h, const XrJointInput& in);
-  // Controller poses become palm-only frames; buttons become triggers in `triggers()`.
+  // Controller poses become palm-only frames; buttons become triggers in `take_triggers()`:
+  // "button.trigger" (the analog trigger with hysteresis), "button.squeeze", "button.a",
+  // "button.b", "button.menu", "button.stick" (its click); "stick.up" / "down" / "left" /
+  // "right" (the thumbstick pushed that way, with hysteresis); "trackpad.up" / "down" / "left" /
+  // "right" / "center" (the region clicked, held until the click ends); "palm_up" (the
+  // controller rolled so that the palm faces up).
   void feed_controller(Hand h, const XrControllerInput& in);
   std::vector<HandFrame> poll() override;
   std::vector<Trigger> take_triggers();
@@ -51,7 +61,14 @@ class XrHandSource : public HandSource {
  private:
   std::vector<HandFrame> pending_;
   std::vector<Trigger> triggers_;
+  void edge(Hand h, const std::string& name, bool on, double time);
+  void stick_edges(Hand h, const XrControllerInput& in);
+  void pad_edges(Hand h, const XrControllerInput& in);
+  void palm_up_edge(Hand h, const XrControllerInput& in);
   bool trigger_down_[2] = {false, false};
+  int stick_dir_[2] = {-1, -1};   // 0 up, 1 down, 2 left, 3 right; -1 centred
+  int pad_region_[2] = {-1, -1};  // as stick_dir_, 4 centre; -1 not clicked
+  bool palm_up_[2] = {false, false};
   std::vector<std::pair<std::string, bool>> buttons_[2];
   double last_time_ = -1;
 };
