@@ -41,7 +41,20 @@ void OperationController::trigger(World& w, const std::string& name, TriggerPhas
     }
     return;
   }
+  if (name == "next") return next_candidate(w, phase, hand);
   apply_trigger(w, name, phase, hand);
+}
+
+// "next": the hand's next pinch takes the next candidate particle (cycling back to the best),
+// through select_candidate so the session log records a selection.
+void OperationController::next_candidate(World& w, TriggerPhase phase, int hand) {
+  if (phase == TriggerPhase::kEnd) return;
+  if (hand != 0 && hand != 1) return w.report("trigger next: hand must be 0 or 1: ignored");
+  const int n = static_cast<int>(state_.candidates[hand].particles.size());
+  if (n == 0)
+    return w.report(std::string("next: no candidate particle near the ") +
+                    (hand == 0 ? "left" : "right") + " hand: ignored");
+  select_candidate(w, hand, (state_.candidates[hand].chosen + 1) % n);
 }
 
 void OperationController::cut_stroke(World& w, int hand, const std::vector<Vec3>& points) {

@@ -27,8 +27,9 @@ class OperationController {
 
   // Hand proxies for this tick (id 0 left, 1 right). Non-finite poses are ignored with a reason.
   void set_hands(World& w, const std::array<HandProxy, 2>& hands);
-  // Trigger names: pinch, release, pin, cut, move, map, smooth, undo, redo, stop. Unknown names
-  // are ignored with a reason. hand: 0 left, 1 right (move uses both hands).
+  // Trigger names: pinch, release, pin, cut, move, map, smooth, undo, redo, stop, next (the
+  // hand's next candidate particle, see select_candidate). Unknown names are ignored with a
+  // reason. hand: 0 left, 1 right (move uses both hands).
   void trigger(World& w, const std::string& name, TriggerPhase phase, int hand);
   // A predetermined cut line (Table 3-3: "cut along a predefined line").
   void cut_stroke(World& w, int hand, const std::vector<Vec3>& points);
@@ -60,6 +61,7 @@ class OperationController {
   void apply_hands(World& w, const std::array<HandProxy, 2>& hands);
   void apply_trigger(World& w, const std::string& name, TriggerPhase phase, int hand);
   void apply_stroke(World& w, int hand, const std::vector<Vec3>& points);
+  void next_candidate(World& w, TriggerPhase phase, int hand);
   bool active(const std::string& name, int hand) const;
   void log(SessionEvent e);
 

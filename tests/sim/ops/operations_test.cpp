@@ -628,6 +628,30 @@ TEST_P(Ops, CandidatesComeFromTheSurfaceUnderTheHand) {
   }
 }
 
+// "next" cycles the hand's candidate through select_candidate: each trigger takes the next
+// particle of the list and wraps back to the best; its end does nothing.
+TEST_P(Ops, NextCyclesTheHandsCandidate) {
+  SetUpWorld(2);
+  int v = middle();
+  if (GetParam() == Initial::kRolled)
+    for (int i = 0; i < w.cloth.num_vertices(); ++i)
+      if (X(i).z() > X(v).z()) v = i;
+  set(1, X(v) + Vec3(0.004, 0.004, 0.10));
+  ops_update_candidates(w, c->state(), c->params());
+  const int n = static_cast<int>(c->state().candidates[1].particles.size());
+  ASSERT_GE(n, 1);
+  std::vector<int32_t> seen;
+  for (int k = 0; k < n + 1; ++k) {
+    seen.push_back(c->state().candidates[1].chosen_vertex());
+    trig("next", TriggerPhase::kBegin);
+    trig("next", TriggerPhase::kEnd);
+  }
+  for (int k = 0; k < n; ++k) EXPECT_EQ(seen[k], c->state().candidates[1].particles[k].vertex) << k;
+  EXPECT_EQ(seen[n], seen[0]);  // wrapped round
+  EXPECT_EQ(c->state().selected[1], 1 % n);
+  EXPECT_EQ(c->state().selected[0], 0);  // the other hand's is untouched
+}
+
 // --- bad input ---------------------------------------------------------------------------
 TEST_P(Ops, BadInputIsIgnoredWithAReason) {
   SetUpWorld(2);
