@@ -101,9 +101,12 @@ class DrapingSession : public SessionContent {
   const sim::SceneSnapshot* snap_ = nullptr;  // the snapshot this frame draws
   bool cloth_matched_ = false;           // the drawn snapshot holds a posted right-hand pose ...
   Clock::time_point cloth_posted_at_{};  // ... posted then
-  Feedback feedback_;  // the text panel's content (feedback.hpp)
+  Feedback feedback_;                    // the text panel's content (feedback.hpp)
   TickProfile ticks_;
   ThreadGroups threads_;
+
+  // Each hand's interaction profile family: controller triggers are looked up under it.
+  std::string profiles_[2];
 };
 
 }  // namespace drape::app

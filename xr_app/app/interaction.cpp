@@ -1,7 +1,8 @@
 // The draping session's interaction: every hand input goes through the tracking XR adapter
 // (tracking::XrHandSource: the joints of XR_EXT_hand_tracking and the controller's grip pose,
-// trigger, squeeze and a/b buttons); its triggers, the gestures' and the voice cues' go through
-// the command map to the sim's operations.
+// trigger, squeeze, buttons, thumbstick and trackpad); its triggers, the gestures' and the voice
+// cues' go through the command map (per hand, and per interaction profile for controllers) to
+// the sim's operations, except the help, which the session shows itself.
 #include <cstdio>
 
 #include "xr_app/app/draping_session.hpp"
@@ -110,6 +111,23 @@ void DrapingSession::drain_free_outcomes() {
   for (const auto& l : lines) rep_.note(l);
 }
 
+namespace {
+// The controller's buttons, stick and trackpad for the XR adapter.
+void feed_buttons(const ControllerState& c, tracking::XrControllerInput& ci) {
+  ci.trigger = c.trigger;
+  ci.squeeze = c.squeeze;
+  ci.a = c.a;
+  ci.b = c.b;
+  ci.menu = c.menu;
+  ci.stick_x = c.stick.x;
+  ci.stick_y = c.stick.y;
+  ci.stick_click = c.stick_click;
+  ci.pad_x = c.pad.x;
+  ci.pad_y = c.pad.y;
+  ci.pad_click = c.pad_click;
+}
+}  // namespace
+
 void DrapingSession::read_hand(int h, double t, const HandInput& in, sim::HandProxy& hand,
                                std::vector<tracking::Trigger>& trig) {
   const auto side = static_cast<tracking::Hand>(h);
@@ -130,7 +148,11 @@ void DrapingSession::read_hand(int h, double t, const HandInput& in, sim::HandPr
     }
     xr_source_.feed_joints(side, ji);
     for (const auto& f : xr_source_.poll()) {
-      gestures_.update(f, trig);  // joint frames only: pinch / grab / open palm
+      // A held controller's joints are the runtime's synthesis from its buttons: its gestures
+      // are ignored (a lost frame ends any in progress) so that a button never fires twice.
+      tracking::HandFrame g = f;
+      g.tracked = f.tracked && !in.controllers[h].active;
+      gestures_.update(g, trig);
       if (f.tracked && f.has_joints) {
         joint_frame = f;
         have_joint_frame = true;
@@ -145,10 +167,8 @@ void DrapingSession::read_hand(int h, double t, const HandInput& in, sim::HandPr
     ci.grip.position = vec3(c.grip.position);
     ci.grip.orientation = quat(c.grip.orientation);
   }
-  ci.trigger = c.trigger;
-  ci.squeeze = c.squeeze;
-  ci.a = c.a;
-  ci.b = c.b;
+  feed_buttons(c, ci);
+  profiles_[h] = c.profile;
   xr_source_.feed_controller(side, ci);
   tracking::HandFrame ctrl_frame;
   bool have_ctrl = false;
@@ -191,7 +211,8 @@ std::vector<DrapingSession::Op> DrapingSession::map_triggers(
     int64_t frame, const std::vector<tracking::Trigger>& trig) {
   std::vector<Op> use;
   for (const auto& tr : trig) {
-    const auto act = commands_.lookup(tr);
+    const int hi = static_cast<int>(tr.hand);
+    const auto act = commands_.lookup(tr, tr.source == "controller" ? profiles_[hi] : "");
     std::string line = "frame " + std::to_string(frame) + ": " + tr.source + " " + tr.command +
                        (tr.begin ? " begin" : " end") + " hand " + tracking::hand_name(tr.hand);
     if (!act) {
@@ -206,6 +227,11 @@ std::vector<DrapingSession::Op> DrapingSession::map_triggers(
     line += " -> " + op.name + " " + tracking::phase_name(act->phase);
     rep_.r.triggers.push_back(line);
     if (opt_.verbose) rep_.note("trigger " + line);
+    // The help is the app's: shown while its gesture or button is held, not sent to the sim.
+    if (op.name == "help") {
+      feedback_.show_help(act->phase != tracking::Phase::End);
+      continue;
+    }
     use.push_back(op);
   }
   return use;

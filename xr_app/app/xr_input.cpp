@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "tracking/command_map.hpp"
+
 namespace drape::app {
 
 namespace {
@@ -39,38 +41,81 @@ void XrInput::create_actions(XrInstance instance) {
   primary_ = make("primary", "Primary button", XR_ACTION_TYPE_BOOLEAN_INPUT);
   secondary_ = make("secondary", "Secondary button", XR_ACTION_TYPE_BOOLEAN_INPUT);
   haptic_ = make("haptic", "Haptic", XR_ACTION_TYPE_VIBRATION_OUTPUT);
+  menu_ = make("menu", "Menu button", XR_ACTION_TYPE_BOOLEAN_INPUT);
+  stick_ = make("thumbstick", "Thumbstick", XR_ACTION_TYPE_VECTOR2F_INPUT);
+  stick_click_ = make("thumbstick_click", "Thumbstick click", XR_ACTION_TYPE_BOOLEAN_INPUT);
+  pad_ = make("trackpad", "Trackpad", XR_ACTION_TYPE_VECTOR2F_INPUT);
+  pad_click_ = make("trackpad_click", "Trackpad click", XR_ACTION_TYPE_BOOLEAN_INPUT);
   suggest_bindings(instance);
 }
 
+namespace {
+// The components of one profile for one hand (paths after /user/hand/<side>), from the
+// OpenXR specification's interaction profile paths; "" where the profile has none.
+struct ProfileComponents {
+  const char* pinch = "/input/trigger/value";
+  const char* grab = "";
+  const char* primary = "";
+  const char* secondary = "";
+  const char* menu = "";
+  bool stick = false, pad = false;
+};
+
+ProfileComponents components(const std::string& profile, bool left) {
+  ProfileComponents c;
+  if (profile.find("khr/simple") != std::string::npos) {
+    c.pinch = "/input/select/click";
+    c.menu = "/input/menu/click";
+  } else if (profile.find("oculus/touch") != std::string::npos) {
+    // Touch: X/Y and menu on the left, A/B on the right (its system button is the runtime's).
+    c.grab = "/input/squeeze/value";
+    c.primary = left ? "/input/x/click" : "/input/a/click";
+    c.secondary = left ? "/input/y/click" : "/input/b/click";
+    c.menu = left ? "/input/menu/click" : "";
+    c.stick = true;
+  } else if (profile.find("valve/index") != std::string::npos) {
+    // Index: no menu button; its trackpad has no click.
+    c.grab = "/input/squeeze/value";
+    c.primary = "/input/a/click";
+    c.secondary = "/input/b/click";
+    c.stick = true;
+  } else if (profile.find("htc/vive") != std::string::npos) {
+    c.grab = "/input/squeeze/click";
+    c.menu = "/input/menu/click";
+    c.pad = true;
+  } else {  // microsoft/motion
+    c.grab = "/input/squeeze/click";
+    c.menu = "/input/menu/click";
+    c.stick = c.pad = true;
+  }
+  return c;
+}
+}  // namespace
+
+// Every profile's components for both hands; what a profile lacks is bound by another input of
+// it where assets/commands.json says so (a trackpad region for a stick), else not at all.
 void XrInput::suggest_bindings(XrInstance instance) {
   for (const char* prof : kProfiles) {
-    std::string p = prof;
     std::vector<XrActionSuggestedBinding> b;
-    const bool simple = p.find("simple") != std::string::npos;
-    const bool oculus = p.find("oculus") != std::string::npos;
-    const bool index = p.find("index") != std::string::npos;
     for (const char* side : {"left", "right"}) {
       const std::string h = std::string("/user/hand/") + side;
-      const bool left = std::string(side) == "left";
+      const ProfileComponents c = components(prof, std::string(side) == "left");
       auto bind = [&](XrAction a, const std::string& comp) {
-        b.push_back({a, xr_path(instance, (h + comp).c_str())});
+        if (!comp.empty()) b.push_back({a, xr_path(instance, (h + comp).c_str())});
       };
-      bind(pinch_, simple ? "/input/select/click" : "/input/trigger/value");
-      if (!simple) bind(grab_, oculus || index ? "/input/squeeze/value" : "/input/squeeze/click");
+      bind(pinch_, c.pinch);
+      bind(grab_, c.grab);
       bind(pose_, "/input/grip/pose");
-      // Primary / secondary buttons ("button.a" / "button.b" of the command map): A/B (X/Y on
-      // the left Touch controller); trackpad click / menu on Vive and WMR; menu on simple.
-      if (oculus) {
-        bind(primary_, left ? "/input/x/click" : "/input/a/click");
-        bind(secondary_, left ? "/input/y/click" : "/input/b/click");
-      } else if (index) {
-        bind(primary_, "/input/a/click");
-        bind(secondary_, "/input/b/click");
-      } else if (simple) {
-        bind(secondary_, "/input/menu/click");
-      } else {
-        bind(primary_, "/input/trackpad/click");
-        bind(secondary_, "/input/menu/click");
+      bind(primary_, c.primary);
+      bind(secondary_, c.secondary);
+      bind(menu_, c.menu);
+      if (c.stick) {
+        bind(stick_, "/input/thumbstick");
+        bind(stick_click_, "/input/thumbstick/click");
+      }
+      if (c.pad) {
+        bind(pad_, "/input/trackpad");
+        bind(pad_click_, "/input/trackpad/click");
       }
       bind(haptic_, "/output/haptic");
     }
@@ -83,6 +128,7 @@ void XrInput::suggest_bindings(XrInstance instance) {
 }
 
 void XrInput::attach(XrInstance instance, XrSession session, bool hand_tracking) {
+  instance_ = instance;
   XrSessionActionSetsAttachInfo at{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
   at.countActionSets = 1;
   at.actionSets = &action_set_;
@@ -176,7 +222,31 @@ void XrInput::read_controllers(XrSession session, XrSpace space, XrTime time, Ha
     c.squeeze = boolean(grab_);
     c.a = boolean(primary_);
     c.b = boolean(secondary_);
+    c.menu = boolean(menu_);
+    c.stick_click = boolean(stick_click_);
+    c.pad_click = boolean(pad_click_);
+    auto vector2 = [&](XrAction a) {
+      gi.action = a;
+      XrActionStateVector2f vv{XR_TYPE_ACTION_STATE_VECTOR2F};
+      const bool ok = XR_SUCCEEDED(xrGetActionStateVector2f(session, &gi, &vv)) && vv.isActive;
+      return ok ? vv.currentState : XrVector2f{0, 0};
+    };
+    c.stick = vector2(stick_);
+    c.pad = vector2(pad_);
+    read_profile(session, h, c);
   }
+}
+
+// The hand's current interaction profile, as the command map's family name.
+void XrInput::read_profile(XrSession session, int hand, ControllerState& c) const {
+  XrInteractionProfileState ps{XR_TYPE_INTERACTION_PROFILE_STATE};
+  if (!XR_SUCCEEDED(xrGetCurrentInteractionProfile(session, hand_paths_[hand], &ps)) ||
+      ps.interactionProfile == XR_NULL_PATH)
+    return;
+  char buf[XR_MAX_PATH_LENGTH];
+  uint32_t n = 0;
+  if (XR_SUCCEEDED(xrPathToString(instance_, ps.interactionProfile, sizeof buf, &n, buf)))
+    c.profile = tracking::profile_family(buf);
 }
 
 }  // namespace drape::app

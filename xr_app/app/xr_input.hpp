@@ -1,9 +1,11 @@
 // The OpenXR app's input: one action set (pinch, grab, hand pose, primary and secondary
-// buttons, haptics) with suggested bindings for the common controllers, the hands' grip spaces,
-// and XR_EXT_hand_tracking's joint sets when the system offers them.
+// buttons, menu, thumbstick and its click, trackpad and its click, haptics) with suggested
+// bindings for the common controllers (only the components each profile has), the hands' grip
+// spaces, and XR_EXT_hand_tracking's joint sets when the system offers them.
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "xr_app/app/xr_common.hpp"
 
@@ -14,7 +16,12 @@ struct ControllerState {
   bool active = false;  // the grip pose is valid
   XrPosef grip{};
   float trigger = 0;  // the pinch action's value (0 while it is inactive)
-  bool squeeze = false, a = false, b = false;
+  bool squeeze = false, a = false, b = false, menu = false;
+  XrVector2f stick{0, 0};  // thumbstick (0 while inactive)
+  bool stick_click = false;
+  XrVector2f pad{0, 0};  // trackpad position (0 while inactive)
+  bool pad_click = false;
+  std::string profile;  // the hand's interaction profile family ("oculus/touch"; "" none)
 };
 
 // This frame's hands: joint sets (index 0 left, 1 right) and, when read, the controllers.
@@ -45,10 +52,14 @@ class XrInput {
 
  private:
   void suggest_bindings(XrInstance instance);
+  void read_profile(XrSession session, int hand, ControllerState& c) const;
   Report& rep_;
+  XrInstance instance_ = XR_NULL_HANDLE;
   XrActionSet action_set_ = XR_NULL_HANDLE;
   XrAction pinch_ = XR_NULL_HANDLE, grab_ = XR_NULL_HANDLE, pose_ = XR_NULL_HANDLE,
-           primary_ = XR_NULL_HANDLE, secondary_ = XR_NULL_HANDLE, haptic_ = XR_NULL_HANDLE;
+           primary_ = XR_NULL_HANDLE, secondary_ = XR_NULL_HANDLE, haptic_ = XR_NULL_HANDLE,
+           menu_ = XR_NULL_HANDLE, stick_ = XR_NULL_HANDLE, stick_click_ = XR_NULL_HANDLE,
+           pad_ = XR_NULL_HANDLE, pad_click_ = XR_NULL_HANDLE;
   XrPath hand_paths_[2] = {XR_NULL_PATH, XR_NULL_PATH};
   XrSpace hand_spaces_[2] = {XR_NULL_HANDLE, XR_NULL_HANDLE};
   XrHandTrackerEXT trackers_[2] = {XR_NULL_HANDLE, XR_NULL_HANDLE};
