@@ -459,10 +459,13 @@ std::string bindings_help() {
   if (!map) map = drape::tracking::CommandMap::defaults();
   for (const drape::tracking::Binding& b : map->bindings()) {
     char line[160];
-    std::snprintf(line, sizeof line, "  %-10s %-22s %-5s -> %s %s\n", b.source.c_str(),
+    std::snprintf(line, sizeof line, "  %-10s %-22s %-5s -> %s %s", b.source.c_str(),
                   b.command.c_str(), b.edge.c_str(), b.action.operation.c_str(),
                   drape::tracking::phase_name(b.action.phase));
-    out += line;
+    std::string who = b.hand.empty() ? "" : b.hand + " hand";
+    if (!b.profile.empty()) who += (who.empty() ? "" : ", ") + b.profile;
+    out += line + (b.label.empty() ? "" : "  " + b.label) + (who.empty() ? "" : "  (" + who + ")") +
+           "\n";
   }
   return out +
          "The simulated runtime's window turns mouse and keys into these hands and buttons: "
