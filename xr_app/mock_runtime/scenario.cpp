@@ -121,9 +121,38 @@ float len(XrVector3f a) {
   return std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
 }
 
+bool hand_shape_from_name(const std::string& name, HandShape* shape) {
+  const char* names[] = {"open", "pinch_middle", "pinch_ring", "pinch_little", "together"};
+  for (int i = 0; i < 5; ++i)
+    if (name == names[i]) return *shape = static_cast<HandShape>(i), true;
+  return false;
+}
+
+namespace {
+// The thumb's tip 5 mm under another fingertip (palm side), its distal and proximal joints
+// dragged along; or the fingers' distal joints drawn together toward the middle finger.
+void shape_hand(HandShape shape, XrVector3f* p) {
+  if (shape >= kShapePinchMiddle && shape <= kShapePinchLittle) {
+    const int tips[] = {XR_HAND_JOINT_MIDDLE_TIP_EXT, XR_HAND_JOINT_RING_TIP_EXT,
+                        XR_HAND_JOINT_LITTLE_TIP_EXT};
+    const int T = XR_HAND_JOINT_THUMB_TIP_EXT;
+    const XrVector3f target = add(p[tips[shape - kShapePinchMiddle]], {0, -0.005f, 0});
+    const XrVector3f d = sub(target, p[T]);
+    p[T] = target;
+    p[XR_HAND_JOINT_THUMB_DISTAL_EXT] = add(p[XR_HAND_JOINT_THUMB_DISTAL_EXT], mul(d, 0.6f));
+    p[XR_HAND_JOINT_THUMB_PROXIMAL_EXT] = add(p[XR_HAND_JOINT_THUMB_PROXIMAL_EXT], mul(d, 0.25f));
+  }
+  if (shape == kShapeTogether) {
+    for (int f0 : {XR_HAND_JOINT_INDEX_INTERMEDIATE_EXT, XR_HAND_JOINT_RING_INTERMEDIATE_EXT,
+                   XR_HAND_JOINT_LITTLE_INTERMEDIATE_EXT})
+      for (int k = 0; k < 3; ++k) p[f0 + k].x *= 0.55f;
+  }
+}
+}  // namespace
+
 void generate_hand(int hand, const XrPosef& palm, float pinch,
                    std::array<XrPosef, kHandJointCount>* joints,
-                   std::array<float, kHandJointCount>* radii, float fist) {
+                   std::array<float, kHandJointCount>* radii, float fist, HandShape shape) {
   pinch = std::clamp(pinch, 0.f, 1.f);
   XrVector3f p[kHandJointCount];
   for (int j = 0; j < kHandJointCount; ++j) p[j] = v3(kRightHand[j]);
@@ -163,6 +192,7 @@ void generate_hand(int hand, const XrPosef& palm, float pinch,
         p[f0 + k] = add(p[f0 + k], mul(sub(curl, p[f0 + k]), amount[k] * fist));
     }
   }
+  shape_hand(shape, p);
   for (int j = 0; j < kHandJointCount; ++j) {
     XrVector3f q = p[j];
     if (hand == 0) q.x = -q.x;  // left hand: mirror image
@@ -195,6 +225,13 @@ void bracket(const std::vector<K>& keys, double frame, size_t* a, size_t* b, flo
   }
   size_t hi = 1;
   while (keys[hi].frame < frame) ++hi;
+  if (keys[hi].frame == frame) {
+    // On a key: that key alone, so its clicks (not interpolated) arrive in the same frame as its
+    // values (which a bracket ending at it would interpolate to it at t = 1).
+    *a = *b = hi;
+    *t = 0;
+    return;
+  }
   *a = hi - 1;
   *b = hi;
   double span = keys[hi].frame - keys[hi - 1].frame;
@@ -239,14 +276,14 @@ HandSample Scenario::hand(int h, double frame) const {
       std::array<XrPosef, kHandJointCount> tmp;
       generate_hand(h, dummy, 0, &tmp, r);
     } else {
-      generate_hand(h, k.palm, k.pinch, j, r, k.fist);
+      generate_hand(h, k.palm, k.pinch, j, r, k.fist, k.shape);
     }
   };
   if (!ka.explicit_joints && !kb.explicit_joints) {
     // Interpolate palm and pinch, then generate: keeps the pinch gap exactly linear.
     XrPosef palm = pose_lerp(ka.palm, kb.palm, t);
     generate_hand(h, palm, ka.pinch + (kb.pinch - ka.pinch) * t, &s.joints, &s.radii,
-                  ka.fist + (kb.fist - ka.fist) * t);
+                  ka.fist + (kb.fist - ka.fist) * t, ka.shape);
     return s;
   }
   joints_of(ka, &ja, &ra);
@@ -266,7 +303,9 @@ bool Scenario::controller(int h, double frame, XrPosef* grip, XrPosef* aim,
     float x = h == 0 ? -0.2f : 0.2f;
     *grip = XrPosef{{0, 0, 0, 1}, {x, 1.3f, 0.6f}};
     *aim = *grip;
-    return true;
+    // A hand the scenario tracks as a hand and not as a controller is bare: its controller is
+    // set down (untracked), as a runtime reports it while it tracks the hand itself.
+    return hands[h].empty();
   }
   size_t a, b;
   float t;
@@ -427,6 +466,15 @@ void parse(const json& root, const std::filesystem::path& dir, Scenario* s) {
             k.pinch = num(kj["pinch"], f + ".pinch");
             if (k.pinch < 0 || k.pinch > 1) throw FieldError(f + ".pinch: must be in [0, 1]");
           }
+          if (kj.contains("fist")) {
+            k.fist = num(kj["fist"], f + ".fist");
+            if (k.fist < 0 || k.fist > 1) throw FieldError(f + ".fist: must be in [0, 1]");
+          }
+          if (kj.contains("shape") &&
+              (!kj["shape"].is_string() || !hand_shape_from_name(kj["shape"], &k.shape)))
+            throw FieldError(f +
+                             ".shape: expected one of open, pinch_middle, pinch_ring, "
+                             "pinch_little, together");
         }
         s->hands[hi].push_back(k);
       }

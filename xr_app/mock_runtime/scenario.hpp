@@ -35,6 +35,16 @@ struct HandSample {
   std::array<float, kHandJointCount> radii{};
 };
 
+// A generated hand's shape: the thumb tip 5 mm under the middle, ring or little fingertip (the
+// thumb's pinch with that finger), or the fingers together (a flat hand); open: as generated.
+enum HandShape {
+  kShapeOpen,
+  kShapePinchMiddle,
+  kShapePinchRing,
+  kShapePinchLittle,
+  kShapeTogether
+};
+
 struct HandKey {
   double frame = 0;
   bool tracked = true;
@@ -42,6 +52,7 @@ struct HandKey {
   XrPosef palm{};  // palm pose (generated mode)
   float pinch = 0.f;
   float fist = 0.f;                               // fingers curled into the palm (generated mode)
+  HandShape shape = kShapeOpen;                   // (generated mode, not interpolated)
   std::array<XrPosef, kHandJointCount> joints{};  // explicit mode
 };
 
@@ -101,9 +112,13 @@ bool load_scenario(const std::string& path, Scenario* out, std::string* error);
 // palm; 0 leaves the hand as without it.
 constexpr float kOpenPinchGap = 0.085f;
 constexpr float kClosedPinchGap = 0.005f;
+// shape: see HandShape.
 void generate_hand(int hand, const XrPosef& palm, float pinch,
                    std::array<XrPosef, kHandJointCount>* joints,
-                   std::array<float, kHandJointCount>* radii, float fist = 0.f);
+                   std::array<float, kHandJointCount>* radii, float fist = 0.f,
+                   HandShape shape = kShapeOpen);
+// "open", "pinch_middle", "pinch_ring", "pinch_little", "together"; false if unknown.
+bool hand_shape_from_name(const std::string& name, HandShape* shape);
 
 // Minimal PNG writer (8-bit RGBA, zlib "stored" blocks). Returns false on I/O error.
 bool write_png_rgba(const std::string& path, int width, int height, const unsigned char* rgba);
