@@ -29,12 +29,45 @@ constexpr float kLookPerPixel = 0.004f;  // rad per pixel of right-drag
 constexpr float kWheelStep = 0.02f;      // m per wheel notch
 constexpr float kSelfHit = 0.01f;        // depth hits within a joint's radius plus this: the hand
 
-// The keys held down (besides the one-shot ones: Tab, R, V, Escape).
-enum Key { kW, kA, kS, kD, kQ, kE, kF, k1, k2, k3, k4, kM, kLeftShift, kRightShift, kKeys };
-constexpr int kGlfwKeys[kKeys] = {GLFW_KEY_W,          GLFW_KEY_A,          GLFW_KEY_S, GLFW_KEY_D,
-                                  GLFW_KEY_Q,          GLFW_KEY_E,          GLFW_KEY_F, GLFW_KEY_1,
-                                  GLFW_KEY_2,          GLFW_KEY_3,          GLFW_KEY_4, GLFW_KEY_M,
-                                  GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT};
+constexpr float kPushDistance = 0.2f;  // m: T thrusts the open palm this far forward ...
+constexpr float kPushSpeed = 1.5f;     // m/s: ... at this speed
+
+// The keys held down (besides the one-shot ones: Tab, R, V, Escape). Z X C G U T: gestures;
+// the arrows and Enter: the thumbstick (trackpad) and its click.
+enum Key {
+  kW,
+  kA,
+  kS,
+  kD,
+  kQ,
+  kE,
+  kF,
+  k1,
+  k2,
+  k3,
+  k4,
+  kM,
+  kLeftShift,
+  kRightShift,
+  kZ,
+  kX,
+  kC,
+  kG,
+  kU,
+  kT,
+  kUp,
+  kDown,
+  kLeft,
+  kRight,
+  kEnter,
+  kKeys
+};
+constexpr int kGlfwKeys[kKeys] = {
+    GLFW_KEY_W,  GLFW_KEY_A,    GLFW_KEY_S,          GLFW_KEY_D,           GLFW_KEY_Q,
+    GLFW_KEY_E,  GLFW_KEY_F,    GLFW_KEY_1,          GLFW_KEY_2,           GLFW_KEY_3,
+    GLFW_KEY_4,  GLFW_KEY_M,    GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT, GLFW_KEY_Z,
+    GLFW_KEY_X,  GLFW_KEY_C,    GLFW_KEY_G,          GLFW_KEY_U,           GLFW_KEY_T,
+    GLFW_KEY_UP, GLFW_KEY_DOWN, GLFW_KEY_LEFT,       GLFW_KEY_RIGHT,       GLFW_KEY_ENTER};
 
 double seconds_now() {
   return static_cast<double>(now_ns()) * 1e-9;
@@ -116,7 +149,12 @@ struct Window {
     float z = kDefaultDistance;  // view depth of the surface it sits on
     float wheel = 0;             // nearer (<0) / farther (>0) than that surface
     float pinch = 0, fist = 0;
-    HandSample published;  // the joints as last published (stage)
+    HandShape shape = kShapeOpen;  // Z X C: the thumb's pinch with middle, ring, little; G: flat
+    bool palm_up = false;          // U
+    float push = -1;               // T: how far the palm has thrust forward (-1: not pushing)
+    XrVector2f stick{0, 0};        // the arrows
+    bool stick_click = false;      // Enter
+    HandSample published;          // the joints as last published (stage)
   } hands[2];
   bool both = false;  // both eyes side by side
   int eye_w = 0, eye_h = 0;
@@ -435,6 +473,59 @@ float depth_to_distance(float d, float min_depth, float max_depth, float near_z,
   return z;
 }
 
+namespace {
+// Z X C G U T and the arrows / Enter for the hand under the mouse; the other hand's gestures and
+// stick are let go. T thrusts the palm forward at kPushSpeed (held_t: T's time held since the
+// last frame) up to kPushDistance.
+template <class On>
+void take_gesture_keys(Window::Hand& hd, Window::Hand& other, On on, float held_t) {
+  hd.shape = on(kZ)   ? kShapePinchMiddle
+             : on(kX) ? kShapePinchRing
+             : on(kC) ? kShapePinchLittle
+             : on(kG) ? kShapeTogether
+                      : kShapeOpen;
+  hd.palm_up = on(kU);
+  hd.push = on(kT) ? std::min(kPushDistance, std::max(0.f, hd.push) + kPushSpeed * held_t) : -1;
+  auto axis = [&](Key plus, Key minus) { return (on(plus) ? 1.f : 0.f) - (on(minus) ? 1.f : 0.f); };
+  hd.stick = {axis(kRight, kLeft), axis(kUp, kDown)};
+  hd.stick_click = on(kEnter);
+  other.shape = kShapeOpen;
+  other.palm_up = false;
+  other.push = -1;
+  other.stick = {0, 0};
+  other.stick_click = false;
+}
+
+const char* gesture_name(const Window::Hand& k) {
+  if (k.push >= 0) return "push";
+  if (k.palm_up) return "palm_up";
+  const char* names[] = {"open", "pinch_middle", "pinch_ring", "pinch_little", "flat"};
+  return names[k.shape];
+}
+
+// The palm's orientation: down with the fingers forward (body), turned up (U), or facing
+// forward with the fingers up (T); and where the pinch point sits (T: thrust forward).
+XrPosef palm_pose(const Window::Hand& k, const XrQuaternionf& body, const XrVector3f& mid) {
+  XrQuaternionf q = body;
+  if (k.palm_up) q = quat_mul(body, axis_angle({0, 0, 1}, 3.14159265f));
+  if (k.push >= 0) q = quat_mul(body, axis_angle({1, 0, 0}, 3.14159265f / 2));
+  const XrVector3f at = k.push > 0 ? add(k.pos, quat_rotate(body, {0, 0, -k.push})) : k.pos;
+  return XrPosef{q, sub(at, quat_rotate(q, mid))};
+}
+
+// The controller of hand h: its grip (rolled palm up on U: the grip's +x is the left palm's
+// normal, -x the right one's), the arrows and Enter as the thumbstick (the trackpad on a
+// profile without a stick) and its click.
+void stick_inputs(const Window::Hand& k, int h, bool pad_only, ControllerKey& ck) {
+  if (k.palm_up)
+    ck.grip.orientation =
+        quat_mul(ck.grip.orientation, axis_angle({0, 0, 1}, (h == 0 ? 1 : -1) * 3.14159265f / 2));
+  const char* stick = pad_only ? "trackpad" : "thumbstick";
+  ck.inputs[stick] = {k.stick.x, k.stick.y};
+  ck.inputs[std::string(stick) + "/click"] = {k.stick_click ? 1.f : 0.f, 0};
+}
+}  // namespace
+
 void window_wait_frame(Session* s, int64_t frame) {
   Window* w = s->window.get();
   Instance* inst = instance_of(s);
@@ -466,6 +557,17 @@ void window_wait_frame(Session* s, int64_t frame) {
     auto it = std::find(w->cycle.begin(), w->cycle.end(), s->profile[0]);
     w->cycle_at = it == w->cycle.end() ? 0 : static_cast<size_t>(it - w->cycle.begin());
     w->cycle_ready = true;
+    // With hand tracking enabled and no scenario naming a profile, the keys make gestures: the
+    // window starts with the hands alone.
+    if (!w->cycle.empty() && w->cycle.back() == XR_NULL_PATH &&
+        inst->scenario.interaction_profile.empty() && s->profile[0] != XR_NULL_PATH) {
+      w->cycle_at = w->cycle.size() - 1;
+      s->profile[0] = s->profile[1] = XR_NULL_PATH;
+      XrEventDataInteractionProfileChanged ev{XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED};
+      ev.session = to_handle<XrSession>(s->handle);
+      push_event(inst, &ev, sizeof(ev));
+      log("window: interaction profile none (hand tracking)");
+    }
   }
   if (w->cycle_ready && w->cycle.size() > 1 && r.tab > 0) {
     w->cycle_at = (w->cycle_at + static_cast<size_t>(r.tab)) % w->cycle.size();
@@ -508,6 +610,7 @@ void window_wait_frame(Session* s, int64_t frame) {
   const bool was_pinching = hd.pinch > 0.5f;
   hd.pinch = r.lmb || r.lmb_presses > 0 ? 1.f : 0.f;
   hd.fist = on(kF) ? 1.f : 0.f;
+  take_gesture_keys(hd, w->hands[1 - act], on, held(kT));
   hd.wheel += static_cast<float>(r.wheel) * kWheelStep;
   int eye = 0;
   float u = 0, v = 0;
@@ -535,6 +638,7 @@ void window_wait_frame(Session* s, int64_t frame) {
 
   // Into the scenario tracks: one key each (the head with frame 0 at home: LOCAL's origin).
   Scenario& sc = inst->scenario;
+  const bool pad_only = path_string(inst, s->profile[0]).find("htc/vive") != std::string::npos;
   sc.head = {PoseKey{0, w->home}, PoseKey{1e-3, head}};
   if (frame == 0) sc.head.resize(1);
   for (int h = 0; h < 2; ++h) {
@@ -546,11 +650,12 @@ void window_wait_frame(Session* s, int64_t frame) {
     // The palm faces down, fingers forward (the body's yaw); the pinch point sits on k.pos.
     std::array<XrPosef, kHandJointCount> j;
     std::array<float, kHandJointCount> rad;
+    hk.shape = k.shape;
     generate_hand(h, pose_identity(), k.pinch, &j, &rad, k.fist);
     XrVector3f mid =
         mul(add(j[XR_HAND_JOINT_THUMB_TIP_EXT].position, j[XR_HAND_JOINT_INDEX_TIP_EXT].position),
             0.5f);
-    hk.palm = XrPosef{body, sub(k.pos, quat_rotate(body, mid))};
+    hk.palm = palm_pose(k, body, mid);
     sc.hands[h] = {hk};
     k.published = sc.hand(h, 0);
     ControllerKey ck;
@@ -570,16 +675,21 @@ void window_wait_frame(Session* s, int64_t frame) {
       ck.inputs["x/click"] = {on(k3) ? 1.f : 0.f, 0};
       ck.inputs["y/click"] = {on(k4) ? 1.f : 0.f, 0};
     }
+    stick_inputs(k, h, pad_only, ck);
     sc.controllers[h] = {ck};
   }
 
   std::string profile = path_string(inst, s->profile[0]);
   if (profile.empty()) profile = "hand_tracking";
-  std::string title = "drape mock runtime | " + profile.substr(profile.rfind('/') + 1) + " | " +
-                      (act ? "right" : "left") + " hand" + (hd.pinch > 0.5f ? " pinch" : "") +
-                      (hd.fist > 0.5f ? " fist" : "") +
-                      " | WASD/QE move, right-drag look, R reset, LMB pinch, F fist, wheel "
-                      "depth, Shift left hand, Tab profile, V eyes, Esc quit";
+  std::string title =
+      "drape mock runtime | " + profile.substr(profile.rfind('/') + 1) + " | " +
+      (act ? "right" : "left") + " hand" + (hd.pinch > 0.5f ? " pinch" : "") +
+      (hd.fist > 0.5f ? " fist" : "") +
+      (hd.shape != kShapeOpen || hd.palm_up || hd.push >= 0 ? std::string(" ") + gesture_name(hd)
+                                                            : std::string()) +
+      " | WASD/QE move, right-drag look, R reset, LMB pinch, F fist, Z/X/C/G/U/T "
+      "gestures, arrows/Enter stick, wheel depth, Shift left hand, Tab profile, "
+      "V eyes, Esc quit";
   if (title != w->shown_title) {
     w->shown_title = title;
     std::lock_guard<std::mutex> g(w->mu);
@@ -596,13 +706,14 @@ void window_wait_frame(Session* s, int64_t frame) {
                  "frame=%lld head=%.4f,%.4f,%.4f yaw=%.4f pitch=%.4f active=%s "
                  "left=%.4f,%.4f,%.4f right=%.4f,%.4f,%.4f pinch=%d,%d fist=%d,%d "
                  "wheel=%.3f,%.3f z=%.4f buttons=%d%d%d%d%d cursor=%s eye=%d depth=%s view=%s "
-                 "profile=%s\n",
+                 "profile=%s gesture=%s,%s stick=%.0f,%.0f,%d\n",
                  static_cast<long long>(frame), head.position.x, head.position.y, head.position.z,
                  w->yaw, w->pitch, act ? "right" : "left", L.x, L.y, L.z, R.x, R.y, R.z,
                  w->hands[0].pinch > 0.5f, w->hands[1].pinch > 0.5f, w->hands[0].fist > 0.5f,
                  w->hands[1].fist > 0.5f, w->hands[0].wheel, w->hands[1].wheel, hd.z, on(k1),
                  on(k2), on(k3), on(k4), on(kM), over ? "in" : "out", eye, depth,
-                 w->both ? "both" : "left", profile.c_str());
+                 w->both ? "both" : "left", profile.c_str(), gesture_name(w->hands[0]),
+                 gesture_name(w->hands[1]), hd.stick.x, hd.stick.y, hd.stick_click ? 1 : 0);
     std::fflush(w->log_file);
   }
 }
