@@ -2,8 +2,10 @@
 // a projection layer with XR_KHR_composition_layer_depth (a plane 0.8 m away over the left half
 // of each eye, nothing on the right half, and the right hand's joints as small squares) and
 // prints, per frame, what it reads back as an app
-// would: the right hand's thumb-to-index gap (XR_EXT_hand_tracking), the select action
-// (khr/simple_controller) and interaction profile changes. It runs until the session exits.
+// would: the right hand's thumb-to-index gap and its thumb's gaps to the other fingertips and
+// palm normal (XR_EXT_hand_tracking), the select action (khr/simple_controller), the right
+// thumbstick and its click (oculus/touch_controller) and interaction profile changes. It runs until
+// the session exits.
 #define XR_USE_GRAPHICS_API_VULKAN
 #include <vulkan/vulkan.h>
 // (Vulkan first: openxr_platform.h uses its types)
@@ -248,6 +250,25 @@ int main() {
   isb.countSuggestedBindings = 1;
   isb.suggestedBindings = &sb;
   XR(xrSuggestInteractionProfileBindings(inst, &isb));
+  // The right Touch controller's thumbstick and its click (the window's arrows and Enter).
+  aci.actionType = XR_ACTION_TYPE_VECTOR2F_INPUT;
+  std::strcpy(aci.actionName, "stick");
+  std::strcpy(aci.localizedActionName, "Stick");
+  XrAction stick, stick_click;
+  XR(xrCreateAction(set, &aci, &stick));
+  aci.actionType = XR_ACTION_TYPE_BOOLEAN_INPUT;
+  std::strcpy(aci.actionName, "stick_click");
+  std::strcpy(aci.localizedActionName, "Stick click");
+  XR(xrCreateAction(set, &aci, &stick_click));
+  XrPath touch, stick_path, stick_click_path;
+  XR(xrStringToPath(inst, "/interaction_profiles/oculus/touch_controller", &touch));
+  XR(xrStringToPath(inst, "/user/hand/right/input/thumbstick", &stick_path));
+  XR(xrStringToPath(inst, "/user/hand/right/input/thumbstick/click", &stick_click_path));
+  XrActionSuggestedBinding tb[2] = {{stick, stick_path}, {stick_click, stick_click_path}};
+  isb.interactionProfile = touch;
+  isb.countSuggestedBindings = 2;
+  isb.suggestedBindings = tb;
+  XR(xrSuggestInteractionProfileBindings(inst, &isb));
   XrSessionActionSetsAttachInfo at{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
   at.countActionSets = 1;
   at.actionSets = &set;
@@ -353,6 +374,12 @@ int main() {
     sgi.action = select;
     XrActionStateBoolean sel{XR_TYPE_ACTION_STATE_BOOLEAN};
     XR(xrGetActionStateBoolean(session, &sgi, &sel));
+    sgi.action = stick;
+    XrActionStateVector2f st{XR_TYPE_ACTION_STATE_VECTOR2F};
+    XR(xrGetActionStateVector2f(session, &sgi, &st));
+    sgi.action = stick_click;
+    XrActionStateBoolean stc{XR_TYPE_ACTION_STATE_BOOLEAN};
+    XR(xrGetActionStateBoolean(session, &sgi, &stc));
     XrHandJointLocationEXT joints[XR_HAND_JOINT_COUNT_EXT];
     XrHandJointLocationsEXT locs{XR_TYPE_HAND_JOINT_LOCATIONS_EXT};
     locs.jointCount = XR_HAND_JOINT_COUNT_EXT;
@@ -366,9 +393,30 @@ int main() {
       const XrVector3f& i = joints[XR_HAND_JOINT_INDEX_TIP_EXT].pose.position;
       float gap = std::sqrt((t.x - i.x) * (t.x - i.x) + (t.y - i.y) * (t.y - i.y) +
                             (t.z - i.z) * (t.z - i.z));
-      std::printf("frame=%ld pinch_gap=%.3f pinch_point=%.3f,%.3f,%.3f select=%d active=%d\n",
-                  frame, gap, (t.x + i.x) / 2, (t.y + i.y) / 2, (t.z + i.z) / 2,
-                  sel.currentState ? 1 : 0, sel.isActive ? 1 : 0);
+      // The thumb tip's distance to the middle, ring and little tips; the palm's normal (its
+      // joint's -y).
+      auto dist = [&](const XrVector3f& p, int tip) {
+        const XrVector3f& q = joints[tip].pose.position;
+        return std::sqrt((p.x - q.x) * (p.x - q.x) + (p.y - q.y) * (p.y - q.y) +
+                         (p.z - q.z) * (p.z - q.z));
+      };
+      auto gap_to = [&](int tip) { return dist(t, tip); };
+      // How far apart the index and little fingertips are (the fingers together or spread).
+      const float spread = dist(i, XR_HAND_JOINT_LITTLE_TIP_EXT);
+      const XrQuaternionf& o = joints[XR_HAND_JOINT_PALM_EXT].pose.orientation;
+      const float nx = -2 * (o.x * o.y - o.w * o.z), ny = -(1 - 2 * (o.x * o.x + o.z * o.z)),
+                  nz = -2 * (o.y * o.z + o.w * o.x);
+      std::printf(
+          "frame=%ld pinch_gap=%.3f pinch_point=%.3f,%.3f,%.3f select=%d active=%d "
+          "gaps=%.3f,%.3f,%.3f spread=%.3f palm_normal=%.2f,%.2f,%.2f palm=%.3f,%.3f,%.3f "
+          "stick=%.2f,%.2f,%d\n",
+          frame, gap, (t.x + i.x) / 2, (t.y + i.y) / 2, (t.z + i.z) / 2, sel.currentState ? 1 : 0,
+          sel.isActive ? 1 : 0, gap_to(XR_HAND_JOINT_MIDDLE_TIP_EXT),
+          gap_to(XR_HAND_JOINT_RING_TIP_EXT), gap_to(XR_HAND_JOINT_LITTLE_TIP_EXT), spread, nx, ny,
+          nz, joints[XR_HAND_JOINT_PALM_EXT].pose.position.x,
+          joints[XR_HAND_JOINT_PALM_EXT].pose.position.y,
+          joints[XR_HAND_JOINT_PALM_EXT].pose.position.z, st.currentState.x, st.currentState.y,
+          stc.currentState ? 1 : 0);
     } else {
       std::printf("frame=%ld hand not tracked select=%d\n", frame, sel.currentState ? 1 : 0);
     }

@@ -31,6 +31,58 @@ WID=$(xdotool search --name "drape mock runtime" | head -1)
 [ -n "$WID" ] || fail "no window named 'drape mock runtime'"
 xdotool getwindowgeometry "$WID" | tee "$OUT/geometry" | grep -q "Geometry: 800x600" || fail "window geometry"
 
+# client_expect "description" EXPR: polls the client's last line of hand joints (up to 20 s)
+# until EXPR holds; f(NAME) is a field as text, v(NAME, I) the I-th number of it.
+client_expect() {
+  python3 - "$OUT/stdout" "$2" <<'PY' || fail "$1 ($2)"
+import sys, time
+out, expr = sys.argv[1], sys.argv[2]
+deadline = time.time() + 20
+while True:
+    rows = [l for l in open(out).read().splitlines() if " gaps=" in l]
+    if rows:
+        kv = dict(p.split("=", 1) for p in rows[-1].split() if "=" in p)
+        f = lambda k: kv.get(k, "")
+        v = lambda k, i=1: float(kv[k].split(",")[i - 1])
+        if eval(expr):
+            break
+    if time.time() > deadline:
+        print("last client line:", rows[-1] if rows else "(none)")
+        sys.exit(1)
+    time.sleep(0.05)
+PY
+  echo "ok: $1"
+}
+
+if [ "$MODE" = depth ]; then
+  # --- the client enables XR_EXT_hand_tracking and no scenario names a profile: the window
+  # starts with the hands alone, and Z X C G U T make the gestures of the hand under the mouse:
+  # the thumb tip 5 mm from the middle, ring, little tip; the fingers together palm down; the
+  # palm up; the open palm facing forward, thrust 20 cm forward.
+  expect "the window starts in hand tracking" "f('profile') == 'hand_tracking'"
+  xdotool mousemove 400 300
+  client_expect "the client reads the open hand" "v('gaps', 1) > 0.02 and v('spread') > 0.065 and v('palm_normal', 2) < -0.9"
+  pz=$(tail -1 "$OUT/stdout" | tr ' ' '\n' | sed -n 's/^palm=//p' | cut -d, -f3)
+  for k in z x c g u t; do
+    case $k in
+      z) want=pinch_middle; reads="v('gaps', 1) < 0.007 and v('gaps', 2) > 0.015 and v('pinch_gap') > 0.02" ;;
+      x) want=pinch_ring; reads="v('gaps', 2) < 0.007 and v('gaps', 1) > 0.015 and v('gaps', 3) > 0.015" ;;
+      c) want=pinch_little; reads="v('gaps', 3) < 0.007 and v('gaps', 2) > 0.015" ;;
+      g) want=flat; reads="v('spread') < 0.055 and v('palm_normal', 2) < -0.9" ;;
+      u) want=palm_up; reads="v('palm_normal', 2) > 0.9 and v('spread') > 0.065" ;;
+      t) want=push; reads="v('palm_normal', 3) < -0.9 and v('palm', 3) < $pz - 0.15" ;;
+    esac
+    xdotool keydown $k
+    expect "key $k makes the right hand's $want" "f('gesture') == 'open,$want'"
+    client_expect "the client reads the $want from the joints" "$reads"
+    xdotool keyup $k
+    expect "releasing $k opens the hand" "f('gesture') == 'open,open'"
+  done
+  client_expect "the client reads the open hand again" "v('gaps', 1) > 0.02 and v('spread') > 0.065 and v('palm_normal', 2) < -0.9"
+  xdotool key Tab
+  expect "Tab: from hand tracking to the first profile" "f('profile').endswith('khr/simple_controller')"
+fi
+
 # --- the right hand follows the cursor
 xdotool mousemove 150 300
 expect "the cursor is over the view, on the left" "f('cursor') == 'in' and v('right', 1) < -0.3"
@@ -111,6 +163,25 @@ p0=$(field profile)
 xdotool key Tab
 expect "Tab switches the profile (from $p0)" "f('profile') != '$p0'"
 echo "   profile now $(field profile)"
+
+if [ "$MODE" = depth ]; then
+  # --- the arrows and Enter: the thumbstick and its click of the hand under the mouse (the
+  # client binds the right Touch controller's)
+  expect "the profile is oculus/touch_controller" "f('profile').endswith('oculus/touch_controller')"
+  for k in Up Down Left Right; do
+    case $k in Up) xy="0,1";; Down) xy="0,-1";; Left) xy="-1,0";; Right) xy="1,0";; esac
+    xdotool keydown $k
+    expect "$k pushes the stick $xy" "f('stick') == '$xy,0'"
+    client_expect "the client reads the thumbstick at $xy" "(v('stick', 1), v('stick', 2)) == tuple(float(c) for c in '$xy'.split(','))"
+    xdotool keyup $k
+    expect "releasing $k centres the stick" "f('stick') == '0,0,0'"
+  done
+  xdotool keydown Return
+  expect "Enter clicks the stick" "f('stick') == '0,0,1'"
+  client_expect "the client reads the thumbstick click" "v('stick', 3) == 1"
+  xdotool keyup Return
+  client_expect "the click is let go" "v('stick', 3) == 0"
+fi
 
 # --- V: both eyes side by side
 xdotool key v

@@ -341,152 +341,207 @@ TEST(XrApp, HandMarkerIsDrawnAtTheFramesOwnPose) {
 
 // Each binding of each controller profile the app suggests bindings for (xr_input.cpp), on
 // the simulated runtime in lock step: a short scenario selects the profile and, with both
-// controllers held over the cloth, pulls and lets go of the trigger (select), squeezes, and
-// presses the primary and the secondary button, one at a time, each with the right controller
-// and then the left one. Every press must reach the command map as the controller trigger its
-// binding names and be mapped to that trigger's operation (assets/commands.json: trigger ->
-// pinch begin/end, squeeze -> move begin/end, button.a -> cut toggle, button.b -> undo), in
-// the frame of the press (release) or the next, and the pinches must take hold; a
-// profile lacking a button (khr/simple: select and menu only) has its other buttons' inputs
-// pressed too and must produce nothing for them.
-struct ProfileButtons {
-  const char* profile;  // after "/interaction_profiles/"
-  // The scenario's input names ("input/" stripped) pressed for each step, per hand (left,
-  // right); `bound` false: the profile has no such button, so no trigger may come of it.
-  const char* trigger;
-  std::vector<std::string> squeeze;
-  bool squeeze_bound;
-  std::vector<std::string> primary[2];
-  bool primary_bound;
-  std::vector<std::string> secondary[2];
+// controllers held over the cloth, presses each input the profile binds (assets/commands.json:
+// trigger/select -> pinch, squeeze -> move, A/X -> cut, B/Y -> undo, thumbstick up / down /
+// left / right -> pin / release / next / redo, its click -> smooth (right) / map (left), menu ->
+// stop, Vive's and WMR's trackpad regions on click, khr/simple's menu -> undo, the left
+// controller rolled palm up -> help), one at a time, with the right controller and then the
+// left one. Every press must reach the command map as the controller trigger its binding
+// names, mapped to that trigger's operation, in the frame of its press (release), and the
+// pinches must take hold; inputs a profile lacks are pressed too and must produce nothing.
+struct BindingStep {
+  int hand;
+  // The scenario's inputs ("input/" stripped) and their JSON values while pressed; "roll":
+  // the grip turned palm up instead.
+  std::vector<std::pair<std::string, std::string>> inputs;
+  std::string command;   // the controller trigger ("" when nothing may come of it)
+  std::string on_press;  // its mapped operation and phase at the press and the release
+  std::string on_release;
+  int press = 0, release = 0;
 };
 
-std::ostream& operator<<(std::ostream& os, const ProfileButtons& p) {
+struct ProfileCase {
+  const char* profile;  // after "/interaction_profiles/"
+  std::vector<BindingStep> steps;
+  std::vector<std::string> absent;  // triggers that must not appear at all
+};
+
+std::ostream& operator<<(std::ostream& os, const ProfileCase& p) {
   return os << p.profile;
 }
 
-// A profile with every button: the inputs pressed for primary and secondary (left, right).
-ProfileButtons full(const char* profile, const char* squeeze, const char* primary_left,
-                    const char* primary_right, const char* secondary_left,
-                    const char* secondary_right) {
-  return {profile,
-          "trigger/value",
-          {squeeze},
-          true,
-          {{primary_left}, {primary_right}},
-          true,
-          {{secondary_left}, {secondary_right}}};
+using Inputs = std::vector<std::pair<std::string, std::string>>;
+
+// The thumbstick's four directions and its click (right: smooth, held; left: map).
+void add_stick(std::vector<BindingStep>& s, const std::string& name, const std::string& prefix) {
+  const char* dir[4][3] = {{"[0.0, 1.0]", "up", "pin once"},
+                           {"[0.0, -1.0]", "down", "release once"},
+                           {"[-1.0, 0.0]", "left", "next once"},
+                           {"[1.0, 0.0]", "right", "redo once"}};
+  for (const auto& d : dir)
+    for (int h : {1, 0}) s.push_back({h, {{name, d[0]}}, prefix + "." + d[1], d[2], ""});
 }
 
-const std::vector<std::string> kSimpleUnbound = {"a/click", "x/click", "trackpad/click",
-                                                 "b/click", "y/click", "thumbstick/click"};
-const ProfileButtons kProfileButtons[] = {
-    {"khr/simple_controller",
-     "select/click",
-     {"squeeze/value", "squeeze/click"},
-     false,
-     {kSimpleUnbound, kSimpleUnbound},
-     false,
-     {{"menu/click"}, {"menu/click"}}},
-    full("oculus/touch_controller", "squeeze/value", "x/click", "a/click", "y/click", "b/click"),
-    full("valve/index_controller", "squeeze/value", "a/click", "a/click", "b/click", "b/click"),
-    full("htc/vive_controller", "squeeze/click", "trackpad/click", "trackpad/click", "menu/click",
-         "menu/click"),
-    full("microsoft/motion_controller", "squeeze/click", "trackpad/click", "trackpad/click",
-         "menu/click", "menu/click"),
+ProfileCase profile_case(const char* profile) {
+  const std::string p = profile;
+  const bool simple = p == "khr/simple_controller", touch = p == "oculus/touch_controller",
+             index = p == "valve/index_controller", vive = p == "htc/vive_controller";
+  ProfileCase c{profile, {}, {}};
+  auto& s = c.steps;
+  for (int h : {1, 0})
+    s.push_back({h,
+                 {{simple ? "select/click" : "trigger/value", simple ? "true" : "1.0"}},
+                 "button.trigger",
+                 "pinch begin",
+                 "pinch end"});
+  if (simple) {
+    for (int h : {1, 0}) s.push_back({h, {{"menu/click", "true"}}, "button.menu", "undo once", ""});
+    // Buttons it lacks: nothing may come of them.
+    for (const char* in : {"squeeze/value", "a/click", "b/click", "thumbstick/click"})
+      s.push_back({1,
+                   {{in, std::string(in).find("/value") != std::string::npos ? "1.0" : "true"}},
+                   "",
+                   "",
+                   ""});
+    s.push_back({1, {{"thumbstick", "[0.0, 1.0]"}}, "", "", ""});
+    c.absent = {"button.squeeze", "button.a", "button.b", "button.stick", "stick.", "trackpad."};
+    return c;
+  }
+  const char* squeeze = touch || index ? "squeeze/value" : "squeeze/click";
+  for (int h : {1, 0})
+    s.push_back({h,
+                 {{squeeze, touch || index ? "1.0" : "true"}},
+                 "button.squeeze",
+                 "move begin",
+                 "move end"});
+  if (touch || index) {
+    for (int h : {1, 0}) {
+      s.push_back(
+          {h, {{h || index ? "a/click" : "x/click", "true"}}, "button.a", "cut toggle", ""});
+      s.push_back({h, {{h || index ? "b/click" : "y/click", "true"}}, "button.b", "undo once", ""});
+    }
+  }
+  if (!vive) {
+    add_stick(s, "thumbstick", "stick");
+    s.push_back({1, {{"thumbstick/click", "true"}}, "button.stick", "smooth begin", "smooth end"});
+    s.push_back({0, {{"thumbstick/click", "true"}}, "button.stick", "map once", ""});
+  }
+  if (vive) {
+    const char* region[7][4] = {
+        {"[0.0, 0.9]", "up", "pin once", "b"},       {"[0.0, -0.9]", "down", "release once", "b"},
+        {"[0.0, 0.0]", "center", "cut toggle", "b"}, {"[-0.9, 0.0]", "left", "next once", "r"},
+        {"[0.9, 0.0]", "right", "redo once", "r"},   {"[-0.9, 0.0]", "left", "undo once", "l"},
+        {"[0.9, 0.0]", "right", "map once", "l"}};
+    for (const auto& r : region)
+      for (int h : {1, 0})
+        if (r[3][0] == 'b' || (r[3][0] == 'r') == (h == 1))
+          s.push_back({h,
+                       {{"trackpad", r[0]}, {"trackpad/click", "true"}},
+                       std::string("trackpad.") + r[1],
+                       r[2],
+                       ""});
+  }
+  if (p == "microsoft/motion_controller") {
+    for (int h : {1, 0}) {
+      s.push_back({h,
+                   {{"trackpad", "[0.0, 0.9]"}, {"trackpad/click", "true"}},
+                   "trackpad.up",
+                   "cut toggle",
+                   ""});
+      s.push_back({h,
+                   {{"trackpad", "[0.0, -0.9]"}, {"trackpad/click", "true"}},
+                   "trackpad.down",
+                   "undo once",
+                   ""});
+    }
+  }
+  // Menu: stop (the right Touch controller has none: its menu input must do nothing).
+  for (int h : {1, 0}) {
+    const bool has = !index && !(touch && h == 1);
+    s.push_back(
+        {h, {{"menu/click", "true"}}, has ? "button.menu" : "", has ? "stop once" : "", ""});
+  }
+  if (index) c.absent = {"button.menu", "trackpad."};
+  // The left controller rolled palm up shows the help while held.
+  s.push_back({0, {{"roll", ""}}, "palm_up", "help begin", "help end"});
+  return c;
+}
+
+const ProfileCase kProfileCases[] = {
+    profile_case("khr/simple_controller"),       profile_case("oculus/touch_controller"),
+    profile_case("valve/index_controller"),      profile_case("htc/vive_controller"),
+    profile_case("microsoft/motion_controller"),
 };
 
-class XrAppProfileBindings : public ::testing::TestWithParam<ProfileButtons> {};
+// The scenario's keyframes of one controller: each step's press and release (the step's inputs
+// pressed, all others released), held over the cloth.
+std::string controller_keys(const std::vector<BindingStep>& steps, int h, int end_frame) {
+  std::vector<std::pair<std::string, std::string>> all;  // input -> its released value
+  for (const auto& st : steps)
+    for (const auto& [name, value] : st.inputs) {
+      if (name == "roll") continue;
+      const std::string off = value[0] == '[' ? "[0.0, 0.0]" : value == "true" ? "false" : "0.0";
+      if (std::find_if(all.begin(), all.end(), [&](auto& e) { return e.first == name; }) ==
+          all.end())
+        all.push_back({name, off});
+    }
+  // Both controllers stay over the cloth, either side of its middle, all the time.
+  const char* over = h == 1 ? "[0.12, 1.02, 0.21]" : "[-0.12, 1.02, 0.21]";
+  std::string out;
+  auto key = [&](int f, const Inputs& pressed) {
+    bool roll = false;
+    for (const auto& e : pressed) roll = roll || e.first == "roll";
+    // Palm up: the left grip's +x (its palm's normal) turned to +y.
+    const char* q = roll ? "[0.0, 0.0, 0.7071, 0.7071]" : "[0.0, 0.0, 0.0, 1.0]";
+    std::string k = std::string(out.empty() ? "" : ",\n") + "{\"frame\": " + std::to_string(f) +
+                    ", \"grip\": {\"position\": " + over + ", \"orientation\": " + q +
+                    "}, \"inputs\": {";
+    for (size_t i = 0; i < all.size(); ++i) {
+      std::string v = all[i].second;
+      for (const auto& e : pressed)
+        if (e.first == all[i].first) v = e.second;
+      k += (i ? ", \"" : "\"") + all[i].first + "\": " + v;
+    }
+    out += k + "}}";
+  };
+  key(0, {});
+  for (const auto& st : steps) {
+    if (st.hand != h) continue;
+    // Values are interpolated between keys: a key each side of an edge makes it a step.
+    key(st.press - 2, {});
+    key(st.press - 1, {});
+    key(st.press, st.inputs);
+    key(st.release - 1, st.inputs);
+    key(st.release, {});
+  }
+  key(end_frame, {});
+  return out;
+}
 
-TEST_P(XrAppProfileBindings, EachButtonReachesItsCommand) {
-  const ProfileButtons& p = GetParam();
+class XrAppProfileBindings : public ::testing::TestWithParam<ProfileCase> {};
+
+TEST_P(XrAppProfileBindings, EachBindingReachesItsCommandInItsFrame) {
+  ProfileCase p = GetParam();
   base_env();
   std::string name = std::string("app_profile_") + p.profile;
   std::replace(name.begin(), name.end(), '/', '_');
   const fs::path dir = fresh_out_dir(name.c_str());
-  // Steps (4 frames pressed, 3 released): trigger, squeeze, primary, secondary, each with the
-  // right hand and then the left (both pinches come before any move or undo). Both controllers are
-  // held over the cloth (the right one where the default scenario's hand pinches it, the left one
-  // mirrored).
-  struct Step {
-    int hand;
-    std::vector<std::string> inputs;
-    std::vector<std::string> expect;  // the mapped lines, without "frame F: "
-    int press = 0, release = 0;
-  };
-  std::vector<Step> steps;
-  std::vector<std::string> all_inputs;
-  const char* side_name[2] = {"left", "right"};
-  std::vector<Step> per_hand[2];
-  for (int h : {1, 0}) {
-    auto& hand_steps = per_hand[h];
-    const std::string hs = std::string(" hand ") + side_name[h] + " -> ";
-    hand_steps.push_back({h,
-                          {p.trigger},
-                          {"controller button.trigger begin" + hs + "pinch begin",
-                           "controller button.trigger end" + hs + "pinch end"}});
-    hand_steps.push_back(
-        {h, p.squeeze,
-         p.squeeze_bound
-             ? std::vector<std::string>{"controller button.squeeze begin" + hs + "move begin",
-                                        "controller button.squeeze end" + hs + "move end"}
-             : std::vector<std::string>{}});
-    hand_steps.push_back(
-        {h, p.primary[h],
-         p.primary_bound ? std::vector<std::string>{"controller button.a begin" + hs + "cut toggle"}
-                         : std::vector<std::string>{}});
-    hand_steps.push_back({h, p.secondary[h], {"controller button.b begin" + hs + "undo once"}});
-  }
-  for (size_t k = 0; k < per_hand[1].size(); ++k)
-    for (int h : {1, 0}) steps.push_back(per_hand[h][k]);
-  for (const auto& s : steps)
-    for (const auto& i : s.inputs)
-      if (std::find(all_inputs.begin(), all_inputs.end(), i) == all_inputs.end())
-        all_inputs.push_back(i);
+  // Steps of 4 frames pressed, 3 released.
   int frame = 4;
-  for (auto& s : steps) {
-    s.press = frame;
-    s.release = frame + 4;
+  for (auto& st : p.steps) {
+    st.press = frame;
+    st.release = frame + 4;
     frame += 7;
   }
   const int end_frame = frame + 3;
-  // Keys: each press and release (the pressed inputs of the step; all others released).
-  auto keys = [&](int h) {
-    // Both controllers stay over the cloth, either side of its middle, all the time.
-    const char* over = h == 1 ? "[0.12, 1.02, 0.21]" : "[-0.12, 1.02, 0.21]";
-    std::string out;
-    auto key = [&](int f, const std::vector<std::string>& pressed) {
-      std::string k = std::string(out.empty() ? "" : ",\n") + "{\"frame\": " + std::to_string(f) +
-                      ", \"grip\": {\"position\": " + over + "}, \"inputs\": {";
-      for (size_t i = 0; i < all_inputs.size(); ++i) {
-        const bool on = std::find(pressed.begin(), pressed.end(), all_inputs[i]) != pressed.end();
-        const bool value = all_inputs[i].find("/value") != std::string::npos;
-        k += (i ? ", " : "") + ("\"" + all_inputs[i] + "\": ") +
-             (value ? (on ? "1.0" : "0.0") : (on ? "true" : "false"));
-      }
-      out += k + "}}";
-    };
-    key(0, {});
-    for (const auto& s : steps) {
-      if (s.hand != h) continue;
-      // Values are interpolated between keys: a key each side of an edge makes it a step.
-      key(s.press - 2, {});  // moves to / stays over the cloth before the first press
-      key(s.press - 1, {});
-      key(s.press, s.inputs);
-      key(s.release - 1, s.inputs);
-      key(s.release, {});
-    }
-    key(end_frame, {});
-    return out;
-  };
   const std::string sc = (dir / "scenario.json").string();
   std::ofstream(sc) << "{\"name\": \"" << name << "\", \"end_after_frames\": " << end_frame
                     << ", \"fast\": true, \"interaction_profile\": \"/interaction_profiles/"
                     << p.profile
                     << "\",\n\"head\": [{\"frame\": 0, \"position\": [0.0, 1.3, 1.2]}],\n"
                        "\"controllers\": {\"right\": [\n"
-                    << keys(1) << "],\n\"left\": [\n"
-                    << keys(0) << "]}}\n";
+                    << controller_keys(p.steps, 1, end_frame) << "],\n\"left\": [\n"
+                    << controller_keys(p.steps, 0, end_frame) << "]}}\n";
   auto o = small();
   play_scenario(o, sc);
   o.eye_size = 64;
@@ -499,35 +554,29 @@ TEST_P(XrAppProfileBindings, EachButtonReachesItsCommand) {
   std::printf("pinched in %lld frames\n", static_cast<long long>(r.frames_pinched));
   ASSERT_EQ(r.exit_code, 0) << r.error;
   EXPECT_EQ(r.frames, end_frame);
-  // The controller triggers, in order, each in the frame of its press (release) or the next.
-  std::vector<long long> got_frame;
+  // The mapped controller triggers, in order, each in the frame of its press (release).
   std::vector<std::string> got, want;
-  std::vector<int> want_frame;
   for (const auto& t : r.triggers) {
     long long f = -1;
     char rest[256] = {};
     if (std::sscanf(t.c_str(), "frame %lld: %255[^\n]", &f, rest) == 2 &&
-        std::string(rest).rfind("controller ", 0) == 0) {
-      got_frame.push_back(f);
-      got.push_back(rest);
-    }
+        std::string(rest).rfind("controller ", 0) == 0)
+      got.push_back("frame " + std::to_string(f) + ": " + rest);
   }
-  for (const auto& s : steps)
-    for (size_t i = 0; i < s.expect.size(); ++i) {
-      want_frame.push_back(i == 0 ? s.press : s.release);
-      want.push_back(s.expect[i]);
-    }
+  const char* side_name[2] = {"left", "right"};
+  for (const auto& st : p.steps) {
+    const std::string hs = std::string(" hand ") + side_name[st.hand] + " -> ";
+    if (!st.on_press.empty())
+      want.push_back("frame " + std::to_string(st.press) + ": controller " + st.command + " begin" +
+                     hs + st.on_press);
+    if (!st.on_release.empty())
+      want.push_back("frame " + std::to_string(st.release) + ": controller " + st.command + " end" +
+                     hs + st.on_release);
+  }
   EXPECT_EQ(got, want) << p.profile;
-  for (size_t i = 0; i < want.size() && got == want; ++i) {
-    EXPECT_GE(got_frame[i], want_frame[i]) << got[i];
-    EXPECT_LE(got_frame[i], want_frame[i] + 1) << got[i];
-  }
-  // Nothing at all (mapped or not: the verbose log notes unmapped triggers too) of the buttons
+  // Nothing at all (mapped or not: the verbose log notes unmapped triggers too) of the inputs
   // the profile lacks.
-  std::vector<std::string> absent;
-  if (!p.squeeze_bound) absent.push_back("button.squeeze");
-  if (!p.primary_bound) absent.push_back("button.a");
-  for (const auto& c : absent) {
+  for (const auto& c : p.absent) {
     for (const auto& l : r.log) EXPECT_EQ(l.find(c), std::string::npos) << p.profile << ": " << l;
     for (const auto& t : r.triggers)
       EXPECT_EQ(t.find(c), std::string::npos) << p.profile << ": " << t;
@@ -538,13 +587,139 @@ TEST_P(XrAppProfileBindings, EachButtonReachesItsCommand) {
   for (const auto& m : r.sim_messages) EXPECT_EQ(m.rfind("pinch", 0), std::string::npos) << m;
 }
 
-INSTANTIATE_TEST_SUITE_P(XrApp, XrAppProfileBindings, ::testing::ValuesIn(kProfileButtons),
-                         [](const ::testing::TestParamInfo<ProfileButtons>& i) {
+INSTANTIATE_TEST_SUITE_P(XrApp, XrAppProfileBindings, ::testing::ValuesIn(kProfileCases),
+                         [](const ::testing::TestParamInfo<ProfileCase>& i) {
                            std::string n = i.param.profile;
                            for (char& c : n)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return n;
                          });
+
+// Each gesture binding (assets/commands.json) made with XR_EXT_hand_tracking joints on the
+// simulated runtime in lock step: a hand-tracking scenario (hands only, their controllers set
+// down) holds each hand over the cloth and makes one gesture at a time with the runtime's
+// generated joints (index pinch, fist, the thumb's pinch with middle / ring / little, fingers
+// together palm down, palm up, the open palm thrust forward). Each must reach the command map as
+// its gesture trigger, mapped to its operation, after the recognizer's minimum duration (80 ms:
+// within 12 frames of the change), and the sim must have run the operations it reports.
+TEST(XrApp, EachGestureBindingReachesItsOperation) {
+  base_env();
+  const fs::path dir = fresh_out_dir("app_gestures");
+  struct Gesture {
+    int hand;
+    std::string key;  // the keyframe's fields making it (palm pose aside)
+    const char* orientation;
+    std::string command, on_press, on_release;
+    bool push = false;
+    int press = 0, release = 0;
+  };
+  const char* down = "[0.0, 0.0, 0.0, 1.0]";
+  const char* up = "[0.0, 0.0, 1.0, 0.0]";             // 180 degrees about z: the palm up
+  const char* forward = "[0.7071, 0.0, 0.0, 0.7071]";  // 90 degrees about x: fingers up
+  std::vector<Gesture> g = {
+      {1, "\"pinch\": 1.0", down, "pinch", "pinch begin", "pinch end"},
+      {0, "\"pinch\": 1.0", down, "pinch", "pinch begin", "pinch end"},
+      {1, "\"shape\": \"pinch_little\"", down, "pinch_little", "undo once", ""},
+      {0, "\"shape\": \"pinch_little\"", down, "pinch_little", "redo once", ""},
+      {1, "\"fist\": 1.0", down, "grab", "move begin", "move end"},
+      {1, "\"shape\": \"together\"", down, "flat", "smooth begin", "smooth end"},
+      {1, "\"shape\": \"pinch_middle\"", down, "pinch_middle", "pin once", ""},
+      {0, "\"shape\": \"pinch_middle\"", down, "pinch_middle", "release once", ""},
+      {1, "\"shape\": \"pinch_ring\"", down, "pinch_ring", "cut toggle", ""},
+      {1, "\"shape\": \"pinch_ring\"", down, "pinch_ring", "cut toggle", ""},
+      {0, "\"shape\": \"pinch_ring\"", down, "pinch_ring", "map once", ""},
+      {1, "\"shape\": \"open\"", up, "palm_up", "next once", ""},
+      {0, "\"shape\": \"open\"", up, "palm_up", "help begin", "help end"},
+      {1, "\"shape\": \"open\"", forward, "push", "stop once", "", true},
+  };
+  int frame = 6;
+  for (auto& x : g) {
+    x.press = frame;
+    x.release = frame + 14;
+    frame += 28;
+  }
+  const int end_frame = frame + 4;
+  // The palm placed so that the pinch point (between the open thumb and index tips) sits over
+  // the cloth, either side of its middle.
+  auto keys = [&](int h) {
+    const double x = h == 1 ? 0.162 : -0.162;
+    auto palm = [&](double z, const char* q) {
+      char b[160];
+      std::snprintf(b, sizeof b,
+                    "\"palm\": {\"position\": [%.3f, 1.031, %.3f], \"orientation\": %s}", x, z, q);
+      return std::string(b);
+    };
+    std::string out;
+    auto key = [&](int f, const std::string& fields) {
+      out += std::string(out.empty() ? "" : ",\n") + "{\"frame\": " + std::to_string(f) + ", " +
+             fields + "}";
+    };
+    key(0, palm(0.29, down));
+    for (const auto& x : g) {
+      if (x.hand != h) continue;
+      key(x.press - 1, palm(0.29, down));
+      key(x.press, palm(0.29, x.orientation) + ", " + x.key);
+      // The push: the palm thrust 20 cm forward (-z) over 10 frames (0.11 s).
+      const double z1 = x.push ? 0.09 : 0.29;
+      if (x.push) key(x.press + 10, palm(z1, x.orientation) + ", " + x.key);
+      key(x.release - 1, palm(z1, x.orientation) + ", " + x.key);
+      key(x.release, palm(0.29, down));
+    }
+    key(end_frame, palm(0.29, down));
+    return out;
+  };
+  const std::string sc = (dir / "scenario.json").string();
+  std::ofstream(sc) << "{\"name\": \"app_gestures\", \"end_after_frames\": " << end_frame
+                    << ", \"fast\": true,\n"
+                       "\"head\": [{\"frame\": 0, \"position\": [0.0, 1.3, 1.2]}],\n"
+                       "\"hands\": {\"right\": [\n"
+                    << keys(1) << "],\n\"left\": [\n"
+                    << keys(0) << "]}}\n";
+  auto o = small();
+  play_scenario(o, sc);
+  o.eye_size = 64;
+  o.cloth_res = 8;
+  o.voice = false;
+  o.verbose = true;
+  auto r = drape::app::run_xr_app(o);
+  print(r);
+  for (const auto& m : r.sim_messages) std::printf("sim: %s\n", m.c_str());
+  ASSERT_EQ(r.exit_code, 0) << r.error;
+  // The mapped triggers (every one a gesture's: no controller is held), in order.
+  std::vector<std::string> got, want;
+  std::vector<long long> got_frame;
+  std::vector<int> want_from;
+  for (const auto& t : r.triggers) {
+    long long f = -1;
+    char rest[256] = {};
+    if (std::sscanf(t.c_str(), "frame %lld: %255[^\n]", &f, rest) != 2) continue;
+    got.push_back(rest);
+    got_frame.push_back(f);
+  }
+  const char* side[2] = {"left", "right"};
+  for (const auto& x : g) {
+    const std::string hs = std::string(" hand ") + side[x.hand] + " -> ";
+    want.push_back("gesture " + x.command + " begin" + hs + x.on_press);
+    want_from.push_back(x.press);
+    if (!x.on_release.empty()) {
+      want.push_back("gesture " + x.command + " end" + hs + x.on_release);
+      want_from.push_back(x.release);
+    }
+  }
+  EXPECT_EQ(got, want);
+  for (size_t i = 0; i < want.size() && got == want; ++i) {
+    EXPECT_GE(got_frame[i], want_from[i]) << got[i];
+    EXPECT_LE(got_frame[i], want_from[i] + 12) << got[i];
+  }
+  // The sim ran them: both pinches took hold, the undo and the redo say what they undid.
+  EXPECT_GE(r.frames_pinched, 8);
+  auto said = [&](const std::string& m) {
+    return std::any_of(r.sim_messages.begin(), r.sim_messages.end(),
+                       [&](const std::string& x) { return x.rfind(m, 0) == 0; });
+  };
+  EXPECT_TRUE(said("undo: pinch"));
+  EXPECT_TRUE(said("redo: pinch"));
+}
 
 TEST(XrApp, SessionLossIsAnOrdinaryState) {
   base_env();
