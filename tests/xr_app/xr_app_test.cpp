@@ -639,14 +639,13 @@ TEST(XrApp, EachGestureBindingReachesItsOperation) {
     frame += 28;
   }
   const int end_frame = frame + 4;
-  // The palm placed so that the pinch point (between the open thumb and index tips) sits over
-  // the cloth, either side of its middle.
+  // The palm where the default scenario's right hand pinches the cloth (the left one mirrored).
   auto keys = [&](int h) {
-    const double x = h == 1 ? 0.162 : -0.162;
+    const double x = h == 1 ? 0.12 : -0.12;
     auto palm = [&](double z, const char* q) {
       char b[160];
       std::snprintf(b, sizeof b,
-                    "\"palm\": {\"position\": [%.3f, 1.031, %.3f], \"orientation\": %s}", x, z, q);
+                    "\"palm\": {\"position\": [%.3f, 1.02, %.3f], \"orientation\": %s}", x, z, q);
       return std::string(b);
     };
     std::string out;
@@ -654,18 +653,18 @@ TEST(XrApp, EachGestureBindingReachesItsOperation) {
       out += std::string(out.empty() ? "" : ",\n") + "{\"frame\": " + std::to_string(f) + ", " +
              fields + "}";
     };
-    key(0, palm(0.29, down));
+    key(0, palm(0.21, down));
     for (const auto& x : g) {
       if (x.hand != h) continue;
-      key(x.press - 1, palm(0.29, down));
-      key(x.press, palm(0.29, x.orientation) + ", " + x.key);
+      key(x.press - 1, palm(0.21, down));
+      key(x.press, palm(0.21, x.orientation) + ", " + x.key);
       // The push: the palm thrust 20 cm forward (-z) over 10 frames (0.11 s).
-      const double z1 = x.push ? 0.09 : 0.29;
+      const double z1 = x.push ? 0.01 : 0.21;
       if (x.push) key(x.press + 10, palm(z1, x.orientation) + ", " + x.key);
       key(x.release - 1, palm(z1, x.orientation) + ", " + x.key);
-      key(x.release, palm(0.29, down));
+      key(x.release, palm(0.21, down));
     }
-    key(end_frame, palm(0.29, down));
+    key(end_frame, palm(0.21, down));
     return out;
   };
   const std::string sc = (dir / "scenario.json").string();
