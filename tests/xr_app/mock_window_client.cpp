@@ -185,6 +185,60 @@ Chain make_chain(XrSession s, int64_t format, XrSwapchainUsageFlags usage) {
 
 }  // namespace
 
+// The right Touch controller's thumbstick and its click (the window's arrows and Enter).
+void stick_actions(XrInstance inst, XrActionSet set, XrAction* stick, XrAction* click) {
+  XrActionCreateInfo aci{XR_TYPE_ACTION_CREATE_INFO};
+  aci.actionType = XR_ACTION_TYPE_VECTOR2F_INPUT;
+  std::strcpy(aci.actionName, "stick");
+  std::strcpy(aci.localizedActionName, "Stick");
+  XR(xrCreateAction(set, &aci, stick));
+  aci.actionType = XR_ACTION_TYPE_BOOLEAN_INPUT;
+  std::strcpy(aci.actionName, "stick_click");
+  std::strcpy(aci.localizedActionName, "Stick click");
+  XR(xrCreateAction(set, &aci, click));
+  XrPath touch, stick_path, click_path;
+  XR(xrStringToPath(inst, "/interaction_profiles/oculus/touch_controller", &touch));
+  XR(xrStringToPath(inst, "/user/hand/right/input/thumbstick", &stick_path));
+  XR(xrStringToPath(inst, "/user/hand/right/input/thumbstick/click", &click_path));
+  XrActionSuggestedBinding tb[2] = {{*stick, stick_path}, {*click, click_path}};
+  XrInteractionProfileSuggestedBinding isb{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+  isb.interactionProfile = touch;
+  isb.countSuggestedBindings = 2;
+  isb.suggestedBindings = tb;
+  XR(xrSuggestInteractionProfileBindings(inst, &isb));
+}
+
+// One line of what the client reads: the right hand's thumb-index gap and pinch point, its
+// thumb's gaps to the middle, ring and little tips, the index-little spread, the palm's normal
+// (its joint's -y) and position; the select action; the thumbstick and its click.
+void print_hand(long frame, bool active, const XrHandJointLocationEXT* joints,
+                const XrActionStateBoolean& sel, const XrActionStateVector2f& st,
+                const XrActionStateBoolean& stc) {
+  if (!active) {
+    std::printf("frame=%ld hand not tracked select=%d\n", frame, sel.currentState ? 1 : 0);
+    return;
+  }
+  auto at = [&](int j) { return joints[j].pose.position; };
+  auto dist = [&](const XrVector3f& p, const XrVector3f& q) {
+    return std::sqrt((p.x - q.x) * (p.x - q.x) + (p.y - q.y) * (p.y - q.y) +
+                     (p.z - q.z) * (p.z - q.z));
+  };
+  const XrVector3f t = at(XR_HAND_JOINT_THUMB_TIP_EXT), i = at(XR_HAND_JOINT_INDEX_TIP_EXT);
+  const XrVector3f palm = at(XR_HAND_JOINT_PALM_EXT);
+  const XrQuaternionf& o = joints[XR_HAND_JOINT_PALM_EXT].pose.orientation;
+  const float nx = -2 * (o.x * o.y - o.w * o.z), ny = -(1 - 2 * (o.x * o.x + o.z * o.z)),
+              nz = -2 * (o.y * o.z + o.w * o.x);
+  std::printf(
+      "frame=%ld pinch_gap=%.3f pinch_point=%.3f,%.3f,%.3f select=%d active=%d "
+      "gaps=%.3f,%.3f,%.3f spread=%.3f palm_normal=%.2f,%.2f,%.2f palm=%.3f,%.3f,%.3f "
+      "stick=%.2f,%.2f,%d\n",
+      frame, dist(t, i), (t.x + i.x) / 2, (t.y + i.y) / 2, (t.z + i.z) / 2,
+      sel.currentState ? 1 : 0, sel.isActive ? 1 : 0, dist(t, at(XR_HAND_JOINT_MIDDLE_TIP_EXT)),
+      dist(t, at(XR_HAND_JOINT_RING_TIP_EXT)), dist(t, at(XR_HAND_JOINT_LITTLE_TIP_EXT)),
+      dist(i, at(XR_HAND_JOINT_LITTLE_TIP_EXT)), nx, ny, nz, palm.x, palm.y, palm.z,
+      st.currentState.x, st.currentState.y, stc.currentState ? 1 : 0);
+}
+
 int main() {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const char* exts[] = {XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME,
@@ -250,25 +304,8 @@ int main() {
   isb.countSuggestedBindings = 1;
   isb.suggestedBindings = &sb;
   XR(xrSuggestInteractionProfileBindings(inst, &isb));
-  // The right Touch controller's thumbstick and its click (the window's arrows and Enter).
-  aci.actionType = XR_ACTION_TYPE_VECTOR2F_INPUT;
-  std::strcpy(aci.actionName, "stick");
-  std::strcpy(aci.localizedActionName, "Stick");
   XrAction stick, stick_click;
-  XR(xrCreateAction(set, &aci, &stick));
-  aci.actionType = XR_ACTION_TYPE_BOOLEAN_INPUT;
-  std::strcpy(aci.actionName, "stick_click");
-  std::strcpy(aci.localizedActionName, "Stick click");
-  XR(xrCreateAction(set, &aci, &stick_click));
-  XrPath touch, stick_path, stick_click_path;
-  XR(xrStringToPath(inst, "/interaction_profiles/oculus/touch_controller", &touch));
-  XR(xrStringToPath(inst, "/user/hand/right/input/thumbstick", &stick_path));
-  XR(xrStringToPath(inst, "/user/hand/right/input/thumbstick/click", &stick_click_path));
-  XrActionSuggestedBinding tb[2] = {{stick, stick_path}, {stick_click, stick_click_path}};
-  isb.interactionProfile = touch;
-  isb.countSuggestedBindings = 2;
-  isb.suggestedBindings = tb;
-  XR(xrSuggestInteractionProfileBindings(inst, &isb));
+  stick_actions(inst, set, &stick, &stick_click);
   XrSessionActionSetsAttachInfo at{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
   at.countActionSets = 1;
   at.actionSets = &set;
@@ -388,38 +425,7 @@ int main() {
     li.baseSpace = stage;
     li.time = fs.predictedDisplayTime;
     XR(locate_joints(tracker, &li, &locs));
-    if (locs.isActive) {
-      const XrVector3f& t = joints[XR_HAND_JOINT_THUMB_TIP_EXT].pose.position;
-      const XrVector3f& i = joints[XR_HAND_JOINT_INDEX_TIP_EXT].pose.position;
-      float gap = std::sqrt((t.x - i.x) * (t.x - i.x) + (t.y - i.y) * (t.y - i.y) +
-                            (t.z - i.z) * (t.z - i.z));
-      // The thumb tip's distance to the middle, ring and little tips; the palm's normal (its
-      // joint's -y).
-      auto dist = [&](const XrVector3f& p, int tip) {
-        const XrVector3f& q = joints[tip].pose.position;
-        return std::sqrt((p.x - q.x) * (p.x - q.x) + (p.y - q.y) * (p.y - q.y) +
-                         (p.z - q.z) * (p.z - q.z));
-      };
-      auto gap_to = [&](int tip) { return dist(t, tip); };
-      // How far apart the index and little fingertips are (the fingers together or spread).
-      const float spread = dist(i, XR_HAND_JOINT_LITTLE_TIP_EXT);
-      const XrQuaternionf& o = joints[XR_HAND_JOINT_PALM_EXT].pose.orientation;
-      const float nx = -2 * (o.x * o.y - o.w * o.z), ny = -(1 - 2 * (o.x * o.x + o.z * o.z)),
-                  nz = -2 * (o.y * o.z + o.w * o.x);
-      std::printf(
-          "frame=%ld pinch_gap=%.3f pinch_point=%.3f,%.3f,%.3f select=%d active=%d "
-          "gaps=%.3f,%.3f,%.3f spread=%.3f palm_normal=%.2f,%.2f,%.2f palm=%.3f,%.3f,%.3f "
-          "stick=%.2f,%.2f,%d\n",
-          frame, gap, (t.x + i.x) / 2, (t.y + i.y) / 2, (t.z + i.z) / 2, sel.currentState ? 1 : 0,
-          sel.isActive ? 1 : 0, gap_to(XR_HAND_JOINT_MIDDLE_TIP_EXT),
-          gap_to(XR_HAND_JOINT_RING_TIP_EXT), gap_to(XR_HAND_JOINT_LITTLE_TIP_EXT), spread, nx, ny,
-          nz, joints[XR_HAND_JOINT_PALM_EXT].pose.position.x,
-          joints[XR_HAND_JOINT_PALM_EXT].pose.position.y,
-          joints[XR_HAND_JOINT_PALM_EXT].pose.position.z, st.currentState.x, st.currentState.y,
-          stc.currentState ? 1 : 0);
-    } else {
-      std::printf("frame=%ld hand not tracked select=%d\n", frame, sel.currentState ? 1 : 0);
-    }
+    print_hand(frame, locs.isActive, joints, sel, st, stc);
     XrViewLocateInfo vli{XR_TYPE_VIEW_LOCATE_INFO};
     vli.viewConfigurationType = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
     vli.displayTime = fs.predictedDisplayTime;

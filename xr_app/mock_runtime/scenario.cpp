@@ -364,6 +364,23 @@ XrPosef pose(const json& j, const std::string& field) {
   return p;
 }
 
+// A generated hand's "pinch" and "fist" (0..1) and "shape" (see HandShape).
+void parse_hand_shape(const json& kj, const std::string& f, HandKey* k) {
+  if (kj.contains("pinch")) {
+    k->pinch = num(kj["pinch"], f + ".pinch");
+    if (k->pinch < 0 || k->pinch > 1) throw FieldError(f + ".pinch: must be in [0, 1]");
+  }
+  if (kj.contains("fist")) {
+    k->fist = num(kj["fist"], f + ".fist");
+    if (k->fist < 0 || k->fist > 1) throw FieldError(f + ".fist: must be in [0, 1]");
+  }
+  if (kj.contains("shape") &&
+      (!kj["shape"].is_string() || !hand_shape_from_name(kj["shape"], &k->shape)))
+    throw FieldError(f +
+                     ".shape: expected one of open, pinch_middle, pinch_ring, pinch_little, "
+                     "together");
+}
+
 double frame_of(const json& j, const std::string& field, double prev) {
   if (!j.contains("frame")) throw FieldError(field + ".frame: missing");
   double f = num(j["frame"], field + ".frame");
@@ -462,19 +479,7 @@ void parse(const json& root, const std::filesystem::path& dir, Scenario* s) {
           if (!kj.contains("palm"))
             throw FieldError(f + ": needs \"palm\" (+ \"pinch\") or \"joints\"");
           k.palm = pose(kj["palm"], f + ".palm");
-          if (kj.contains("pinch")) {
-            k.pinch = num(kj["pinch"], f + ".pinch");
-            if (k.pinch < 0 || k.pinch > 1) throw FieldError(f + ".pinch: must be in [0, 1]");
-          }
-          if (kj.contains("fist")) {
-            k.fist = num(kj["fist"], f + ".fist");
-            if (k.fist < 0 || k.fist > 1) throw FieldError(f + ".fist: must be in [0, 1]");
-          }
-          if (kj.contains("shape") &&
-              (!kj["shape"].is_string() || !hand_shape_from_name(kj["shape"], &k.shape)))
-            throw FieldError(f +
-                             ".shape: expected one of open, pinch_middle, pinch_ring, "
-                             "pinch_little, together");
+          parse_hand_shape(kj, f, &k);
         }
         s->hands[hi].push_back(k);
       }

@@ -526,6 +526,32 @@ void stick_inputs(const Window::Hand& k, int h, bool pad_only, ControllerKey& ck
 }
 }  // namespace
 
+namespace {
+// Interaction profile: the one chosen at attach, then Tab cycles through the suggested ones
+// and, with XR_EXT_hand_tracking enabled, hand tracking alone (no controller).
+void init_profile_cycle(Window* w, Session* s, Instance* inst) {
+  if (!w->cycle_ready && !s->attached_sets.empty()) {
+    w->cycle = suggested_profiles(s);
+    if (inst->extensions.count(XR_EXT_HAND_TRACKING_EXTENSION_NAME))
+      w->cycle.push_back(XR_NULL_PATH);
+    auto it = std::find(w->cycle.begin(), w->cycle.end(), s->profile[0]);
+    w->cycle_at = it == w->cycle.end() ? 0 : static_cast<size_t>(it - w->cycle.begin());
+    w->cycle_ready = true;
+    // With hand tracking enabled and no scenario naming a profile, the keys make gestures: the
+    // window starts with the hands alone.
+    if (!w->cycle.empty() && w->cycle.back() == XR_NULL_PATH &&
+        inst->scenario.interaction_profile.empty() && s->profile[0] != XR_NULL_PATH) {
+      w->cycle_at = w->cycle.size() - 1;
+      s->profile[0] = s->profile[1] = XR_NULL_PATH;
+      XrEventDataInteractionProfileChanged ev{XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED};
+      ev.session = to_handle<XrSession>(s->handle);
+      push_event(inst, &ev, sizeof(ev));
+      log("window: interaction profile none (hand tracking)");
+    }
+  }
+}
+}  // namespace
+
 void window_wait_frame(Session* s, int64_t frame) {
   Window* w = s->window.get();
   Instance* inst = instance_of(s);
@@ -548,27 +574,7 @@ void window_wait_frame(Session* s, int64_t frame) {
   auto on = [&](Key k) { return r.key[k].down || r.key[k].presses > 0; };
   auto held = [&](Key k) { return static_cast<float>(std::min(r.key[k].held, 0.25)); };
 
-  // Interaction profile: the one chosen at attach, then Tab cycles through the suggested ones
-  // and, with XR_EXT_hand_tracking enabled, hand tracking alone (no controller).
-  if (!w->cycle_ready && !s->attached_sets.empty()) {
-    w->cycle = suggested_profiles(s);
-    if (inst->extensions.count(XR_EXT_HAND_TRACKING_EXTENSION_NAME))
-      w->cycle.push_back(XR_NULL_PATH);
-    auto it = std::find(w->cycle.begin(), w->cycle.end(), s->profile[0]);
-    w->cycle_at = it == w->cycle.end() ? 0 : static_cast<size_t>(it - w->cycle.begin());
-    w->cycle_ready = true;
-    // With hand tracking enabled and no scenario naming a profile, the keys make gestures: the
-    // window starts with the hands alone.
-    if (!w->cycle.empty() && w->cycle.back() == XR_NULL_PATH &&
-        inst->scenario.interaction_profile.empty() && s->profile[0] != XR_NULL_PATH) {
-      w->cycle_at = w->cycle.size() - 1;
-      s->profile[0] = s->profile[1] = XR_NULL_PATH;
-      XrEventDataInteractionProfileChanged ev{XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED};
-      ev.session = to_handle<XrSession>(s->handle);
-      push_event(inst, &ev, sizeof(ev));
-      log("window: interaction profile none (hand tracking)");
-    }
-  }
+  init_profile_cycle(w, s, inst);
   if (w->cycle_ready && w->cycle.size() > 1 && r.tab > 0) {
     w->cycle_at = (w->cycle_at + static_cast<size_t>(r.tab)) % w->cycle.size();
     s->profile[0] = s->profile[1] = w->cycle[w->cycle_at];
