@@ -720,6 +720,56 @@ TEST(XrApp, EachGestureBindingReachesItsOperation) {
   EXPECT_TRUE(said("redo: pinch"));
 }
 
+// A hand whose controller is held: the runtime's joints for it (here a thumb-index pinch) make
+// no gesture, so only the controller's trigger pinches (no button fires twice); the other,
+// bare hand's pinch is a gesture as usual.
+TEST(XrApp, HeldControllersJointsMakeNoGestures) {
+  base_env();
+  const fs::path dir = fresh_out_dir("app_held_controller");
+  const std::string sc = (dir / "scenario.json").string();
+  auto hand = [](double x, int f, double pinch) {
+    char b[160];
+    std::snprintf(b, sizeof b,
+                  "{\"frame\": %d, \"palm\": {\"position\": [%.2f, 1.02, 0.21]}, \"pinch\": %.1f}",
+                  f, x, pinch);
+    return std::string(b);
+  };
+  auto grip = [](int f, bool pulled) {
+    return "{\"frame\": " + std::to_string(f) +
+           ", \"grip\": {\"position\": [0.12, 1.02, 0.21]}, \"inputs\": {\"trigger/value\": " +
+           (pulled ? "1.0" : "0.0") + "}}";
+  };
+  std::ofstream(sc)
+      << "{\"name\": \"held\", \"end_after_frames\": 70, \"fast\": true,\n"
+      << "\"interaction_profile\": \"/interaction_profiles/oculus/touch_controller\",\n"
+      << "\"head\": [{\"frame\": 0, \"position\": [0.0, 1.3, 1.2]}],\n"
+      << "\"hands\": {\"right\": [" << hand(0.12, 0, 0) << ", " << hand(0.12, 9, 0) << ", "
+      << hand(0.12, 10, 1) << ", " << hand(0.12, 30, 1) << ", " << hand(0.12, 31, 0)
+      << "],\n\"left\": [" << hand(-0.12, 0, 0) << ", " << hand(-0.12, 9, 0) << ", "
+      << hand(-0.12, 10, 1) << ", " << hand(-0.12, 30, 1) << ", " << hand(-0.12, 31, 0) << "]},\n"
+      << "\"controllers\": {\"right\": [" << grip(0, false) << ", " << grip(39, false) << ", "
+      << grip(40, true) << ", " << grip(49, true) << ", " << grip(50, false) << "]}}\n";
+  auto o = small();
+  play_scenario(o, sc);
+  o.eye_size = 64;
+  o.cloth_res = 8;
+  o.voice = false;
+  auto r = drape::app::run_xr_app(o);
+  print(r);
+  ASSERT_EQ(r.exit_code, 0) << r.error;
+  std::vector<std::string> got;
+  for (const auto& t : r.triggers) {
+    long long f = -1;
+    char rest[256] = {};
+    if (std::sscanf(t.c_str(), "frame %lld: %255[^\n]", &f, rest) == 2) got.push_back(rest);
+  }
+  const std::vector<std::string> want = {
+      "gesture pinch begin hand left -> pinch begin", "gesture pinch end hand left -> pinch end",
+      "controller button.trigger begin hand right -> pinch begin",
+      "controller button.trigger end hand right -> pinch end"};
+  EXPECT_EQ(got, want);
+}
+
 TEST(XrApp, SessionLossIsAnOrdinaryState) {
   base_env();
   setenv("DRAPE_MOCK_LOSE_SESSION_AT_FRAME", "5", 1);
