@@ -1278,6 +1278,7 @@ sim::Result<Image> Renderer::render_offscreen(const sim::SceneSnapshot& snap, co
 void Renderer::set_text_panel(const TextPanel& panel) {
   TextPanel& p = impl_->text.panel;
   if (panel.version != p.version || panel.lines.empty() != p.lines.empty()) p.lines = panel.lines;
+  if (std::memcmp(&panel.style, &p.style, sizeof(PanelStyle)) != 0) impl_->text.built = false;
   p.version = panel.version;
   p.head = panel.head;
   p.style = panel.style;

@@ -5,6 +5,7 @@
 #include FT_FREETYPE_H
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 
@@ -216,6 +217,20 @@ TextMesh build_text_panel(const FontAtlas& font, const std::vector<std::string>&
     }
   }
   return m;
+}
+
+PanelStyle scaled(const PanelStyle& s, float k) {
+  PanelStyle o = s;
+  o.width *= k;
+  o.line_height *= k;
+  o.max_height *= k;
+  o.margin *= k;
+  return o;
+}
+
+float legible_scale(const PanelStyle& s, float rad_per_pixel, float distance, float min_px) {
+  const float px_per_line = std::atan(s.line_height / distance) / rad_per_pixel;
+  return std::clamp(min_px / px_per_line, 1.0f, 3.0f);
 }
 
 Mat4f head_locked_panel(const Pose& head, float panel_height, float distance, float drop) {

@@ -64,6 +64,14 @@ struct PanelStyle {
   float background[4] = {0.02f, 0.02f, 0.03f, 0.72f};
   float text[4] = {0.95f, 0.95f, 0.90f, 1.0f};
 };
+// The style with every length times k (a panel k times as large at the same distance).
+PanelStyle scaled(const PanelStyle& s, float k);
+// How much larger than `s` the panel must be for a line of text to span at least `min_px`
+// pixels of a view with `rad_per_pixel` at `distance` (1 when it already does; at most 3). A
+// headset's eye (~20 px per degree) reads the panel at its size; a small desk window needs it
+// larger.
+float legible_scale(const PanelStyle& s, float rad_per_pixel, float distance = 0.55f,
+                    float min_px = 9.0f);
 
 // Wraps `lines` to `columns` characters (UTF-8 aware; continuation lines indented by two).
 std::vector<std::string> wrap_lines(const std::vector<std::string>& lines, int columns);

@@ -62,6 +62,9 @@ struct XrAppOptions {
   // Draw the dress form at a level of detail chosen from the eyes' pixel size
   // (render::form_lod_for_pixels); false: the renderer's full-detail default.
   bool form_lod = true;
+  // Draw the feedback panel (the hands' operations, voice, refusals, help) over the scene;
+  // false: the scene alone (screenshots compared with golden images of the scene).
+  bool feedback_panel = true;
 };
 
 struct XrAppResult {
@@ -88,8 +91,9 @@ struct XrAppResult {
   int components_before = 0, components_after = 0;  // of the last successful cut
   std::vector<std::string> voice_commands;          // commands the recogniser accepted
   std::vector<std::string> sim_messages;            // World::messages at the end
-  std::vector<std::string> written;                 // files written to out_dir
-  std::vector<double> frame_ms;                     // wall time per frame (wait → end)
+  std::vector<std::string> refusals;  // "frame F: reason" as shown in the feedback panel
+  std::vector<std::string> written;   // files written to out_dir
+  std::vector<double> frame_ms;       // wall time per frame (wait → end)
   // Per-stage profile, one sample per frame (or per sim tick for "sim.*"): wall ms of each stage
   // of the frame loop ("xr.wait_frame", "input", "interact", "pose_wait", "render.build",
   // "render.upload", "render.record_submit", "render.gpu_wait", "xr.end_frame", ...), the frame
