@@ -121,6 +121,17 @@ PushConstants push_constants(const sim::SceneSnapshot& snap, const View& view, V
   return pc;
 }
 
+// Colour (the background, encoded when the shader encodes), depth, resolve colour.
+std::array<VkClearValue, 3> clear_values(const DrawOptions& opt, bool encode) {
+  std::array<VkClearValue, 3> clears{};
+  for (int k = 0; k < 3; ++k)
+    clears[0].color.float32[k] = encode ? srgb_encode(opt.background[k]) : opt.background[k];
+  clears[0].color.float32[3] = 1.0f;
+  clears[1].depthStencil = {1.0f, 0};
+  clears[2] = clears[0];
+  return clears;
+}
+
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
@@ -429,8 +440,8 @@ struct Renderer::Impl {
       }
       t.font = std::move(*font);
       if (Status s = text_create_gpu(); !s) {
-        t.error = "text: " + s.error;
-        return s;
+        t.error = "text: " + s.error;  // the scene is still drawn, without the panel
+        return {};
       }
     }
     if (!t.error.empty() || (t.built && t.built_version == t.panel.version)) return {};
@@ -445,6 +456,7 @@ struct Renderer::Impl {
     t.height = m.height;
     t.built = true;
     t.built_version = t.panel.version;
+    stats.text_rebuilt = true;
     return {};
   }
 
@@ -1018,11 +1030,7 @@ struct Renderer::Impl {
             depth_rw, VK_PIPELINE_STAGE_TRANSFER_BIT, tests);
   }
 
-  // Records and submits one frame into every target of `views` (the geometry is built and
-  // uploaded once); with `readback_copy` (one view) also copies the result into the readback
-  // buffer. Waits for completion.
-  Status draw(const sim::SceneSnapshot& snap, const ViewTarget* views, int count,
-              const DrawOptions& opt, bool readback_copy) {
+  Status check_targets(const ViewTarget* views, int count) const {
     if (lost) return Status{"vulkan: the device was lost earlier; recreate the renderer"};
     if (!views || count <= 0) return Status{"render: no view to draw"};
     for (int i = 0; i < count; ++i) {
@@ -1035,6 +1043,32 @@ struct Renderer::Impl {
           t.depth_format != VK_FORMAT_D16_UNORM)
         return Status{"render: the depth image must be D32_SFLOAT or D16_UNORM"};
     }
+    return {};
+  }
+
+  // The target's colour (TRANSFER_SRC_OPTIMAL) into the readback buffer, visible to the host.
+  void record_readback(const ColorTarget& t) {
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, t.array_layer, 1};
+    region.imageExtent = {t.width, t.height, 1};
+    vkCmdCopyImageToBuffer(cmd, t.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1,
+                           &region);
+    VkBufferMemoryBarrier bar{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+    bar.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    bar.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    bar.srcQueueFamilyIndex = bar.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    bar.buffer = readback.buffer;
+    bar.size = VK_WHOLE_SIZE;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
+                         nullptr, 1, &bar, 0, nullptr);
+  }
+
+  // Records and submits one frame into every target of `views` (the geometry is built and
+  // uploaded once); with `readback_copy` (one view) also copies the result into the readback
+  // buffer. Waits for completion.
+  Status draw(const sim::SceneSnapshot& snap, const ViewTarget* views, int count,
+              const DrawOptions& opt, bool readback_copy) {
+    if (Status s = check_targets(views, count); !s) return s;
     const double cpu0 = thread_cpu_ms();
     auto t0 = Clock::now();
     stats = FrameStats{};
@@ -1089,19 +1123,13 @@ struct Renderer::Impl {
 
       const PushConstants pc = push_constants(snap, view, t.format, opt);
 
-      VkClearValue clears[3]{};
-      for (int k = 0; k < 3; ++k)
-        clears[0].color.float32[k] =
-            pc.flags[1] ? srgb_encode(opt.background[k]) : opt.background[k];
-      clears[0].color.float32[3] = 1.0f;
-      clears[1].depthStencil = {1.0f, 0};
-      clears[2] = clears[0];
+      const std::array<VkClearValue, 3> clears = clear_values(opt, pc.flags[1] != 0);
       VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
       rbi.renderPass = *rp;
       rbi.framebuffer = fb->framebuffer;
       rbi.renderArea = {{0, 0}, {t.width, t.height}};
       rbi.clearValueCount = samples > 1 ? 3 : 2;
-      rbi.pClearValues = clears;
+      rbi.pClearValues = clears.data();
       vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
       VkViewport viewport{0, 0, static_cast<float>(t.width), static_cast<float>(t.height), 0, 1};
       VkRect2D scissor{{0, 0}, {t.width, t.height}};
@@ -1162,21 +1190,7 @@ struct Renderer::Impl {
         return drawn;
       }
       vkCmdEndRenderPass(cmd);
-      if (readback_copy && i == 0) {
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, t.array_layer, 1};
-        region.imageExtent = {t.width, t.height, 1};
-        vkCmdCopyImageToBuffer(cmd, t.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer,
-                               1, &region);
-        VkBufferMemoryBarrier bar{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-        bar.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        bar.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        bar.srcQueueFamilyIndex = bar.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        bar.buffer = readback.buffer;
-        bar.size = VK_WHOLE_SIZE;
-        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
-                             nullptr, 1, &bar, 0, nullptr);
-      }
+      if (readback_copy && i == 0) record_readback(t);
     }
     if (VkResult r = vkEndCommandBuffer(cmd); r != VK_SUCCESS) return fail("vkEndCommandBuffer", r);
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};

@@ -68,6 +68,7 @@ struct FrameStats {
   size_t triangles = 0;        // per view
   int views = 0;               // views drawn by the call
   bool cloth_rebuilt = false;  // the cloth's vertices were rebuilt and uploaded (else cached)
+  bool text_rebuilt = false;   // the feedback panel's quads were rebuilt (its version changed)
 };
 
 // One view of a multi-view frame (e.g. an XR eye): where it looks from and what it draws into.

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 
@@ -156,7 +157,7 @@ TEST(TextPanel, DrawnOverTheSceneWithGlyphsInsideItsRectangle) {
       const uint8_t *pa = a->px(x, y), *pb = b->px(x, y), *p0 = plain->px(x, y);
       if (inside) {
         bright += luma(pa) > 200;
-        dark += luma(pa) < 70;
+        dark += luma(pa) < luma(p0) - 40;  // darkened by the panel
         ab_differ += std::abs(luma(pa) - luma(pb)) > 60;
       } else if (!near) {
         outside_changed += std::memcmp(pa, p0, 4) != 0;
@@ -168,7 +169,7 @@ TEST(TextPanel, DrawnOverTheSceneWithGlyphsInsideItsRectangle) {
       bright, dark, ab_differ, outside_changed);
   const int area = (rc.x1 - rc.x0) * (rc.y1 - rc.y0);
   EXPECT_GT(bright, 150);         // the letters
-  EXPECT_GT(dark, area / 3);      // the dark rectangle behind them
+  EXPECT_GT(dark, area / 2);      // the dark rectangle behind them
   EXPECT_GT(ab_differ, 50);       // a different second line
   EXPECT_EQ(outside_changed, 0);  // nothing else drawn
   // No lines: the scene alone again, byte for byte.
@@ -337,6 +338,60 @@ TEST(TextPanel, LeavesTheCallersDepthUntouched) {
   for (float d : plain) scene_px += d < 1.0f;
   EXPECT_GT(scene_px, int(W * H) / 4);  // the depth holds the scene
   EXPECT_EQ(with_panel, plain);
+  r->forget_targets();
+  expect_no_validation_messages(*r);
+}
+
+// Two 512² eyes with one submission, as the XR app draws them: the panel's quads are built once
+// per version, and what the panel costs is printed (the median of 15 frames each way).
+TEST(TextPanel, QuadsRebuiltOnlyWhenTheVersionChanges) {
+  auto r = test::make_test_renderer();
+  ASSERT_TRUE(r);
+  sim::SceneSnapshot s = test::decorated_scene();
+  const uint32_t W = 512;
+  Images im[2];
+  ViewTarget vt[2];
+  for (int e = 0; e < 2; ++e) {
+    make_images(r->context(), W, W, im[e]);
+    Pose p;
+    p.position = Eigen::Vector3f(e == 0 ? -0.032f : 0.032f, 1.45f, 1.2f);
+    vt[e].view = make_view(p, Fov{-0.785f, 0.785f, 0.785f, -0.785f});
+    vt[e].target = ColorTarget{
+        im[e].color, VK_FORMAT_R8G8B8A8_SRGB, W, W, 0, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+  }
+  auto median_ms = [&](int n) {
+    std::vector<double> ms;
+    for (int i = 0; i < n; ++i) {
+      EXPECT_TRUE(r->render_views(s, vt, 2).ok());
+      const FrameStats& f = r->last_frame();
+      ms.push_back(f.submit_ms + f.wait_ms + f.build_ms);
+    }
+    std::sort(ms.begin(), ms.end());
+    return ms[ms.size() / 2];
+  };
+  const double plain = median_ms(15);
+  TextPanel p;
+  p.lines = {"left hand: -", "right hand: pinching particle 12", "voice: heard \"pin\" -> pin",
+             "pinch: nothing within 3 cm of the right hand to pinch"};
+  p.version = 7;
+  p.head.position = Eigen::Vector3f(0, 1.45f, 1.2f);
+  r->set_text_panel(p);
+  ASSERT_TRUE(r->render_views(s, vt, 2).ok());
+  EXPECT_TRUE(r->last_frame().text_rebuilt);
+  ASSERT_TRUE(r->render_views(s, vt, 2).ok());
+  EXPECT_FALSE(r->last_frame().text_rebuilt);  // same version: the quads are kept
+  p.head.position.x() += 0.1f;                 // the head moved: still the same quads
+  r->set_text_panel(p);
+  ASSERT_TRUE(r->render_views(s, vt, 2).ok());
+  EXPECT_FALSE(r->last_frame().text_rebuilt);
+  const double with = median_ms(15);
+  p.lines.push_back("cut: ignored: stroke has fewer than 2 samples");
+  p.version = 8;
+  r->set_text_panel(p);
+  ASSERT_TRUE(r->render_views(s, vt, 2).ok());
+  EXPECT_TRUE(r->last_frame().text_rebuilt);
+  std::printf("2 x 512^2 views on %s: %.2f ms without the panel, %.2f ms with it (x%.3f)\n",
+              r->device_name().c_str(), plain, with, with / plain);
   r->forget_targets();
   expect_no_validation_messages(*r);
 }
