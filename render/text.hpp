@@ -61,7 +61,7 @@ struct PanelStyle {
   float line_height = 0.014f;  // m (before shrinking)
   float max_height = 0.30f;    // m
   float margin = 0.008f;       // m
-  float background[4] = {0.02f, 0.02f, 0.03f, 0.72f};
+  float background[4] = {0.02f, 0.02f, 0.03f, 0.8f};
   float text[4] = {0.95f, 0.95f, 0.90f, 1.0f};
 };
 // The style with every length times k (a panel k times as large at the same distance).
@@ -71,7 +71,7 @@ PanelStyle scaled(const PanelStyle& s, float k);
 // headset's eye (~20 px per degree) reads the panel at its size; a small desk window needs it
 // larger.
 float legible_scale(const PanelStyle& s, float rad_per_pixel, float distance = 0.55f,
-                    float min_px = 9.0f);
+                    float min_px = 12.0f);
 
 // Wraps `lines` to `columns` characters (UTF-8 aware; continuation lines indented by two).
 std::vector<std::string> wrap_lines(const std::vector<std::string>& lines, int columns);
