@@ -91,9 +91,8 @@ struct XrAppResult {
   int components_before = 0, components_after = 0;  // of the last successful cut
   std::vector<std::string> voice_commands;          // commands the recogniser accepted
   std::vector<std::string> sim_messages;            // World::messages at the end
-  std::vector<std::string> refusals;  // "frame F: reason" as shown in the feedback panel
-  std::vector<std::string> written;   // files written to out_dir
-  std::vector<double> frame_ms;       // wall time per frame (wait → end)
+  std::vector<std::string> written;                 // files written to out_dir
+  std::vector<double> frame_ms;                     // wall time per frame (wait → end)
   // Per-stage profile, one sample per frame (or per sim tick for "sim.*"): wall ms of each stage
   // of the frame loop ("xr.wait_frame", "input", "interact", "pose_wait", "render.build",
   // "render.upload", "render.record_submit", "render.gpu_wait", "xr.end_frame", ...), the frame
@@ -128,6 +127,8 @@ struct XrAppResult {
   };
   std::vector<PointerProbe> pointer_probe;
   std::string commands_file;  // the command map used
+  // Each refusal as the feedback panel showed it: "frame F: reason".
+  std::vector<std::string> refusals;
 };
 
 XrAppResult run_xr_app(const XrAppOptions& opt);
