@@ -15,6 +15,8 @@
 #include "scene_frag.spv.h"
 #include "scene_vert.spv.h"
 #include "sim/form/dress_form.hpp"
+#include "text_frag.spv.h"
+#include "text_vert.spv.h"
 
 namespace drape::render {
 namespace {
@@ -27,6 +29,11 @@ struct PushConstants {
   int32_t flags[4];
 };
 static_assert(sizeof(PushConstants) == 128, "push constants must fit the guaranteed 128 bytes");
+
+struct TextPushConstants {  // render/shaders/text.vert
+  float mvp[16];
+  int32_t flags[4];
+};
 
 struct Buffer {
   VkBuffer buffer = VK_NULL_HANDLE;
@@ -86,6 +93,43 @@ double thread_cpu_ms() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+PushConstants push_constants(const sim::SceneSnapshot& snap, const View& view, VkFormat format,
+                             const DrawOptions& opt) {
+  PushConstants pc{};
+  const Mat4f vp = view.view_proj();
+  std::memcpy(pc.view_proj, vp.data(), sizeof(pc.view_proj));
+  pc.eye[0] = view.eye.x();
+  pc.eye[1] = view.eye.y();
+  pc.eye[2] = view.eye.z();
+  pc.eye[3] = opt.grain_spacing;
+  if (snap.form) {
+    const auto& lm = snap.form->landmarks();
+    pc.heights[0] = static_cast<float>(lm.waist_y);
+    pc.heights[1] = static_cast<float>(lm.hip_y);
+    pc.heights[2] = static_cast<float>(lm.bust_y);
+    pc.angles[0] = static_cast<float>(lm.centre_front_theta);
+    pc.angles[1] = static_cast<float>(lm.centre_back_theta);
+    pc.angles[2] = static_cast<float>(lm.left_side_theta);
+    pc.angles[3] = static_cast<float>(lm.right_side_theta);
+  }
+  pc.heights[3] = opt.line_half_width;
+  pc.flags[0] = static_cast<int32_t>(opt.colour_map);
+  pc.flags[1] = needs_shader_encode(format) ? 1 : 0;
+  pc.flags[2] = opt.grain ? 1 : 0;
+  return pc;
+}
+
+// Colour (the background, encoded when the shader encodes), depth, resolve colour.
+std::array<VkClearValue, 3> clear_values(const DrawOptions& opt, bool encode) {
+  std::array<VkClearValue, 3> clears{};
+  for (int k = 0; k < 3; ++k)
+    clears[0].color.float32[k] = encode ? srgb_encode(opt.background[k]) : opt.background[k];
+  clears[0].color.float32[3] = 1.0f;
+  clears[1].depthStencil = {1.0f, 0};
+  clears[2] = clears[0];
+  return clears;
 }
 
 using Clock = std::chrono::steady_clock;
@@ -150,6 +194,29 @@ struct Renderer::Impl {
   } cloth_in;
   bool cloth_valid = false;
   uint32_t cloth_count = 0;
+
+  // The feedback panel (TextPanel): its pipeline (text.vert/frag, alpha-blended, no depth test
+  // or write), the glyph atlas (R8, uploaded once from `staging` in the first frame's command
+  // buffer), its sampler and descriptor, and the panel's quads (rebuilt when the version changes).
+  struct TextGpu {
+    std::string font_path, error;
+    bool font_tried = false, atlas_uploaded = false;
+    FontAtlas font;
+    Attachment atlas;
+    Buffer staging, vb, ib;
+    VkSampler sampler = VK_NULL_HANDLE;
+    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkShaderModule vs = VK_NULL_HANDLE, fs = VK_NULL_HANDLE;
+    std::map<std::tuple<VkFormat, int, VkFormat>, VkPipeline> pipelines;
+    TextPanel panel;
+    uint64_t built_version = 0;
+    bool built = false;
+    uint32_t count = 0;
+    float height = 0;
+  } text;
 
   ~Impl() { destroy(); }
 
@@ -287,10 +354,266 @@ struct Renderer::Impl {
     return {};
   }
 
+  // The atlas image, sampler, descriptor, shaders and pipeline layout of the panel.
+  Status text_create_gpu() {
+    TextGpu& t = text;
+    if (Status s = make_image(t.atlas, static_cast<uint32_t>(t.font.width),
+                              static_cast<uint32_t>(t.font.height), VK_FORMAT_R8_UNORM,
+                              VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                              VK_IMAGE_ASPECT_COLOR_BIT, 1);
+        !s)
+      return s;
+    if (Status s = ensure_buffer(t.staging, t.font.alpha.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+        !s)
+      return s;
+    std::memcpy(t.staging.mapped, t.font.alpha.data(), t.font.alpha.size());
+    VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+    si.magFilter = si.minFilter = VK_FILTER_LINEAR;
+    si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    if (VkResult r = vkCreateSampler(dev(), &si, nullptr, &t.sampler); r != VK_SUCCESS)
+      return fail("vkCreateSampler", r);
+    VkDescriptorSetLayoutBinding b{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1,
+                                   VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+    VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    li.bindingCount = 1;
+    li.pBindings = &b;
+    if (VkResult r = vkCreateDescriptorSetLayout(dev(), &li, nullptr, &t.set_layout);
+        r != VK_SUCCESS)
+      return fail("vkCreateDescriptorSetLayout", r);
+    VkDescriptorPoolSize ps{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
+    VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    pi.maxSets = 1;
+    pi.poolSizeCount = 1;
+    pi.pPoolSizes = &ps;
+    if (VkResult r = vkCreateDescriptorPool(dev(), &pi, nullptr, &t.pool); r != VK_SUCCESS)
+      return fail("vkCreateDescriptorPool", r);
+    VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    ai.descriptorPool = t.pool;
+    ai.descriptorSetCount = 1;
+    ai.pSetLayouts = &t.set_layout;
+    if (VkResult r = vkAllocateDescriptorSets(dev(), &ai, &t.set); r != VK_SUCCESS)
+      return fail("vkAllocateDescriptorSets", r);
+    VkDescriptorImageInfo ii{t.sampler, t.atlas.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = t.set;
+    w.descriptorCount = 1;
+    w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    w.pImageInfo = &ii;
+    vkUpdateDescriptorSets(dev(), 1, &w, 0, nullptr);
+    return text_create_layout();
+  }
+
+  Status text_create_layout() {
+    TextGpu& t = text;
+    VkShaderModuleCreateInfo si{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    si.codeSize = sizeof(k_text_vert_spv);
+    si.pCode = k_text_vert_spv;
+    if (VkResult r = vkCreateShaderModule(dev(), &si, nullptr, &t.vs); r != VK_SUCCESS)
+      return fail("vkCreateShaderModule (text)", r);
+    si.codeSize = sizeof(k_text_frag_spv);
+    si.pCode = k_text_frag_spv;
+    if (VkResult r = vkCreateShaderModule(dev(), &si, nullptr, &t.fs); r != VK_SUCCESS)
+      return fail("vkCreateShaderModule (text)", r);
+    VkPushConstantRange pc{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                           sizeof(TextPushConstants)};
+    VkPipelineLayoutCreateInfo li{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    li.setLayoutCount = 1;
+    li.pSetLayouts = &t.set_layout;
+    li.pushConstantRangeCount = 1;
+    li.pPushConstantRanges = &pc;
+    if (VkResult r = vkCreatePipelineLayout(dev(), &li, nullptr, &t.layout); r != VK_SUCCESS)
+      return fail("vkCreatePipelineLayout (text)", r);
+    return {};
+  }
+
+  // Before recording: the font (once), the GPU objects (once) and the panel's quads (when its
+  // version changed). A font that does not load leaves the panel out (text.error says why).
+  Status text_prepare() {
+    TextGpu& t = text;
+    if (t.panel.lines.empty()) return {};
+    if (!t.font_tried) {
+      t.font_tried = true;
+      auto font = load_font_atlas(t.font_path.empty() ? default_font_path() : t.font_path);
+      if (!font) {
+        t.error = font.error();
+        return {};
+      }
+      t.font = std::move(*font);
+      if (Status s = text_create_gpu(); !s) {
+        t.error = "text: " + s.error;  // the scene is still drawn, without the panel
+        return {};
+      }
+    }
+    if (!t.error.empty() || (t.built && t.built_version == t.panel.version)) return {};
+    const TextMesh m = build_text_panel(t.font, t.panel.lines, t.panel.style);
+    const VkDeviceSize vbytes = std::max<size_t>(m.vertices.size(), 1) * sizeof(TextVertex);
+    const VkDeviceSize ibytes = std::max<size_t>(m.indices.size(), 1) * sizeof(uint32_t);
+    if (Status s = ensure_buffer(t.vb, vbytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT); !s) return s;
+    if (Status s = ensure_buffer(t.ib, ibytes, VK_BUFFER_USAGE_INDEX_BUFFER_BIT); !s) return s;
+    std::memcpy(t.vb.mapped, m.vertices.data(), m.vertices.size() * sizeof(TextVertex));
+    std::memcpy(t.ib.mapped, m.indices.data(), m.indices.size() * sizeof(uint32_t));
+    t.count = static_cast<uint32_t>(m.indices.size());
+    t.height = m.height;
+    t.built = true;
+    t.built_version = t.panel.version;
+    stats.text_rebuilt = true;
+    return {};
+  }
+
+  bool text_drawn() const { return !text.panel.lines.empty() && text.error.empty() && text.built; }
+
+  // In the frame's command buffer before any pass: the atlas from the staging buffer (once).
+  void text_record_upload() {
+    TextGpu& t = text;
+    if (!text_drawn() || t.atlas_uploaded) return;
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = t.atlas.image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                         0, nullptr, 0, nullptr, 1, &b);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {static_cast<uint32_t>(t.font.width), static_cast<uint32_t>(t.font.height),
+                          1};
+    vkCmdCopyBufferToImage(cmd, t.staging.buffer, t.atlas.image,
+                           VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+                         0, 0, nullptr, 0, nullptr, 1, &b);
+    t.atlas_uploaded = true;
+  }
+
+  sim::Result<VkPipeline> text_pipeline_for(VkFormat fmt, VkRenderPass rp, VkFormat depth_fmt) {
+    const auto key = std::make_tuple(fmt, samples, depth_fmt);
+    if (auto it = text.pipelines.find(key); it != text.pipelines.end()) return it->second;
+    VkPipelineShaderStageCreateInfo stages[2]{};
+    stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stages[0].module = text.vs;
+    stages[0].pName = "main";
+    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+    stages[1].module = text.fs;
+    stages[1].pName = "main";
+    VkVertexInputBindingDescription binding{0, sizeof(TextVertex), VK_VERTEX_INPUT_RATE_VERTEX};
+    VkVertexInputAttributeDescription attrs[3] = {
+        {0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(TextVertex, pos)},
+        {1, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(TextVertex, uv)},
+        {2, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(TextVertex, color)}};
+    VkPipelineVertexInputStateCreateInfo vin{
+        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    vin.vertexBindingDescriptionCount = 1;
+    vin.pVertexBindingDescriptions = &binding;
+    vin.vertexAttributeDescriptionCount = 3;
+    vin.pVertexAttributeDescriptions = attrs;
+    VkPipelineInputAssemblyStateCreateInfo ia{
+        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    vp.viewportCount = 1;
+    vp.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo rs{
+        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    rs.polygonMode = VK_POLYGON_MODE_FILL;
+    rs.cullMode = VK_CULL_MODE_NONE;
+    rs.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo ms{
+        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    ms.rasterizationSamples = static_cast<VkSampleCountFlagBits>(samples);
+    // Over everything, and no depth written: the panel is not a surface of the scene.
+    VkPipelineDepthStencilStateCreateInfo ds{
+        VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    VkPipelineColorBlendAttachmentState cba{};
+    cba.blendEnable = VK_TRUE;
+    cba.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+    cba.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    cba.colorBlendOp = VK_BLEND_OP_ADD;
+    cba.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    cba.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    cba.alphaBlendOp = VK_BLEND_OP_ADD;
+    cba.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                         VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+    VkPipelineColorBlendStateCreateInfo cb{
+        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    cb.attachmentCount = 1;
+    cb.pAttachments = &cba;
+    VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dsi{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dsi.dynamicStateCount = 2;
+    dsi.pDynamicStates = dyn;
+    VkGraphicsPipelineCreateInfo gi{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    gi.stageCount = 2;
+    gi.pStages = stages;
+    gi.pVertexInputState = &vin;
+    gi.pInputAssemblyState = &ia;
+    gi.pViewportState = &vp;
+    gi.pRasterizationState = &rs;
+    gi.pMultisampleState = &ms;
+    gi.pDepthStencilState = &ds;
+    gi.pColorBlendState = &cb;
+    gi.pDynamicState = &dsi;
+    gi.layout = text.layout;
+    gi.renderPass = rp;
+    VkPipeline p = VK_NULL_HANDLE;
+    if (VkResult r = vkCreateGraphicsPipelines(dev(), VK_NULL_HANDLE, 1, &gi, nullptr, &p);
+        r != VK_SUCCESS)
+      return sim::Error{fail("vkCreateGraphicsPipelines (text)", r).error};
+    text.pipelines[key] = p;
+    return p;
+  }
+
+  // Inside a view's last pass: the panel over what is drawn (viewport and scissor are set).
+  Status text_record_draw(const View& view, VkFormat fmt, VkRenderPass rp, VkFormat depth_fmt,
+                          bool encode) {
+    if (!text_drawn()) return {};
+    auto pipe = text_pipeline_for(fmt, rp, depth_fmt);
+    if (!pipe) return Status{pipe.error()};
+    TextPushConstants pc{};
+    const Mat4f mvp = view.view_proj() * head_locked_panel(text.panel.head, text.height);
+    std::memcpy(pc.mvp, mvp.data(), sizeof(pc.mvp));
+    pc.flags[1] = encode ? 1 : 0;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, *pipe);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, text.layout, 0, 1, &text.set, 0,
+                            nullptr);
+    vkCmdPushConstants(cmd, text.layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                       0, sizeof(pc), &pc);
+    const VkDeviceSize zero = 0;
+    vkCmdBindVertexBuffers(cmd, 0, 1, &text.vb.buffer, &zero);
+    vkCmdBindIndexBuffer(cmd, text.ib.buffer, 0, VK_INDEX_TYPE_UINT32);
+    vkCmdDrawIndexed(cmd, text.count, 1, 0, 0, 0);
+    return {};
+  }
+
+  void text_destroy() {
+    TextGpu& t = text;
+    for (auto& [k, p] : t.pipelines) vkDestroyPipeline(dev(), p, nullptr);
+    t.pipelines.clear();
+    if (t.layout) vkDestroyPipelineLayout(dev(), t.layout, nullptr);
+    if (t.pool) vkDestroyDescriptorPool(dev(), t.pool, nullptr);
+    if (t.set_layout) vkDestroyDescriptorSetLayout(dev(), t.set_layout, nullptr);
+    if (t.sampler) vkDestroySampler(dev(), t.sampler, nullptr);
+    if (t.vs) vkDestroyShaderModule(dev(), t.vs, nullptr);
+    if (t.fs) vkDestroyShaderModule(dev(), t.fs, nullptr);
+    for (Buffer* b : {&t.staging, &t.vb, &t.ib}) destroy_buffer(*b);
+    destroy_attachment(t.atlas);
+    t.layout = VK_NULL_HANDLE;
+    t.pool = VK_NULL_HANDLE;
+    t.set_layout = VK_NULL_HANDLE;
+    t.sampler = VK_NULL_HANDLE;
+    t.vs = t.fs = VK_NULL_HANDLE;
+  }
+
   void destroy() {
     if (!ctx || !ctx->device) return;
     vkDeviceWaitIdle(dev());
     forget_targets();
+    text_destroy();
     for (auto& [k, a] : attachments) {
       destroy_attachment(a.first);
       destroy_attachment(a.second);
@@ -707,11 +1030,7 @@ struct Renderer::Impl {
             depth_rw, VK_PIPELINE_STAGE_TRANSFER_BIT, tests);
   }
 
-  // Records and submits one frame into every target of `views` (the geometry is built and
-  // uploaded once); with `readback_copy` (one view) also copies the result into the readback
-  // buffer. Waits for completion.
-  Status draw(const sim::SceneSnapshot& snap, const ViewTarget* views, int count,
-              const DrawOptions& opt, bool readback_copy) {
+  Status check_targets(const ViewTarget* views, int count) const {
     if (lost) return Status{"vulkan: the device was lost earlier; recreate the renderer"};
     if (!views || count <= 0) return Status{"render: no view to draw"};
     for (int i = 0; i < count; ++i) {
@@ -724,6 +1043,32 @@ struct Renderer::Impl {
           t.depth_format != VK_FORMAT_D16_UNORM)
         return Status{"render: the depth image must be D32_SFLOAT or D16_UNORM"};
     }
+    return {};
+  }
+
+  // The target's colour (TRANSFER_SRC_OPTIMAL) into the readback buffer, visible to the host.
+  void record_readback(const ColorTarget& t) {
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, t.array_layer, 1};
+    region.imageExtent = {t.width, t.height, 1};
+    vkCmdCopyImageToBuffer(cmd, t.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1,
+                           &region);
+    VkBufferMemoryBarrier bar{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+    bar.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    bar.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    bar.srcQueueFamilyIndex = bar.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    bar.buffer = readback.buffer;
+    bar.size = VK_WHOLE_SIZE;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
+                         nullptr, 1, &bar, 0, nullptr);
+  }
+
+  // Records and submits one frame into every target of `views` (the geometry is built and
+  // uploaded once); with `readback_copy` (one view) also copies the result into the readback
+  // buffer. Waits for completion.
+  Status draw(const sim::SceneSnapshot& snap, const ViewTarget* views, int count,
+              const DrawOptions& opt, bool readback_copy) {
+    if (Status s = check_targets(views, count); !s) return s;
     const double cpu0 = thread_cpu_ms();
     auto t0 = Clock::now();
     stats = FrameStats{};
@@ -756,11 +1101,13 @@ struct Renderer::Impl {
     stats.build_ms = ms_since(t0) - stats.upload_ms;
     t0 = Clock::now();
 
+    if (Status s = text_prepare(); !s) return s;
     vkResetCommandBuffer(cmd, 0);
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     if (VkResult r = vkBeginCommandBuffer(cmd, &bi); r != VK_SUCCESS)
       return fail("vkBeginCommandBuffer", r);
+    text_record_upload();
     for (int i = 0; i < count; ++i) {
       const View& view = views[i].view;
       const ColorTarget& t = views[i].target;
@@ -774,41 +1121,15 @@ struct Renderer::Impl {
       auto fb = framebuffer_for(t, *rp, *overlay_rp);
       if (!fb) return Status{fb.error()};
 
-      PushConstants pc{};
-      const Mat4f vp = view.view_proj();
-      std::memcpy(pc.view_proj, vp.data(), sizeof(pc.view_proj));
-      pc.eye[0] = view.eye.x();
-      pc.eye[1] = view.eye.y();
-      pc.eye[2] = view.eye.z();
-      pc.eye[3] = opt.grain_spacing;
-      if (snap.form) {
-        const auto& lm = snap.form->landmarks();
-        pc.heights[0] = static_cast<float>(lm.waist_y);
-        pc.heights[1] = static_cast<float>(lm.hip_y);
-        pc.heights[2] = static_cast<float>(lm.bust_y);
-        pc.angles[0] = static_cast<float>(lm.centre_front_theta);
-        pc.angles[1] = static_cast<float>(lm.centre_back_theta);
-        pc.angles[2] = static_cast<float>(lm.left_side_theta);
-        pc.angles[3] = static_cast<float>(lm.right_side_theta);
-      }
-      pc.heights[3] = opt.line_half_width;
-      pc.flags[0] = static_cast<int32_t>(opt.colour_map);
-      pc.flags[1] = needs_shader_encode(t.format) ? 1 : 0;
-      pc.flags[2] = opt.grain ? 1 : 0;
+      const PushConstants pc = push_constants(snap, view, t.format, opt);
 
-      VkClearValue clears[3]{};
-      for (int k = 0; k < 3; ++k)
-        clears[0].color.float32[k] =
-            pc.flags[1] ? srgb_encode(opt.background[k]) : opt.background[k];
-      clears[0].color.float32[3] = 1.0f;
-      clears[1].depthStencil = {1.0f, 0};
-      clears[2] = clears[0];
+      const std::array<VkClearValue, 3> clears = clear_values(opt, pc.flags[1] != 0);
       VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
       rbi.renderPass = *rp;
       rbi.framebuffer = fb->framebuffer;
       rbi.renderArea = {{0, 0}, {t.width, t.height}};
       rbi.clearValueCount = samples > 1 ? 3 : 2;
-      rbi.pClearValues = clears;
+      rbi.pClearValues = clears.data();
       vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
       VkViewport viewport{0, 0, static_cast<float>(t.width), static_cast<float>(t.height), 0, 1};
       VkRect2D scissor{{0, 0}, {t.width, t.height}};
@@ -859,27 +1180,17 @@ struct Renderer::Impl {
         bound_vb = nullptr;
         drawn = draw_ranges({0});
       }
+      // The panel last, over the hands, in the pass whose depth is not the caller's.
+      if (drawn)
+        drawn = text_record_draw(view, t.format, stored ? *overlay_rp : *rp, depth_fmt,
+                                 pc.flags[1] != 0);
       if (!drawn) {
         vkCmdEndRenderPass(cmd);
         vkEndCommandBuffer(cmd);
         return drawn;
       }
       vkCmdEndRenderPass(cmd);
-      if (readback_copy && i == 0) {
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, t.array_layer, 1};
-        region.imageExtent = {t.width, t.height, 1};
-        vkCmdCopyImageToBuffer(cmd, t.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer,
-                               1, &region);
-        VkBufferMemoryBarrier bar{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-        bar.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        bar.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        bar.srcQueueFamilyIndex = bar.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        bar.buffer = readback.buffer;
-        bar.size = VK_WHOLE_SIZE;
-        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
-                             nullptr, 1, &bar, 0, nullptr);
-      }
+      if (readback_copy && i == 0) record_readback(t);
     }
     if (VkResult r = vkEndCommandBuffer(cmd); r != VK_SUCCESS) return fail("vkEndCommandBuffer", r);
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
@@ -946,6 +1257,7 @@ sim::Result<std::unique_ptr<Renderer>> Renderer::create(const RendererOptions& o
   if (!ctx) return sim::Error{ctx.error()};
   std::unique_ptr<Renderer> r(new Renderer());
   r->impl_->ctx = std::move(*ctx);
+  r->impl_->text.font_path = opt.font_path;
   if (Status s = r->impl_->init(opt.samples); !s) return sim::Error{s.error};
   return r;
 }
@@ -956,6 +1268,7 @@ sim::Result<std::unique_ptr<Renderer>> Renderer::create_on(const ExternalDevice&
   if (!ctx) return sim::Error{ctx.error()};
   std::unique_ptr<Renderer> r(new Renderer());
   r->impl_->ctx = std::move(*ctx);
+  r->impl_->text.font_path = opt.font_path;
   if (Status s = r->impl_->init(opt.samples); !s) return sim::Error{s.error};
   return r;
 }
@@ -974,6 +1287,19 @@ Status Renderer::render_views(const sim::SceneSnapshot& snap, const ViewTarget* 
 sim::Result<Image> Renderer::render_offscreen(const sim::SceneSnapshot& snap, const View& view,
                                               int width, int height, const DrawOptions& opt) {
   return impl_->draw_offscreen(snap, view, width, height, opt);
+}
+
+void Renderer::set_text_panel(const TextPanel& panel) {
+  TextPanel& p = impl_->text.panel;
+  if (panel.version != p.version || panel.lines.empty() != p.lines.empty()) p.lines = panel.lines;
+  if (std::memcmp(&panel.style, &p.style, sizeof(PanelStyle)) != 0) impl_->text.built = false;
+  p.version = panel.version;
+  p.head = panel.head;
+  p.style = panel.style;
+}
+
+const std::string& Renderer::text_error() const {
+  return impl_->text.error;
 }
 
 void Renderer::forget_targets() {

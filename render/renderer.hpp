@@ -12,6 +12,7 @@
 
 #include "render/camera.hpp"
 #include "render/geometry.hpp"
+#include "render/text.hpp"
 #include "render/vk_context.hpp"
 #include "sim/core/snapshot.hpp"
 
@@ -20,6 +21,17 @@ namespace drape::render {
 struct RendererOptions {
   ContextOptions context;  // validation, device choice, extra extensions (ignored on handover)
   int samples = 1;         // MSAA sample count (1, 2, 4, 8; clamped to what the device has)
+  std::string font_path;   // the feedback panel's font ("" = default_font_path())
+};
+
+// The feedback panel (text.hpp): lines of text on a dark rectangle, head-locked at arm's length
+// (head_locked_panel), drawn over the scene in every view and kept out of a caller's depth
+// image (it never hides the surface a desk runtime places the hand on).
+struct TextPanel {
+  std::vector<std::string> lines;  // none: no panel
+  uint64_t version = 0;            // the quads are rebuilt only when it changes
+  Pose head;                       // the head it hangs in front of (stage space)
+  PanelStyle style;
 };
 
 // An image the caller owns (e.g. from xrEnumerateSwapchainImages): colour-attachment usage,
@@ -56,6 +68,7 @@ struct FrameStats {
   size_t triangles = 0;        // per view
   int views = 0;               // views drawn by the call
   bool cloth_rebuilt = false;  // the cloth's vertices were rebuilt and uploaded (else cached)
+  bool text_rebuilt = false;   // the feedback panel's quads were rebuilt (its version changed)
 };
 
 // One view of a multi-view frame (e.g. an XR eye): where it looks from and what it draws into.
@@ -88,6 +101,11 @@ class Renderer {
   // Draws into the renderer's own target and reads it back.
   sim::Result<Image> render_offscreen(const sim::SceneSnapshot& snap, const View& view, int width,
                                       int height, const DrawOptions& opt = {});
+  // The panel drawn by the following calls (until replaced; no lines: none). Its font is loaded
+  // at the first panel with lines; when that fails the scene is drawn without the panel and
+  // text_error() says why (naming the font file).
+  void set_text_panel(const TextPanel& panel);
+  const std::string& text_error() const;
   // Drops the cached image views/framebuffers of caller images (call before destroying them).
   void forget_targets();
 

@@ -60,6 +60,13 @@ std::string mm(double m) {
   return buf;
 }
 
+// A reach as a user reads it ("3 cm", "2.5 cm").
+std::string cm(double m) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g cm", m * 100.0);
+  return buf;
+}
+
 }  // namespace
 
 Vec3 hand_direction(const HandProxy& h) {
@@ -224,8 +231,8 @@ bool ops_pinch_begin(World& w, OperationsState& s, const OperationParams& p, int
   const int32_t v = hc.chosen_vertex();
   const double reach = std::max(p.pinch_reach, s.hands[hand].radius);
   if (v < 0 || hc.particles[hc.chosen].distance > reach)
-    return w.report("pinch: no particle within " + mm(reach) + " of the " + hand_name(hand) +
-                    ": ignored"),
+    return w.report("pinch: nothing within " + cm(reach) + " of the " + hand_name(hand) +
+                    " to pinch"),
            false;
   if (is_pinched_by_any(s, v))
     return w.report("pinch: that particle is held by the other hand: ignored"), false;

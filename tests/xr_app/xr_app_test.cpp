@@ -189,6 +189,7 @@ TEST(XrApp, DefaultScenarioPinchesPinsAndCutsTheCloth) {
   o.eye_size = 128;
   o.cloth_res = 12;
   o.out_dir = dir.string();
+  o.feedback_panel = false;  // the golden images are of the scene
   auto r = run_with_screenshots(o, dir, "30");
   for (const auto& t : r.triggers) std::printf("trigger %s\n", t.c_str());
   for (const auto& l : r.log)
@@ -258,6 +259,7 @@ TEST(XrApp, HandMarkerIsDrawnAtTheFramesOwnPose) {
   o.cloth_res = 8;
   o.voice = false;
   o.pointer_probe = true;
+  o.feedback_panel = false;  // the panel may hide the marker
   auto r = run_with_screenshots(o, dir);
   ASSERT_EQ(r.exit_code, 0);
   ASSERT_GE(r.pointer_probe.size(), 25u);

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -21,6 +22,26 @@ int count_pinned(const sim::Cloth& c) {
   for (uint8_t f : c.state.flags) n += (f & sim::kFlagPinned) != 0;
   return n;
 }
+
+// Whether a report of an operation says it did nothing (sim/ops/operations.cpp words every
+// such report with one of these), as opposed to a result ("cut: 12 edges, ...").
+bool is_refusal(const std::string& m) {
+  for (const char* w : {"ignored", "nothing", " no ", "not ", "already", "failed", "discarded"})
+    if (m.find(w) != std::string::npos) return true;
+  return false;
+}
+
+// What the hand is doing, for the panel ("" when nothing).
+std::string operation_text(const sim::OperationsState& st, int h) {
+  if (st.pinched[h] >= 0) return "pinching particle " + std::to_string(st.pinched[h]);
+  if (st.cutting[h]) return "cutting";
+  if (st.smoothing[h]) return "smoothing";
+  if (st.moving) return "moving the cloth";
+  return "";
+}
+
+// How long a live session shows the help at its start (frames at 90 Hz).
+constexpr int64_t kIntroHelpFrames = 8 * 90;
 }  // namespace
 
 std::unique_ptr<SessionContent> make_draping_session(const VulkanDevice& device,
@@ -82,6 +103,9 @@ void DrapingSession::start_sim() {
     ops_->start_recording(w);
     load_cues();
     load_commands();
+    feedback_.set_help(help_lines(commands_));
+    // Live (the user at the headset or the desk window, no scenario): the help first.
+    if (opt_.scenario_path.empty()) feedback_.show_help_until(kIntroHelpFrames);
   }
   profile_ticks(w);
   // Lock step: the ticks run on the frame loop's thread inside advance() (no hand-off per frame).
@@ -228,6 +252,7 @@ void DrapingSession::draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& 
     dopt.form_angle_step = lod.angle_step;
   }
   if (opt_.pointer_probe && ops_) record_pointer_probe(frame, vt[0]);
+  if (opt_.feedback_panel) prepare_panel(frame, eyes);
   auto st = renderer_->render_views(*snap_, vt, 2, dopt);
   if (!st) rep_.note("render: " + st.error);
   laps.lap("render");
@@ -237,6 +262,63 @@ void DrapingSession::draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& 
   laps.add("render.record_submit", rs.submit_ms - rs.upload_ms);
   laps.add("render.gpu_wait", rs.wait_ms);
   laps.add("render.cloth_rebuilt", rs.cloth_rebuilt ? 1.0 : 0.0);
+}
+
+// The feedback panel: its lines re-read only when they changed; it hangs in front of the head
+// (between the eyes, looking where the left eye looks), sized for the eyes' pixels.
+void DrapingSession::prepare_panel(int64_t frame, const EyeTarget (&eyes)[2]) {
+  const uint64_t v = feedback_.shown_version(frame);
+  if (!panel_set_ || v != panel_.version) {
+    panel_.lines = feedback_.lines(frame);
+    panel_.version = v;
+    panel_set_ = true;
+  }
+  // Legible in the eyes' pixels: larger than arm's-length size when they are coarse (a desk
+  // window of a few hundred pixels).
+  const XrFovf& f = eyes[0].view.fov;
+  const float rad_per_px = (f.angleRight - f.angleLeft) / static_cast<float>(eyes[0].width);
+  panel_.style =
+      render::scaled(render::PanelStyle{}, render::legible_scale(render::PanelStyle{}, rad_per_px));
+  const XrPosef& l = eyes[0].view.pose;
+  const XrPosef& r = eyes[1].view.pose;
+  panel_.head.orientation =
+      Eigen::Quaternionf(l.orientation.w, l.orientation.x, l.orientation.y, l.orientation.z);
+  panel_.head.position = 0.5f * (Eigen::Vector3f(l.position.x, l.position.y, l.position.z) +
+                                 Eigen::Vector3f(r.position.x, r.position.y, r.position.z));
+  renderer_->set_text_panel(panel_);
+  if (!text_error_noted_ && !renderer_->text_error().empty()) {
+    rep_.note("feedback panel: " + renderer_->text_error() + " (drawn without it)");
+    text_error_noted_ = true;
+  }
+}
+
+// On the sim thread. World::messages is swapped out around the triggers so that exactly their
+// reports are seen, then restored with them appended (it keeps its last 32).
+void DrapingSession::apply_triggers(sim::World& w, const std::vector<Op>& use,
+                                    sim::OperationController& ops, Said& out) {
+  std::deque<std::string> kept;
+  kept.swap(w.messages);
+  for (const auto& op : use) ops.trigger(w, op.name, op.phase, op.hand);
+  std::vector<std::string> said(w.messages.begin(), w.messages.end());
+  for (const auto& m : said) kept.push_back(m);
+  while (kept.size() > 32) kept.pop_front();
+  w.messages.swap(kept);
+  std::lock_guard lock(out.m);
+  for (auto& m : said) out.messages.push_back(std::move(m));
+  for (int h = 0; h < 2; ++h) out.operation[h] = operation_text(ops.state(), h);
+}
+
+// On the frame loop: the refusals and the hands' operations into the panel.
+void DrapingSession::drain_said(int64_t frame) {
+  std::vector<std::string> messages;
+  std::lock_guard lock(said_->m);
+  messages.swap(said_->messages);
+  for (int h = 0; h < 2; ++h) feedback_.set_operation(h, said_->operation[h]);
+  for (const auto& m : messages) {
+    if (!is_refusal(m)) continue;
+    feedback_.refused(frame, m);
+    rep_.r.refusals.push_back("frame " + std::to_string(frame) + ": " + m);
+  }
 }
 
 void DrapingSession::frame_ended(Clock::time_point end) {

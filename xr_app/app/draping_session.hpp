@@ -79,6 +79,19 @@ class DrapingSession : public SessionContent {
   static void note_free_outcomes(const sim::World& w, const sim::OperationsState& st,
                                  FreeOutcomes& out);
   void drain_free_outcomes();
+  // What the sim said while applying a frame's triggers, and the hands' operations after them
+  // (filled on the sim thread, drained by the frame loop into the feedback panel).
+  struct Said {
+    std::mutex m;
+    std::vector<std::string> messages;
+    std::string operation[2];
+  };
+  // On the sim thread: applies the triggers, keeping what they report (World::messages keeps it
+  // too) and each hand's operation afterwards.
+  static void apply_triggers(sim::World& w, const std::vector<Op>& use,
+                             sim::OperationController& ops, Said& out);
+  void drain_said(int64_t frame);
+  void prepare_panel(int64_t frame, const EyeTarget (&eyes)[2]);
   void record_pointer_probe(int64_t frame, const render::ViewTarget& left_eye);
   void write_outputs(sim::World& w);
 
@@ -102,6 +115,9 @@ class DrapingSession : public SessionContent {
   bool cloth_matched_ = false;           // the drawn snapshot holds a posted right-hand pose ...
   Clock::time_point cloth_posted_at_{};  // ... posted then
   Feedback feedback_;                    // the text panel's content (feedback.hpp)
+  std::shared_ptr<Said> said_ = std::make_shared<Said>();
+  render::TextPanel panel_;  // what the renderer draws of feedback_ (rebuilt when it changes)
+  bool panel_set_ = false, text_error_noted_ = false;
   TickProfile ticks_;
   ThreadGroups threads_;
 

@@ -34,6 +34,19 @@ void Feedback::set_status(const std::string& key, const std::string& message) {
   ++version_;
 }
 
+void Feedback::show_help_until(int64_t frame) {
+  help_until_ = frame;
+  ++version_;
+}
+
+uint64_t Feedback::shown_version(int64_t frame) const {
+  uint64_t expired = 0;
+  for (const auto& r : refusals_) expired += frame - r.frame >= kRefusalFrames;
+  const uint64_t intro = frame < help_until_ ? 1 : 0;
+  static_assert(kMaxRefusals <= 3, "the expired count takes two bits");
+  return (version_ << 3) | (expired << 1) | intro;
+}
+
 std::vector<std::string> Feedback::lines(int64_t frame) const {
   std::vector<std::string> out;
   for (const auto& [key, msg] : status_) out.push_back(key + ": " + msg);
@@ -43,10 +56,23 @@ std::vector<std::string> Feedback::lines(int64_t frame) const {
   if (!heard_.empty()) out.push_back("voice: " + heard_);
   for (const auto& r : refusals_)
     if (frame - r.frame < kRefusalFrames) out.push_back(r.text);
-  if (show_help_) {
+  if (show_help_ || frame < help_until_) {
     out.push_back("");
     for (const auto& l : help_) out.push_back(l);
   }
+  return out;
+}
+
+std::string help_line(const tracking::Binding& b) {
+  std::string when = b.source + " " + b.command;
+  if (!b.edge.empty() && b.edge != "any") when += " " + b.edge;
+  const std::string op = b.action.operation == "*" ? "stop" : b.action.operation;
+  return when + ": " + op + " " + tracking::phase_name(b.action.phase);
+}
+
+std::vector<std::string> help_lines(const tracking::CommandMap& map) {
+  std::vector<std::string> out{"help: what each gesture, button and phrase does"};
+  for (const auto& b : map.bindings()) out.push_back(help_line(b));
   return out;
 }
 

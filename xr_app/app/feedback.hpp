@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "tracking/command_map.hpp"
+
 namespace drape::app {
 
 class Feedback {
@@ -28,12 +30,17 @@ class Feedback {
   void toggle_help() { show_help_ = !show_help_; }
   void show_help(bool on) { show_help_ = on; }
   bool help_shown() const { return show_help_; }
+  // The help also shows before `frame` (the first seconds of a live session).
+  void show_help_until(int64_t frame);
 
   // The panel's lines at `frame` (90 frames a second): statuses, the hands, the voice, the
   // refusals of the last kRefusalFrames frames, then the help when shown.
   std::vector<std::string> lines(int64_t frame) const;
   // Bumped on every change, so a renderer rebuilds its text only when it changed.
   uint64_t version() const { return version_; }
+  // Changes whenever lines(frame) may differ from the last frame's: version() and what the
+  // frame itself changes (refusals expired, the first seconds' help over).
+  uint64_t shown_version(int64_t frame) const;
 
   static constexpr int64_t kRefusalFrames = 4 * 90;
   static constexpr size_t kMaxRefusals = 3;
@@ -50,7 +57,14 @@ class Feedback {
   std::map<std::string, std::string> status_;
   std::vector<std::string> help_;
   bool show_help_ = false;
+  int64_t help_until_ = -1;
   uint64_t version_ = 0;
 };
+
+// One line of the help: what a binding of the command map does ("gesture pinch begin: pinch
+// begin"). Kept to this one function so that more of a binding's fields can join the line.
+std::string help_line(const tracking::Binding& b);
+// The help: a title and one line per binding.
+std::vector<std::string> help_lines(const tracking::CommandMap& map);
 
 }  // namespace drape::app

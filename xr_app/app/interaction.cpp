@@ -49,10 +49,11 @@ void DrapingSession::interact(int64_t frame, const HandInput& in) {
   if (ops_) {
     auto ops = ops_;
     std::shared_ptr<FreeOutcomes> free = opt_.sim_lock_step ? nullptr : free_;
-    sim_->post([ops, hands, use, free](sim::World& w) {
+    std::shared_ptr<Said> said = said_;
+    sim_->post([ops, hands, use, free, said](sim::World& w) {
       ops->set_hands(w, hands);
       w.scene.hands.assign(hands.begin(), hands.end());  // into the snapshot (latency probe)
-      for (const auto& op : use) ops->trigger(w, op.name, op.phase, op.hand);
+      apply_triggers(w, use, *ops, *said);
       if (free) note_free_outcomes(w, ops->state(), *free);
     });
   }
@@ -62,6 +63,8 @@ void DrapingSession::interact(int64_t frame, const HandInput& in) {
   } else if (ops_) {
     drain_free_outcomes();
   }
+  if (ops_) drain_said(frame);  // refusals and the hands' operations into the feedback panel
+  feedback_.set_status("hands", hands[0].tracked || hands[1].tracked ? "" : "no hand tracked");
 }
 
 // On the sim thread, after a frame's hands and triggers: pinches taken and let go (with how far

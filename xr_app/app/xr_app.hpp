@@ -62,6 +62,9 @@ struct XrAppOptions {
   // Draw the dress form at a level of detail chosen from the eyes' pixel size
   // (render::form_lod_for_pixels); false: the renderer's full-detail default.
   bool form_lod = true;
+  // Draw the feedback panel (the hands' operations, voice, refusals, help) over the scene;
+  // false: the scene alone (screenshots compared with golden images of the scene).
+  bool feedback_panel = true;
 };
 
 struct XrAppResult {
@@ -124,6 +127,8 @@ struct XrAppResult {
   };
   std::vector<PointerProbe> pointer_probe;
   std::string commands_file;  // the command map used
+  // Each refusal as the feedback panel showed it: "frame F: reason".
+  std::vector<std::string> refusals;
 };
 
 XrAppResult run_xr_app(const XrAppOptions& opt);
