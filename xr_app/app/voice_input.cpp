@@ -63,17 +63,15 @@ double AudioClock::time_of(long sample) const {
   return it == reads_.end() ? -1.0 : it->second;
 }
 
-VoiceInput::VoiceInput(const std::string& spec) {
-  std::unique_ptr<tracking::AudioInput> in;
-  if (spec == "mic") {
-    name_ = "microphone (ALSA 'default')";
-    in = tracking::open_alsa_input("default");
-  } else {
-    name_ = "recording '" + spec + "'";
-    in = tracking::open_wav_input(spec, false);  // ClockedInput paces it
-  }
+VoiceInput::VoiceInput(const std::string& spec)
+    : VoiceInput(spec == "mic" ? "microphone (ALSA 'default')" : "recording '" + spec + "'",
+                 spec == "mic" ? tracking::open_alsa_input("default")
+                               : tracking::open_wav_input(spec, false)) {}  // ClockedInput paces
+
+VoiceInput::VoiceInput(std::string name, std::unique_ptr<tracking::AudioInput> input)
+    : name_(std::move(name)) {
   source_ = std::make_unique<tracking::VoiceSource>(
-      tracking::VoiceConfig{}, std::make_unique<ClockedInput>(std::move(in), clock_));
+      tracking::VoiceConfig{}, std::make_unique<ClockedInput>(std::move(input), clock_));
 }
 
 VoiceInput::~VoiceInput() = default;

@@ -37,6 +37,8 @@ class VoiceInput {
  public:
   // spec: "mic" (the default ALSA capture device) or the path of a WAV file (16 kHz mono 16-bit).
   explicit VoiceInput(const std::string& spec);
+  // Any audio input (tests: a device that fails mid-stream); `name` is used in messages.
+  VoiceInput(std::string name, std::unique_ptr<tracking::AudioInput> input);
   ~VoiceInput();
   VoiceInput(const VoiceInput&) = delete;
   VoiceInput& operator=(const VoiceInput&) = delete;
