@@ -83,9 +83,13 @@ void DrapingSession::hear_live_voice(int64_t frame, double t,
   }
   for (const VoiceInput::Heard& h : live_voice_->poll(frame)) {
     const tracking::VoiceResult& vr = h.result;
-    char lat[96];
-    std::snprintf(lat, sizeof lat, " (speech ended in frame %lld: %d frames, %.0f ms)",
-                  static_cast<long long>(h.speech_end_frame), h.latency_frames, h.latency_ms);
+    char lat[128];
+    std::snprintf(
+        lat, sizeof lat,
+        " (speech ended in frame %lld: %d frames, %.0f ms; VAD hangover and decoding %.0f "
+        "ms)",
+        static_cast<long long>(h.speech_end_frame), h.latency_frames, h.latency_ms,
+        h.vad_decode_ms);
     rep_.note("voice: frame " + std::to_string(frame) + " heard '" + vr.hypothesis + "' -> " +
               (vr.command.empty() ? "(rejected: " + vr.reason + ")" : vr.command) + lat);
     feedback_.heard(frame, vr.hypothesis, vr.command);

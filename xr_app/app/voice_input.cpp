@@ -94,6 +94,7 @@ std::vector<VoiceInput::Heard> VoiceInput::poll(int64_t frame) {
   for (auto& ev : source_->take_events()) {
     Heard h;
     h.result = std::move(ev.result);
+    h.vad_decode_ms = ev.latency_ms;
     const double end = clock_->time_of(ev.speech_end);
     if (end >= 0) {
       h.latency_ms = (now - end) * 1e3;

@@ -51,6 +51,7 @@ class VoiceInput {
     int latency_frames = -1;        // frames from the end of the speech to this frame (-1: unknown)
     double latency_ms = -1;         // time from reading the last voiced sample to this poll
     int64_t speech_end_frame = -1;  // the frame during which the last voiced sample was read
+    double vad_decode_ms = 0;       // of which: the VAD's hangover and the decoding (voice thread)
   };
   // Once per frame: the utterances decoded since the last call (accepted or rejected).
   std::vector<Heard> poll(int64_t frame);
