@@ -11,6 +11,8 @@
 #   no_mic   --voice mic with the default PCM on a card that does not exist: exit 0, all frames,
 #            the message naming the device in the log, the cloth the same as with --voice off.
 #   bad_wav  --voice on a malformed WAV: exit 0, the message naming the file, the cloth the same.
+#   args     --voice on a file that does not exist exits 2 naming the option (both commands);
+#            `drape run --headless --voice off` exits 2; --help of both lists --voice.
 # usage: drape_voice_test.sh DRAPE_EXE MODE WORKDIR
 set -u
 exe=$1 mode=$2 work=$3
@@ -138,6 +140,23 @@ EOF
     printf 'RIFF\x24\x00\x00\x00WAVEjunk' >"$work/bad.wav"
     run bad_wav --frames 120 --voice "$work/bad.wav"
     check_failure "$work/bad.wav: " bad_wav
+    ;;
+  args)
+    for cmd in xr run; do
+      "$exe" $cmd --voice "$work/missing.wav" --out "$work/args_$cmd" >"$work/args.txt" 2>&1
+      rc=$?
+      cat "$work/args.txt" >>"$log"
+      [ $rc -eq 2 ] || fail "drape $cmd --voice missing.wav exited $rc, not 2"
+      grep -q -- "--voice: no such file: .*missing.wav" "$work/args.txt" ||
+        fail "drape $cmd: the message does not name --voice and the file"
+      "$exe" $cmd --help >"$work/help.txt" 2>&1 || fail "drape $cmd --help failed"
+      grep -q -- "--voice" "$work/help.txt" || fail "drape $cmd --help does not list --voice"
+    done
+    "$exe" run --headless --voice off >"$work/args.txt" 2>&1
+    rc=$?
+    cat "$work/args.txt" >>"$log"
+    [ $rc -eq 2 ] || fail "drape run --headless --voice off exited $rc, not 2"
+    echo "--voice: a missing file and --headless are usage errors (exit 2)"
     ;;
   *)
     fail "unknown mode $mode"
