@@ -25,9 +25,9 @@ class ClockedInput : public tracking::AudioInput {
   long read(int16_t* buf, long n) override {
     // A device that reports samples without writing them gives silence, not the last block again.
     std::memset(buf, 0, static_cast<size_t>(n) * sizeof(int16_t));
+    if (t0_ < 0) t0_ = now_s();  // the capture starts with the first read
     const long got = in_->read(buf, n);
     if (got <= 0) return got;
-    if (t0_ < 0) t0_ = now_s();
     total_ += got;
     const double wait = t0_ + static_cast<double>(total_) / tracking::kVoiceRate - now_s();
     if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
