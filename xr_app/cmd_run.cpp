@@ -365,9 +365,10 @@ int run_xr(XrRunOptions& o) {
   // no display, or --scenario) the scripted run. A headset or the window is a live session: the
   // microphone by default, and no scenario audio cues (a headset plays no scenario).
   const bool window = simulated && app::has_display() && !o.scenario_given;
-  if (!app::resolve_voice("drape run", o.voice, window || !simulated, o.app.voice_input)) return 2;
+  const bool headset = !app::simulated_runtime(manifest, simulated);
+  if (!app::resolve_voice("drape run", o.voice, window || headset, o.app.voice_input)) return 2;
   if (window) return run_live(o, manifest);
-  if (!simulated) o.app.voice = false;
+  if (headset) o.app.voice = false;
   const auto wall0 = std::chrono::steady_clock::now();
   if (!make_dir(o.out + "/frames", o.out)) return 1;
   std::error_code ec;

@@ -179,7 +179,8 @@ int cmd_xr(int argc, char** argv) {
   // A live session (a headset, or the simulated runtime's window with no scenario) listens to the
   // microphone by default; the scenario's audio cues play only on the simulated runtime's
   // scripted runs, which it plays.
-  const bool live = !simulated || (app::mock_window() && opt.scenario_path.empty());
+  const bool live = !app::simulated_runtime(manifest, simulated) ||
+                    (app::mock_window() && opt.scenario_path.empty());
   if (live) opt.voice = false;
   if (!app::resolve_voice("drape xr", voice, live, opt.voice_input)) return 2;
   std::fprintf(stderr, "drape xr: runtime manifest: %s\n",

@@ -61,6 +61,14 @@ bool mock_window() {
   return env("DRAPE_MOCK_WINDOW") == "1";
 }
 
+bool simulated_runtime(const std::string& manifest, bool simulated) {
+  if (simulated) return true;
+  if (manifest.empty()) return false;
+  const fs::path mock = mock_runtime_manifest();
+  std::error_code ec;
+  return !mock.empty() && fs::equivalent(manifest, mock, ec);
+}
+
 std::vector<std::string> loader_api_layers() {
   return split(env("XR_ENABLE_API_LAYERS"), ":;");
 }

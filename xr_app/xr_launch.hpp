@@ -30,6 +30,10 @@ void set_mock_window();
 // Whether the simulated runtime opens its desktop window (DRAPE_MOCK_WINDOW=1).
 bool mock_window();
 
+// Whether the loader will load the simulated runtime: the fallback (`simulated`, from
+// select_runtime) or a manifest (XR_RUNTIME_JSON) that is the simulated runtime's own file.
+bool simulated_runtime(const std::string& manifest, bool simulated);
+
 // The API layers the loader enables from XR_ENABLE_API_LAYERS (':' or ';' separated).
 std::vector<std::string> loader_api_layers();
 

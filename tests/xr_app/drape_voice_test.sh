@@ -11,6 +11,10 @@
 #   no_mic   --voice mic with the default PCM on a card that does not exist: exit 0, all frames,
 #            the message naming the device in the log, the cloth the same as with --voice off.
 #   bad_wav  --voice on a malformed WAV: exit 0, the message naming the file, the cloth the same.
+#   defaults without --voice: the simulated runtime (the fallback, or XR_RUNTIME_JSON naming its
+#            manifest) is a scripted run: live voice off, the scenario's audio cue read; a
+#            configured runtime (an active_runtime.json, here a copy of the simulated runtime's
+#            manifest standing in for a headset) is live: the microphone, no audio cue.
 #   args     --voice on a file that does not exist exits 2 naming the option (both commands);
 #            `drape run --headless --voice off` exits 2; --help of both lists --voice.
 # usage: drape_voice_test.sh DRAPE_EXE MODE WORKDIR
@@ -140,6 +144,40 @@ EOF
     printf 'RIFF\x24\x00\x00\x00WAVEjunk' >"$work/bad.wav"
     run bad_wav --frames 120 --voice "$work/bad.wav"
     check_failure "$work/bad.wav: " bad_wav
+    ;;
+  defaults)
+    make_speech
+    python3 - "$scenario" "$work/pin.wav" <<'EOF' || fail "cannot add the audio cue"
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["audio"] = [{"frame": 20, "wav": sys.argv[2], "text": "pin here"}]
+json.dump(s, open(sys.argv[1], "w"))
+EOF
+    printf 'pcm.!default {\n  type hw\n  card 7\n}\n' >"$work/asound.conf"
+    export ALSA_CONFIG_PATH=$work/asound.conf
+    run fallback --frames 30
+    [ $rc -eq 0 ] || fail "fallback: exit code $rc"
+    grep -q "^drape xr: live voice: off" "$work/fallback.txt" || fail "fallback: voice not off"
+    grep -q "^voice: 1 audio cue(s)" "$out/xr_session.txt" || fail "fallback: no audio cue"
+    XR_RUNTIME_JSON=$(dirname "$exe")/drape_mock_runtime.json run named --frames 30
+    [ $rc -eq 0 ] || fail "XR_RUNTIME_JSON: exit code $rc"
+    grep -q "^drape xr: live voice: off" "$work/named.txt" || fail "XR_RUNTIME_JSON: voice not off"
+    mkdir -p "$work/home/.config/openxr/1"
+    bin=$(cd "$(dirname "$exe")" && pwd)
+    sed "s|\./libdrape_mock_runtime.so|$bin/libdrape_mock_runtime.so|" \
+      "$bin/drape_mock_runtime.json" >"$work/home/.config/openxr/1/active_runtime.json"
+    DRAPE_MOCK_SCENARIO=$scenario "$exe" xr --frames 30 --eye-size 64 --cloth-res 12 \
+      --out "$work/headset" >"$work/headset.txt" 2>&1
+    rc=$?
+    { echo "--- drape xr (active_runtime.json, exit $rc)"; cat "$work/headset.txt"; } >>"$log"
+    [ $rc -eq 0 ] || fail "configured runtime: exit code $rc"
+    grep -q "runtime manifest: (system active runtime)" "$work/headset.txt" ||
+      fail "configured runtime: active_runtime.json not used"
+    grep -q "^drape xr: live voice: mic" "$work/headset.txt" || fail "configured runtime: not mic"
+    grep -q "audio cue" "$work/headset/xr_session.txt" && fail "configured runtime: a cue played"
+    grep -q "^voice: microphone 'default': cannot open" "$work/headset/xr_session.txt" ||
+      fail "configured runtime: no microphone message"
+    echo "simulated runtime: scripted (voice off, cue read); configured runtime: live (mic, no cue)"
     ;;
   args)
     for cmd in xr run; do
