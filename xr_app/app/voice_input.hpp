@@ -64,8 +64,8 @@ class VoiceInput {
   std::string name_;
   std::shared_ptr<AudioClock> clock_ = std::make_shared<AudioClock>();
   std::unique_ptr<tracking::VoiceSource> source_;
-  std::deque<std::pair<int64_t, double>> frames_;  // (frame, when polled), the last few seconds
-  std::string last_status_ = "(none)";
+  std::deque<std::pair<int64_t, double>> frames_;  // (frame, when polled), the last minute
+  std::string last_status_ = "(none)";             // the last status reported; none yet
 };
 
 }  // namespace drape::app
