@@ -114,10 +114,10 @@ class WavInput : public AudioInput {
 
 class AlsaInput : public AudioInput {
  public:
-  explicit AlsaInput(const std::string& dev) {
+  explicit AlsaInput(const std::string& dev) : dev_(dev) {
     int rc = snd_pcm_open(&pcm_, dev.c_str(), SND_PCM_STREAM_CAPTURE, 0);
     if (rc < 0) {
-      err_ = "microphone '" + dev + "': " + snd_strerror(rc);
+      err_ = "microphone '" + dev + "': cannot open it for capture: " + snd_strerror(rc);
       pcm_ = nullptr;
       return;
     }
@@ -139,7 +139,7 @@ class AlsaInput : public AudioInput {
     snd_pcm_sframes_t r = snd_pcm_readi(pcm_, buf, static_cast<snd_pcm_uframes_t>(n));
     if (r < 0) r = snd_pcm_recover(pcm_, static_cast<int>(r), 1);
     if (r < 0) {
-      err_ = std::string("microphone: ") + snd_strerror(static_cast<int>(r));
+      err_ = "microphone '" + dev_ + "': " + snd_strerror(static_cast<int>(r));
       ok_ = false;
       return -1;
     }
@@ -148,7 +148,7 @@ class AlsaInput : public AudioInput {
 
  private:
   snd_pcm_t* pcm_ = nullptr;
-  std::string err_;
+  std::string dev_, err_;
   bool ok_ = false;
 };
 

@@ -217,6 +217,7 @@ std::string make_voice_wav(const std::string& dir, const std::string& name,
 struct XrRunOptions {
   drape::app::XrAppOptions app;
   std::string scenario = "assets/scenarios/default.json", out = "out";
+  std::string voice;  // --voice as given ("" = the default of the session's kind)
   bool pattern = true;
   int every = 30;
   bool scenario_given = false;   // --scenario: always the scripted run
@@ -252,12 +253,13 @@ int run_live(XrRunOptions& o, const std::string& manifest) {
   std::printf(
       "drape run: live in the simulated runtime's window (%s): the mouse moves the right hand, "
       "the left button pinches, right-drag looks, W/A/S/D/Q/E move the head; Escape or closing "
-      "the window ends the session (docs/mock-window.md)\n",
-      manifest.c_str());
+      "the window ends the session (docs/mock-window.md); live voice %s\n",
+      manifest.c_str(), o.app.voice_input.empty() ? "off" : o.app.voice_input.c_str());
   std::fflush(stdout);
   auto r = app::run_xr_app(o.app);
   for (const auto& l : r.log)
-    if (l.rfind("pinch:", 0) == 0 || l.rfind("depth:", 0) == 0 || l.rfind("cut", 0) == 0)
+    if (l.rfind("pinch:", 0) == 0 || l.rfind("depth:", 0) == 0 || l.rfind("cut", 0) == 0 ||
+        l.rfind("voice", 0) == 0)
       std::printf("  %s\n", l.c_str());
   for (const auto& t : r.triggers) std::printf("  trigger %s\n", t.c_str());
   const double secs =
@@ -360,8 +362,13 @@ int run_xr(XrRunOptions& o) {
   bool simulated = false;
   const std::string manifest = app::select_runtime(&simulated);
   // At a desk without a headset: live in the simulated runtime's window. Otherwise (a headset,
-  // no display, or --scenario) the scripted run.
-  if (simulated && app::has_display() && !o.scenario_given) return run_live(o, manifest);
+  // no display, or --scenario) the scripted run. A headset or the window is a live session: the
+  // microphone by default, and no scenario audio cues (a headset plays no scenario).
+  const bool window = simulated && app::has_display() && !o.scenario_given;
+  const bool headset = !app::simulated_runtime(manifest, simulated);
+  if (!app::resolve_voice("drape run", o.voice, window || headset, o.app.voice_input)) return 2;
+  if (window) return run_live(o, manifest);
+  if (headset) o.app.voice = false;
   const auto wall0 = std::chrono::steady_clock::now();
   if (!make_dir(o.out + "/frames", o.out)) return 1;
   std::error_code ec;
@@ -376,8 +383,9 @@ int run_xr(XrRunOptions& o) {
   o.app.scenario_path = sc_path;
   o.app.commands_path = app::commands_file("");
   o.app.api_layers = app::loader_api_layers();
-  std::printf("drape run: runtime manifest %s, scenario %s\n",
-              manifest.empty() ? "(system active runtime)" : manifest.c_str(), o.scenario.c_str());
+  std::printf("drape run: runtime manifest %s, scenario %s, live voice %s\n",
+              manifest.empty() ? "(system active runtime)" : manifest.c_str(), o.scenario.c_str(),
+              o.app.voice_input.empty() ? "off" : o.app.voice_input.c_str());
   auto r = app::run_xr_app(o.app);
   for (const auto& l : r.log)
     if (l.rfind("voice", 0) == 0 || l.rfind("cut", 0) == 0) std::printf("  %s\n", l.c_str());
@@ -413,8 +421,9 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
                                      {"--no-pattern", &o.pattern, "skip the pattern export"}});
   cli.add_option("--every", o.every, "write every K-th frame's screenshot")
       ->check(CLI::Range(1, 1000000));
+  drape::app::add_voice_option(cli, o.voice);
   for (const char* name : {"--frames", "--eye-size", "--cloth-res", "--verbose", "--scenario",
-                           "--no-voice", "--no-pattern", "--every"})
+                           "--no-voice", "--no-pattern", "--every", "--voice"})
     cli.get_option(name)->excludes(headless);
 }
 #endif

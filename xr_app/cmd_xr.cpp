@@ -131,7 +131,7 @@ int cmd_xr(int argc, char** argv) {
 #else
   namespace app = drape::app;
   XrAppOptions opt;
-  std::string scenario, commands, json_path;
+  std::string scenario, commands, json_path, voice;
   CLI::App cli(
       "Runs the OpenXR app. Without XR_RUNTIME_JSON or an active_runtime.json it uses the "
       "simulated runtime (<exe dir>/drape_mock_runtime.json). Exit codes: 0 ok, 1 failure, "
@@ -141,6 +141,7 @@ int cmd_xr(int argc, char** argv) {
   cli.add_option("--scenario", scenario,
                  "the scenario the simulated runtime plays (default: $DRAPE_MOCK_SCENARIO); its "
                  "audio cues are the voice input");
+  app::add_voice_option(cli, voice);
   cli.add_option("--pose-wait-ms", opt.pose_wait_ms,
                  "free sim: how long a frame waits for the tick that took its hand pose")
       ->check(CLI::Range(0.0, 1000.0));
@@ -174,9 +175,19 @@ int cmd_xr(int argc, char** argv) {
   opt.scenario_path = app::mock_scenario();
   opt.commands_path = app::commands_file(commands);
   opt.api_layers = app::loader_api_layers();
-  const std::string manifest = app::select_runtime();
+  bool simulated = false;
+  const std::string manifest = app::select_runtime(&simulated);
+  // A live session (a headset, or the simulated runtime's window with no scenario) listens to the
+  // microphone by default; the scenario's audio cues play only on the simulated runtime's
+  // scripted runs, which it plays.
+  const bool live = !app::simulated_runtime(manifest, simulated) ||
+                    (app::mock_window() && opt.scenario_path.empty());
+  if (live) opt.voice = false;
+  if (!app::resolve_voice("drape xr", voice, live, opt.voice_input)) return 2;
   std::fprintf(stderr, "drape xr: runtime manifest: %s\n",
                manifest.empty() ? "(system active runtime)" : manifest.c_str());
+  std::fprintf(stderr, "drape xr: live voice: %s\n",
+               opt.voice_input.empty() ? "off" : opt.voice_input.c_str());
   const XrAppResult r = app::run_xr_app(opt);
   const Summary s = summarise(r);
   print_summary(r, s);

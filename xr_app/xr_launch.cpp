@@ -57,6 +57,18 @@ void set_mock_window() {
   setenv("DRAPE_MOCK_WINDOW", "1", 1);
 }
 
+bool mock_window() {
+  return env("DRAPE_MOCK_WINDOW") == "1";
+}
+
+bool simulated_runtime(const std::string& manifest, bool simulated) {
+  if (simulated) return true;
+  if (manifest.empty()) return false;
+  const fs::path mock = mock_runtime_manifest();
+  std::error_code ec;
+  return !mock.empty() && fs::equivalent(manifest, mock, ec);
+}
+
 std::vector<std::string> loader_api_layers() {
   return split(env("XR_ENABLE_API_LAYERS"), ":;");
 }
@@ -100,6 +112,27 @@ bool resolve_input_file(const char* command, const char* option, std::string& pa
   if (fs::is_regular_file(path, ec)) return true;
   std::fprintf(stderr, "%s: %s: no such file: %s\n", command, option, path.c_str());
   return false;
+}
+
+void add_voice_option(CLI::App& cli, std::string& voice) {
+  cli.add_option("--voice", voice,
+                 "live voice commands: mic (the default ALSA capture device), off, or a 16 kHz "
+                 "mono WAV file streamed at real time as if it were the microphone (default: mic "
+                 "on a live session, off on a scripted run)")
+      ->always_capture_default(false);
+}
+
+bool resolve_voice(const char* command, const std::string& given, bool live, std::string& out) {
+  if (given.empty()) {
+    out = live ? "mic" : "";
+    return true;
+  }
+  if (given == "off" || given == "mic") {
+    out = given == "mic" ? "mic" : "";
+    return true;
+  }
+  out = given;
+  return resolve_input_file(command, "--voice", out);
 }
 
 std::string commands_file(const std::string& given) {

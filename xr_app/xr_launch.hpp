@@ -27,6 +27,13 @@ bool has_display();
 // the person at the desk is the headset's wearer.
 void set_mock_window();
 
+// Whether the simulated runtime opens its desktop window (DRAPE_MOCK_WINDOW=1).
+bool mock_window();
+
+// Whether the loader will load the simulated runtime: the fallback (`simulated`, from
+// select_runtime) or a manifest (XR_RUNTIME_JSON) that is the simulated runtime's own file.
+bool simulated_runtime(const std::string& manifest, bool simulated);
+
 // The API layers the loader enables from XR_ENABLE_API_LAYERS (':' or ';' separated).
 std::vector<std::string> loader_api_layers();
 
@@ -50,6 +57,16 @@ void add_off_switches(CLI::App& cli, std::initializer_list<OffSwitch> switches);
 // After parsing: resolves `path` (user_or_asset) and checks that it is a file; else prints
 // "<command>: <option>: no such file: <path>" and returns false.
 bool resolve_input_file(const char* command, const char* option, std::string& path);
+
+// --voice mic|off|FILE.wav, the live voice input (both commands); `voice` stays "" when not
+// given.
+void add_voice_option(CLI::App& cli, std::string& voice);
+
+// After parsing: XrAppOptions::voice_input from --voice's value `given`: "" (not given) = "mic"
+// on a live session (a headset, or the simulated runtime's window without a scenario), none on a
+// scripted run; "off" = none; "mic"; else a WAV file, resolved as resolve_input_file does (a
+// missing file prints its message and returns false; a malformed one is the session's message).
+bool resolve_voice(const char* command, const std::string& given, bool live, std::string& out);
 
 // The command map: `given` when set (already resolved), else assets/commands.json (from the
 // working directory, else the assets directory) when present, else "" (the built-in defaults).

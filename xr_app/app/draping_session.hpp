@@ -1,8 +1,9 @@
 // The draping session: the simulation on its thread (lock step: one tick per frame; else its
 // own 90 Hz clock), the interaction (hands, controller buttons, gestures and the scenario's
-// voice cues, through the command map, drive the sim's operations), the renderer drawing the
-// latest snapshot, and the pose-to-photon probes. Files: draping_session.cpp (set-up, drawing,
-// the end), interaction.cpp (hands and triggers), voice_cues.cpp (the scenario's audio cues).
+// voice cues or the live voice input, through the command map, drive the sim's operations), the
+// renderer drawing the latest snapshot, and the pose-to-photon probes. Files: draping_session.cpp
+// (set-up, drawing, the end), interaction.cpp (hands and triggers), voice_cues.cpp (the
+// scenario's audio cues and the live voice input).
 #pragma once
 
 #include <array>
@@ -21,6 +22,7 @@
 #include "tracking/voice.hpp"
 #include "xr_app/app/feedback.hpp"
 #include "xr_app/app/session_content.hpp"
+#include "xr_app/app/voice_input.hpp"
 
 namespace drape::app {
 
@@ -65,6 +67,7 @@ class DrapingSession : public SessionContent {
   void read_hand(int h, double t, const HandInput& in, sim::HandProxy& hand,
                  std::vector<tracking::Trigger>& trig);
   void hear_cues(int64_t frame, double t, std::vector<tracking::Trigger>& trig);
+  void hear_live_voice(int64_t frame, double t, std::vector<tracking::Trigger>& trig);
   std::vector<Op> map_triggers(int64_t frame, const std::vector<tracking::Trigger>& trig);
   void note_lock_step_outcomes(bool cut_trigger);
   // Free-running sim: what the sim thread saw of the pinches, read by the frame loop.
@@ -104,6 +107,7 @@ class DrapingSession : public SessionContent {
   tracking::GestureRecognizer gestures_;
   std::vector<Cue> cues_;
   std::unique_ptr<tracking::VoiceRecognizer> voice_;
+  std::unique_ptr<VoiceInput> live_voice_;     // the microphone or a recording (opt_.voice_input)
   tracking::XrHandSource xr_source_;           // the tracking XR adapter: joints + controllers
   tracking::CommandMap commands_;              // triggers -> operations (assets/commands.json)
   std::vector<render::HandOverlay> overlays_;  // this frame's hands, drawn from its own pose

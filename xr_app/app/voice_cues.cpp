@@ -1,5 +1,8 @@
 // The draping session's voice input: the scenario's audio cues (the simulated runtime's voice
-// side channel, docs/xr.md), each decoded by the voice recogniser when its frame is reached.
+// side channel, docs/xr.md), each decoded by the voice recogniser when its frame is reached, and
+// the live input (the microphone or a recording, voice_input.hpp), polled every frame. Both give
+// voice triggers of the right hand, like the gestures' and buttons' through the command map.
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -9,6 +12,10 @@
 namespace drape::app {
 
 void DrapingSession::load_cues() {
+  if (!opt_.voice_input.empty()) {
+    live_voice_ = std::make_unique<VoiceInput>(opt_.voice_input);
+    rep_.note("voice: live input: " + live_voice_->name());
+  }
   if (!opt_.voice || opt_.scenario_path.empty()) return;
   std::ifstream in(opt_.scenario_path);
   if (!in) return;  // the runtime reports an unreadable scenario itself
@@ -28,6 +35,7 @@ void DrapingSession::load_cues() {
 }
 
 void DrapingSession::hear_cues(int64_t frame, double t, std::vector<tracking::Trigger>& trig) {
+  if (live_voice_) hear_live_voice(frame, t, trig);
   for (auto& c : cues_) {
     if (c.done || frame < c.frame) continue;
     c.done = true;
@@ -56,10 +64,39 @@ void DrapingSession::hear_cues(int64_t frame, double t, std::vector<tracking::Tr
                              static_cast<double>(sg.speech_end - sg.start) / tracking::kVoiceRate);
     rep_.note("voice: frame " + std::to_string(frame) + " '" + c.wav + "' heard '" + vr.hypothesis +
               "' -> " + (vr.command.empty() ? "(rejected: " + vr.reason + ")" : vr.command));
+    feedback_.heard(frame, vr.hypothesis, vr.command);
     if (!vr.command.empty()) {
       rep_.r.voice_commands.push_back(vr.command);
       trig.push_back({vr.command, "voice", t, tracking::Hand::Right, true});
     }
+  }
+}
+
+// The live input's utterances decoded since the last frame -> voice triggers (right hand), the
+// panel's "heard" line and the log; its failures (no microphone, a device error, a malformed
+// recording) -> the panel's "voice" status and the log, while the session goes on.
+void DrapingSession::hear_live_voice(int64_t frame, double t,
+                                     std::vector<tracking::Trigger>& trig) {
+  if (auto status = live_voice_->status_change()) {
+    feedback_.set_status("voice", *status);
+    rep_.note("voice: " + (status->empty() ? "listening to " + live_voice_->name() : *status));
+  }
+  for (const VoiceInput::Heard& h : live_voice_->poll(frame)) {
+    const tracking::VoiceResult& vr = h.result;
+    char lat[128];
+    std::snprintf(
+        lat, sizeof lat,
+        " (speech ended in frame %lld: %d frames, %.0f ms; VAD hangover and decoding %.0f "
+        "ms)",
+        static_cast<long long>(h.speech_end_frame), h.latency_frames, h.latency_ms,
+        h.vad_decode_ms);
+    rep_.note("voice: frame " + std::to_string(frame) + " heard '" + vr.hypothesis + "' -> " +
+              (vr.command.empty() ? "(rejected: " + vr.reason + ")" : vr.command) + lat);
+    feedback_.heard(frame, vr.hypothesis, vr.command);
+    if (h.latency_frames >= 0) rep_.r.voice_latency_frames.push_back(h.latency_frames);
+    if (vr.command.empty()) continue;
+    rep_.r.voice_commands.push_back(vr.command);
+    trig.push_back({vr.command, "voice", t, tracking::Hand::Right, true});
   }
 }
 

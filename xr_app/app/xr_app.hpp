@@ -46,6 +46,9 @@ struct XrAppOptions {
   // The scenario file the simulated runtime plays ("" = none): its audio cues are the voice
   // input (docs/xr.md).
   std::string scenario_path;
+  // Live voice commands: "" none, "mic" the default ALSA capture device, else a WAV file (16 kHz
+  // mono 16-bit) streamed at real time as if it were the microphone (app/voice_input.hpp).
+  std::string voice_input;
   // The API layers the loader enables (its XR_ENABLE_API_LAYERS): their instance extensions are
   // offered too (the core validation layer's XR_EXT_debug_utils).
   std::vector<std::string> api_layers;
@@ -129,6 +132,9 @@ struct XrAppResult {
   std::string commands_file;  // the command map used
   // Each refusal as the feedback panel showed it: "frame F: reason".
   std::vector<std::string> refusals;
+  // Live voice (XrAppOptions::voice_input): per decoded utterance, the frames from the frame
+  // during which its last voiced sample was read to the frame that received it.
+  std::vector<int> voice_latency_frames;
 };
 
 XrAppResult run_xr_app(const XrAppOptions& opt);
