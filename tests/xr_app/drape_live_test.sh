@@ -1,16 +1,35 @@
 #!/usr/bin/env bash
 # `drape run` at a desk: a display (Xvfb), no headset runtime configured, so the app runs live
 # in the simulated runtime's window (DRAPE_MOCK_WINDOW, docs/mock-window.md) with no scenario.
-# A person's input as real X events (xdotool, XTEST): the mouse over the cloth, the left button
-# held (pinch), a drag, the release, Escape. Checks
+# A person's input as real X events (xdotool, XTEST).
+#   drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin] [--update-golden]
+# free (default): the sim on its own 90 Hz thread, a 12² cloth; the mouse over the cloth, the
+#   left button held (pinch), a drag, the release, Escape. Checks
 #   * the runtime put the hand on the depth the app submitted (DRAPE_MOCK_WINDOW_LOG: z is the
 #     depth under the cursor, at the cloth's distance, not the 0.45 m default without depth);
 #   * the pinch took a cloth particle and the drag moved it (the app's xr_session.txt);
 #   * the session ended by Escape with exit 0;
-# and keeps a screenshot (OUT/window.png) to look at.
-#   drape_live_test.sh DRAPE_EXE OUTDIR
+#   and keeps a screenshot (OUT/window.png) to look at.
+# golden: the sim in lock step (--sim-lock-step, repeatable), a 16² cloth: press-drag-release
+#   pinches and moves the cloth; in the oculus/touch profile (Tab) key 1 (A) starts a cut stroke,
+#   the mouse crosses the cloth, 1 again ends it and the cut splits the cloth; key 2 (B) undoes
+#   it. Each step is checked in the session's outputs (xr_session.txt with --state-hashes,
+#   session_log.json) and in a screenshot compared with tests/xr_app/golden/live_*.png
+#   (compare_golden in window_test_lib.sh).
+# pin: hand tracking (the window's start profile when the app enables hand tracking), lock step:
+#   the left button pinches the cloth, Z (the thumb-middle pinch: the right hand's pin) pins it;
+#   checked in xr_session.txt (pinned vertices added), session_log.json (a pin trigger) and the
+#   golden image live_pin.png.
+# --update-golden: the screenshots become the golden images (look at them before committing).
 set -uo pipefail
-EXE="$1" OUT="$2"
+EXE="$1" OUT="$2" MODE="${3:-free}"
+[ "${4:-}" = "--update-golden" ] && UPDATE_GOLDEN=1
+GOLDEN="$(cd "$(dirname "$0")" && pwd)/golden"
+case "$MODE" in
+  free) ARGS=(--resolution 12 --eye-size 256) ;;
+  golden | pin) ARGS=(--resolution 16 --eye-size 256 --sim-lock-step --state-hashes) ;;
+  *) echo "usage: drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin] [--update-golden]"; exit 2 ;;
+esac
 rm -rf "$OUT" && mkdir -p "$OUT/home"
 source "$(dirname "$0")/window_test_lib.sh"
 start_xvfb
@@ -21,7 +40,7 @@ unset XR_RUNTIME_JSON XR_ENABLE_API_LAYERS DRAPE_MOCK_WINDOW DRAPE_MOCK_SCENARIO
   DRAPE_MOCK_WRITE_FRAMES DRAPE_MOCK_END_AFTER_FRAMES
 export HOME="$OUT/home" XDG_CONFIG_HOME="$OUT/home/.config" XDG_CONFIG_DIRS="$OUT/home/xdg"
 export DRAPE_MOCK_WINDOW_SIZE=800x600 DRAPE_MOCK_WINDOW_LOG="$LOG"
-"$EXE" run --out "$OUT/out" --no-pattern >"$OUT/stdout" 2>"$OUT/stderr" &
+"$EXE" run --out "$OUT/out" --no-pattern "${ARGS[@]}" >"$OUT/stdout" 2>"$OUT/stderr" &
 CLIENT_PID=$!
 
 
@@ -50,20 +69,92 @@ expect "the hand stays on the cloth (not pulled toward the eye by its own drawin
   "f('depth') != '-' and $z_cloth - 0.01 < v('z') < $z_cloth + 0.05"
 
 # --- pinch, drag up and to the left, release
-xdotool mousedown 1
-expect "the left button pinches the right hand" "v('pinch', 2) == 1"
-frames 20
-for step in $(seq 8); do
-  xdotool mousemove $(( 410 - 5 * step )) $(( 500 - 10 * step ))
-  frames 3
-done
-frames 30
-xdotool mouseup 1
-expect "the release opens the hand" "v('pinch', 2) == 0"
-frames 20
+pinch_drag() {
+  xdotool mousedown 1
+  expect "the left button pinches the right hand" "v('pinch', 2) == 1"
+  frames 20
+  for step in $(seq 8); do
+    xdotool mousemove $(( 410 - 5 * step )) $(( 500 - 10 * step ))
+    frames 3
+  done
+  frames 30
+  xdotool mouseup 1
+  expect "the release opens the hand" "v('pinch', 2) == 0"
+  frames 20
+}
 
-frames 4  # the last image drawn in the window
-screenshot
+# session_check NAME PYTHON: runs the Python code with `session` (xr_session.txt's text), `log`
+# (session_log.json parsed) and `triggers` (its trigger events: (name, phase) pairs) defined.
+session_check() {
+  python3 - "$OUT/out/xr_session.txt" "$OUT/out/session_log.json" "$2" <<'PY' || fail "$1"
+import json, re, sys
+session = open(sys.argv[1]).read()
+log = json.load(open(sys.argv[2]))
+triggers = [(e.get("name"), e.get("phase")) for e in log.get("events", []) if e.get("name")]
+exec(sys.argv[3])
+PY
+  echo "ok: $1"
+}
+
+# hashes OUTCOME: the "state hash A -> B: OUTCOME..." lines of xr_session.txt as "A B" pairs.
+hashes() { sed -n "s/^sim: state hash \([0-9a-f]*\) -> \([0-9a-f]*\): $1.*/\1 \2/p" "$OUT/out/xr_session.txt"; }
+
+# to_profile WORD: Tab until the window's profile (its log) contains WORD (at most 7 presses).
+to_profile() {
+  for _ in $(seq 7); do
+    [[ "$(field profile)" == *"$1"* ]] && { echo "ok: profile $(field profile)"; return 0; }
+    xdotool key Tab
+    frames 5
+  done
+  fail "no profile containing '$1' after 7 Tab presses (last: $(field profile))"
+}
+
+case "$MODE" in
+  free)
+    pinch_drag
+    frames 4  # the last image drawn in the window
+    screenshot
+    ;;
+  golden)
+    frames 60
+    screenshot live_start
+    pinch_drag
+    frames 90  # the cloth comes to rest (lock step: the same ticks every run)
+    screenshot live_pinch
+    moved=$(image_change live_start live_pinch)
+    echo "the pinch and drag changed $moved % of the view"
+    python3 -c "import sys; sys.exit(0 if $moved > 1.0 else 1)" || fail "the drag did not move the cloth"
+    compare_golden live_pinch
+    # A cut across the cloth: A (key 1) starts the stroke beside its left edge, the hand crosses
+    # it, A again beside its right edge ends it.
+    to_profile oculus
+    xdotool mousemove $CUT_X0 $CUT_Y
+    frames 10
+    xdotool key 1
+    frames 5
+    for x in $(seq $CUT_X0 10 $CUT_X1); do xdotool mousemove "$x" $CUT_Y; frames 2; done
+    xdotool key 1
+    frames 90
+    screenshot live_cut
+    compare_golden live_cut
+    xdotool key 2  # B: undo
+    frames 90
+    screenshot live_undo
+    compare_golden live_undo
+    ;;
+  pin)
+    frames 60
+    xdotool mousedown 1
+    expect "the left button pinches the right hand" "v('pinch', 2) == 1"
+    frames 20
+    xdotool key z
+    frames 20
+    xdotool mouseup 1
+    frames 90
+    screenshot live_pin
+    compare_golden live_pin
+    ;;
+esac
 
 # --- Escape ends the session; the app writes its outputs and exits 0
 xdotool key Escape
@@ -78,8 +169,10 @@ grep -q "depth: D32_SFLOAT swapchain per eye\|depth: D16_UNORM swapchain per eye
 SESSION="$OUT/out/xr_session.txt"
 [ -s "$SESSION" ] && [ -s "$OUT/out/session_log.json" ] || fail "no xr_session.txt / session_log.json"
 
-# The pinch took a particle at the hand, the drag moved it.
-python3 - "$SESSION" "$LOG" <<'PY' || fail "pinch outcome"
+case "$MODE" in
+  free)
+    # The pinch took a particle at the hand, the drag moved it.
+    python3 - "$SESSION" "$LOG" <<'PY' || fail "pinch outcome"
 import math, re, sys
 text = open(sys.argv[1]).read()
 took = re.findall(r"pinch: right hand took particle (\d+) at \(([-\d.]+), ([-\d.]+), ([-\d.]+)\)", text)
@@ -107,6 +200,33 @@ assert dh > 0.7, "the hand was not at the cloth's depth"
 m = re.search(r"pinched_frames (\d+)", text)
 assert m and int(m.group(1)) > 10, "too few frames with the particle held"
 PY
-echo "ok: the pinch took a cloth particle at the hand and the drag moved it"
-grep "fps (frame work p50" "$OUT/stdout"
+    echo "ok: the pinch took a cloth particle at the hand and the drag moved it"
+    grep "fps (frame work p50" "$OUT/stdout"
+    ;;
+  golden)
+    session_check "the session log holds the pinch, the cut stroke (A twice) and the undo" '
+names = [n for n, _ in triggers]
+print("triggers:", triggers)
+assert names.count("pinch") >= 2, "no pinch begin and end"
+assert names.count("cut") == 2, "the cut stroke was not started and ended"
+assert names.count("undo") == 1, "no undo"
+m = re.search(r"pinched_frames (\d+)", session)
+assert m and int(m.group(1)) > 10, "too few frames with the particle held"
+assert re.search(r"^cut: ok, components 1 -> 2$", session, re.M), "the cut did not split the cloth"'
+    read -r cut_before cut_after <<<"$(hashes "cut: [0-9]* edges")"
+    read -r undo_before undo_after <<<"$(hashes "undo: cut")"
+    echo "state hashes: cut $cut_before -> $cut_after, undo $undo_before -> $undo_after"
+    [ -n "$cut_before" ] && [ -n "$undo_after" ] || fail "no state hash lines for the cut and the undo"
+    [ "$cut_before" != "$cut_after" ] || fail "the cut did not change the state"
+    [ "$undo_after" = "$cut_before" ] || fail "the undo did not restore the state before the cut"
+    echo "ok: the undo restored the state hash from before the cut"
+    ;;
+  pin)
+    session_check "the session log holds a pin, and vertices were pinned" '
+print("triggers:", triggers)
+assert "pin" in [n for n, _ in triggers], "no pin trigger"
+m = re.search(r"pinned_added (-?\d+)", session)
+assert m and int(m.group(1)) >= 1, "no vertex pinned"'
+    ;;
+esac
 echo PASS
