@@ -1,6 +1,7 @@
 // The live session's scene: fabric, form and start state (see desk_scene.hpp).
 #include "xr_app/app/desk_scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
