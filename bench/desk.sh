@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# ./drape bench desk [--frames N] [--repeat R]: `drape run` at a desk as a person gets it: the
-# simulated runtime's window (1280x720, under Xvfb; real X input from xdotool), 720 px eyes,
+# ./drape bench desk [--frames N] [--repeat R] [--eye-size PX]: `drape run` at a desk as a person
+# gets it: the simulated runtime's window (1280x720, under Xvfb; real X input from xdotool), its
+# default eye size (--eye-size: another),
 # lavapipe, the sim on its own 90 Hz thread, no scenario. Measures
 #   fps_64, fps_128        frames per second (frames over the frame loop's time after the first
 #                          30) with a 64² and a 128² cloth while the mouse's hand pinches the
@@ -19,13 +20,14 @@
 set -euo pipefail
 ROOT="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
 shift || true
-FRAMES=540 REPEAT=1
+FRAMES=540 REPEAT=1 EYE=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --frames) FRAMES="$2"; shift 2 ;;
     --repeat) REPEAT="$2"; shift 2 ;;
+    --eye-size) EYE=(--eye-size "$2"); shift 2 ;;
     -h | --help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-    *) echo "bench desk: unknown flag '$1' (--frames N, --repeat R)" >&2; exit 2 ;;
+    *) echo "bench desk: unknown flag '$1' (--frames N, --repeat R, --eye-size PX)" >&2; exit 2 ;;
   esac
 done
 [[ "$FRAMES" =~ ^[0-9]+$ && "$FRAMES" -ge 120 ]] || { echo "bench desk: --frames: at least 120" >&2; exit 2; }
@@ -56,7 +58,7 @@ unset WAYLAND_DISPLAY XR_RUNTIME_JSON XR_ENABLE_API_LAYERS DRAPE_MOCK_WINDOW DRA
 export HOME="$WORK/home" XDG_CONFIG_HOME="$WORK/home/.config" XDG_CONFIG_DIRS="$WORK/home/xdg"
 export DRAPE_MOCK_WINDOW_SIZE=1280x720
 
-# The view: the left eye (720 px) letterboxed at x 280..1000; the cloth hangs on the form around
+# The view: the left eye letterboxed at x 280..1000 (720 px high); the cloth hangs on the form around
 # x 570..730, y 490..680.
 lines() { [ -f "$LOG" ] && wc -l <"$LOG" || echo 0; }
 frames() {  # frames N: waits for N more frames in the window log (false when the app ended)
@@ -68,7 +70,7 @@ start_app() {
   local name="$1"; shift
   LOG="$WORK/$name.log"
   export DRAPE_MOCK_WINDOW_LOG="$LOG"
-  "$EXE" run --no-pattern --out "$WORK/$name" "$@" >"$WORK/$name.stdout" 2>"$WORK/$name.stderr" &
+  "$EXE" run --no-pattern --out "$WORK/$name" "${EYE[@]}" "$@" >"$WORK/$name.stdout" 2>"$WORK/$name.stderr" &
   APP_PID=$!
   frames 5 || { echo "bench desk: $name: the app ended early:" >&2; tail -5 "$WORK/$name.stderr" >&2; exit 1; }
 }
@@ -92,7 +94,7 @@ pinch_and_drag() {
 }
 
 load() { uptime | sed 's/.*load average: //'; }
-echo "== bench desk: drape run live, window 1280x720, eyes 720 px, lavapipe, sim thread 90 Hz, $FRAMES frames"
+echo "== bench desk: drape run live, window 1280x720, ${EYE[*]:-default eye size}, lavapipe, sim thread 90 Hz, $FRAMES frames"
 echo "   load before: $(load) ($(nproc) cores)"
 for r in $(seq "$REPEAT"); do
   for res in 64 128; do
@@ -131,31 +133,34 @@ for line in open(lat_log):
 jumps = [f for f in sorted(hands) if f - 1 in hands and math.dist(hands[f], hands[f - 1]) > 0.05]
 
 def marker(frame, x0, x1, cy):
-    """The median of the pointer marker's pixels in x0..x1, cy +- 30 of the frame's image."""
+    """The median of the pointer marker's pixels in window x0..x1, cy +- 30 (the left eye fills
+    the window's height at x 280..1000), in window pixels."""
     path = f"{work}/latency/frames/frame_{frame:06d}.png"
     if not os.path.exists(path):
         return None
     d = open(path, "rb").read()
     w, h = struct.unpack(">II", d[16:24])
+    k = w / 720  # eye pixels per window pixel
     pos, idat = 8, b""
     while pos < len(d):
         n, t = struct.unpack(">I4s", d[pos:pos + 8])
         if t == b"IDAT":
             idat += d[pos + 8:pos + 8 + n]
         pos += 12 + n
-    raw = zlib.decompress(idat)
+    raw = zlib.decompress(idat)  # the runtime's PNG: RGBA, filter 0 on every row
     xs, ys = [], []
-    for y in range(max(0, cy - 30), min(h, cy + 30)):
+    for y in range(max(0, int(k * (cy - 30))), min(h, int(k * (cy + 30)))):
         row = raw[y * (4 * w + 1) + 1:(y + 1) * (4 * w + 1)]
-        for x in range(max(0, x0), min(w, x1)):
+        for x in range(max(0, int(k * (x0 - 280))), min(w, int(k * (x1 - 280)))):
             r, g, b = row[4 * x], row[4 * x + 1], row[4 * x + 2]
             if r > 235 and 215 < g < 252 and 80 < b < 170:
                 xs.append(x)
                 ys.append(y)
-    return (statistics.median(xs), statistics.median(ys)) if len(xs) >= 3 else None
+    if len(xs) < 3:
+        return None
+    return statistics.median(xs) / k + 280, statistics.median(ys) / k
 
-# Window x 600 / 710 at y 600 -> left-eye pixels (the 720 px eye fills the window's height).
-A, B = (600 - 280, 600), (710 - 280, 600)
+A, B = (600, 600), (710, 600)  # the cursor's two places (window pixels)
 lat = []
 for f0 in jumps:
     new = B if hands[f0][0] > hands[f0 - 1][0] else A
@@ -171,7 +176,8 @@ fps128 = med([j["fps"] for j in runs[128]])
 cl = runs[64][len(runs[64]) // 2]["cloth_latency_frames"]
 out = {
     "machine": {"load_after": load, "cores": int(cores), "gpu": "lavapipe (CPU)"},
-    "setup": "drape run live, mock runtime window 1280x720 under Xvfb, 720 px eyes, sim thread 90 Hz",
+    "setup": "drape run live, mock runtime window 1280x720 under Xvfb, sim thread 90 Hz",
+    "eye_size": runs[64][0].get("eye_size", 0),
     "repeat": repeat,
     "fps_64": fps64, "fps_128": fps128,
     "fps_64_runs": [j["fps"] for j in runs[64]], "fps_128_runs": [j["fps"] for j in runs[128]],

@@ -231,9 +231,11 @@ struct XrRunOptions {
 
 int export_pattern(const std::string& out);
 
-// A live session's cloth resolution, eye size (swapchain edge: the window's height at the desk
-// benchmark's 1280x720) and screenshot interval unless the options say otherwise.
-constexpr int kLiveClothRes = 128, kLiveEyeSize = 720, kLiveEvery = 90;
+// A live session's cloth resolution, eye size in the simulated runtime's window (swapchain edge:
+// shown 1.4x in a 720 px high window; lavapipe renders 2 x 720^2 at about half the frame rate of
+// 2 x 512^2, ./drape bench desk --eye-size) and screenshot interval unless the options say
+// otherwise.
+constexpr int kLiveClothRes = 128, kLiveEyeSize = 512, kLiveEvery = 90;
 constexpr const char* kLiveStart = "pinned-top";
 
 double median(std::vector<double> v) {
@@ -253,7 +255,8 @@ double quantile(std::vector<double> v, double q) {
 // frames (pipeline and cache warm-up), the frame's own work, the sim's step, and the app's
 // pose-to-photon probes in frames (hand: the frame whose pose the drawn hand has; cloth: the
 // frame whose pose the drawn snapshot holds) and in time. Written as JSON to `path`.
-bool write_live_json(const std::string& path, const drape::app::XrAppResult& r, int cloth_res) {
+bool write_live_json(const std::string& path, const drape::app::XrAppResult& r,
+                     const drape::app::XrAppOptions& o) {
   const auto& wait = r.profile_ms.count("xr.wait_frame") ? r.profile_ms.at("xr.wait_frame")
                                                          : std::vector<double>{};
   const size_t skip = std::min<size_t>(30, r.frame_ms.size());
@@ -270,7 +273,8 @@ bool write_live_json(const std::string& path, const drape::app::XrAppResult& r, 
                                        ? r.profile_ms.at("sim.step_wall")
                                        : std::vector<double>{};
   nlohmann::json j = {
-      {"cloth_res", cloth_res},
+      {"cloth_res", o.cloth_res},
+      {"eye_size", o.eye_size},
       {"frames", r.frames},
       {"fps", loop_ms > 0 ? 1000.0 * n / loop_ms : 0.0},
       {"frame_work_p50_ms", quantile(r.frame_ms, 0.5)},
@@ -353,7 +357,7 @@ int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
   if (!r.error.empty()) std::fprintf(stderr, "drape run: error: %s\n", r.error.c_str());
   if (r.exit_code != 0) return r.exit_code;
   for (const auto& w : r.written) std::printf("wrote %s\n", std::filesystem::absolute(w).c_str());
-  if (!o.json.empty() && !write_live_json(o.json, r, o.app.cloth_res)) return 1;
+  if (!o.json.empty() && !write_live_json(o.json, r, o.app)) return 1;
   if (o.pattern)
     if (int rc = export_pattern(o.out); rc != 0) return rc;
   std::printf("drape run: done in %.1f s\n", secs);
