@@ -167,6 +167,8 @@ case "$MODE" in
     compare_golden live_pinch
     ;;
   pin)
+    expect "the window starts in hand tracking (the app enabled it, no scenario)" \
+      "f('profile') == 'hand_tracking'"
     frames 60
     xdotool mousedown 1
     expect "the left button pinches the right hand" "v('pinch', 2) == 1"
@@ -176,7 +178,6 @@ case "$MODE" in
     xdotool mouseup 1
     frames 90
     screenshot live_pin
-    compare_golden live_pin
     ;;
 esac
 
@@ -251,6 +252,7 @@ print("triggers:", triggers)
 assert "pin" in [n for n, _ in triggers], "no pin trigger"
 m = re.search(r"pinned_added (-?\d+)", session)
 assert m and int(m.group(1)) >= 1, "no vertex pinned"'
+    compare_golden live_pin
     ;;
 esac
 echo PASS
