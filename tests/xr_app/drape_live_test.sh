@@ -2,7 +2,7 @@
 # `drape run` at a desk: a display (Xvfb), no headset runtime configured, so the app runs live
 # in the simulated runtime's window (DRAPE_MOCK_WINDOW, docs/mock-window.md) with no scenario.
 # A person's input as real X events (xdotool, XTEST).
-#   drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin] [--update-golden]
+#   drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin|scene] [--update-golden]
 # free (default): the sim on its own 90 Hz thread, a 12² cloth; the mouse over the cloth, the
 #   left button held (pinch), a drag, the release, Escape. Checks
 #   * the runtime put the hand on the depth the app submitted (DRAPE_MOCK_WINDOW_LOG: z is the
@@ -20,6 +20,8 @@
 #   the left button pinches the cloth, Z (the thumb-middle pinch: the right hand's pin) pins it;
 #   checked in xr_session.txt (pinned vertices added), session_log.json (a pin trigger) and the
 #   golden image live_pin.png.
+# scene: the scene's options (--fabric, --form, --mesh, --start, --resolution): bad values exit 2
+#   naming the option and file before a window opens; good ones run 20 live frames.
 # --update-golden: the screenshots become the golden images (look at them before committing).
 set -uo pipefail
 EXE="$1" OUT="$2" MODE="${3:-free}"
@@ -29,7 +31,8 @@ REGION="300 380 520 600"  # the form and the cloth in the view: the image checks
 case "$MODE" in
   free) ARGS=(--resolution 12 --eye-size 256) ;;
   golden | pin) ARGS=(--resolution 16 --eye-size 256 --sim-lock-step --state-hashes) ;;
-  *) echo "usage: drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin] [--update-golden]"; exit 2 ;;
+  scene) ;;
+  *) echo "usage: drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin|scene] [--update-golden]"; exit 2 ;;
 esac
 rm -rf "$OUT" && mkdir -p "$OUT/home"
 source "$(dirname "$0")/window_test_lib.sh"
@@ -41,6 +44,49 @@ unset XR_RUNTIME_JSON XR_ENABLE_API_LAYERS DRAPE_MOCK_WINDOW DRAPE_MOCK_SCENARIO
   DRAPE_MOCK_WRITE_FRAMES DRAPE_MOCK_END_AFTER_FRAMES
 export HOME="$OUT/home" XDG_CONFIG_HOME="$OUT/home/.config" XDG_CONFIG_DIRS="$OUT/home/xdg"
 export DRAPE_MOCK_WINDOW_SIZE=800x600 DRAPE_MOCK_WINDOW_LOG="$LOG"
+
+# scene: the live scene's options. Bad values exit 2 with a message naming the option (and the
+# file) before a window opens; each start state, a measurements file, a fabric and a mesh form
+# run a short live session (--frames) to exit 0.
+if [ "$MODE" = scene ]; then
+  bad() {  # bad "MESSAGE" ARGS...: drape run ARGS exits 2, stderr holds MESSAGE, no window frame
+    local want="$1"; shift
+    rm -f "$LOG"
+    "$EXE" run --out "$OUT/bad" --no-pattern "$@" >"$OUT/stdout" 2>"$OUT/stderr"; local rc=$?
+    [ "$rc" -eq 2 ] || fail "drape run $* exited with $rc, not 2"
+    grep -qF -- "$want" "$OUT/stderr" || fail "drape run $*: no '$want' in: $(cat "$OUT/stderr")"
+    [ "$(lines)" -eq 0 ] || fail "drape run $*: a window opened"
+    echo "ok: $* -> $(head -1 "$OUT/stderr")"
+  }
+  bad "--fabric silk: " --fabric silk
+  bad "fabrics.json" --fabric silk
+  bad "--form 99XX: 99XX: unknown form size" --form 99XX
+  bad "--form: no such file: nowhere.json" --form nowhere.json
+  bad "--mesh: no such file: nowhere.obj" --mesh nowhere.obj
+  bad "--start: 'upside' is none of spread|rolled|pinned-top" --start upside
+  bad "--resolution: Value 300 not in range 4 to 256" --resolution 300
+  echo '{"bust_girth": -1}' >"$OUT/bad_form.json"
+  bad "--form $OUT/bad_form.json: $OUT/bad_form.json" --form "$OUT/bad_form.json"
+  "$EXE" form --size 11AR --export "$OUT/form.obj" >/dev/null || fail "drape form --export"
+  good() {  # good WHAT ARGS...: a 20-frame live session with ARGS exits 0 and says WHAT
+    local want="$1"; shift
+    rm -f "$LOG"
+    "$EXE" run --out "$OUT/good" --no-pattern --resolution 16 --eye-size 128 --frames 20 "$@" \
+      >"$OUT/stdout" 2>"$OUT/stderr" || fail "drape run $* failed: $(tail -3 "$OUT/stderr")"
+    grep -qF -- "$want" "$OUT/stdout" || fail "drape run $*: no '$want' in: $(head -3 "$OUT/stdout")"
+    [ "$(lines)" -ge 20 ] || fail "drape run $*: fewer than 20 window frames"
+    echo "ok: $* -> $want"
+  }
+  good "16 x 16 muslin cloth, start pinned-top, form 9AR"
+  good "start spread" --start spread
+  good "start rolled" --start rolled
+  good "denim cloth" --fabric denim --form 13AR
+  good "form $(cd "$(dirname "$0")/../.." && pwd)/assets/forms/7AR.json" \
+    --form "$(cd "$(dirname "$0")/../.." && pwd)/assets/forms/7AR.json"
+  good "form $OUT/form.obj" --mesh "$OUT/form.obj" --start spread
+  echo PASS
+  exit 0
+fi
 "$EXE" run --out "$OUT/out" --no-pattern "${ARGS[@]}" >"$OUT/stdout" 2>"$OUT/stderr" &
 CLIENT_PID=$!
 
