@@ -466,7 +466,7 @@ int run_xr(XrRunOptions& o) {
   // simulated runtime without a display, or --scenario) the scripted run.
   if (!o.scenario_given && (!simulated || app::has_display())) {
     if (!o.cloth_res_given) o.app.cloth_res = kLiveClothRes;
-    if (!o.eye_size_given) o.app.eye_size = simulated ? kLiveEyeSize : 0;
+    if (!o.eye_size_given && !simulated) o.app.eye_size = 0;  // the headset's own size
     if (o.app.start.empty()) o.app.start = kLiveStart;
     if (!check_scene(o)) return 2;
     return run_live(o, manifest, simulated);
@@ -514,7 +514,7 @@ int run_xr(XrRunOptions& o) {
 
 // The XR job's options; they exclude --headless.
 void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
-  o.app.eye_size = 256;
+  o.app.eye_size = kLiveEyeSize;  // screenshots a person can read (512 px), scripted or live
   o.app.cloth_res = 12;
   o.form = "9AR";
   drape::app::add_app_options(cli, o.app);
