@@ -1,11 +1,12 @@
-// `drape run`: the main job. With an OpenXR runtime (a headset, or else the headless simulated
-// runtime built next to the executable) it runs the XR app on the default draping scenario
-// (assets/scenarios/default.json) and writes screenshots, the session log, the draped cloth and
-// the pattern to out/ (see docs/xr.md). At a desk (a display, no headset runtime, no --scenario)
-// the simulated runtime opens its window instead and the person drapes live until Escape. `drape
-// run --headless` (or no XR build) is the sim-core job: builds the 9AR form, drops a muslin panel
-// over its shoulders on the simulation thread (lock step, or real time), then writes the draped
-// cloth and the form as glTF and prints where, with the max penetration.
+// `drape run`: the main job. Live (a headset with no --scenario, or at a desk: a display, no
+// headset runtime, no --scenario, the simulated runtime's window) the person drapes the desk scene
+// (xr_app/app/desk_scene.hpp: --resolution, --fabric, --form, --mesh, --start) with the sim on its
+// own 90 Hz thread until the session ends. Otherwise the simulated runtime plays a scenario
+// (assets/scenarios/default.json, or --scenario) and the run writes screenshots, the session log,
+// the draped cloth and the pattern to out/ (see docs/xr.md). `drape run --headless` (or no XR
+// build) is the sim-core job: builds the 9AR form, drops a muslin panel over its shoulders on the
+// simulation thread (lock step, or real time), then writes the draped cloth and the form as glTF
+// and prints where, with the max penetration.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -626,13 +627,17 @@ bool xr_scene_args(CLI::App& cli, const HeadlessOptions& ho, XrRunOptions& xo) {
 
 int run(int argc, char** argv) {
   CLI::App cli(
-      "Runs the OpenXR app (headset, or the simulated runtime when none is configured) on a "
-      "draping scenario: pinch, pin (a spoken 'pin here' made with espeak-ng), a cut stroke; "
+      "Runs the OpenXR app on a draping scenario (--scenario; without it on the simulated "
+      "runtime when no headset runtime is configured and there is no display): pinch, pin (a "
+      "spoken 'pin here' made with espeak-ng), a cut stroke; "
       "then the pattern export. Writes DIR/frames/*.png, DIR/session_log.json, "
       "DIR/xr_session.txt, DIR/drape_cloth.gltf, DIR/pattern/.\n"
       "At a desk (DISPLAY or WAYLAND_DISPLAY set, no headset runtime configured, no --scenario): "
       "the simulated runtime's window instead; drape live with mouse and keyboard until Escape "
-      "(docs/mock-window.md). Writes the session log, xr_session.txt, the cloth, the pattern.\n"
+      "(docs/mock-window.md); on a headset with no --scenario, live the same way. Live: a 128^2 "
+      "panel (--resolution, --fabric) on the form (--form, --mesh) in a start state (--start), "
+      "the sim on its own 90 Hz thread. Writes the session log, xr_session.txt, the cloth, "
+      "every 90th frame, the pattern.\n"
       "With --headless: drops a 0.6 m x 0.7 m panel over the dress form's shoulders, its centre "
       "pinned above the neck, and simulates it with the baseline solver (mass-spring + damped "
       "Verlet, substeps chosen for stability) on the 90 Hz simulation thread. Writes "
