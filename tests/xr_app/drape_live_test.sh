@@ -219,7 +219,9 @@ case "$MODE" in
     xdotool mousedown 1
     expect "the left button pinches the right hand" "v('pinch', 2) == 1"
     frames 20
-    xdotool key z
+    xdotool keydown z  # held like a gesture (a recogniser debounces a one-frame tap)
+    frames 20
+    xdotool keyup z
     frames 20
     xdotool mouseup 1
     frames 90
