@@ -1,11 +1,12 @@
-// `drape run`: the main job. With an OpenXR runtime (a headset, or else the headless simulated
-// runtime built next to the executable) it runs the XR app on the default draping scenario
-// (assets/scenarios/default.json) and writes screenshots, the session log, the draped cloth and
-// the pattern to out/ (see docs/xr.md). At a desk (a display, no headset runtime, no --scenario)
-// the simulated runtime opens its window instead and the person drapes live until Escape. `drape
-// run --headless` (or no XR build) is the sim-core job: builds the 9AR form, drops a muslin panel
-// over its shoulders on the simulation thread (lock step, or real time), then writes the draped
-// cloth and the form as glTF and prints where, with the max penetration.
+// `drape run`: the main job. Live (a headset with no --scenario, or at a desk: a display, no
+// headset runtime, no --scenario, the simulated runtime's window) the person drapes the desk scene
+// (xr_app/app/desk_scene.hpp: --resolution, --fabric, --form, --mesh, --start) with the sim on its
+// own 90 Hz thread until the session ends. Otherwise the simulated runtime plays a scenario
+// (assets/scenarios/default.json, or --scenario) and the run writes screenshots, the session log,
+// the draped cloth and the pattern to out/ (see docs/xr.md). `drape run --headless` (or no XR
+// build) is the sim-core job: builds the 9AR form, drops a muslin panel over its shoulders on the
+// simulation thread (lock step, or real time), then writes the draped cloth and the form as glTF
+// and prints where, with the max penetration.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -29,6 +30,7 @@
 #ifdef DRAPE_HAVE_XR_APP
 #include <nlohmann/json.hpp>
 
+#include "xr_app/app/desk_scene.hpp"
 #include "xr_app/app/xr_app.hpp"
 #include "xr_app/xr_launch.hpp"
 #endif
@@ -221,13 +223,22 @@ struct XrRunOptions {
   bool pattern = true;
   int every = 30;
   bool scenario_given = false;   // --scenario: always the scripted run
-  bool cloth_res_given = false;  // --cloth-res: also live
+  bool cloth_res_given = false;  // --cloth-res / --resolution: also live
+  bool eye_size_given = false, every_given = false;
+  bool scene_given = false;  // --start, --fabric, --form or --mesh: the desk scene when scripted
+  std::string form;          // --form: a size or a measurements file
+  std::string json;          // --json: the live session's figures
+  bool lock_step = false;    // --sim-lock-step: live with one sim tick per frame
 };
 
 int export_pattern(const std::string& out);
 
-// The cloth resolution of a live session unless --cloth-res says otherwise.
-constexpr int kLiveClothRes = 12;
+// A live session's cloth resolution, eye size in the simulated runtime's window (swapchain edge:
+// shown 1.4x in a 720 px high window; lavapipe renders 2 x 720^2 at about half the frame rate of
+// 2 x 512^2, ./drape bench desk --eye-size) and screenshot interval unless the options say
+// otherwise.
+constexpr int kLiveClothRes = 128, kLiveEyeSize = 512, kLiveEvery = 90;
+constexpr const char* kLiveStart = "pinned-top";
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -235,26 +246,96 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// The fraction q of the sorted values (0 when empty).
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))];
+}
+
+// The live session's figures: frames per second over the loop's time after the first 30
+// frames (pipeline and cache warm-up), the frame's own work, the sim's step, and the app's
+// pose-to-photon probes in frames (hand: the frame whose pose the drawn hand has; cloth: the
+// frame whose pose the drawn snapshot holds) and in time. Written as JSON to `path`.
+bool write_live_json(const std::string& path, const drape::app::XrAppResult& r,
+                     const drape::app::XrAppOptions& o) {
+  const auto& wait = r.profile_ms.count("xr.wait_frame") ? r.profile_ms.at("xr.wait_frame")
+                                                         : std::vector<double>{};
+  const size_t skip = std::min<size_t>(30, r.frame_ms.size());
+  double loop_ms = 0;
+  for (size_t i = skip; i < r.frame_ms.size(); ++i)
+    loop_ms += r.frame_ms[i] + (i < wait.size() ? wait[i] : 0.0);
+  const auto n = static_cast<double>(r.frame_ms.size() - skip);
+  auto as_doubles = [](const std::vector<int>& v) {
+    return std::vector<double>(v.begin(), v.end());
+  };
+  const std::vector<double> hand = as_doubles(r.latency_frames),
+                            cloth = as_doubles(r.cloth_latency_frames);
+  const std::vector<double> step = r.profile_ms.count("sim.step_wall")
+                                       ? r.profile_ms.at("sim.step_wall")
+                                       : std::vector<double>{};
+  nlohmann::json j = {
+      {"cloth_res", o.cloth_res},
+      {"eye_size", o.eye_size},
+      {"frames", r.frames},
+      {"fps", loop_ms > 0 ? 1000.0 * n / loop_ms : 0.0},
+      {"frame_work_p50_ms", quantile(r.frame_ms, 0.5)},
+      {"sim_step_p50_ms", quantile(step, 0.5)},
+      {"sim_ticks", step.size()},
+      {"frames_pinched", r.frames_pinched},
+      {"hand_latency_frames",
+       {{"n", hand.size()}, {"p50", quantile(hand, 0.5)}, {"max", quantile(hand, 1.0)}}},
+      {"cloth_latency_frames",
+       {{"n", cloth.size()},
+        {"p50", quantile(cloth, 0.5)},
+        {"p90", quantile(cloth, 0.9)},
+        {"max", quantile(cloth, 1.0)}}},
+      {"cloth_latency_ms",
+       {{"p50", quantile(r.cloth_latency_ms, 0.5)}, {"p90", quantile(r.cloth_latency_ms, 0.9)}}}};
+  std::ofstream out(path);
+  out << j.dump(2) << "\n";
+  if (!out) std::fprintf(stderr, "drape run: --json: cannot write %s\n", path.c_str());
+  return static_cast<bool>(out);
+}
+
 // Live at a desk: the simulated runtime's window (DRAPE_MOCK_WINDOW, docs/mock-window.md) is the
 // headset; the person drives the head and hands with mouse and keyboard, no scenario, the sim
 // on its own 90 Hz clock, until Escape or the window is closed (or --frames).
-int run_live(XrRunOptions& o, const std::string& manifest) {
+int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
   namespace app = drape::app;
   const auto wall0 = std::chrono::steady_clock::now();
-  if (!make_dir(o.out, o.out)) return 1;
-  app::set_mock_window();
+  if (!make_dir(o.out + "/frames", o.out)) return 1;
+  if (simulated) {
+    app::set_mock_window();
+    // Every K-th frame's left eye as a screenshot, at the eye size.
+    const std::string frames_dir = std::filesystem::absolute(o.out + "/frames").string();
+    setenv("DRAPE_MOCK_WRITE_FRAMES", frames_dir.c_str(), 1);
+    setenv("DRAPE_MOCK_WRITE_EVERY", std::to_string(o.every_given ? o.every : kLiveEvery).c_str(),
+           1);
+  }
   o.app.out_dir = o.out;
   o.app.scenario_path.clear();
   o.app.voice = false;  // no scenario: no audio cues
-  o.app.sim_lock_step = false;
-  if (!o.cloth_res_given) o.app.cloth_res = kLiveClothRes;
+  o.app.sim_lock_step = o.lock_step;
   o.app.commands_path = app::commands_file("");
   o.app.api_layers = app::loader_api_layers();
-  std::printf(
-      "drape run: live in the simulated runtime's window (%s): the mouse moves the right hand, "
-      "the left button pinches, right-drag looks, W/A/S/D/Q/E move the head; Escape or closing "
-      "the window ends the session (docs/mock-window.md); live voice %s\n",
-      manifest.c_str(), o.app.voice_input.empty() ? "off" : o.app.voice_input.c_str());
+  std::printf("drape run: live, %d x %d %s cloth, start %s, form %s, eyes %d px\n", o.app.cloth_res,
+              o.app.cloth_res, o.app.fabric.c_str(), o.app.start.c_str(),
+              !o.app.form_mesh.empty()           ? o.app.form_mesh.c_str()
+              : !o.app.form_measurements.empty() ? o.app.form_measurements.c_str()
+                                                 : o.app.form_size.c_str(),
+              o.app.eye_size);
+  if (simulated)
+    std::printf(
+        "drape run: live in the simulated runtime's window (%s): the mouse moves the right hand, "
+        "the left button pinches, right-drag looks, W/A/S/D/Q/E move the head; Escape or "
+        "closing the window ends the session (docs/mock-window.md); live voice %s\n",
+        manifest.c_str(), o.app.voice_input.empty() ? "off" : o.app.voice_input.c_str());
+  else
+    std::printf(
+        "drape run: live on the headset (runtime %s); the headset's quit ends it; live voice %s\n",
+        manifest.empty() ? "(system active runtime)" : manifest.c_str(),
+        o.app.voice_input.empty() ? "off" : o.app.voice_input.c_str());
   std::fflush(stdout);
   auto r = app::run_xr_app(o.app);
   for (const auto& l : r.log)
@@ -281,6 +362,7 @@ int run_live(XrRunOptions& o, const std::string& manifest) {
   if (!r.error.empty()) std::fprintf(stderr, "drape run: error: %s\n", r.error.c_str());
   if (r.exit_code != 0) return r.exit_code;
   for (const auto& w : r.written) std::printf("wrote %s\n", std::filesystem::absolute(w).c_str());
+  if (!o.json.empty() && !write_live_json(o.json, r, o.app)) return 1;
   if (o.pattern)
     if (int rc = export_pattern(o.out); rc != 0) return rc;
   std::printf("drape run: done in %.1f s\n", secs);
@@ -357,18 +439,50 @@ int export_pattern(const std::string& out) {
   return 0;
 }
 
+// Resolves --form (a standard size, else a measurements file), --mesh and the fabrics file, then
+// builds the desk scene once: bad input is reported (naming the option and the file) before a
+// session opens. No desk scene (the default scenario's): nothing to check.
+bool check_scene(XrRunOptions& o) {
+  namespace app = drape::app;
+  app::XrAppOptions& a = o.app;
+  a.fabrics_path = fabrics_path();
+  a.forms_dir = app::asset("forms").string();
+  const bool is_file = o.form.find('/') != std::string::npos ||
+                       (o.form.size() > 5 && o.form.compare(o.form.size() - 5, 5, ".json") == 0);
+  if (!is_file) {
+    a.form_size = o.form;
+  } else {
+    a.form_measurements = o.form;
+    if (!app::resolve_input_file("drape run", "--form", a.form_measurements)) return false;
+  }
+  if (!a.form_mesh.empty() && !app::resolve_input_file("drape run", "--mesh", a.form_mesh))
+    return false;
+  if (a.start.empty()) return true;
+  auto scene = app::make_desk_scene(a);
+  if (!scene) std::fprintf(stderr, "drape run: %s\n", scene.error().c_str());
+  return scene.ok();
+}
+
 int run_xr(XrRunOptions& o) {
   namespace app = drape::app;
   bool simulated = false;
   const std::string manifest = app::select_runtime(&simulated);
-  // At a desk without a headset: live in the simulated runtime's window. Otherwise (a headset,
-  // no display, or --scenario) the scripted run. A headset or the window is a live session: the
-  // microphone by default, and no scenario audio cues (a headset plays no scenario).
+  // Live on a headset, or at a desk without one in the simulated runtime's window. Otherwise (the
+  // simulated runtime without a display, or --scenario) the scripted run. A live session takes
+  // the microphone by default and plays no scenario audio cues.
   const bool window = simulated && app::has_display() && !o.scenario_given;
   const bool headset = !app::simulated_runtime(manifest, simulated);
   if (!app::resolve_voice("drape run", o.voice, window || headset, o.app.voice_input)) return 2;
-  if (window) return run_live(o, manifest);
+  if (window || (headset && !o.scenario_given)) {
+    if (!o.cloth_res_given) o.app.cloth_res = kLiveClothRes;
+    if (!o.eye_size_given && !simulated) o.app.eye_size = 0;  // the headset's own size
+    if (o.app.start.empty()) o.app.start = kLiveStart;
+    if (!check_scene(o)) return 2;
+    return run_live(o, manifest, simulated);
+  }
   if (headset) o.app.voice = false;
+  if (o.scene_given && o.app.start.empty()) o.app.start = kLiveStart;
+  if (!check_scene(o)) return 2;
   const auto wall0 = std::chrono::steady_clock::now();
   if (!make_dir(o.out + "/frames", o.out)) return 1;
   std::error_code ec;
@@ -411,19 +525,40 @@ int run_xr(XrRunOptions& o) {
 
 // The XR job's options; they exclude --headless.
 void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
-  o.app.eye_size = 256;
+  o.app.eye_size = kLiveEyeSize;  // screenshots a person can read (512 px), scripted or live
   o.app.cloth_res = 12;
+  o.form = "9AR";
   drape::app::add_app_options(cli, o.app);
   cli.add_option("--scenario", o.scenario,
                  "the draping scenario the simulated runtime plays (given: the scripted run even "
                  "with a display)");
   drape::app::add_off_switches(cli, {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
                                      {"--no-pattern", &o.pattern, "skip the pattern export"}});
-  cli.add_option("--every", o.every, "write every K-th frame's screenshot")
+  cli.add_option("--json", o.json,
+                 "live: write the session's frame rate, sim step and pose-to-photon probes "
+                 "(frames) as JSON to this file");
+  cli.add_option("--every", o.every, "write every K-th frame's screenshot (live default: 90)")
       ->check(CLI::Range(1, 1000000));
   drape::app::add_voice_option(cli, o.voice);
+  cli.add_option("--form", o.form,
+                 "the dress form: a standard size (7AR, 9AR, 11AR, 13AR) or a measurements file "
+                 "(JSON, as assets/forms/9AR.json)");
+  cli.add_option("--mesh", o.app.form_mesh,
+                 "a scanned or modelled dress form (OBJ, PLY, STL, glTF; as drape form --mesh)")
+      ->excludes("--form");
+  cli.add_flag_callback(
+      "--sim-lock-step", [&o] { o.lock_step = true; },
+      "live: one sim tick per frame (repeatable: tests, replays) instead of the sim's own 90 Hz "
+      "thread");
+  cli.add_flag("--state-hashes", o.app.log_state_hashes,
+               "log the cloth's state hash before and after each operation's outcome in "
+               "xr_session.txt (tests)");
+  cli.add_option("--start", o.app.start,
+                 std::string("the cloth's start state: ") + drape::app::desk_start_names() +
+                     " (default: pinned-top live; the scenario's scene when scripted)");
   for (const char* name : {"--frames", "--eye-size", "--cloth-res", "--verbose", "--scenario",
-                           "--no-voice", "--no-pattern", "--every", "--voice"})
+                           "--no-voice", "--no-pattern", "--every", "--form", "--mesh", "--start",
+                           "--json", "--sim-lock-step", "--state-hashes", "--voice"})
     cli.get_option(name)->excludes(headless);
 }
 #endif
@@ -444,10 +579,10 @@ void add_headless_options(CLI::App& cli, HeadlessOptions& o, CLI::Option* headle
   cli.add_option("--seconds", o.seconds, "simulated seconds")
       ->check(number_in(0, 3600, false, "(0, 3600)"))
       ->needs(headless);
-  cli.add_option("--resolution", o.resolution, "panel vertices across (2 cm at 31)")
-      ->check(CLI::Range(3, 400))
-      ->needs(headless);
-  cli.add_option("--fabric", o.fabric, "a fabric of assets/fabrics.json")->needs(headless);
+  cli.add_option("--resolution", o.resolution,
+                 "cloth vertices across (--headless: 31, 2 cm; live: 128; scripted: 12)")
+      ->check(CLI::Range(3, 400));
+  cli.add_option("--fabric", o.fabric, "a fabric of assets/fabrics.json");
   cli.add_option("--size", o.size, "the dress form's size")->needs(headless);
   cli.add_flag("--realtime", o.realtime,
                "the sim on its real-time 90 Hz clock (default: lock step)")
@@ -481,15 +616,42 @@ std::string bindings_help() {
          "docs/mock-window.md.";
 }
 
+#ifdef DRAPE_HAVE_XR_APP
+// After parsing: the options the headless job shares with the XR job (--resolution, --fabric) and
+// which of the scene's options were given. False (the message printed) when --resolution is out
+// of the XR app's range.
+bool xr_scene_args(CLI::App& cli, const HeadlessOptions& ho, XrRunOptions& xo) {
+  auto given = [&](const char* name) { return cli.get_option(name)->count() > 0; };
+  if (given("--resolution")) {
+    if (ho.resolution < 4 || ho.resolution > 256) {
+      std::fprintf(stderr, "drape run: --resolution: Value %d not in range 4 to 256\n",
+                   ho.resolution);
+      return false;
+    }
+    xo.app.cloth_res = ho.resolution;
+  }
+  xo.app.fabric = ho.fabric;
+  xo.cloth_res_given = given("--cloth-res") || given("--resolution");
+  xo.eye_size_given = given("--eye-size");
+  xo.every_given = given("--every");
+  xo.scene_given = given("--start") || given("--fabric") || given("--form") || given("--mesh");
+  return true;
+}
+#endif
+
 int run(int argc, char** argv) {
   CLI::App cli(
-      "Runs the OpenXR app (headset, or the simulated runtime when none is configured) on a "
-      "draping scenario: pinch, pin (a spoken 'pin here' made with espeak-ng), a cut stroke; "
+      "Runs the OpenXR app on a draping scenario (--scenario; without it on the simulated "
+      "runtime when no headset runtime is configured and there is no display): pinch, pin (a "
+      "spoken 'pin here' made with espeak-ng), a cut stroke; "
       "then the pattern export. Writes DIR/frames/*.png, DIR/session_log.json, "
       "DIR/xr_session.txt, DIR/drape_cloth.gltf, DIR/pattern/.\n"
       "At a desk (DISPLAY or WAYLAND_DISPLAY set, no headset runtime configured, no --scenario): "
       "the simulated runtime's window instead; drape live with mouse and keyboard until Escape "
-      "(docs/mock-window.md). Writes the session log, xr_session.txt, the cloth, the pattern.\n"
+      "(docs/mock-window.md); on a headset with no --scenario, live the same way. Live: a 128^2 "
+      "panel (--resolution, --fabric) on the form (--form, --mesh) in a start state (--start), "
+      "the sim on its own 90 Hz thread. Writes the session log, xr_session.txt, the cloth, "
+      "every 90th frame, the pattern.\n"
       "With --headless: drops a 0.6 m x 0.7 m panel over the dress form's shoulders, its centre "
       "pinned above the neck, and simulates it with the baseline solver (mass-spring + damped "
       "Verlet, substeps chosen for stability) on the 90 Hz simulation thread. Writes "
@@ -518,7 +680,7 @@ int run(int argc, char** argv) {
   if (!headless_job) {
     xo.out = out;
     xo.scenario_given = cli.get_option("--scenario")->count() > 0;
-    xo.cloth_res_given = cli.get_option("--cloth-res")->count() > 0;
+    if (!xr_scene_args(cli, ho, xo)) return 2;
     if (!drape::app::resolve_input_file("drape run", "--scenario", xo.scenario)) return 2;
     return run_xr(xo);
   }

@@ -76,11 +76,13 @@ PY
   echo "ok: $1"
 }
 
-# screenshot: the 800x600 window at (0, 0) as OUT/window.png (from xwd, no other tool); fails
-# when the view (x 100..700) is blank or the letterbox bars beside it are not plain.
+# screenshot [NAME]: the 800x600 window at (0, 0) as OUT/NAME.png (default: window; from xwd,
+# no other tool); fails when the view (x 100..700) is blank or the letterbox bars beside it are
+# not plain.
 screenshot() {
+  local name="${1:-window}"
   xwd -root -silent >"$OUT/screen.xwd" || fail "xwd"
-  python3 - "$OUT/screen.xwd" "$OUT/window.png" <<'PY' || fail "screenshot check"
+  python3 - "$OUT/screen.xwd" "$OUT/$name.png" <<'PY' || fail "screenshot check"
 import struct, sys, zlib
 d = open(sys.argv[1], "rb").read()
 f = struct.unpack(">25I", d[:100])
@@ -105,5 +107,107 @@ print(f"screenshot: {len(view)} distinct colours in the view, {len(bars)} in the
 assert len(view) >= 3, "the view is blank: the submitted image is not shown"
 assert len(bars) == 1, "the letterbox bars are not plain"
 PY
-  echo "ok: screenshot $OUT/window.png shows the submitted image"
+  echo "ok: screenshot $OUT/$name.png shows the submitted image"
+}
+
+# REGION: the part of the 800x600 window the image checks look at, "X0 Y0 X1 Y1" (default: the
+# view, x 100..700); a caller narrows it to where the action is.
+REGION="${REGION:-100 0 700 600}"
+# compare_golden NAME: OUT/NAME.png against GOLDEN/NAME.png (GOLDEN: the caller's folder of
+# golden images) over REGION, both averaged over 4x4 blocks: a block differs when a channel is
+# off by more than 24/255; at most 3 % of the blocks may differ and the RMS over all blocks must
+# be below 8/255 (a live session's input lands in frames a little apart from run to run: the held
+# or cut cloth ends a few pixels apart). Prints the measured difference; writes OUT/NAME_diff.png (the difference, x4)
+# on failure. With UPDATE_GOLDEN=1 the screenshot becomes the golden image instead (look at it
+# before committing it).
+compare_golden() {
+  local name="$1"
+  if [ "${UPDATE_GOLDEN:-0}" = 1 ]; then
+    cp "$OUT/$name.png" "$GOLDEN/$name.png" || fail "cannot write $GOLDEN/$name.png"
+    echo "updated: $GOLDEN/$name.png"
+    return 0
+  fi
+  [ -f "$GOLDEN/$name.png" ] || fail "no golden image $GOLDEN/$name.png (make it with --update-golden)"
+  python3 - "$OUT/$name.png" "$GOLDEN/$name.png" "$OUT/${name}_diff.png" "$name" $REGION <<'PY' ||
+import math, struct, sys, zlib
+def read_png(path):
+    d = open(path, "rb").read()
+    assert d[:8] == b"\x89PNG\r\n\x1a\n", f"{path}: not a PNG"
+    pos, idat, w = 8, b"", 0
+    while pos < len(d):
+        n, t = struct.unpack(">I4s", d[pos:pos + 8])
+        body = d[pos + 8:pos + 8 + n]
+        if t == b"IHDR":
+            w, h, depth, ctype = struct.unpack(">IIBB", body[:10])
+            assert depth == 8 and ctype == 2, f"{path}: not 8-bit RGB"
+        elif t == b"IDAT":
+            idat += body
+        pos += 12 + n
+    raw, stride, rows, prev = zlib.decompress(idat), 3 * w, [], bytearray(3 * w)
+    for y in range(h):
+        f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - 3] if i >= 3 else 0
+            b, c = prev[i], prev[i - 3] if i >= 3 else 0
+            if f == 1: line[i] = (line[i] + a) & 255
+            elif f == 2: line[i] = (line[i] + b) & 255
+            elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(bytes(line))
+        prev = line
+    return w, h, rows
+def blocks(rows, x0, y0, x1, y1):
+    return [[tuple(sum(rows[by + k][3 * (bx + i) + c] for k in range(4) for i in range(4)) / 16
+                   for c in range(3)) for bx in range(x0, x1 - 3, 4)] for by in range(y0, y1 - 3, 4)]
+shot, gold, diff_path, name = sys.argv[1:5]
+x0, y0, x1, y1 = (int(v) for v in sys.argv[5:9])
+(w1, h1, a), (w2, h2, b) = read_png(shot), read_png(gold)
+assert (w1, h1) == (w2, h2) == (800, 600), f"sizes {w1}x{h1} and {w2}x{h2}, expected 800x600"
+A, B = blocks(a, x0, y0, x1, y1), blocks(b, x0, y0, x1, y1)
+off, sq, n = 0, 0.0, len(A) * len(A[0])
+for ra, rb in zip(A, B):
+    for pa, pb in zip(ra, rb):
+        d = [abs(pa[c] - pb[c]) for c in range(3)]
+        off += max(d) > 24
+        sq += sum(v * v for v in d) / 3
+frac, rms = off / n, math.sqrt(sq / n)
+print(f"{name}: {100 * frac:.2f} % of the {n} 4x4 blocks of x {x0}..{x1}, y {y0}..{y1} differ by > 24/255 (max 3 %), RMS {rms:.2f}/255 (max 8)")
+if frac <= 0.03 and rms < 8:
+    sys.exit(0)
+raw = b"".join(b"\0" + bytes(min(255, 4 * abs(a[y][i] - b[y][i])) for i in range(2400)) for y in range(600))
+def chunk(t, body): return struct.pack(">I", len(body)) + t + body + struct.pack(">I", zlib.crc32(t + body))
+open(diff_path, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 800, 600, 8, 2, 0, 0, 0))
+                          + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+print(f"the difference (x4): {diff_path}")
+sys.exit(1)
+PY
+    fail "$name.png does not match its golden image"
+  echo "ok: $name.png matches $GOLDEN/$name.png"
+}
+
+# image_change A B: the fraction of REGION's 4x4 blocks (as compare_golden) that differ by more
+# than 24/255 between OUT/A.png and OUT/B.png, printed as a percentage.
+image_change() {
+  python3 - "$OUT/$1.png" "$OUT/$2.png" $REGION <<'PY' || fail "image_change $1 $2"
+import struct, sys, zlib
+x0, y0, x1, y1 = (int(v) for v in sys.argv[3:7])
+def view(path):
+    d = open(path, "rb").read()
+    pos, idat = 8, b""
+    while pos < len(d):
+        n, t = struct.unpack(">I4s", d[pos:pos + 8])
+        if t == b"IDAT": idat += d[pos + 8:pos + 8 + n]
+        pos += 12 + n
+    raw = zlib.decompress(idat)  # written by screenshot(): filter 0 on every row
+    rows = [raw[y * 2401 + 1:(y + 1) * 2401] for y in range(600)]
+    return [[tuple(sum(rows[by + k][3 * (bx + i) + c] for k in range(4) for i in range(4)) / 16
+                   for c in range(3)) for bx in range(x0, x1 - 3, 4)] for by in range(y0, y1 - 3, 4)]
+A, B = view(sys.argv[1]), view(sys.argv[2])
+n = len(A) * len(A[0])
+off = sum(max(abs(pa[c] - pb[c]) for c in range(3)) > 24 for ra, rb in zip(A, B) for pa, pb in zip(ra, rb))
+print(f"{100 * off / n:.2f}")
+PY
 }

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include "sim/io/mesh_io.hpp"
 #include "sim/solvers/solver_factory.hpp"
 #include "sim/testbeds/testbed.hpp"
+#include "xr_app/app/desk_scene.hpp"
 
 namespace drape::app {
 
@@ -42,6 +44,46 @@ std::string operation_text(const sim::OperationsState& st, int h) {
 
 // How long a live session shows the help at its start (frames at 90 Hz).
 constexpr int64_t kIntroHelpFrames = 8 * 90;
+// After each step the cloth's state hash and the newest message; when a command of the next tick
+// (a trigger) reports an outcome, the message "state hash <before> -> <after>: <outcome>" (an
+// undo restores the hash from before the operation it undoes). Hashing costs a pass over the
+// cloth per tick: only when XrAppOptions::log_state_hashes asks.
+void hash_outcomes(sim::World& w) {
+  struct Last {
+    uint64_t hash = 0;
+    size_t count = 0;
+    std::string back;
+  };
+  auto last = std::make_shared<Last>();
+  last->hash = sim::state_hash(w.cloth);
+  last->count = w.messages.size();
+  last->back = w.messages.empty() ? "" : w.messages.back();
+  auto inner_before = w.before_step;
+  w.before_step = [last, inner_before](sim::World& world, double dt) {
+    const std::string back = world.messages.empty() ? "" : world.messages.back();
+    if (world.messages.size() != last->count || back != last->back) {
+      char line[64];
+      std::snprintf(line, sizeof line,
+                    "state hash %016llx -> %016llx: ", static_cast<unsigned long long>(last->hash),
+                    static_cast<unsigned long long>(sim::state_hash(world.cloth)));
+      world.report(line + back);
+    }
+    if (inner_before) inner_before(world, dt);
+  };
+  auto inner_after = w.after_step;
+  w.after_step = [last, inner_after](sim::World& world, double dt) {
+    if (inner_after) inner_after(world, dt);
+    last->hash = sim::state_hash(world.cloth);
+    last->count = world.messages.size();
+    last->back = world.messages.empty() ? "" : world.messages.back();
+  };
+}
+
+// The scene: the default scenario's, or the desk scene of the options (desk_scene.hpp).
+sim::Result<sim::Testbed> make_scene(const XrAppOptions& opt) {
+  if (opt.start.empty()) return sim::make_form_drape(opt.cloth_res);
+  return make_desk_scene(opt);
+}
 }  // namespace
 
 std::unique_ptr<SessionContent> make_draping_session(const VulkanDevice& device,
@@ -71,7 +113,11 @@ bool DrapingSession::create(const VulkanDevice& device) {
   }
   renderer_ = std::move(rr.value());
   threads_.mark_before_sim();
-  auto scene = sim::make_form_drape(opt_.cloth_res);
+  auto scene = make_scene(opt_);
+  if (!scene) {
+    rep_.r.error = "scene: " + scene.error();
+    return false;
+  }
   sim::SolverConfig solver_cfg;
   solver_cfg.freeze = true;  // pieces at rest sleep until a hand, pin or cut disturbs them
   // A lock-step run replays bit for bit: the static finish of a sleeping piece then runs one
@@ -83,8 +129,8 @@ bool DrapingSession::create(const VulkanDevice& device) {
     return false;
   }
   sim::World w;
-  w.cloth = std::move(scene.cloth);
-  w.scene = std::move(scene.objects);
+  w.cloth = std::move(scene->cloth);
+  w.scene = std::move(scene->objects);
   w.solver = std::move(solver.value());
   sim::SimThreadOptions so;
   so.lock_step = opt_.sim_lock_step;
@@ -106,6 +152,7 @@ void DrapingSession::start_sim() {
     feedback_.set_help(help_lines(commands_));
     // Live (the user at the headset or the desk window, no scenario): the help first.
     if (opt_.scenario_path.empty()) feedback_.show_help_until(kIntroHelpFrames);
+    if (opt_.log_state_hashes) hash_outcomes(w);
   }
   profile_ticks(w);
   // Lock step: the ticks run on the frame loop's thread inside advance() (no hand-off per frame).

@@ -34,6 +34,17 @@ struct XrAppOptions {
   int eye_size = 0;         // swapchain edge (px); 0 = the runtime's recommendation
   bool render = true;       // draw the scene (drape_render) or submit the images undrawn
   int cloth_res = 24;       // cloth resolution of the default scene
+  // The scene (desk_scene.hpp): "" = the default scenario's (sim::make_form_drape: muslin
+  // hanging from the 9AR form's chest line); else a start state ("spread", "rolled",
+  // "pinned-top") of the fabric `fabric` (from `fabrics_path`; "" = the built-in muslin) on the
+  // form `form_mesh` when set, else `form_measurements` when set, else the size `form_size`
+  // (measurements read from `forms_dir`, else built in).
+  std::string start;
+  std::string fabric = "muslin", fabrics_path;
+  std::string form_size = "9AR", form_measurements, form_mesh, forms_dir;
+  // The sim's messages get the cloth's state hash before and after each operation's outcome
+  // (tests: an undo restores the hash from before the operation).
+  bool log_state_hashes = false;
   int max_session_restarts = 3;
   bool verbose = false;
   // Interaction (needs the renderer/sim build): hands (XR joints, else controller grips) and
