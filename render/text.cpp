@@ -233,16 +233,18 @@ float legible_scale(const PanelStyle& s, float rad_per_pixel, float distance, fl
   return std::clamp(min_px / px_per_line, 1.0f, 3.0f);
 }
 
-Mat4f head_locked_panel(const Pose& head, float panel_height, float distance, float drop) {
+Mat4f head_locked_panel(const Pose& head, float panel_height, float distance, float drop,
+                        float max_centre_drop) {
   const Eigen::Matrix3f r = head.orientation.toRotationMatrix();
-  const Vec3f top = head.position + r * Vec3f(0, -drop, -distance);
-  const Vec3f centre = top - r.col(1) * (0.5f * panel_height);
+  const float centre_drop = std::min(drop + 0.5f * panel_height, max_centre_drop);
+  const Vec3f centre = head.position + r * Vec3f(0, -centre_drop, -distance);
+  const Vec3f top = centre + r.col(1) * (0.5f * panel_height);
   // Facing the eye: the panel's normal (+z) points from its centre to the eye; its x stays the
   // head's right, so the panel turns about the head's horizontal axis only.
   const Vec3f z = (head.position - centre).normalized();
   const Vec3f x = (r.col(0) - r.col(0).dot(z) * z).normalized();
   const Vec3f y = z.cross(x);
-  // The top edge keeps its place: the panel hangs from it.
+  // The origin of the panel's plane is the middle of its top edge.
   Mat4f m = Mat4f::Identity();
   m.block<3, 1>(0, 0) = x;
   m.block<3, 1>(0, 1) = y;

@@ -81,9 +81,11 @@ TextMesh build_text_panel(const FontAtlas& font, const std::vector<std::string>&
 
 // Where the panel hangs for a head at `head` (the eye looking down its local -z): the middle of
 // its top edge `distance` in front of the eye and `drop` below the line of sight, turned to face
-// the eye. Maps the panel's plane (TextVertex::pos, z = 0) to stage space.
+// the eye; a tall panel (the help) is raised so that its centre is at most `max_centre_drop`
+// below the line of sight, so it stays in view. Maps the panel's plane (TextVertex::pos, z = 0)
+// to stage space.
 Mat4f head_locked_panel(const Pose& head, float panel_height, float distance = 0.55f,
-                        float drop = 0.04f);
+                        float drop = 0.04f, float max_centre_drop = 0.15f);
 // The pose of a view's eye (the inverse of View::view).
 Pose pose_of(const View& view);
 

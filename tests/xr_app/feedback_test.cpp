@@ -60,7 +60,7 @@ const std::string kManifest = std::string(DRAPE_BINARY_DIR) + "/bin/drape_mock_r
 
 // Runs a lock-step session of the scenario (the right hand away from the cloth, pinching or
 // not), writing the left eye's frames to dir/frames.
-drape::app::XrAppResult run(const fs::path& dir, bool pinch) {
+drape::app::XrAppResult run(const fs::path& dir, bool pinch, bool live = false) {
   for (const char* v : {"DRAPE_MOCK_END_AFTER_FRAMES", "DRAPE_MOCK_LOSE_SESSION_AT_FRAME",
                         "XR_ENABLE_API_LAYERS", "DRAPE_MOCK_WRITE_EVERY"})
     unsetenv(v);
@@ -83,13 +83,31 @@ drape::app::XrAppResult run(const fs::path& dir, bool pinch) {
   o.eye_size = 512;
   o.cloth_res = 12;
   o.commands_path = std::string(DRAPE_SOURCE_DIR) + "/assets/commands.json";
-  o.scenario_path = sc;
+  // Live: the app is not told of the scenario the runtime plays (as at the desk window).
+  o.scenario_path = live ? "" : sc;
   o.voice = false;
   auto r = drape::app::run_xr_app(o);
   unsetenv("DRAPE_MOCK_WRITE_FRAMES");
   unsetenv("DRAPE_MOCK_SCENARIO");
   if (!r.error.empty()) std::printf("error: %s\n", r.error.c_str());
   return r;
+}
+
+// The pixels of two screenshots that differ (summed channel difference over 60), in the lower
+// and the upper half.
+std::pair<int, int> differing(const fs::path& a_png, const fs::path& b_png) {
+  auto a = drape::render::read_png(a_png.string());
+  auto b = drape::render::read_png(b_png.string());
+  EXPECT_TRUE(a.ok() && b.ok());
+  if (!a.ok() || !b.ok() || a->width != b->width || a->height != b->height) return {-1, -1};
+  int low = 0, high = 0;
+  for (int y = 0; y < a->height; ++y)
+    for (int x = 0; x < a->width; ++x) {
+      const uint8_t *pa = a->px(x, y), *pb = b->px(x, y);
+      const int d = std::abs(pa[0] - pb[0]) + std::abs(pa[1] - pb[1]) + std::abs(pa[2] - pb[2]);
+      if (d > 60) (y > a->height / 2 ? low : high) += 1;
+    }
+  return {low, high};
 }
 
 TEST(FeedbackPanel, PinchWithNothingWithinReachIsRefusedInView) {
@@ -103,29 +121,31 @@ TEST(FeedbackPanel, PinchWithNothingWithinReachIsRefusedInView) {
   EXPECT_NE(with.refusals[0].find("pinch: nothing within"), std::string::npos) << with.refusals[0];
   EXPECT_NE(with.refusals[0].find("of the right hand to pinch"), std::string::npos);
   EXPECT_TRUE(without.refusals.empty());
-  // Frame 30: the refusal (taken at ~frame 15) shows. The panel's part of the image (its
-  // rectangle projected from the head; the eyes sit a few millimetres beside it, hence the
-  // margin) differs; the rest of the frame is the same scene.
+  // Frame 30: the refusal (made when the pinch closed, ~frame 22) shows in the panel, which
+  // hangs below the line of sight: the lower half of the frame differs from the frame without
+  // it.
   const std::string f30 = "frame_000030.png";
-  auto a = drape::render::read_png((base / "feedback_refusal" / "frames" / f30).string());
-  auto b = drape::render::read_png((base / "feedback_no_refusal" / "frames" / f30).string());
-  ASSERT_TRUE(a.ok()) << a.error();
-  ASSERT_TRUE(b.ok()) << b.error();
-  ASSERT_EQ(a->width, b->width);
-  const int w = a->width, h = a->height;
-  // The panel hangs below the line of sight: the lower part of the view, the middle of it.
-  int differ_low = 0, differ_high = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const uint8_t *pa = a->px(x, y), *pb = b->px(x, y);
-      const int d = std::abs(pa[0] - pb[0]) + std::abs(pa[1] - pb[1]) + std::abs(pa[2] - pb[2]);
-      if (d <= 60) continue;
-      (y > h / 2 ? differ_low : differ_high) += 1;
-    }
+  const auto [differ_low, differ_high] = differing(base / "feedback_refusal" / "frames" / f30,
+                                                   base / "feedback_no_refusal" / "frames" / f30);
   std::printf("pixels that differ: %d below the middle, %d above\n", differ_low, differ_high);
-  EXPECT_GT(differ_low, 100);  // the refusal's text
+  EXPECT_GT(differ_low, 500);  // the refusal's text (two lines)
   // Above the line of sight the hand (pinched or open) alone may differ: far less.
   EXPECT_LT(differ_high, differ_low);
+}
+
+// A live session (no scenario known to the app) shows the help, every binding of the command
+// map, for its first seconds: the panel is far larger than a scripted session's.
+TEST(FeedbackPanel, LiveSessionShowsTheHelpFirst) {
+  const fs::path base = fs::path(DRAPE_BINARY_DIR) / "xr_test_out";
+  const auto live = run(base / "feedback_live", false, true);
+  const auto scripted = run(base / "feedback_scripted", false);
+  ASSERT_EQ(live.exit_code, 0);
+  ASSERT_EQ(scripted.exit_code, 0);
+  const std::string f5 = "frame_000005.png";
+  const auto [low, high] =
+      differing(base / "feedback_live" / "frames" / f5, base / "feedback_scripted" / "frames" / f5);
+  std::printf("help vs no help, pixels that differ: %d below the middle, %d above\n", low, high);
+  EXPECT_GT(low, 20000);  // ~22 lines of help at 512 px over 90 degrees
 }
 #endif
 
