@@ -11,6 +11,13 @@
 
 namespace drape::app {
 
+namespace {
+// The phrase the panel shows: what the decoder heard, or a mark when it heard no word at all.
+std::string shown_phrase(const tracking::VoiceResult& vr) {
+  return vr.hypothesis.empty() ? "(no words)" : vr.hypothesis;
+}
+}  // namespace
+
 void DrapingSession::load_cues() {
   if (!opt_.voice_input.empty()) {
     live_voice_ = std::make_unique<VoiceInput>(opt_.voice_input);
@@ -64,7 +71,7 @@ void DrapingSession::hear_cues(int64_t frame, double t, std::vector<tracking::Tr
                              static_cast<double>(sg.speech_end - sg.start) / tracking::kVoiceRate);
     rep_.note("voice: frame " + std::to_string(frame) + " '" + c.wav + "' heard '" + vr.hypothesis +
               "' -> " + (vr.command.empty() ? "(rejected: " + vr.reason + ")" : vr.command));
-    feedback_.heard(frame, vr.hypothesis, vr.command);
+    feedback_.heard(frame, shown_phrase(vr), vr.command);
     if (!vr.command.empty()) {
       rep_.r.voice_commands.push_back(vr.command);
       trig.push_back({vr.command, "voice", t, tracking::Hand::Right, true});
@@ -92,7 +99,7 @@ void DrapingSession::hear_live_voice(int64_t frame, double t,
         h.vad_decode_ms);
     rep_.note("voice: frame " + std::to_string(frame) + " heard '" + vr.hypothesis + "' -> " +
               (vr.command.empty() ? "(rejected: " + vr.reason + ")" : vr.command) + lat);
-    feedback_.heard(frame, vr.hypothesis, vr.command);
+    feedback_.heard(frame, shown_phrase(vr), vr.command);
     if (h.latency_frames >= 0) rep_.r.voice_latency_frames.push_back(h.latency_frames);
     if (vr.command.empty()) continue;
     rep_.r.voice_commands.push_back(vr.command);
