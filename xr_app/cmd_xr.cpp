@@ -160,8 +160,7 @@ int cmd_xr(int argc, char** argv) {
        {"--no-ops", &opt.operations, "no interaction: hands and triggers do not drive the sim"},
        {"--full-form", &opt.form_lod,
         "draw the form at full detail (no level of detail from the eye size)"},
-       {"--no-malloc-tuning", &opt.tune_malloc, "let glibc trim freed memory every frame"},
-       {"--no-feedback-panel", &opt.feedback_panel, "no feedback panel over the scene"}});
+       {"--no-malloc-tuning", &opt.tune_malloc, "let glibc trim freed memory every frame"}});
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

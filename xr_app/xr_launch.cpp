@@ -94,6 +94,8 @@ void add_app_options(CLI::App& cli, XrAppOptions& opt) {
   cli.add_option("--cloth-res", opt.cloth_res, "cloth vertices across the default scene's panel")
       ->check(CLI::Range(4, 256));
   cli.add_flag("-v,--verbose", opt.verbose, "print the app's log as it happens");
+  add_off_switches(cli, {{"--no-feedback-panel", &opt.feedback_panel,
+                          "no feedback panel over the scene (tests of the cloth's image)"}});
   cli.add_option_function<std::string>(
          "--assets", [](const std::string& dir) { set_assets_dir(dir); },
          "the assets directory (default: <exe dir>/../share/drape/assets)")
