@@ -85,7 +85,7 @@ TextMesh build_text_panel(const FontAtlas& font, const std::vector<std::string>&
 // below the line of sight, so it stays in view. Maps the panel's plane (TextVertex::pos, z = 0)
 // to stage space.
 Mat4f head_locked_panel(const Pose& head, float panel_height, float distance = 0.55f,
-                        float drop = 0.04f, float max_centre_drop = 0.15f);
+                        float drop = 0.12f, float max_centre_drop = 0.24f);
 // The pose of a view's eye (the inverse of View::view).
 Pose pose_of(const View& view);
 
