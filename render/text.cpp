@@ -104,7 +104,6 @@ void pack_glyphs(FT_Face face, const std::vector<uint32_t>& cps, FontAtlas& a) {
 }  // namespace
 
 std::string default_font_path() {
-  if (const char* env = std::getenv("DRAPE_FONT"); env && *env) return env;
   return "/usr/share/fonts/truetype/dejavu/DejaVuSansMono.ttf";
 }
 
@@ -113,7 +112,7 @@ sim::Result<FontAtlas> load_font_atlas(const std::string& path, int pixel_size) 
   if (!std::filesystem::is_regular_file(path))
     return sim::make_error(where,
                            "no such file (install the Debian package fonts-dejavu-core, "
-                           "or name a TrueType file in DRAPE_FONT)");
+                           "or give the renderer another TrueType file)");
   if (pixel_size < 4 || pixel_size > 256)
     return sim::make_error(where, "pixel size " + std::to_string(pixel_size) + " out of 4..256");
   FT_Library lib = nullptr;

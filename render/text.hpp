@@ -15,8 +15,8 @@
 
 namespace drape::render {
 
-// The font of the panel: DejaVu Sans Mono of the Debian package fonts-dejavu-core. The
-// environment variable DRAPE_FONT names another file.
+// The font of the panel: DejaVu Sans Mono of the Debian package fonts-dejavu-core
+// (RendererOptions::font_path names another file).
 std::string default_font_path();
 
 struct Glyph {

@@ -279,18 +279,36 @@ bool ops_release(World& w, OperationsState& s, const OperationParams& p, int han
   return true;
 }
 
+// The particle a pin takes: the one the hand pinches, else the cloth under the hand (a pattern
+// maker also pins muslin where the hand lays it on the form; a tracked hand cannot hold a
+// thumb-index pinch while it makes the pin gesture). -1 with the reason reported.
+static int32_t pin_particle(World& w, const OperationsState& s, const OperationParams& p,
+                            int hand) {
+  if (s.pinched[hand] >= 0) return s.pinched[hand];
+  const std::string none = "pin: nothing pinched by the " + hand_name(hand);
+  if (!s.hand_valid[hand]) return w.report(none + " and it is not tracked: ignored"), -1;
+  const HandCandidates& hc = s.candidates[hand];
+  const int32_t v = hc.chosen_vertex();
+  const double reach = std::max(p.pinch_reach, s.hands[hand].radius);
+  if (v < 0 || hc.particles[hc.chosen].distance > reach)
+    return w.report(none + " and no cloth within " + cm(reach) + " of it: ignored"), -1;
+  if (is_pinched_by_any(s, v) || (w.cloth.state.flags[v] & kFlagKinematic))
+    return w.report(none + "; the cloth under it is held or moved: ignored"), -1;
+  return v;
+}
+
 bool ops_pin(World& w, OperationsState& s, const OperationParams& p, int hand) {
   if (!valid_index(hand)) return w.report("pin: no hand " + std::to_string(hand)), false;
-  if (s.pinched[hand] < 0)
-    return w.report("pin: nothing pinched by the " + hand_name(hand) + ": ignored"), false;
   ops_update_candidates(w, s, p);
+  const int32_t v = pin_particle(w, s, p, hand);
+  if (v < 0) return false;
   const HandCandidates& hc = s.candidates[hand];
+  const bool held = s.pinched[hand] == v;
   if (!hc.has_object_point)
     return w.report("pin: no object point within " + mm(p.pin_reach) + " of the " +
-                    hand_name(hand) + ": ignored (still pinched)"),
+                    hand_name(hand) + ": ignored" + (held ? " (still pinched)" : "")),
            false;
-  const int32_t v = s.pinched[hand];
-  s.pinched[hand] = -1;
+  if (held) s.pinched[hand] = -1;
   // Fix first, exactly on the chosen point; the rest relaxes around it for a few ticks; then the
   // particle is offset out of collision along the surface normal.
   set_vertex_flags(w.cloth, v, kFlagPinned, kFlagPinched);

@@ -141,12 +141,12 @@ TEST_F(Voice, CorruptAudioAndMissingMicrophoneGiveStatus) {
 }
 
 TEST_F(Voice, PhraseFileAndGrammar) {
-  // The shipped phrase file: nine distinct two-word phrases mapping to the nine commands.
+  // The shipped phrase file: twelve distinct two-word phrases mapping to the twelve commands.
   std::vector<VoicePhrase> ph;
   std::string err;
   ASSERT_TRUE(load_phrases(std::string(DRAPE_SOURCE_DIR) + "/assets/voice/phrases.tsv", ph, &err))
       << err;
-  ASSERT_EQ(ph.size(), 9u);
+  ASSERT_EQ(ph.size(), 12u);
   for (const auto& p : ph) EXPECT_NE(p.phrase.find(' '), std::string::npos) << p.phrase;
   VoiceRecognizer rec(VoiceConfig{});
   ASSERT_TRUE(rec.ok()) << rec.error();

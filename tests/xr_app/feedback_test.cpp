@@ -44,15 +44,24 @@ TEST(Feedback, HelpFromTheCommandMapAndForTheFirstSeconds) {
   Feedback f;
   const auto help = drape::app::help_lines(drape::tracking::CommandMap::defaults());
   ASSERT_GT(help.size(), 5u);
-  EXPECT_TRUE(contains(help, "gesture pinch begin: pinch begin")) << help[1];
+  EXPECT_TRUE(contains(help, "pin: right: thumb-middle pinch | thumbstick up | \"pin here\""))
+      << help[3];
+  EXPECT_TRUE(contains(help,
+                       "help: left: palm up (held) | left: controller rolled palm up (held) | "
+                       "\"show help\""))
+      << help.back();
   f.set_help(help);
-  EXPECT_FALSE(contains(f.lines(0), "gesture pinch begin"));
+  EXPECT_FALSE(contains(f.lines(0), "pinch: thumb-index pinch (held)"));
   f.show_help_until(720);
-  EXPECT_TRUE(contains(f.lines(719), "gesture pinch begin"));
-  EXPECT_FALSE(contains(f.lines(720), "gesture pinch begin"));
+  EXPECT_TRUE(contains(f.lines(719), "pinch: thumb-index pinch (held)"));
+  EXPECT_FALSE(contains(f.lines(720), "pinch: thumb-index pinch (held)"));
   EXPECT_NE(f.shown_version(719), f.shown_version(720));
+  const uint64_t hidden = f.version();
   f.show_help(true);  // held: shown whatever the frame
-  EXPECT_TRUE(contains(f.lines(5000), "gesture pinch begin"));
+  EXPECT_TRUE(contains(f.lines(5000), "pinch: thumb-index pinch (held)"));
+  EXPECT_NE(f.version(), hidden);  // showing it is a change the panel redraws
+  f.toggle_help();                 // the spoken "show help" again: hidden
+  EXPECT_FALSE(contains(f.lines(5000), "pinch: thumb-index pinch (held)"));
 }
 
 #ifdef DRAPE_XR_TEST_WITH_RENDER

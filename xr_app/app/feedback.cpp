@@ -34,6 +34,17 @@ void Feedback::set_status(const std::string& key, const std::string& message) {
   ++version_;
 }
 
+void Feedback::toggle_help() {
+  show_help_ = !show_help_;
+  ++version_;
+}
+
+void Feedback::show_help(bool on) {
+  if (show_help_ == on) return;
+  show_help_ = on;
+  ++version_;
+}
+
 void Feedback::show_help_until(int64_t frame) {
   help_until_ = frame;
   ++version_;
@@ -63,16 +74,33 @@ std::vector<std::string> Feedback::lines(int64_t frame) const {
   return out;
 }
 
-std::string help_line(const tracking::Binding& b) {
-  std::string when = b.source + " " + b.command;
-  if (!b.edge.empty() && b.edge != "any") when += " " + b.edge;
-  const std::string op = b.action.operation == "*" ? "stop" : b.action.operation;
-  return when + ": " + op + " " + tracking::phase_name(b.action.phase);
+std::string help_label(const tracking::Binding& b) {
+  std::string label = b.label.empty() ? b.source + " " + b.command : b.label;
+  if (!b.hand.empty()) label = b.hand + ": " + label;
+  return label;
 }
 
+// One line per operation: its gestures (the hand where it matters), the controller inputs every
+// profile shares, its phrase ("pin: right: thumb-middle pinch | thumbstick up | "pin here"").
+// The end of a held input is its begin's ("(held)" in the label); per-profile variants and the
+// palm-only trackers' gestures are in commands.json and `drape run --help`.
 std::vector<std::string> help_lines(const tracking::CommandMap& map) {
-  std::vector<std::string> out{"help: what each gesture, button and phrase does"};
-  for (const auto& b : map.bindings()) out.push_back(help_line(b));
+  static const char* kOps[] = {"pinch",  "move", "pin",  "release", "cut",  "map",
+                               "smooth", "next", "undo", "redo",    "stop", "help"};
+  std::vector<std::string> out{"help: each operation's gesture | buttons | phrase"};
+  for (const char* op : kOps) {
+    std::string by[3];  // gesture, controller, voice
+    for (const auto& b : map.bindings()) {
+      const std::string name = b.action.operation == "*" ? "stop" : b.action.operation;
+      if (name != op || b.edge == "end" || !b.profile.empty()) continue;
+      if (b.command == "palm_push" || b.command == "dwell") continue;  // palm-only trackers
+      const int k = b.source == "gesture" ? 0 : b.source == "controller" ? 1 : 2;
+      by[k] += (by[k].empty() ? "" : ", ") + help_label(b);
+    }
+    std::string line = std::string(op) + ":";
+    for (int k = 0; k < 3; ++k) line += (k ? " | " : " ") + (by[k].empty() ? "-" : by[k]);
+    out.push_back(line);
+  }
   return out;
 }
 

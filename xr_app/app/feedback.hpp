@@ -25,10 +25,10 @@ class Feedback {
   void refused(int64_t frame, const std::string& reason);
   // A state that lasts until cleared (key: "voice", "hands", ...; "" message clears it).
   void set_status(const std::string& key, const std::string& message);
-  // The help: every binding, one line each (set once from the command map).
+  // The help: a line per operation with its bindings (set once from the command map).
   void set_help(std::vector<std::string> lines) { help_ = std::move(lines); }
-  void toggle_help() { show_help_ = !show_help_; }
-  void show_help(bool on) { show_help_ = on; }
+  void toggle_help();
+  void show_help(bool on);
   bool help_shown() const { return show_help_; }
   // The help also shows before `frame` (the first seconds of a live session).
   void show_help_until(int64_t frame);
@@ -61,10 +61,9 @@ class Feedback {
   uint64_t version_ = 0;
 };
 
-// One line of the help: what a binding of the command map does ("gesture pinch begin: pinch
-// begin"). Kept to this one function so that more of a binding's fields can join the line.
-std::string help_line(const tracking::Binding& b);
-// The help: a title and one line per binding.
+// How the help names a binding's input: its label (else source and command), with its hand.
+std::string help_label(const tracking::Binding& b);
+// The help: a title and one line per operation with its gestures, buttons and phrase.
 std::vector<std::string> help_lines(const tracking::CommandMap& map);
 
 }  // namespace drape::app

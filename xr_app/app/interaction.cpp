@@ -230,9 +230,13 @@ std::vector<DrapingSession::Op> DrapingSession::map_triggers(
     line += " -> " + op.name + " " + tracking::phase_name(act->phase);
     rep_.r.triggers.push_back(line);
     if (opt_.verbose) rep_.note("trigger " + line);
-    // The help is the app's: shown while its gesture or button is held, not sent to the sim.
+    // The help is the app's, not sent to the sim: shown while its gesture or button is held;
+    // the spoken "show help" turns it on or off.
     if (op.name == "help") {
-      feedback_.show_help(act->phase != tracking::Phase::End);
+      if (act->phase == tracking::Phase::Toggle)
+        feedback_.toggle_help();
+      else
+        feedback_.show_help(act->phase != tracking::Phase::End);
       continue;
     }
     use.push_back(op);

@@ -300,6 +300,30 @@ TEST_P(Ops, PinchThenPin) {
   pinch_then_pin(*this);
 }
 
+// Pin without a pinch: the cloth under the hand is pinned onto the object point nearest it (the
+// tracked hand's pin gesture follows a released pinch), and undo takes it back exactly.
+TEST_P(Ops, PinWithoutAPinchPinsTheClothUnderTheHand) {
+  SetUpWorld(2);
+  run(3);
+  Box box;
+  box.centre = Vec3(0, 1.1, 0.25);
+  box.half = Vec3(0.1, 0.1, 0.1);
+  w.scene.boxes.push_back(box);
+  const int v = middle();
+  set(1, X(v));
+  const uint64_t h0 = state_hash(w.cloth);
+  ASSERT_FALSE(w.cloth.state.flags[v] & kFlagPinned);
+  trig("pin", TriggerPhase::kBegin);
+  ASSERT_TRUE(w.cloth.state.flags[v] & kFlagPinned) << "the particle under the hand";
+  EXPECT_LT(c->state().pinched[1], 0);
+  expect_undo_exact(h0);
+  set(1, Vec3(3, 3, 3));  // far from any cloth: refused, nothing changes
+  const uint64_t h1 = state_hash(w.cloth);
+  trig("pin", TriggerPhase::kBegin);
+  EXPECT_TRUE(has_message(w, "pin: nothing pinched by the right hand and no cloth within"));
+  EXPECT_EQ(state_hash(w.cloth), h1);
+}
+
 // --- cut ---------------------------------------------------------------------------------
 TEST_P(Ops, CutAlongPredeterminedLines) {
   // Vertical, horizontal and diagonal half-lines, and a full horizontal line.
@@ -662,9 +686,10 @@ TEST_P(Ops, BadInputIsIgnoredWithAReason) {
   trig("redo", TriggerPhase::kBegin);
   EXPECT_TRUE(has_message(w, "redo: nothing to redo"));
   EXPECT_EQ(state_hash(w.cloth), h0);
-  set(1, X(middle()));
+  set(1, X(middle()) + Vec3(0, 0.5, 0));  // no cloth within reach
   trig("pin", TriggerPhase::kBegin);
   EXPECT_TRUE(has_message(w, "pin: nothing pinched"));
+  set(1, X(middle()));
   c->cut_stroke(w, 1, {X(middle())});
   EXPECT_TRUE(has_message(w, "fewer than 2 samples"));
   c->cut_stroke(w, 1, {Vec3(3, 3, 3), Vec3(3.5, 3, 3)});
