@@ -119,7 +119,7 @@ finish_app latency
 
 echo "   load after: $(load)"
 python3 - "$WORK" "$LAT_LOG" "$REPEAT" "$(load)" "$(nproc)" <<'PY'
-import json, math, os, statistics, struct, sys, zlib
+import csv, json, math, os, statistics, struct, sys, zlib
 work, lat_log, repeat, load, cores = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
 runs = {res: [json.load(open(f"{work}/fps_{res}_{r}.json")) for r in range(1, repeat + 1)] for res in (64, 128)}
 med = lambda xs: statistics.median(xs) if xs else -1
@@ -206,10 +206,11 @@ rows = [("fps_64", fps64, ">= 30", out["goals_met"]["fps_64"]),
         ("frame_work_p50_ms_128", out["frame_work_p50_ms_128"], "", ""),
         ("sim_step_p50_ms_64", out["sim_step_p50_ms_64"], "", ""),
         ("sim_step_p50_ms_128", out["sim_step_p50_ms_128"], "", "")]
-with open("out/bench/desk.csv", "w") as f:
-    f.write("metric,value,goal,met\n")
+with open("out/bench/desk.csv", "w", newline="") as f:
+    w = csv.writer(f)  # quotes a note that holds a comma
+    w.writerow(["metric", "value", "goal", "met"])
     for k, v, g, m in rows:
-        f.write(f"{k},{v:.3f},{g},{m}\n")
+        w.writerow([k, f"{v:.3f}", g, m])
 print(f"{'metric':28s} {'value':>9s}  goal / note")
 for k, v, g, m in rows:
     print(f"{k:28s} {v:9.2f}  {g}{'' if m == '' else ('  met' if m else '  NOT met')}")

@@ -1163,7 +1163,7 @@ struct Renderer::Impl {
       // drawn in a second pass over a copy of it, so the depth under a hand is the surface it
       // is over, not its own pointer (a compositor reprojecting the scene, a desk runtime
       // placing the hand on it). The colour is the same as in one pass.
-      Status drawn = stored ? draw_ranges({1, 2, 3}) : draw_ranges({0, 1, 2, 3});
+      Status drawn = draw_ranges({1, 2, 3});
       if (drawn && stored) {
         vkCmdEndRenderPass(cmd);
         copy_depth(t, (*attachments_for(t.width, t.height, t.format, depth_fmt))->first.image);
@@ -1174,16 +1174,19 @@ struct Renderer::Impl {
         vkCmdBeginRenderPass(cmd, &rbi, VK_SUBPASS_CONTENTS_INLINE);
         vkCmdSetViewport(cmd, 0, 1, &viewport);
         vkCmdSetScissor(cmd, 0, 1, &scissor);
+      }
+      // The panel over the scene, in the pass whose depth is not the caller's; then the hands
+      // and markers over both, so the panel never hides the hand the user steers.
+      if (drawn)
+        drawn = text_record_draw(view, t.format, stored ? *overlay_rp : *rp, depth_fmt,
+                                 pc.flags[1] != 0);
+      if (drawn) {
         vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                            0, sizeof(pc), &pc);
         bound = VK_NULL_HANDLE;
         bound_vb = nullptr;
         drawn = draw_ranges({0});
       }
-      // The panel last, over the hands, in the pass whose depth is not the caller's.
-      if (drawn)
-        drawn = text_record_draw(view, t.format, stored ? *overlay_rp : *rp, depth_fmt,
-                                 pc.flags[1] != 0);
       if (!drawn) {
         vkCmdEndRenderPass(cmd);
         vkEndCommandBuffer(cmd);
