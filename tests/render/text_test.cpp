@@ -138,8 +138,8 @@ TEST(TextPanel, DrawnOverTheSceneWithGlyphsInsideItsRectangle) {
   auto plain = r->render_offscreen(s, v, W, H);
   ASSERT_TRUE(plain.ok()) << plain.error();
   TextPanel p;
-  p.lines = {"voice: listening (say \"show help\")", "left hand: -", "right hand: pinching particle 12",
-             "voice: heard \"pin here\" -> pin",
+  p.lines = {"voice: listening (say \"show help\")", "left hand: -",
+             "right hand: pinching particle 12", "voice: heard \"pin here\" -> pin",
              "pinch: nothing within 3 cm of the left hand to pinch"};
   p.version = 1;
   p.head = pose_of(v);
