@@ -54,7 +54,7 @@ constexpr const char* kDefaults = R"json({
     {"source": "voice", "command": "move", "edge": "any", "label": "\"move cloth\"", "phrase": "move cloth", "operation": "move", "phase": "toggle"},
     {"source": "voice", "command": "undo", "edge": "any", "label": "\"undo change\"", "phrase": "undo change", "operation": "undo", "phase": "once"},
     {"source": "voice", "command": "redo", "edge": "any", "label": "\"redo change\"", "phrase": "redo change", "operation": "redo", "phase": "once"},
-    {"source": "voice", "command": "smooth", "edge": "any", "label": "\"smooth cloth\"", "phrase": "smooth cloth", "operation": "smooth", "phase": "toggle"},
+    {"source": "voice", "command": "smooth", "edge": "any", "label": "\"smooth out\"", "phrase": "smooth out", "operation": "smooth", "phase": "toggle"},
     {"source": "voice", "command": "next", "edge": "any", "label": "\"next layer\"", "phrase": "next layer", "operation": "next", "phase": "once"},
     {"source": "voice", "command": "help", "edge": "any", "label": "\"show help\"", "phrase": "show help", "operation": "help", "phase": "toggle"},
     {"source": "controller", "command": "button.trigger", "edge": "begin", "profile": "khr/simple", "label": "select (held)", "operation": "pinch", "phase": "begin"},
