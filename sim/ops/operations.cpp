@@ -537,7 +537,56 @@ void ops_stop(World& w, OperationsState& s) {
   if (s.moving) ops_move_end(w, s);
 }
 
+bool hand_busy(const OperationsState& s, int hand) {
+  return s.pinched[hand] >= 0 || s.cutting[hand] || s.smoothing[hand] ||
+         (s.moving && s.move_vertex[hand] >= 0 && s.move_grabbed[hand]);
+}
+
+int grace_ticks(const OperationParams& p, double dt) {
+  const double g = p.tracking_grace;
+  if (!(g > 0) || !(dt > 0)) return 1;  // no grace (or a bad value): ends on the first tick
+  return std::max(1, static_cast<int>(std::ceil(g / dt - 1e-9)));
+}
+
+void ops_track_loss(World& w, OperationsState& s, const OperationParams& p, double dt) {
+  for (int h = 0; h < 2; ++h) {
+    if (s.hand_valid[h] || !hand_busy(s, h)) {
+      s.lost_ticks[h] = 0;
+      continue;
+    }
+    if (++s.lost_ticks[h] < grace_ticks(p, dt)) continue;
+    char secs[32];
+    std::snprintf(secs, sizeof secs, "%.2g s", s.lost_ticks[h] * dt);
+    const std::string lost = hand_name(h) + " lost for " + secs + ": ";
+    s.lost_ticks[h] = 0;
+    auto say = [&](const std::string& m) {
+      w.report(m);
+      s.loss_reports.push_back(m);
+      if (s.loss_reports.size() > 16) s.loss_reports.erase(s.loss_reports.begin());
+    };
+    if (s.pinched[h] >= 0) {
+      const int32_t v = s.pinched[h];
+      ops_pinch_end(w, s, h);
+      say("pinch: " + lost + "let go of particle " + std::to_string(v));
+    }
+    if (s.cutting[h]) {
+      s.cutting[h] = false;
+      s.stroke[h].clear();
+      say("cut: " + lost + "stroke cancelled, nothing cut");
+    }
+    if (s.smoothing[h]) {
+      s.smoothing[h] = false;
+      say("smooth: " + lost + "smoothing ended");
+    }
+    if (s.moving && s.move_vertex[h] >= 0) {
+      ops_move_end(w, s);
+      say("move: " + lost + "move ended, the corners fixed where they are");
+    }
+  }
+}
+
 void ops_before_step(World& w, OperationsState& s, const OperationParams& p, double dt) {
+  ops_track_loss(w, s, p, dt);
   Cloth& c = w.cloth;
   auto& st = c.state;
   const int n = c.num_vertices();

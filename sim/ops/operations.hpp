@@ -23,6 +23,9 @@ struct OperationParams {
   double smooth_pressure = 0.5;  // Pa: weak pressure toward the form (as geometric draping's)
   double ray_length = 0.40;      // m: candidate ray along the hand's pointing direction
   int max_candidates = 6;        // alternatives exposed per hand
+  // s: how long an operation waits for its hand after tracking drops out (held meanwhile);
+  // then it ends as if the user had ended it. Counted in ticks of the sim's dt.
+  double tracking_grace = 0.3;
   CutOptions cut;
 };
 
@@ -79,6 +82,12 @@ struct OperationsState {
   std::array<int, 2> selected{0, 0};
   std::array<HandCandidates, 2> candidates{};
   std::vector<CutStroke> cut_strokes;
+  // Ticks a hand doing an operation has been untracked (0: tracked, or doing nothing); the
+  // operation is held until this reaches the grace ticks (OperationParams::tracking_grace).
+  std::array<int, 2> lost_ticks{0, 0};
+  // The reports of operations ended by a lost hand, for the app to show and log (it takes them;
+  // the newest 16 are kept).
+  std::vector<std::string> loss_reports;
   // Last results (for tests and the status line).
   double last_pin_landing_error = -1;  // m, |final − (object point + offset·normal)|
   double last_pin_distance = -1;       // m, |final − object point|
@@ -114,6 +123,14 @@ bool ops_map(World& w, OperationsState& s);
 // Ends every operation in progress (an unfinished cut stroke is discarded).
 void ops_stop(World& w, OperationsState& s);
 
+// Whether the hand is doing an operation: pinching, cutting, smoothing or holding a moved corner.
+bool hand_busy(const OperationsState& s, int hand);
+// The grace time in ticks of dt (at least 1).
+int grace_ticks(const OperationParams& p, double dt);
+// Per tick: counts the ticks each busy hand has been untracked; once they reach the grace, ends
+// its operations as the user would (pinch let go, cut stroke cancelled, smoothing and move
+// ended) with a report naming the hand. Called by ops_before_step.
+void ops_track_loss(World& w, OperationsState& s, const OperationParams& p, double dt);
 // Per tick, before the solver step: drive pinched and moved particles to the hands, record cut
 // samples, press the cloth under smoothing hands.
 void ops_before_step(World& w, OperationsState& s, const OperationParams& p, double dt);

@@ -187,6 +187,153 @@ TEST_P(Ops, PinchWithTwoFixed) {
   pinch_and_carry(*this);
 }
 
+// --- tracking loss -----------------------------------------------------------------------
+int count_fixed(const Cloth& c) {
+  int n = 0;
+  for (uint8_t f : c.state.flags) n += (f & (kFlagPinned | kFlagKinematic)) ? 1 : 0;
+  return n;
+}
+
+// Lost mid-pinch and back within the grace: the particle waits where the hand was last seen
+// (fixed, not falling), then follows the hand again.
+TEST_P(Ops, PinchHeldWhileTheHandIsLostWithinTheGrace) {
+  SetUpWorld(2);
+  run(5);
+  const int v = middle();
+  set(1, X(v) + Vec3(0.005, 0.005, 0.005));
+  trig("pinch", TriggerPhase::kBegin);
+  ASSERT_EQ(c->state().pinched[1], v);
+  run(3);
+  const int g = grace_ticks(c->params(), testing::kDt);
+  EXPECT_EQ(g, 27);  // 0.3 s at 90 Hz
+  const Vec3 last = hands[1].position;
+  hands[1].tracked = false;
+  run(g - 1);
+  EXPECT_EQ(c->state().pinched[1], v);
+  EXPECT_EQ(c->state().lost_ticks[1], g - 1);
+  EXPECT_LT((X(v) - last).norm(), 1e-12);  // held, not falling
+  EXPECT_FALSE(has_message(w, "lost for"));
+  set(1, last + Vec3(0.02, 0.01, 0));
+  run(5);
+  EXPECT_EQ(c->state().pinched[1], v);
+  EXPECT_EQ(c->state().lost_ticks[1], 0);
+  EXPECT_LT((X(v) - hands[1].position).norm(), 1e-9);
+  EXPECT_FALSE(has_message(w, "lost for"));
+}
+
+// Lost for longer: the pinch ends at the grace tick (not before) as a pinch end would, with a
+// report; nothing else changes (no pin, no particle added, the undo history as it was).
+TEST_P(Ops, PinchLetGoAfterTheGrace) {
+  SetUpWorld(2);
+  run(5);
+  const int v = middle();
+  set(1, X(v) + Vec3(0.005, 0.005, 0.005));
+  const uint64_t h0 = state_hash(w.cloth);
+  trig("pinch", TriggerPhase::kBegin);
+  ASSERT_EQ(c->state().pinched[1], v);
+  const size_t undo = c->history().undo_size();
+  const int fixed = count_fixed(w.cloth), nv = w.cloth.num_vertices();
+  const int g = grace_ticks(c->params(), testing::kDt);
+  const Vec3 last = X(v);
+  hands[1].tracked = false;
+  run(g - 1);
+  ASSERT_EQ(c->state().pinched[1], v);
+  EXPECT_FALSE(has_message(w, "lost for"));
+  run(1);
+  EXPECT_EQ(c->state().pinched[1], -1);
+  EXPECT_EQ(c->state().lost_ticks[1], 0);
+  EXPECT_TRUE(
+      has_message(w, "pinch: right hand lost for 0.3 s: let go of particle " + std::to_string(v)));
+  EXPECT_FALSE(w.cloth.state.flags[v] & (kFlagPinched | kFlagPinned));
+  EXPECT_GT(w.cloth.state.inv_mass[v], 0);
+  EXPECT_EQ(count_fixed(w.cloth), fixed);
+  EXPECT_EQ(w.cloth.num_vertices(), nv);
+  EXPECT_EQ(c->history().undo_size(), undo);
+  run(20);
+  EXPECT_LT(X(v).y(), last.y());  // freed: falls under gravity
+  // The hand back later takes nothing by itself; undo still returns to before the pinch.
+  set(1, last);
+  run(2);
+  EXPECT_EQ(c->state().pinched[1], -1);
+  trig("undo", TriggerPhase::kBegin);
+  EXPECT_EQ(state_hash(w.cloth), h0);
+}
+
+// Lost mid-cut: the stroke pauses, then is cancelled after the grace; nothing is cut.
+TEST_P(Ops, CutStrokeCancelledWhenTheHandIsLost) {
+  SetUpWorld(2);
+  run(30);
+  const int row = 6;
+  const int nv = w.cloth.num_vertices();
+  set(1, X(row * 9) + (X(row * 9) - X(row * 9 + 8)) * 0.05);
+  trig("cut", TriggerPhase::kBegin);
+  for (int i = 0; i <= 10; ++i) {
+    set(1, X(row * 9) + (X(row * 9 + 8) - X(row * 9)) * (-0.05 + 1.1 * i / 20.0));
+    run(1);
+  }
+  const size_t samples = c->state().stroke[1].size();
+  hands[1].tracked = false;
+  const int g = grace_ticks(c->params(), testing::kDt);
+  run(g - 1);
+  EXPECT_TRUE(c->state().cutting[1]);
+  EXPECT_EQ(c->state().stroke[1].size(), samples);  // paused: no samples while lost
+  run(1);
+  EXPECT_FALSE(c->state().cutting[1]);
+  EXPECT_TRUE(c->state().stroke[1].empty());
+  EXPECT_TRUE(has_message(w, "cut: right hand lost for 0.3 s: stroke cancelled"));
+  set(1, X(row * 9 + 8) + (X(row * 9 + 8) - X(row * 9)) * 0.05);
+  run(1);
+  trig("cut", TriggerPhase::kEnd);  // the user's end comes too late: nothing to cut
+  EXPECT_TRUE(has_message(w, "cut end: the right hand is not cutting"));
+  EXPECT_EQ(count_components(w.cloth), 1);
+  EXPECT_EQ(w.cloth.num_vertices(), nv);
+  EXPECT_TRUE(c->state().cut_strokes.empty());
+  EXPECT_EQ(c->history().undo_size(), 0u);
+}
+
+// A non-finite pose is reported and the previous pose kept, as before; held that long it is a
+// lost hand: the pinch ends after the grace.
+TEST_P(Ops, NonFinitePoseIsALostHand) {
+  SetUpWorld(2);
+  run(5);
+  const int v = middle();
+  set(1, X(v) + Vec3(0.005, 0.005, 0.005));
+  trig("pinch", TriggerPhase::kBegin);
+  ASSERT_EQ(c->state().pinched[1], v);
+  const Vec3 last = hands[1].position;
+  hands[1].position = Vec3(std::nan(""), 0, 0);
+  const int g = grace_ticks(c->params(), testing::kDt);
+  run(g - 1);
+  EXPECT_TRUE(has_message(w, "not finite"));
+  EXPECT_TRUE((c->state().hands[1].position - last).norm() < 1e-12);  // previous pose kept
+  EXPECT_EQ(c->state().pinched[1], v);
+  EXPECT_LT((X(v) - last).norm(), 1e-12);
+  run(1);
+  EXPECT_EQ(c->state().pinched[1], -1);
+  EXPECT_TRUE(has_message(w, "pinch: right hand lost for 0.3 s: let go"));
+  EXPECT_EQ(w.cloth.validate(), "");
+}
+
+// A move with a hand lost past the grace ends as a move end does: the corners stay fixed.
+TEST_P(Ops, MoveEndedWhenAHandIsLost) {
+  SetUpWorld(2);
+  run(5);
+  set(0, X(top(0)) + Vec3(0, 0.001, 0));
+  set(1, X(top(8)) + Vec3(0, 0.001, 0));
+  trig("move", TriggerPhase::kBegin);
+  ASSERT_TRUE(c->state().moving);
+  run(2);
+  hands[0].tracked = false;
+  const int g = grace_ticks(c->params(), testing::kDt);
+  run(g - 1);
+  EXPECT_TRUE(c->state().moving);
+  run(1);
+  EXPECT_FALSE(c->state().moving);
+  EXPECT_TRUE(has_message(w, "move: left hand lost for 0.3 s: move ended"));
+  EXPECT_TRUE(w.cloth.state.flags[top(0)] & kFlagPinned);
+  EXPECT_TRUE(w.cloth.state.flags[top(8)] & kFlagPinned);
+}
+
 // --- release -----------------------------------------------------------------------------
 TEST_P(Ops, ReleaseWithOneFixedLetsTheClothFall) {
   SetUpWorld(1);
