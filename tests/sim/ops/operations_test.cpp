@@ -334,6 +334,34 @@ TEST_P(Ops, MoveEndedWhenAHandIsLost) {
   EXPECT_TRUE(w.cloth.state.flags[top(8)] & kFlagPinned);
 }
 
+// The grace counts ticks, so a recorded session with a lost hand replays to the same cloth:
+// the let-go happens at the same tick.
+TEST_P(Ops, TrackingLossReplaysBitExact) {
+  SetUpWorld(2);  // no tick before the recording: the replay's solver starts as fresh
+  const int v = middle();
+  set(1, X(v) + Vec3(0.005, 0.005, 0.005));
+  c->start_recording(w);
+  trig("pinch", TriggerPhase::kBegin);
+  run(5);
+  hands[1].tracked = false;
+  run(10);  // within the grace
+  set(1, hands[1].position + Vec3(0.01, 0, 0));
+  run(5);
+  hands[1].tracked = false;
+  run(40);  // past it: let go
+  SessionLog log = c->stop_recording(w);
+  ASSERT_TRUE(has_message(w, "let go of particle"));
+  World w2 = testing::make_world(GetParam(), 2);
+  OperationController c2;
+  c2.install(w2);
+  c2.start_replay(w2, std::move(log));
+  for (int i = 0; i < 60; ++i) tick(w2);
+  EXPECT_FALSE(c2.replaying());
+  EXPECT_TRUE(has_message(w2, "let go of particle " + std::to_string(v)));
+  EXPECT_TRUE(has_message(w2, "matches the recording"));
+  EXPECT_EQ(state_hash(w2.cloth), state_hash(w.cloth));
+}
+
 // --- release -----------------------------------------------------------------------------
 TEST_P(Ops, ReleaseWithOneFixedLetsTheClothFall) {
   SetUpWorld(1);
