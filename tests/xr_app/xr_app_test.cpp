@@ -772,6 +772,65 @@ TEST(XrApp, HeldControllersJointsMakeNoGestures) {
   EXPECT_EQ(got, want);
 }
 
+// Tracking loss in lock step: the right hand pinches the cloth with XR_EXT_hand_tracking
+// joints, loses tracking for 10 frames (within the sim's 0.3 s grace: 27 ticks at 90 Hz) and
+// comes back still pinching: the same pinch goes on, no let-go. Then it is lost for 60 frames:
+// the sim lets go at the grace, with the line in the session's log, and no gesture end reaches
+// the sim (it has ended the pinch itself).
+TEST(XrApp, LostHandHoldsThePinchForTheGrace) {
+  base_env();
+  const fs::path dir = fresh_out_dir("app_tracking_loss");
+  const std::string sc = (dir / "scenario.json").string();
+  auto hand = [](double x, int f, double pinch) {
+    char b[160];
+    std::snprintf(b, sizeof b,
+                  "{\"frame\": %d, \"palm\": {\"position\": [%.2f, 1.02, 0.21]}, \"pinch\": %.1f}",
+                  f, x, pinch);
+    return std::string(b);
+  };
+  auto lost = [](int f) { return "{\"frame\": " + std::to_string(f) + ", \"tracked\": false}"; };
+  // Right: pinch from frame 10; lost 31..40 (10 frames); back pinching 41..70; lost 71..130
+  // (60 frames); back open from 131.
+  std::ofstream(sc) << "{\"name\": \"tracking_loss\", \"end_after_frames\": 150, \"fast\": true,\n"
+                    << "\"head\": [{\"frame\": 0, \"position\": [0.0, 1.3, 1.2]}],\n"
+                    << "\"hands\": {\"right\": [" << hand(0.12, 0, 0) << ", " << hand(0.12, 9, 0)
+                    << ", " << hand(0.12, 10, 1) << ", " << hand(0.12, 30, 1) << ", " << lost(31)
+                    << ", " << lost(40) << ", " << hand(0.12, 41, 1) << ", " << hand(0.12, 70, 1)
+                    << ", " << lost(71) << ", " << lost(130) << ", " << hand(0.12, 131, 0) << ", "
+                    << hand(0.12, 150, 0) << "],\n\"left\": [" << hand(-0.3, 0, 0) << ", "
+                    << hand(-0.3, 150, 0) << "]}}\n";
+  auto o = small();
+  play_scenario(o, sc);
+  o.eye_size = 64;
+  o.cloth_res = 8;
+  o.voice = false;
+  auto r = drape::app::run_xr_app(o);
+  print(r);
+  for (const auto& m : r.log) std::printf("log: %s\n", m.c_str());
+  ASSERT_EQ(r.exit_code, 0) << r.error;
+  // One pinch begin (the gesture), no end: neither loss ends it from the app's side.
+  std::vector<std::string> got;
+  for (const auto& t : r.triggers) {
+    long long f = -1;
+    char rest[256] = {};
+    if (std::sscanf(t.c_str(), "frame %lld: %255[^\n]", &f, rest) == 2) got.push_back(rest);
+  }
+  EXPECT_EQ(got, std::vector<std::string>{"gesture pinch begin hand right -> pinch begin"});
+  auto count = [&](const std::string& m) {
+    return std::count_if(r.log.begin(), r.log.end(),
+                         [&](const std::string& x) { return x.find(m) != std::string::npos; });
+  };
+  // The grace shown twice (each loss), the let-go once (the long loss only).
+  EXPECT_EQ(count("right hand lost: holding the pinch"), 2);
+  EXPECT_EQ(count("pinch: right hand lost for 0.3 s: let go"), 1);
+  // Held from the pinch (frame 10 + the recognizer's 80 ms) through the short loss to the
+  // long loss's grace (frame 71 + 27 ticks): about 80 frames; let go at the grace, so well
+  // under the 130 frames to the end.
+  std::printf("frames pinched %lld\n", static_cast<long long>(r.frames_pinched));
+  EXPECT_GE(r.frames_pinched, 75);
+  EXPECT_LE(r.frames_pinched, 92);
+}
+
 TEST(XrApp, SessionLossIsAnOrdinaryState) {
   base_env();
   setenv("DRAPE_MOCK_LOSE_SESSION_AT_FRAME", "5", 1);

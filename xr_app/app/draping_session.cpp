@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <filesystem>
@@ -35,6 +36,14 @@ bool is_refusal(const std::string& m) {
 
 // What the hand is doing, for the panel ("" when nothing).
 std::string operation_text(const sim::OperationsState& st, int h) {
+  // Tracking lost: the sim holds the operation for its grace time (sim::ops_track_loss).
+  if (st.lost_ticks[h] > 0 && sim::hand_busy(st, h)) {
+    const char* op = st.pinched[h] >= 0 ? "the pinch"
+                     : st.cutting[h]    ? "the cut"
+                     : st.smoothing[h]  ? "the smoothing"
+                                        : "the move";
+    return std::string("lost: holding ") + op;
+  }
   if (st.pinched[h] >= 0) return "pinching particle " + std::to_string(st.pinched[h]);
   if (st.cutting[h]) return "cutting";
   if (st.smoothing[h]) return "smoothing";
@@ -146,6 +155,7 @@ void DrapingSession::start_sim() {
   if (opt_.operations) {
     ops_ = std::make_shared<sim::OperationController>();
     ops_->install(w);
+    grace_frames_ = static_cast<int>(std::ceil(ops_->params().tracking_grace * 90.0));
     ops_->start_recording(w);
     load_cues();
     load_commands();
@@ -352,15 +362,28 @@ void DrapingSession::apply_triggers(sim::World& w, const std::vector<Op>& use,
   w.messages.swap(kept);
   std::lock_guard lock(out.m);
   for (auto& m : said) out.messages.push_back(std::move(m));
+  for (auto& m : ops.state().loss_reports) out.lost.push_back(std::move(m));
+  ops.state().loss_reports.clear();
   for (int h = 0; h < 2; ++h) out.operation[h] = operation_text(ops.state(), h);
 }
 
 // On the frame loop: the refusals and the hands' operations into the panel.
 void DrapingSession::drain_said(int64_t frame) {
-  std::vector<std::string> messages;
+  std::vector<std::string> messages, lost;
   std::lock_guard lock(said_->m);
   messages.swap(said_->messages);
-  for (int h = 0; h < 2; ++h) feedback_.set_operation(h, said_->operation[h]);
+  lost.swap(said_->lost);
+  for (int h = 0; h < 2; ++h) {
+    // The grace after a tracking loss, once into the log ("right hand lost: holding the pinch").
+    const std::string& op = said_->operation[h];
+    if (op.rfind("lost:", 0) == 0 && op != feedback_.operation(h))
+      rep_.note(std::string(h == 0 ? "left" : "right") + " hand " + op);
+    feedback_.set_operation(h, op);
+  }
+  for (const auto& m : lost) {  // shown like a refusal: the user did not end it
+    feedback_.refused(frame, m);
+    rep_.note(m);
+  }
   for (const auto& m : messages) {
     if (!is_refusal(m)) continue;
     feedback_.refused(frame, m);

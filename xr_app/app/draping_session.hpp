@@ -88,6 +88,7 @@ class DrapingSession : public SessionContent {
     std::mutex m;
     std::vector<std::string> messages;
     std::string operation[2];
+    std::vector<std::string> lost;  // operations the sim ended for a lost hand
   };
   // On the sim thread: applies the triggers, keeping what they report (World::messages keeps it
   // too) and each hand's operation afterwards.
@@ -112,6 +113,10 @@ class DrapingSession : public SessionContent {
   tracking::CommandMap commands_;              // triggers -> operations (assets/commands.json)
   std::vector<render::HandOverlay> overlays_;  // this frame's hands, drawn from its own pose
   bool ops_busy_[2] = {false, false}, cutting_[2] = {false, false};
+  // Frames each hand's joints have been lost (held controller aside), and the sim's grace time
+  // in frames: the gestures are kept as they were while the sim holds the hand's operation.
+  int lost_frames_[2] = {0, 0};
+  int grace_frames_ = 0;
   std::shared_ptr<FreeOutcomes> free_ = std::make_shared<FreeOutcomes>();
   int pinned_at_start_ = 0;
   std::vector<Posted> posted_;                // right-hand pose posted per frame

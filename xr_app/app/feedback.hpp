@@ -18,6 +18,7 @@ class Feedback {
  public:
   // The operation the hand (0 left, 1 right) is doing now; "" when none.
   void set_operation(int hand, const std::string& op);
+  const std::string& operation(int hand) const { return op_[hand == 0 ? 0 : 1]; }
   // A voice command recognised: the phrase heard and the command it gave ("" when rejected).
   void heard(int64_t frame, const std::string& phrase, const std::string& command);
   // An operation refused, with its reason ("pinch: nothing within 3 cm to pinch"); shown for a

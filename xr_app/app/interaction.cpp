@@ -155,7 +155,16 @@ void DrapingSession::read_hand(int h, double t, const HandInput& in, sim::HandPr
       // are ignored (a lost frame ends any in progress) so that a button never fires twice.
       tracking::HandFrame g = f;
       g.tracked = f.tracked && !in.controllers[h].active;
-      gestures_.update(g, trig);
+      lost_frames_[h] = f.tracked || in.controllers[h].active ? 0 : lost_frames_[h] + 1;
+      if (lost_frames_[h] == 0) {
+        gestures_.update(g, trig);
+      } else if (lost_frames_[h] > grace_frames_) {
+        // Lost past the sim's grace: the sim has ended the hand's operations itself
+        // (sim::ops_track_loss), so the ends the recognizer makes now are not sent. Within the
+        // grace the recognizer keeps its state: a hand back in time goes on with its gesture.
+        std::vector<tracking::Trigger> ended;
+        gestures_.update(g, ended);
+      }
       if (f.tracked && f.has_joints) {
         joint_frame = f;
         have_joint_frame = true;
