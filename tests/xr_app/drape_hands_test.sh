@@ -46,6 +46,7 @@ case $mode in
     ;;
   udp|noisy)
     scenario 1000 false
+    : >"$log"
     xr --hands "udp:127.0.0.1:$port" >"$log" 2>&1 &
     app=$!
     for _ in $(seq 1 300); do grep -q "hands: udp: no packets yet" "$log" && break; sleep 0.1; done
