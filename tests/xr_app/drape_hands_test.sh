@@ -3,6 +3,7 @@
 #   trace   --hands trace FILE: a trace of the right palm approaching the cloth, a palm push (the
 #           pinch on), a move, a dwell (release), a second palm push (the pinch off) -> the log
 #           shows the pinch taking a particle, the release and the pinch letting it go.
+#   calibrated the same trace 0.5 m lower, lifted into the stage by --calibration FILE.
 #   udp     the same poses sent over UDP at their timestamps (--hands udp:127.0.0.1:PORT).
 #   noisy   the same with malformed and out-of-order packets mixed in: a message, still the pinch.
 #   missing --hands trace with no such file: exit 2 naming the file; a bad --hands value: exit 2
@@ -34,6 +35,7 @@ check_pinch() {
   grep -q "pinch: right hand took particle" "$s" || fail "the pinch took no particle"
   grep -q "gesture dwell begin hand right -> release" "$s" || fail "no dwell -> release"
   grep -q "pinch: right hand let particle .* go" "$s" || fail "the pinch never let go"
+  grep -q "pinned_added -1 " "$s" || fail "the dwell did not release exactly one pin"
   grep "pinch: right hand\|-> release\|pinched_frames" "$s"
 }
 case $mode in
@@ -42,6 +44,19 @@ case $mode in
     scenario 600 true
     xr --hands trace "$work/hands.csv" >"$log" 2>&1 || fail "exit code $?"
     grep -q "hands: trace source" "$log" || fail "the trace source not opened"
+    check_pinch
+    ;;
+  calibrated)  # the trace in a tracker frame 0.5 m below the stage's, --calibration lifts it
+    python3 "$here/hands_trace.py" trace "$work/hands.csv" 0.11 0.65 0.115 || fail "trace writer"
+    cat >"$work/calibration.json" <<JSON
+{"format": "drape-calibration", "version": 1, "scale": 1.0,
+ "rotation": [[1,0,0],[0,1,0],[0,0,1]], "translation": [0, 0.5, 0],
+ "rms_residual_m": 0.002, "max_residual_m": 0.004, "pairs": 4}
+JSON
+    scenario 600 true
+    xr --hands trace "$work/hands.csv" --calibration "$work/calibration.json" >"$log" 2>&1 ||
+      fail "exit code $?"
+    grep -q "hands: calibration .*calibration.json" "$log" || fail "the calibration not loaded"
     check_pinch
     ;;
   udp|noisy)
