@@ -24,13 +24,14 @@ def path(p):
     """(time, position) of the palm at RATE: segments of straight motion and holds."""
     px, py, pz = p
     start = (px, py, pz + 0.35)
-    before_push = (px, py, pz + 0.14)
-    at_cloth = (px, py, pz - 0.01)
+    before_push = (px, py, pz + 0.13)
+    at_cloth = (px, py, pz - 0.04)  # through it: the push fires ~12 cm in
     moved = (px + 0.08, py - 0.05, pz + 0.10)
     pushed = (moved[0], moved[1], moved[2] - 0.15)
     segments = [  # (from, to, seconds)
-        (start, before_push, 1.6),     # the approach: 13 cm/s, no push
-        (before_push, at_cloth, 0.2),  # palm push: 75 cm/s
+        (start, before_push, 1.5),     # the approach: 13 cm/s, no push
+        (before_push, before_push, 0.4),  # a short rest: the push is measured from here
+        (before_push, at_cloth, 0.25),  # palm push: 68 cm/s
         (at_cloth, moved, 1.2),        # the move (backwards: no push)
         (moved, moved, 1.5),           # dwell
         (moved, pushed, 0.2),          # palm push again: the pinch off
