@@ -141,9 +141,9 @@ void add_hands_options(CLI::App& cli, std::vector<std::string>& hands, std::stri
   cli.add_option("--hands", hands,
                  "where the hands come from: xr (the runtime's), udp[:ADDR:PORT] (a skeleton "
                  "stream, docs/tracking.md; default 127.0.0.1:9740) or trace FILE (a recorded "
-                 "trace played from the first frame) (default: xr)")
+                 "trace played from the first frame)")
       ->expected(1, 2)
-      ->always_capture_default(false);
+      ->default_str("xr");
   cli.add_option("--calibration", calibration,
                  "tracker-to-stage calibration file (tracking/calibration's JSON) for --hands "
                  "udp or trace (default: identity)")
