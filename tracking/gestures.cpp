@@ -117,14 +117,16 @@ void GestureRecognizer::update_joints(const HandFrame& f, State& s, std::vector<
 // Palm-only source: dwell and push from the palm trajectory.
 void GestureRecognizer::update_palm_only(const HandFrame& f, State& s, std::vector<Trigger>& out) {
   const Vec3 p = f.palm.position;
-  // dwell: every sample in the last dwell_time within dwell_radius of the current position.
-  bool still = s.history.front().first <= f.time - p_.dwell_time + 1e-9;
+  // dwell: every sample in the last dwell_time within dwell_radius of the current position. Only
+  // a move re-arms it: a gap in the samples (a source's burst) shortens the history, not the stay.
+  bool moved = false;
   for (const auto& [t, q] : s.history)
-    if (t >= f.time - p_.dwell_time && (q - p).norm() > p_.dwell_radius) still = false;
+    if (t >= f.time - p_.dwell_time && (q - p).norm() > p_.dwell_radius) moved = true;
+  const bool still = !moved && s.history.front().first <= f.time - p_.dwell_time + 1e-9;
   if (still && !s.dwell_fired) {
     out.push_back(Trigger{"dwell", "gesture", f.time, f.hand, true});
     s.dwell_fired = true;
-  } else if (!still && s.dwell_fired) {
+  } else if (moved) {
     s.dwell_fired = false;
   }
   if (f.time >= s.push_block_until) {

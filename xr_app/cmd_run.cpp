@@ -219,7 +219,9 @@ std::string make_voice_wav(const std::string& dir, const std::string& name,
 struct XrRunOptions {
   drape::app::XrAppOptions app;
   std::string scenario = "assets/scenarios/default.json", out = "out";
-  std::string voice;  // --voice as given ("" = the default of the session's kind)
+  std::string voice;               // --voice as given ("" = the default of the session's kind)
+  std::vector<std::string> hands;  // --hands as given (resolved into app by resolve_hands)
+  std::string calibration;         // --calibration as given
   bool pattern = true;
   int every = 30;
   bool scenario_given = false;   // --scenario: always the scripted run
@@ -473,6 +475,7 @@ int run_xr(XrRunOptions& o) {
   const bool window = simulated && app::has_display() && !o.scenario_given;
   const bool headset = !app::simulated_runtime(manifest, simulated);
   if (!app::resolve_voice("drape run", o.voice, window || headset, o.app.voice_input)) return 2;
+  if (!app::resolve_hands("drape run", o.hands, o.calibration, o.app)) return 2;
   if (window || (headset && !o.scenario_given)) {
     if (!o.cloth_res_given) o.app.cloth_res = kLiveClothRes;
     if (!o.eye_size_given && !simulated) o.app.eye_size = 0;  // the headset's own size
@@ -540,6 +543,7 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
   cli.add_option("--every", o.every, "write every K-th frame's screenshot (live default: 90)")
       ->check(CLI::Range(1, 1000000));
   drape::app::add_voice_option(cli, o.voice);
+  drape::app::add_hands_options(cli, o.hands, o.calibration);
   cli.add_option("--form", o.form,
                  "the dress form: a standard size (7AR, 9AR, 11AR, 13AR) or a measurements file "
                  "(JSON, as assets/forms/9AR.json)");

@@ -142,6 +142,9 @@ int cmd_xr(int argc, char** argv) {
                  "the scenario the simulated runtime plays (default: $DRAPE_MOCK_SCENARIO); its "
                  "audio cues are the voice input");
   app::add_voice_option(cli, voice);
+  std::vector<std::string> hands;
+  std::string calibration;
+  app::add_hands_options(cli, hands, calibration);
   cli.add_option("--pose-wait-ms", opt.pose_wait_ms,
                  "free sim: how long a frame waits for the tick that took its hand pose")
       ->check(CLI::Range(0.0, 1000.0));
@@ -183,6 +186,7 @@ int cmd_xr(int argc, char** argv) {
                     (app::mock_window() && opt.scenario_path.empty());
   if (live) opt.voice = false;
   if (!app::resolve_voice("drape xr", voice, live, opt.voice_input)) return 2;
+  if (!app::resolve_hands("drape xr", hands, calibration, opt)) return 2;
   std::fprintf(stderr, "drape xr: runtime manifest: %s\n",
                manifest.empty() ? "(system active runtime)" : manifest.c_str());
   std::fprintf(stderr, "drape xr: live voice: %s\n",

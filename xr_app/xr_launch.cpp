@@ -137,6 +137,66 @@ bool resolve_voice(const char* command, const std::string& given, bool live, std
   return resolve_input_file(command, "--voice", out);
 }
 
+void add_hands_options(CLI::App& cli, std::vector<std::string>& hands, std::string& calibration) {
+  cli.add_option("--hands", hands,
+                 "where the hands come from: xr (the runtime's), udp[:ADDR:PORT] (a skeleton "
+                 "stream, docs/tracking.md; default 127.0.0.1:9740) or trace FILE (a recorded "
+                 "trace played from the first frame)")
+      ->expected(1, 2)
+      ->default_str("xr");
+  cli.add_option("--calibration", calibration,
+                 "tracker-to-stage calibration file (tracking/calibration's JSON) for --hands "
+                 "udp or trace (default: identity)")
+      ->always_capture_default(false);
+}
+
+namespace {
+bool hands_usage(const char* command, const std::string& why) {
+  std::fprintf(stderr, "%s: --hands: %s (xr, udp[:ADDR:PORT] or trace FILE)\n", command,
+               why.c_str());
+  return false;
+}
+
+// "udp", "udp:PORT" or "udp:ADDR:PORT" into opt.
+bool parse_udp(const char* command, const std::string& v, XrAppOptions& opt) {
+  if (v == "udp") return true;
+  const std::string rest = v.substr(4);
+  const size_t colon = rest.rfind(':');
+  const std::string port = colon == std::string::npos ? rest : rest.substr(colon + 1);
+  if (colon != std::string::npos) opt.hands_address = rest.substr(0, colon);
+  if (opt.hands_address.empty()) return hands_usage(command, "empty address in '" + v + "'");
+  char* end = nullptr;
+  const long p = std::strtol(port.c_str(), &end, 10);
+  if (port.empty() || *end != '\0' || p < 1 || p > 65535)
+    return hands_usage(command, "bad port '" + port + "' in '" + v + "' (1..65535)");
+  opt.hands_port = static_cast<int>(p);
+  return true;
+}
+}  // namespace
+
+bool resolve_hands(const char* command, const std::vector<std::string>& hands,
+                   const std::string& calibration, XrAppOptions& opt) {
+  const std::string kind = hands.empty() ? "xr" : hands[0];
+  if (kind == "trace") {
+    if (hands.size() != 2) return hands_usage(command, "trace needs a FILE");
+    opt.hands = "trace";
+    opt.hands_trace = hands[1];
+    if (!resolve_input_file(command, "--hands trace", opt.hands_trace)) return false;
+  } else if (hands.size() > 1) {
+    return hands_usage(command, "unexpected '" + hands[1] + "' after '" + kind + "'");
+  } else if (kind == "xr") {
+    opt.hands = "xr";
+  } else if (kind == "udp" || kind.rfind("udp:", 0) == 0) {
+    opt.hands = "udp";
+    if (!parse_udp(command, kind, opt)) return false;
+  } else {
+    return hands_usage(command, "unknown source '" + kind + "'");
+  }
+  opt.calibration_path = calibration;
+  if (calibration.empty()) return true;
+  return resolve_input_file(command, "--calibration", opt.calibration_path);
+}
+
 std::string commands_file(const std::string& given) {
   if (!given.empty()) return given;
   std::error_code ec;

@@ -68,6 +68,15 @@ void add_voice_option(CLI::App& cli, std::string& voice);
 // missing file prints its message and returns false; a malformed one is the session's message).
 bool resolve_voice(const char* command, const std::string& given, bool live, std::string& out);
 
+// --hands xr|udp[:ADDR:PORT]|trace FILE and --calibration FILE (both commands).
+void add_hands_options(CLI::App& cli, std::vector<std::string>& hands, std::string& calibration);
+
+// After parsing: the hands' options into opt (hands, hands_address, hands_port, hands_trace,
+// calibration_path). A bad value or a missing file prints "<command>: <option>: ..." and returns
+// false (the caller exits with the usage status 2).
+bool resolve_hands(const char* command, const std::vector<std::string>& hands,
+                   const std::string& calibration, XrAppOptions& opt);
+
 // The command map: `given` when set (already resolved), else assets/commands.json (from the
 // working directory, else the assets directory) when present, else "" (the built-in defaults).
 std::string commands_file(const std::string& given);

@@ -271,6 +271,34 @@ TEST(Gestures, DwellAndPushForPalmOnlySources) {
   EXPECT_EQ(count(out, "dwell", true), 1);
 }
 
+// A source that delivers in bursts (a stalled frame loop polls several packets at once): gaps in
+// the samples do not re-arm the dwell; only a move does.
+TEST(Gestures, DwellFiresOnceWhenSamplesComeInBursts) {
+  GestureRecognizer g;
+  std::vector<Trigger> out;
+  HandFrame f;
+  f.tracked = true;
+  f.confidence = 1;
+  double t = 0;
+  for (int i = 0; i < 180; ++i) {  // 3 s still, with a 0.3 s gap after 1.2 s
+    t += i == 72 ? 0.3 : 1 / 60.0;
+    f.time = t;
+    f.palm.position = Vec3(0, 1, -1);
+    g.update(f, out);
+  }
+  EXPECT_EQ(count(out, "dwell", true), 1);
+  for (int i = 0; i < 30; ++i, t += 1 / 30.0) {  // 10 cm sideways in 1 s, then still again
+    f.time = t;
+    f.palm.position = Vec3(0.1 * std::min(1.0, i / 15.0), 1, -1);
+    g.update(f, out);
+  }
+  for (int i = 0; i < 45; ++i, t += 1 / 30.0) {
+    f.time = t;
+    g.update(f, out);
+  }
+  EXPECT_EQ(count(out, "dwell", true), 2);
+}
+
 TEST(Gestures, ControllerButtonsGiveEdges) {
   ButtonMapper m;
   std::vector<Trigger> out;

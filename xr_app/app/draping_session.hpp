@@ -16,9 +16,13 @@
 #include "render/renderer.hpp"
 #include "sim/ops/operation_controller.hpp"
 #include "sim/runtime/sim_thread.hpp"
+#include "tracking/calibration.hpp"
 #include "tracking/command_map.hpp"
 #include "tracking/gestures.hpp"
 #include "tracking/hand_source.hpp"
+#include "tracking/one_euro.hpp"
+#include "tracking/trace.hpp"
+#include "tracking/udp_source.hpp"
 #include "tracking/voice.hpp"
 #include "xr_app/app/feedback.hpp"
 #include "xr_app/app/session_content.hpp"
@@ -66,11 +70,19 @@ class DrapingSession : public SessionContent {
   // One hand's joints and controller -> its proxy, overlay and triggers.
   void read_hand(int h, double t, const HandInput& in, sim::HandProxy& hand,
                  std::vector<tracking::Trigger>& trig);
+  // External hands (opt_.hands udp or trace, external_hands.cpp): the source opened on the
+  // first frame, then polled every frame; each hand's palm filtered, calibrated into the stage
+  // and made the hand proxy; its palm-only gestures into `trig`.
+  void open_external_hands();
+  void read_external_hands(double t, std::array<sim::HandProxy, 2>& hands,
+                           std::vector<tracking::Trigger>& trig);
+  void note_external_status();
   void hear_cues(int64_t frame, double t, std::vector<tracking::Trigger>& trig);
   void hear_live_voice(int64_t frame, double t, std::vector<tracking::Trigger>& trig);
   std::vector<Op> map_triggers(int64_t frame, const std::vector<tracking::Trigger>& trig);
   void note_lock_step_outcomes(bool cut_trigger);
-  // Free-running sim: what the sim thread saw of the pinches, read by the frame loop.
+  // What the sim thread saw of the pinches, read by the frame loop (free-running sim; the lines
+  // in both modes).
   struct FreeOutcomes {
     std::atomic<int64_t> frames_pinched{0};      // posted frames after which a hand held a particle
     std::atomic<bool> busy[2] = {false, false};  // pinching (the hand's overlay is drawn active)
@@ -82,6 +94,7 @@ class DrapingSession : public SessionContent {
   static void note_free_outcomes(const sim::World& w, const sim::OperationsState& st,
                                  FreeOutcomes& out);
   void drain_free_outcomes();
+  void drain_pinch_lines();
   // What the sim said while applying a frame's triggers, and the hands' operations after them
   // (filled on the sim thread, drained by the frame loop into the feedback panel).
   struct Said {
@@ -129,6 +142,20 @@ class DrapingSession : public SessionContent {
   bool panel_set_ = false, text_error_noted_ = false;
   TickProfile ticks_;
   ThreadGroups threads_;
+
+  // The external hand source (opt_.hands != "xr") and what the session keeps of it.
+  struct ExternalHands {
+    std::unique_ptr<tracking::HandSource> source;
+    tracking::TraceSource* trace = nullptr;      // source, when it is a trace
+    tracking::UdpSkeletonSource* udp = nullptr;  // source, when it is a UDP stream
+    double start = -1;                           // the frame time the trace started at
+    std::array<tracking::HandFilter, 2> filter;
+    std::array<tracking::HandFrame, 2> last;  // filtered, in the stage
+    std::array<double, 2> last_seen{-1e9, -1e9};
+    tracking::Calibration calibration;
+    std::string status;  // the status shown ("" = all well)
+  };
+  std::unique_ptr<ExternalHands> ext_;
 
   // Each hand's interaction profile family: controller triggers are looked up under it.
   std::string profiles_[2];

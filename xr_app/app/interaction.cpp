@@ -37,7 +37,10 @@ void DrapingSession::interact(int64_t frame, const HandInput& in) {
   std::array<sim::HandProxy, 2> hands{};
   std::vector<tracking::Trigger> trig;
   overlays_.clear();
-  for (int h = 0; h < 2; ++h) read_hand(h, t, in, hands[h], trig);
+  if (opt_.hands != "xr")
+    read_external_hands(t, hands, trig);
+  else
+    for (int h = 0; h < 2; ++h) read_hand(h, t, in, hands[h], trig);
   hear_cues(frame, t, trig);
   const std::vector<Op> use = map_triggers(frame, trig);
   if (hands[1].tracked) {
@@ -48,7 +51,7 @@ void DrapingSession::interact(int64_t frame, const HandInput& in) {
   for (const auto& op : use) cut_trigger = cut_trigger || op.name == "cut" || op.name == "stop";
   if (ops_) {
     auto ops = ops_;
-    std::shared_ptr<FreeOutcomes> free = opt_.sim_lock_step ? nullptr : free_;
+    std::shared_ptr<FreeOutcomes> free = free_;  // the pinches taken and let go, both modes
     std::shared_ptr<Said> said = said_;
     sim_->post([ops, hands, use, free, said](sim::World& w) {
       ops->set_hands(w, hands);
@@ -60,11 +63,13 @@ void DrapingSession::interact(int64_t frame, const HandInput& in) {
   if (opt_.sim_lock_step) {
     sim_->advance(1);  // orders the sim's writes before these reads (sim_thread.hpp)
     if (ops_) note_lock_step_outcomes(cut_trigger);
+    if (ops_) drain_pinch_lines();
   } else if (ops_) {
     drain_free_outcomes();
   }
   if (ops_) drain_said(frame);  // refusals and the hands' operations into the feedback panel
-  feedback_.set_status("hands", hands[0].tracked || hands[1].tracked ? "" : "no hand tracked");
+  if (!ext_)
+    feedback_.set_status("hands", hands[0].tracked || hands[1].tracked ? "" : "no hand tracked");
 }
 
 // On the sim thread, after a frame's hands and triggers: pinches taken and let go (with how far
@@ -102,10 +107,16 @@ void DrapingSession::note_free_outcomes(const sim::World& w, const sim::Operatio
   for (auto& l : lines) out.lines.push_back(std::move(l));
 }
 
-// On the frame loop: the sim thread's pinch outcomes into the result and the log.
+// On the frame loop (free-running sim): the sim thread's pinch outcomes into the result and the
+// log.
 void DrapingSession::drain_free_outcomes() {
   rep_.r.frames_pinched = free_->frames_pinched;
   for (int h = 0; h < 2; ++h) ops_busy_[h] = free_->busy[h];
+  drain_pinch_lines();
+}
+
+// The pinches taken and let go (note_free_outcomes' lines) into the log.
+void DrapingSession::drain_pinch_lines() {
   std::vector<std::string> lines;
   {
     std::lock_guard lock(free_->m);

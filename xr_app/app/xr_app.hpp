@@ -60,6 +60,14 @@ struct XrAppOptions {
   // Live voice commands: "" none, "mic" the default ALSA capture device, else a WAV file (16 kHz
   // mono 16-bit) streamed at real time as if it were the microphone (app/voice_input.hpp).
   std::string voice_input;
+  // The hands: "xr" the runtime's; "udp" a skeleton stream (tracking::UdpSkeletonSource bound to
+  // hands_address:hands_port); "trace" a recorded trace (hands_trace, played from the session's
+  // first frame). udp and trace replace the runtime's hands (palm-only gestures, filtered, brought
+  // into the stage by the calibration file `calibration_path`, "" = identity).
+  std::string hands = "xr";
+  std::string hands_address = "127.0.0.1";
+  int hands_port = 9740;
+  std::string hands_trace, calibration_path;
   // The API layers the loader enables (its XR_ENABLE_API_LAYERS): their instance extensions are
   // offered too (the core validation layer's XR_EXT_debug_utils).
   std::vector<std::string> api_layers;

@@ -1,0 +1,100 @@
+#!/usr/bin/env bash
+# External hands in the app (`drape xr --hands ...`, the simulated runtime giving the head):
+#   trace   --hands trace FILE: a trace of the right palm approaching the cloth, a palm push (the
+#           pinch on), a move, a dwell (release), a second palm push (the pinch off) -> the log
+#           shows the pinch taking a particle, the release and the pinch letting it go.
+#   calibrated the same trace 0.5 m lower, lifted into the stage by --calibration FILE.
+#   udp     the same poses sent over UDP at their timestamps (--hands udp:127.0.0.1:PORT).
+#   noisy   the same with malformed and out-of-order packets mixed in: a message, still the pinch.
+#   missing --hands trace with no such file: exit 2 naming the file; a bad --hands value: exit 2
+#           naming the option; a malformed trace: the session runs (exit 0), its status logged.
+# usage: drape_hands_test.sh DRAPE_EXE MODE WORKDIR PORT
+set -u
+exe=$1 mode=$2 work=$3 port=${4:-0}
+here=$(cd "$(dirname "$0")" && pwd)
+rm -rf "$work" && mkdir -p "$work"
+log=$work/log.txt
+fail() { echo "FAIL: $*"; echo "--- log:"; cat "$log"; [ -f "$work/out/xr_session.txt" ] && { echo "--- xr_session.txt:"; cat "$work/out/xr_session.txt"; }; exit 1; }
+unset XR_RUNTIME_JSON DRAPE_MOCK_SCENARIO DRAPE_MOCK_END_AFTER_FRAMES DRAPE_MOCK_WRITE_FRAMES DRAPE_MOCK_FAST
+export HOME=$work/home XDG_CONFIG_HOME=$work/home/.config XDG_CONFIG_DIRS=$work/none
+# A point on the hanging muslin of the default scene, in front of the form (stage metres).
+P="0.11 1.15 0.115"
+# The head looks at the form from 1 m; no hands or controllers (the hands are external). Fast
+# (the runtime's virtual 90 Hz clock) for a trace; paced at 90 Hz for UDP (real-time packets).
+scenario() {  # frames fast
+  cat >"$work/scenario.json" <<JSON
+{"name": "external_hands", "end_after_frames": $1, "fast": $2,
+ "head": [{"frame": 0, "position": [0.0, 1.6, 1.0], "orientation": [0, 0, 0, 1]}]}
+JSON
+}
+xr() { "$exe" xr --eye-size 64 --cloth-res 12 --scenario "$work/scenario.json" --out "$work/out" -v "$@"; }
+check_pinch() {
+  local s=$work/out/xr_session.txt
+  [ -f "$s" ] || fail "no xr_session.txt"
+  grep -q "gesture palm_push begin hand right -> pinch toggle" "$s" || fail "no palm push -> pinch"
+  grep -q "pinch: right hand took particle" "$s" || fail "the pinch took no particle"
+  grep -q "gesture dwell begin hand right -> release" "$s" || fail "no dwell -> release"
+  grep -q "pinch: right hand let particle .* go" "$s" || fail "the pinch never let go"
+  grep -q "pinned_added -1 " "$s" || fail "the dwell did not release exactly one pin"
+  grep "pinch: right hand\|-> release\|pinched_frames" "$s"
+}
+case $mode in
+  trace)
+    python3 "$here/hands_trace.py" trace "$work/hands.csv" $P || fail "trace writer"
+    scenario 600 true
+    xr --hands trace "$work/hands.csv" >"$log" 2>&1 || fail "exit code $?"
+    grep -q "hands: trace source" "$log" || fail "the trace source not opened"
+    check_pinch
+    ;;
+  calibrated)  # the trace in a tracker frame 0.5 m below the stage's, --calibration lifts it
+    python3 "$here/hands_trace.py" trace "$work/hands.csv" 0.11 0.65 0.115 || fail "trace writer"
+    cat >"$work/calibration.json" <<JSON
+{"format": "drape-calibration", "version": 1, "scale": 1.0,
+ "rotation": [[1,0,0],[0,1,0],[0,0,1]], "translation": [0, 0.5, 0],
+ "rms_residual_m": 0.002, "max_residual_m": 0.004, "pairs": 4}
+JSON
+    scenario 600 true
+    xr --hands trace "$work/hands.csv" --calibration "$work/calibration.json" >"$log" 2>&1 ||
+      fail "exit code $?"
+    grep -q "hands: calibration .*calibration.json" "$log" || fail "the calibration not loaded"
+    check_pinch
+    ;;
+  udp|noisy)
+    scenario 1000 false
+    : >"$log"
+    xr --hands "udp:127.0.0.1:$port" >"$log" 2>&1 &
+    app=$!
+    for _ in $(seq 1 300); do grep -q "hands: udp: no packets yet" "$log" && break; sleep 0.1; done
+    grep -q "hands: udp: no packets yet on 127.0.0.1:$port" "$log" || { kill "$app"; fail "no 'no packets yet' status"; }
+    noise=""
+    [ "$mode" = noisy ] && noise=--noise
+    python3 "$here/hands_trace.py" udp 127.0.0.1 "$port" $P $noise || { kill "$app"; fail "sender"; }
+    wait "$app" || fail "exit code $?"
+    check_pinch
+    if [ "$mode" = noisy ]; then
+      grep -q "hands: udp: .* packets dropped (.* malformed, .* out of order), last: " "$log" ||
+        fail "no message about the dropped packets"
+      grep -m2 "packets dropped" "$log"
+    fi
+    ;;
+  missing)
+    "$exe" xr --frames 5 --hands trace "$work/none.csv" >"$log" 2>&1
+    rc=$?
+    [ $rc -eq 2 ] || fail "missing trace: exit $rc, expected 2"
+    grep -q "drape xr: --hands trace: no such file: .*none.csv" "$log" || fail "no message naming the file"
+    "$exe" xr --frames 5 --hands kinect >"$log" 2>&1
+    rc=$?
+    [ $rc -eq 2 ] || fail "bad --hands: exit $rc, expected 2"
+    grep -q "drape xr: --hands: unknown source 'kinect'" "$log" || fail "no message naming --hands"
+    "$exe" xr --frames 5 --hands udp:127.0.0.1:99999 >"$log" 2>&1
+    [ $? -eq 2 ] || fail "bad port: not exit 2"
+    grep -q "drape xr: --hands: bad port '99999'" "$log" || fail "no message naming the port"
+    printf '# drape-trace v1\n0.0,1,1,0.9,0.1,1.3,0.5,0,0,0,1,0\n0.1,7,1,0.9,0.1,1.3,0.5,0,0,0,1,0\n' >"$work/bad.csv"
+    scenario 30 true
+    xr --hands trace "$work/bad.csv" >"$log" 2>&1 || fail "malformed trace: exit code $?"
+    grep -q "hands: .*bad.csv.*hand" "$log" || fail "no status naming the malformed trace"
+    grep "hands: " "$log"
+    ;;
+  *) echo "unknown mode $mode"; exit 2 ;;
+esac
+echo "PASS $mode"
