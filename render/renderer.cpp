@@ -490,6 +490,58 @@ struct Renderer::Impl {
     t.atlas_uploaded = true;
   }
 
+  // A triangle-list pipeline, two-sided (the cloth is; everything else is cheap enough), at the
+  // renderer's sample count, one colour attachment, dynamic viewport and scissor: the scene's and
+  // the panel's pipelines differ only in what is passed in.
+  sim::Result<VkPipeline> make_pipeline(const VkPipelineShaderStageCreateInfo (&stages)[2],
+                                        const VkPipelineVertexInputStateCreateInfo& vin,
+                                        const VkPipelineDepthStencilStateCreateInfo& ds,
+                                        const VkPipelineColorBlendAttachmentState& cba,
+                                        VkPipelineLayout pipeline_layout, VkRenderPass rp,
+                                        const char* what) {
+    VkPipelineInputAssemblyStateCreateInfo ia{
+        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    vp.viewportCount = 1;
+    vp.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo rs{
+        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    rs.polygonMode = VK_POLYGON_MODE_FILL;
+    rs.cullMode = VK_CULL_MODE_NONE;
+    rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    rs.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo ms{
+        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    ms.rasterizationSamples = static_cast<VkSampleCountFlagBits>(samples);
+    VkPipelineColorBlendStateCreateInfo cb{
+        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    cb.attachmentCount = 1;
+    cb.pAttachments = &cba;
+    VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dsi{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dsi.dynamicStateCount = 2;
+    dsi.pDynamicStates = dyn;
+    VkGraphicsPipelineCreateInfo gi{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    gi.stageCount = 2;
+    gi.pStages = stages;
+    gi.pVertexInputState = &vin;
+    gi.pInputAssemblyState = &ia;
+    gi.pViewportState = &vp;
+    gi.pRasterizationState = &rs;
+    gi.pMultisampleState = &ms;
+    gi.pDepthStencilState = &ds;
+    gi.pColorBlendState = &cb;
+    gi.pDynamicState = &dsi;
+    gi.layout = pipeline_layout;
+    gi.renderPass = rp;
+    VkPipeline p = VK_NULL_HANDLE;
+    if (VkResult r = vkCreateGraphicsPipelines(dev(), VK_NULL_HANDLE, 1, &gi, nullptr, &p);
+        r != VK_SUCCESS)
+      return sim::Error{fail(std::string("vkCreateGraphicsPipelines (") + what + ")", r).error};
+    return p;
+  }
+
   sim::Result<VkPipeline> text_pipeline_for(VkFormat fmt, VkRenderPass rp, VkFormat depth_fmt) {
     const auto key = std::make_tuple(fmt, samples, depth_fmt);
     if (auto it = text.pipelines.find(key); it != text.pipelines.end()) return it->second;
@@ -512,20 +564,6 @@ struct Renderer::Impl {
     vin.pVertexBindingDescriptions = &binding;
     vin.vertexAttributeDescriptionCount = 3;
     vin.pVertexAttributeDescriptions = attrs;
-    VkPipelineInputAssemblyStateCreateInfo ia{
-        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
-    ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-    VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
-    vp.viewportCount = 1;
-    vp.scissorCount = 1;
-    VkPipelineRasterizationStateCreateInfo rs{
-        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
-    rs.polygonMode = VK_POLYGON_MODE_FILL;
-    rs.cullMode = VK_CULL_MODE_NONE;
-    rs.lineWidth = 1.0f;
-    VkPipelineMultisampleStateCreateInfo ms{
-        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
-    ms.rasterizationSamples = static_cast<VkSampleCountFlagBits>(samples);
     // Over everything, and no depth written: the panel is not a surface of the scene.
     VkPipelineDepthStencilStateCreateInfo ds{
         VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
@@ -539,32 +577,8 @@ struct Renderer::Impl {
     cba.alphaBlendOp = VK_BLEND_OP_ADD;
     cba.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                          VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
-    VkPipelineColorBlendStateCreateInfo cb{
-        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    cb.attachmentCount = 1;
-    cb.pAttachments = &cba;
-    VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-    VkPipelineDynamicStateCreateInfo dsi{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-    dsi.dynamicStateCount = 2;
-    dsi.pDynamicStates = dyn;
-    VkGraphicsPipelineCreateInfo gi{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-    gi.stageCount = 2;
-    gi.pStages = stages;
-    gi.pVertexInputState = &vin;
-    gi.pInputAssemblyState = &ia;
-    gi.pViewportState = &vp;
-    gi.pRasterizationState = &rs;
-    gi.pMultisampleState = &ms;
-    gi.pDepthStencilState = &ds;
-    gi.pColorBlendState = &cb;
-    gi.pDynamicState = &dsi;
-    gi.layout = text.layout;
-    gi.renderPass = rp;
-    VkPipeline p = VK_NULL_HANDLE;
-    if (VkResult r = vkCreateGraphicsPipelines(dev(), VK_NULL_HANDLE, 1, &gi, nullptr, &p);
-        r != VK_SUCCESS)
-      return sim::Error{fail("vkCreateGraphicsPipelines (text)", r).error};
-    text.pipelines[key] = p;
+    auto p = make_pipeline(stages, vin, ds, cba, text.layout, rp, "text");
+    if (p) text.pipelines[key] = *p;
     return p;
   }
 
@@ -766,21 +780,6 @@ struct Renderer::Impl {
     vin.pVertexBindingDescriptions = &binding;
     vin.vertexAttributeDescriptionCount = 5;
     vin.pVertexAttributeDescriptions = attrs;
-    VkPipelineInputAssemblyStateCreateInfo ia{
-        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
-    ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-    VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
-    vp.viewportCount = 1;
-    vp.scissorCount = 1;
-    VkPipelineRasterizationStateCreateInfo rs{
-        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
-    rs.polygonMode = VK_POLYGON_MODE_FILL;
-    rs.cullMode = VK_CULL_MODE_NONE;  // cloth is two-sided; everything else is cheap enough
-    rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-    rs.lineWidth = 1.0f;
-    VkPipelineMultisampleStateCreateInfo ms{
-        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
-    ms.rasterizationSamples = static_cast<VkSampleCountFlagBits>(samples);
     VkPipelineDepthStencilStateCreateInfo ds{
         VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
     ds.depthTestEnable = VK_TRUE;
@@ -789,32 +788,8 @@ struct Renderer::Impl {
     VkPipelineColorBlendAttachmentState cba{};
     cba.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                          VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
-    VkPipelineColorBlendStateCreateInfo cb{
-        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    cb.attachmentCount = 1;
-    cb.pAttachments = &cba;
-    VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-    VkPipelineDynamicStateCreateInfo dsi{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-    dsi.dynamicStateCount = 2;
-    dsi.pDynamicStates = dyn;
-    VkGraphicsPipelineCreateInfo gi{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-    gi.stageCount = 2;
-    gi.pStages = stages;
-    gi.pVertexInputState = &vin;
-    gi.pInputAssemblyState = &ia;
-    gi.pViewportState = &vp;
-    gi.pRasterizationState = &rs;
-    gi.pMultisampleState = &ms;
-    gi.pDepthStencilState = &ds;
-    gi.pColorBlendState = &cb;
-    gi.pDynamicState = &dsi;
-    gi.layout = layout;
-    gi.renderPass = rp;
-    VkPipeline p = VK_NULL_HANDLE;
-    if (VkResult r = vkCreateGraphicsPipelines(dev(), VK_NULL_HANDLE, 1, &gi, nullptr, &p);
-        r != VK_SUCCESS)
-      return sim::Error{fail("vkCreateGraphicsPipelines", r).error};
-    pipelines[key] = p;
+    auto p = make_pipeline(stages, vin, ds, cba, layout, rp, "scene");
+    if (p) pipelines[key] = *p;
     return p;
   }
 
