@@ -25,18 +25,23 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   std::filesystem::create_directories("out/bench");
   std::ofstream csv("out/bench/stress.csv");
-  csv << "case,solver,steps,failures\n";
-  std::printf("%-16s %-8s %6s %8s %9s %8s\n", "case", "solver", "steps", "failures", "rollbacks",
-              "vertices");
+  csv << "case,solver,steps,failures,rollbacks,vertices,max_kinetic_j_per_kg,energy_growth_j_per_"
+         "kg,"
+         "max_penetration_mm\n";
+  std::printf("%-16s %-8s %6s %8s %9s %8s %12s %12s %10s\n", "case", "solver", "steps", "failures",
+              "rollbacks", "vertices", "max_ke_J/kg", "growth_J/kg", "penetr_mm");
   for (const auto& c : stress_case_names())
     for (const std::string& s : solvers) {
       if ((!only_case.empty() && c != only_case) || (!only_solver.empty() && only_solver != s))
         continue;
       StressResult r = run_stress_case(c, s, scale);
-      std::printf("%-16s %-8s %6d %8d %9d %8d %s\n", c.c_str(), s.c_str(), r.steps, r.failures,
-                  r.rollbacks, r.vertices, r.note.c_str());
+      std::printf("%-16s %-8s %6d %8d %9d %8d %12.4f %12.5f %10.3f %s\n", c.c_str(), s.c_str(),
+                  r.steps, r.failures, r.rollbacks, r.vertices, r.max_kinetic, r.energy_growth,
+                  r.max_penetration * 1e3, r.note.c_str());
       std::fflush(stdout);
-      csv << c << "," << s << "," << r.steps << "," << r.failures << std::endl;
+      csv << c << "," << s << "," << r.steps << "," << r.failures << "," << r.rollbacks << ","
+          << r.vertices << "," << r.max_kinetic << "," << r.energy_growth << ","
+          << r.max_penetration * 1e3 << std::endl;
     }
   std::printf("wrote out/bench/stress.csv\n");
   return 0;

@@ -16,9 +16,30 @@ endif()
 
 # drape_add_test(<name> SOURCES a.cpp b.cpp LIBS lib1 lib2 [LABELS l1 l2])
 # Builds one GoogleTest executable and registers each TEST with ctest.
+# A test whose sources start threads (std::thread/jthread/async, the sim's thread classes, a
+# solver or energy run with more than one thread) gets the label "threads" whatever its name, and
+# joins the target drape_threads_tests: the TSan build builds that target and runs that label.
+set(DRAPE_THREADED_SOURCE_REGEX
+  "std::(j?thread|async)|SimThread|FinishThread|ThreadPool|KinectSource|VoiceInput|threads *= *([2-9]|[a-z_(])")
 function(drape_add_test name)
   cmake_parse_arguments(T "" "" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${name} ${T_SOURCES})
+  if(NOT "threads" IN_LIST T_LABELS)
+    foreach(src ${T_SOURCES})
+      get_filename_component(path ${src} ABSOLUTE)
+      file(READ ${path} text)
+      if(text MATCHES "${DRAPE_THREADED_SOURCE_REGEX}")
+        list(APPEND T_LABELS threads)
+        break()
+      endif()
+    endforeach()
+  endif()
+  if("threads" IN_LIST T_LABELS)
+    if(NOT TARGET drape_threads_tests)
+      add_custom_target(drape_threads_tests)
+    endif()
+    add_dependencies(drape_threads_tests ${name})
+  endif()
   target_link_libraries(${name} PRIVATE ${T_LIBS} drape_options GTest::gtest GTest::gtest_main)
   target_compile_definitions(${name} PRIVATE
     DRAPE_SOURCE_DIR="${CMAKE_SOURCE_DIR}" DRAPE_BINARY_DIR="${CMAKE_BINARY_DIR}")
