@@ -6,8 +6,14 @@
 #   calibrated the same trace 0.5 m lower, lifted into the stage by --calibration FILE.
 #   udp     the same poses sent over UDP at their timestamps (--hands udp:127.0.0.1:PORT).
 #   noisy   the same with malformed and out-of-order packets mixed in: a message, still the pinch.
+#   kinect  --hands kinect --kinect-record DIR: a synthesized fakenect recording (kinect_record.py)
+#           of the same palm seen by a depth camera behind the form facing the user, brought into
+#           the stage by its --calibration file -> the same pinch, move, release and pinch off.
+#   kinect_end the recording ends mid-pinch (the Kinect going away): its message, the pinch held
+#           for the grace and let go, the session runs on to its last frame (exit 0).
 #   missing --hands trace with no such file: exit 2 naming the file; a bad --hands value: exit 2
-#           naming the option; a malformed trace: the session runs (exit 0), its status logged.
+#           naming the option; a malformed trace: the session runs (exit 0), its status logged;
+#           --kinect-record with no recording, or without --hands kinect: exit 2 naming it.
 # usage: drape_hands_test.sh DRAPE_EXE MODE WORKDIR PORT
 set -u
 exe=$1 mode=$2 work=$3 port=${4:-0}
@@ -77,15 +83,53 @@ JSON
       grep -m2 "packets dropped" "$log"
     fi
     ;;
+  kinect|kinect_end)
+    until=""
+    [ "$mode" = kinect_end ] && until="--until 2.6"  # after the push, during the move
+    python3 "$here/kinect_record.py" "$work/rec" "$work/calibration.json" $P $until ||
+      fail "recording writer"
+    frames=1000
+    [ "$mode" = kinect_end ] && frames=600
+    scenario $frames false
+    xr --hands kinect --kinect-record "$work/rec" --calibration "$work/calibration.json" \
+      >"$log" 2>&1 || fail "exit code $?"
+    grep -q "hands: kinect source recording .*/rec" "$log" || fail "the kinect source not opened"
+    grep -q "hands: calibration .*calibration.json" "$log" || fail "the calibration not loaded"
+    s=$work/out/xr_session.txt
+    if [ "$mode" = kinect ]; then
+      check_pinch
+    else
+      [ -f "$s" ] || fail "no xr_session.txt"
+      grep -q "pinch: right hand took particle" "$s" || fail "the pinch took no particle"
+      grep -q "hands: kinect: the recording .*/rec ended" "$s" || fail "no message: the Kinect ended"
+      grep -q "right hand lost: holding the pinch" "$s" || fail "the pinch not held over the grace"
+      grep -q "pinch: right hand lost for 0.3 s: let go of particle" "$s" || fail "not let go after the grace"
+      grep -q "pinch: right hand let particle .* go" "$s" || fail "the pinch never let go"
+      grep -q "frames: $frames\b\|frames $frames\b\|\"frames\": $frames\b" "$s" "$log" ||
+        fail "the session did not run to its last frame"
+      grep "kinect: \|lost\|pinch: right" "$s"
+    fi
+    rm -rf "$work/rec"  # 100 MB of depth frames
+    ;;
   missing)
     "$exe" xr --frames 5 --hands trace "$work/none.csv" >"$log" 2>&1
     rc=$?
     [ $rc -eq 2 ] || fail "missing trace: exit $rc, expected 2"
     grep -q "drape xr: --hands trace: no such file: .*none.csv" "$log" || fail "no message naming the file"
-    "$exe" xr --frames 5 --hands kinect >"$log" 2>&1
+    "$exe" xr --frames 5 --hands leap >"$log" 2>&1
     rc=$?
     [ $rc -eq 2 ] || fail "bad --hands: exit $rc, expected 2"
-    grep -q "drape xr: --hands: unknown source 'kinect'" "$log" || fail "no message naming --hands"
+    grep -q "drape xr: --hands: unknown source 'leap'" "$log" || fail "no message naming --hands"
+    "$exe" xr --frames 5 --hands kinect --kinect-record "$work/norec" >"$log" 2>&1
+    rc=$?
+    [ $rc -eq 2 ] || fail "missing recording: exit $rc, expected 2"
+    grep -q "drape xr: --kinect-record: no fakenect recording in .*norec (no INDEX.txt)" "$log" ||
+      fail "no message naming --kinect-record and the directory"
+    mkdir -p "$work/rec" && : >"$work/rec/INDEX.txt"
+    "$exe" run --frames 5 --hands udp --kinect-record "$work/rec" >"$log" 2>&1
+    rc=$?
+    [ $rc -eq 2 ] || fail "--kinect-record without kinect: exit $rc, expected 2"
+    grep -q "drape run: --kinect-record: needs --hands kinect" "$log" || fail "no message: needs kinect"
     "$exe" xr --frames 5 --hands udp:127.0.0.1:99999 >"$log" 2>&1
     [ $? -eq 2 ] || fail "bad port: not exit 2"
     grep -q "drape xr: --hands: bad port '99999'" "$log" || fail "no message naming the port"

@@ -1,11 +1,14 @@
-// External hands (XrAppOptions::hands udp or trace): a tracking::HandSource polled every frame
-// instead of the runtime's hands. Each hand's palm goes through tracking::HandFilter (One-Euro;
-// frames below its confidence threshold count as untracked), then the calibration into the stage,
-// then the palm-only gestures (palm_push, dwell); the runtime still gives the head and the frame
-// loop. The source's troubles (no packets yet, dropped packets, an unreadable trace) are log
-// lines and the feedback panel's "hands" status, never a failed session.
+// External hands (XrAppOptions::hands udp, trace or kinect): a tracking::HandSource polled every
+// frame instead of the runtime's hands. Each hand's palm goes through tracking::HandFilter
+// (One-Euro; frames below its confidence threshold count as untracked), then the calibration into
+// the stage, then the palm-only gestures (palm_push, dwell); the runtime still gives the head and
+// the frame loop. The source's troubles (no packets yet, dropped packets, an unreadable trace, a
+// Kinect that is missing or goes away) are log lines and the feedback panel's "hands" status, never
+// a failed session: a hand that stops coming is untracked after kExternalStale, and the sim holds
+// its operation for its tracking grace, then ends it.
 #include <chrono>
 
+#include "tracking/kinect.hpp"
 #include "xr_app/app/draping_session.hpp"
 
 namespace drape::app {
@@ -21,19 +24,26 @@ double steady_now() {
 
 void DrapingSession::open_external_hands() {
   ext_ = std::make_unique<ExternalHands>();
+  std::string where;
   if (opt_.hands == "trace") {
     auto trace = std::make_unique<tracking::TraceSource>(opt_.hands_trace);
     ext_->trace = trace.get();
     ext_->source = std::move(trace);
+    where = opt_.hands_trace;
+  } else if (opt_.hands == "kinect") {
+    // Under fakenect (--kinect-record) the recording's directory is checked before libfreenect
+    // opens it; the device otherwise.
+    ext_->source = std::make_unique<tracking::KinectSource>(tracking::SegmenterParams{}, 0,
+                                                            opt_.kinect_record);
+    where = opt_.kinect_record.empty() ? "device 0" : "recording " + opt_.kinect_record;
   } else {
     auto udp = std::make_unique<tracking::UdpSkeletonSource>(static_cast<uint16_t>(opt_.hands_port),
                                                              opt_.hands_address);
     ext_->udp = udp.get();
     ext_->source = std::move(udp);
+    where = opt_.hands_address + ":" + std::to_string(opt_.hands_port);
   }
-  rep_.note("hands: " + opt_.hands + " source " +
-            (opt_.hands == "trace" ? opt_.hands_trace
-                                   : opt_.hands_address + ":" + std::to_string(opt_.hands_port)));
+  rep_.note("hands: " + opt_.hands + " source " + where);
   if (!opt_.calibration_path.empty()) {
     std::string error;
     if (auto c = tracking::load_calibration(opt_.calibration_path, &error)) {
