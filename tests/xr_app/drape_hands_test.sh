@@ -6,6 +6,8 @@
 #   calibrated the same trace 0.5 m lower, lifted into the stage by --calibration FILE.
 #   udp     the same poses sent over UDP at their timestamps (--hands udp:127.0.0.1:PORT).
 #   noisy   the same with malformed and out-of-order packets mixed in: a message, still the pinch.
+#   two     --hands trace FILE of both palms: together (pin), spread slowly (nothing), spread
+#           quickly (undo), both pushed twice (the cut's start and end).
 #   kinect  --hands kinect --kinect-record DIR: a synthesized fakenect recording (kinect_record.py)
 #           of the same palm seen by a depth camera behind the form facing the user, brought into
 #           the stage by its --calibration file -> the same pinch, move, release and pinch off.
@@ -110,6 +112,23 @@ JSON
       grep "kinect: \|lost\|pinch: right" "$s"
     fi
     rm -rf "$work/rec"  # 100 MB of depth frames
+    ;;
+  two)  # both palms: together -> pin, a quick spread -> undo, both pushed -> the cut's ends
+    python3 "$here/hands_trace.py" two "$work/hands.csv" $P || fail "trace writer"
+    scenario 1000 true
+    xr --hands trace "$work/hands.csv" >"$log" 2>&1 || fail "exit code $?"
+    s=$work/out/xr_session.txt
+    [ -f "$s" ] || fail "no xr_session.txt"
+    n() { grep -c "^\[drape xr\] trigger frame [0-9]*: gesture $1" "$log"; }
+    [ "$(n "hands_together begin hand right -> pin once")" = 1 ] || fail "not one together -> pin"
+    grep -q "sim: pin: particle" "$s" || fail "the pin not made"
+    [ "$(n "hands_apart begin hand right -> undo once")" = 1 ] ||
+      fail "not one hands_apart -> undo (the slow spread must not fire it)"
+    grep -q "sim: undo: pin" "$s" || fail "the pin not undone"
+    [ "$(n "both_push begin hand right -> cut toggle")" = 2 ] || fail "not two both_push -> cut"
+    grep -q "cuts 1 " "$s" || fail "no cut made"
+    grep -q "palm_push\|gesture dwell" "$s" && fail "a single palm push or a dwell fired"
+    grep "gesture \|pin\|undo\|cut" "$s"
     ;;
   missing)
     "$exe" xr --frames 5 --hands trace "$work/none.csv" >"$log" 2>&1
