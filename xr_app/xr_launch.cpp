@@ -149,22 +149,39 @@ bool resolve_voice(const char* command, const std::string& given, bool live, std
 }
 
 void add_hands_options(CLI::App& cli, std::vector<std::string>& hands, std::string& calibration,
-                       std::string& kinect_record) {
+                       XrAppOptions& opt) {
   cli.add_option("--hands", hands,
                  "where the hands come from: xr (the runtime's), udp[:ADDR:PORT] (a skeleton "
                  "stream, docs/tracking.md; default 127.0.0.1:9740), trace FILE (a recorded "
                  "trace played from the first frame) or kinect (a Kinect v1 through libfreenect)")
       ->expected(1, 2)
       ->default_str("xr");
-  cli.add_option("--kinect-record", kinect_record,
+  cli.add_option("--kinect-record", opt.kinect_record,
                  "with --hands kinect: replay this fakenect recording directory (DIR/INDEX.txt, "
                  "libfreenect's fakenect-record) instead of the device; its end is the Kinect "
                  "going away")
       ->always_capture_default(false);
   cli.add_option("--calibration", calibration,
                  "tracker-to-stage calibration file (tracking/calibration's JSON) for --hands "
-                 "udp, trace or kinect (default: identity)")
+                 "udp, trace or kinect (default: the source's saved calibration, "
+                 "$XDG_CONFIG_HOME/drape/calibration-<source>.json, when there is one; else "
+                 "identity)")
       ->always_capture_default(false);
+  cli.add_flag("--calibrate", opt.calibrate,
+               "calibrate --hands udp, trace or kinect: touch the 4 marked points in turn, "
+               "holding the palm still 1 s on each; the result is saved as the source's "
+               "calibration");
+}
+
+std::string saved_calibration_file(const std::string& source) {
+  fs::path dir;
+  if (std::string x = env("XDG_CONFIG_HOME"); !x.empty())
+    dir = x;
+  else if (std::string h = env("HOME"); !h.empty())
+    dir = fs::path(h) / ".config";
+  else
+    return "";
+  return (dir / "drape" / ("calibration-" + source + ".json")).string();
 }
 
 namespace {
@@ -263,6 +280,27 @@ bool resolve_hands(const char* command, const std::vector<std::string>& hands,
   opt.calibration_path = calibration;
   if (!calibration.empty() && !resolve_input_file(command, "--calibration", opt.calibration_path))
     return false;
+  if (opt.calibrate) {
+    if (opt.hands == "xr") {
+      std::fprintf(stderr, "%s: --calibrate: needs --hands udp, trace or kinect\n", command);
+      return false;
+    }
+    opt.calibration_save = saved_calibration_file(opt.hands);
+    if (opt.calibration_save.empty()) {
+      std::fprintf(stderr,
+                   "%s: --calibrate: no config directory to save to (neither XDG_CONFIG_HOME "
+                   "nor HOME is set)\n",
+                   command);
+      return false;
+    }
+  } else if (calibration.empty() && opt.hands != "xr") {
+    std::error_code ec;
+    const std::string saved = saved_calibration_file(opt.hands);
+    if (!saved.empty() && fs::is_regular_file(saved, ec)) {
+      opt.calibration_path = saved;
+      opt.calibration_saved = true;
+    }
+  }
   if (opt.kinect_record.empty()) return true;
   if (opt.hands != "kinect") {
     std::fprintf(stderr, "%s: --kinect-record: needs --hands kinect\n", command);

@@ -8,6 +8,10 @@
 #   noisy   the same with malformed and out-of-order packets mixed in: a message, still the pinch.
 #   two     --hands trace FILE of both palms: together (pin), spread slowly (nothing), spread
 #           quickly (undo), both pushed twice (the cut's start and end).
+#   calibrate --calibrate with a trace of the palm resting on the 4 markers as a tracker turned
+#           30 degrees and moved sees them: the saved file's transform is that one within 1 mm,
+#           the residual logged; a later session loads the saved file by itself.
+#   calibrate_collinear the touches on one line: refused with its reason, nothing saved.
 #   kinect  --hands kinect --kinect-record DIR: a synthesized fakenect recording (kinect_record.py)
 #           of the same palm seen by a depth camera behind the form facing the user, brought into
 #           the stage by its --calibration file -> the same pinch, move, release and pinch off.
@@ -129,6 +133,55 @@ JSON
     grep -q "cuts 1 " "$s" || fail "no cut made"
     grep -q "palm_push\|gesture dwell" "$s" && fail "a single palm push or a dwell fired"
     grep "gesture \|pin\|undo\|cut" "$s"
+    ;;
+  calibrate)  # --calibrate: the palm dwells on the 4 markers seen by a tracker yawed 30 degrees
+    python3 "$here/hands_trace.py" calib "$work/hands.csv" 30 0.2 0.9 -1.5 || fail "trace writer"
+    scenario 1000 true
+    xr --hands trace "$work/hands.csv" --calibrate >"$log" 2>&1 || fail "exit code $?"
+    s=$work/out/xr_session.txt
+    saved=$XDG_CONFIG_HOME/drape/calibration-trace.json
+    [ "$(grep -c "^calibration: marker [1-4] (.*) taken at" "$s")" = 4 ] || fail "not 4 markers taken"
+    grep -q "^calibration: residual rms [0-9.]* mm, max [0-9.]* mm over 4 points; saved to $saved" "$s" ||
+      fail "no residual or not saved"
+    [ -f "$saved" ] || fail "no $saved"
+    grep -q "palm_push\|gesture dwell" "$s" && fail "a gesture reached the operations while calibrating"
+    python3 - "$saved" <<'PY' || fail "the saved transform is not the trace's"
+import json, math, sys
+c = json.load(open(sys.argv[1]))
+a = math.radians(30)
+R = [[math.cos(a), 0, math.sin(a)], [0, 1, 0], [-math.sin(a), 0, math.cos(a)]]
+t = [0.2, 0.9, -1.5]
+# Each axis of the tracker mapped 1 m out: the transform's image within 1 mm of the truth's.
+for k in range(4):
+    p = [1.0 if i == k else 0.0 for i in range(3)]
+    got = [c["scale"] * sum(c["rotation"][i][j] * p[j] for j in range(3)) + c["translation"][i] for i in range(3)]
+    want = [sum(R[i][j] * p[j] for j in range(3)) + t[i] for i in range(3)]
+    err = math.dist(got, want)
+    print(f"point {p}: {got} vs {want}: {err * 1e3:.3f} mm")
+    assert err < 1e-3, err
+print("scale", c["scale"], "rms", c["rms_residual_m"], "max", c["max_residual_m"])
+PY
+    grep "^calibration: " "$s"
+    # A later session with no --calibration uses the saved one and says so.
+    python3 "$here/hands_trace.py" trace "$work/hands2.csv" $P || fail "trace writer"
+    scenario 30 true
+    "$exe" xr --eye-size 64 --cloth-res 12 --scenario "$work/scenario.json" --out "$work/out2" -v \
+      --hands trace "$work/hands2.csv" >"$log" 2>&1 || fail "exit code $?"
+    grep -q "hands: calibration $saved (the saved calibration of this source)" "$log" ||
+      fail "the saved calibration not loaded"
+    ;;
+  calibrate_collinear)  # the four touches on one line: refused with its reason, nothing saved
+    python3 "$here/hands_trace.py" calib "$work/hands.csv" 0 0 0 0 --collinear || fail "trace writer"
+    scenario 1000 true
+    xr --hands trace "$work/hands.csv" --calibrate >"$log" 2>&1 || fail "exit code $?"
+    s=$work/out/xr_session.txt
+    grep -q "^calibration: refused: calibration: points are coincident or collinear; nothing saved" "$s" ||
+      fail "no message: collinear"
+    [ -e "$XDG_CONFIG_HOME/drape/calibration-trace.json" ] && fail "a calibration saved"
+    grep "^calibration: " "$s"
+    "$exe" xr --frames 5 --calibrate >"$log" 2>&1
+    [ $? -eq 2 ] || fail "--calibrate with the runtime's hands: not exit 2"
+    grep -q "drape xr: --calibrate: needs --hands udp, trace or kinect" "$log" || fail "no message naming --calibrate"
     ;;
   missing)
     "$exe" xr --frames 5 --hands trace "$work/none.csv" >"$log" 2>&1

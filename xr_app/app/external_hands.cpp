@@ -48,12 +48,16 @@ void DrapingSession::open_external_hands() {
     std::string error;
     if (auto c = tracking::load_calibration(opt_.calibration_path, &error)) {
       ext_->calibration = *c;
-      rep_.note("hands: calibration " + opt_.calibration_path);
+      rep_.note("hands: calibration " + opt_.calibration_path +
+                (opt_.calibration_saved ? " (the saved calibration of this source)" : ""));
+      if (opt_.calibration_saved)
+        feedback_.set_status("calibration", "saved one, " + opt_.calibration_path);
     } else {
       rep_.note("hands: calibration " + opt_.calibration_path + " not used (identity): " + error);
       feedback_.set_status("calibration", "calibration not loaded: " + error);
     }
   }
+  if (opt_.calibrate) open_calibration_mode();
 }
 
 // The source's status into the log and the panel when it changes: a trace that does not load, a
@@ -89,10 +93,13 @@ void DrapingSession::read_external_hands(double t, std::array<sim::HandProxy, 2>
   }
   std::vector<tracking::HandFrame> frames = ext_->source->poll();
   note_external_status();
+  const bool calibrating = ext_->calibrating && !ext_->calibrating->done();
   for (auto& raw : frames) {
     const int h = static_cast<int>(raw.hand);
-    tracking::HandFrame f = ext_->calibration.apply(ext_->filter[h].update(raw));
-    gestures_.update(f, trig);
+    const tracking::HandFrame filtered = ext_->filter[h].update(raw);
+    if (calibrating) calibration_frame(raw, filtered);  // the markers' touches, no operations
+    tracking::HandFrame f = ext_->calibration.apply(filtered);
+    if (!calibrating) gestures_.update(f, trig);
     ext_->last[h] = f;
     ext_->last_seen[h] = now;
   }
@@ -105,8 +112,9 @@ void DrapingSession::read_external_hands(double t, std::array<sim::HandProxy, 2>
       f.tracked = false;  // the source stopped sending this hand: whatever it held ends
       gestures_.update(f, trig);
     }
-    hand.tracked = f.tracked;
-    if (!hand.tracked) continue;
+    // While calibrating, the hands are drawn but do not touch the cloth.
+    hand.tracked = f.tracked && !calibrating;
+    if (!f.tracked) continue;
     hand.position = f.palm.position;
     hand.orientation = f.palm.orientation;
     hand.tip = hand.position;
