@@ -7,6 +7,8 @@
 // a failed session: a hand that stops coming is untracked after kExternalStale, and the sim holds
 // its operation for its tracking grace, then ends it.
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
 
 #include "tracking/kinect.hpp"
 #include "xr_app/app/draping_session.hpp"
@@ -125,6 +127,77 @@ void DrapingSession::read_external_hands(double t, std::array<sim::HandProxy, 2>
     ov.active = ops_busy_[h];
     overlays_.push_back(ov);
   }
+}
+
+namespace {
+std::string mm(double metres) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.1f mm", metres * 1e3);
+  return b;
+}
+
+std::string point(const tracking::Vec3& p) {
+  char b[96];
+  std::snprintf(b, sizeof b, "(%.4f, %.4f, %.4f)", p.x(), p.y(), p.z());
+  return b;
+}
+}  // namespace
+
+// --calibrate: the markers drawn, the first one asked for.
+void DrapingSession::open_calibration_mode() {
+  ext_->calibrating = std::make_unique<CalibrationMode>();
+  rep_.note("calibration: touch the " + std::to_string(calibration_markers().size()) +
+            " marked points in turn; the result goes to " + opt_.calibration_save);
+  feedback_.set_status("calibration", ext_->calibrating->guidance());
+  markers_.clear();
+  for (size_t i = 0; i < calibration_markers().size(); ++i)
+    markers_.push_back({calibration_markers()[i].stage.cast<float>(),
+                        i == 0 ? std::array<float, 3>{1.0f, 0.2f, 0.8f}
+                               : std::array<float, 3>{0.45f, 0.45f, 0.5f}});
+}
+
+// One palm frame while calibrating: the points taken, then the result computed, shown, logged
+// and saved (or refused: the reason, nothing saved, the markers again from the first).
+void DrapingSession::calibration_frame(const tracking::HandFrame& raw,
+                                       const tracking::HandFrame& filtered) {
+  CalibrationMode& cm = *ext_->calibrating;
+  const auto events = cm.update(raw, filtered);
+  for (const auto& e : events) {
+    if (e.kind == CalibrationMode::Event::Taken) {
+      rep_.note("calibration: marker " + std::to_string(e.marker + 1) + " (" +
+                calibration_markers()[e.marker].name + ") taken at " + point(e.tracker) +
+                " in the tracker's frame");
+    } else if (e.kind == CalibrationMode::Event::Refused) {
+      rep_.note("calibration: refused: " + e.message +
+                "; nothing saved; touch the markers again from the first");
+      feedback_.set_status("calibration", "refused (" + e.message + "), again from marker 1");
+    } else {
+      const tracking::Calibration& c = *cm.result();
+      ext_->calibration = c;
+      const std::string residual =
+          "residual rms " + mm(c.rms_residual) + ", max " + mm(c.max_residual);
+      std::string error;
+      std::error_code ec;
+      std::filesystem::create_directories(
+          std::filesystem::path(opt_.calibration_save).parent_path(), ec);
+      const bool saved = tracking::save_calibration(c, opt_.calibration_save, &error);
+      rep_.note("calibration: " + residual + " over " + std::to_string(c.pairs) + " points; " +
+                (saved ? "saved to " + opt_.calibration_save : "not saved: " + error));
+      feedback_.set_status("calibration", residual + (saved ? ", saved" : ", NOT saved: " + error));
+    }
+  }
+  if (events.empty()) return;
+  if (cm.done()) {
+    markers_.clear();
+    return;
+  }
+  if (events.back().kind != CalibrationMode::Event::Refused)
+    feedback_.set_status("calibration", cm.guidance());
+  for (size_t i = 0; i < markers_.size(); ++i)
+    markers_[i].colour = static_cast<int>(i) < cm.current() ? std::array<float, 3>{0.2f, 0.9f, 0.3f}
+                         : static_cast<int>(i) == cm.current()
+                             ? std::array<float, 3>{1.0f, 0.2f, 0.8f}
+                             : std::array<float, 3>{0.45f, 0.45f, 0.5f};
 }
 
 }  // namespace drape::app
