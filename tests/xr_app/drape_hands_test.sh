@@ -19,7 +19,8 @@
 #           for the grace and let go, the session runs on to its last frame (exit 0).
 #   missing --hands trace with no such file: exit 2 naming the file; a bad --hands value: exit 2
 #           naming the option; a malformed trace: the session runs (exit 0), its status logged;
-#           --kinect-record with no recording, or without --hands kinect: exit 2 naming it.
+#           --kinect-record with no recording, or without --hands kinect: exit 2 naming it;
+#           --hands kinect with no device: its status, the session runs (exit 0).
 # usage: drape_hands_test.sh DRAPE_EXE MODE WORKDIR PORT
 set -u
 exe=$1 mode=$2 work=$3 port=${4:-0}
@@ -197,6 +198,11 @@ PY
     [ $rc -eq 2 ] || fail "missing recording: exit $rc, expected 2"
     grep -q "drape xr: --kinect-record: no fakenect recording in .*norec (no INDEX.txt)" "$log" ||
       fail "no message naming --kinect-record and the directory"
+    # No Kinect plugged in (no USB device here): a status, the session runs.
+    scenario 30 true
+    xr --hands kinect >"$log" 2>&1 || fail "--hands kinect with no device: exit code $?"
+    grep -q "hands: kinect: no Kinect found (libfreenect reports 0 devices)\|hands: kinect: libfreenect init failed" "$log" ||
+      fail "no status: no Kinect"
     mkdir -p "$work/rec" && : >"$work/rec/INDEX.txt"
     "$exe" run --frames 5 --hands udp --kinect-record "$work/rec" >"$log" 2>&1
     rc=$?
