@@ -136,6 +136,13 @@ std::string mm(double metres) {
   return b;
 }
 
+// A marker's colour: taken (green), the one to touch (magenta), later (grey).
+std::array<float, 3> marker_colour(int marker, int current) {
+  if (marker < current) return {0.2f, 0.9f, 0.3f};
+  if (marker == current) return {1.0f, 0.2f, 0.8f};
+  return {0.45f, 0.45f, 0.5f};
+}
+
 std::string point(const tracking::Vec3& p) {
   char b[96];
   std::snprintf(b, sizeof b, "(%.4f, %.4f, %.4f)", p.x(), p.y(), p.z());
@@ -151,9 +158,8 @@ void DrapingSession::open_calibration_mode() {
   feedback_.set_status("calibration", ext_->calibrating->guidance());
   markers_.clear();
   for (size_t i = 0; i < calibration_markers().size(); ++i)
-    markers_.push_back({calibration_markers()[i].stage.cast<float>(),
-                        i == 0 ? std::array<float, 3>{1.0f, 0.2f, 0.8f}
-                               : std::array<float, 3>{0.45f, 0.45f, 0.5f}});
+    markers_.push_back(
+        {calibration_markers()[i].stage.cast<float>(), marker_colour(static_cast<int>(i), 0)});
 }
 
 // One palm frame while calibrating: the points taken, then the result computed, shown, logged
@@ -194,10 +200,7 @@ void DrapingSession::calibration_frame(const tracking::HandFrame& raw,
   if (events.back().kind != CalibrationMode::Event::Refused)
     feedback_.set_status("calibration", cm.guidance());
   for (size_t i = 0; i < markers_.size(); ++i)
-    markers_[i].colour = static_cast<int>(i) < cm.current() ? std::array<float, 3>{0.2f, 0.9f, 0.3f}
-                         : static_cast<int>(i) == cm.current()
-                             ? std::array<float, 3>{1.0f, 0.2f, 0.8f}
-                             : std::array<float, 3>{0.45f, 0.45f, 0.5f};
+    markers_[i].colour = marker_colour(static_cast<int>(i), cm.current());
 }
 
 }  // namespace drape::app
