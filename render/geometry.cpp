@@ -364,6 +364,8 @@ void append_hand_overlays(const sim::SceneSnapshot& snap, const DrawOptions& opt
                                     {1, 11, 12, 13, 14, 15},
                                     {1, 16, 17, 18, 19, 20},
                                     {1, 21, 22, 23, 24, 25}};
+  for (const auto& m : opt.markers)
+    if (m.at.allFinite()) append_sphere(out, m.at, 0.015f, m.colour, ShadeMode::kUnlit, 12, 8);
   for (const auto& h : opt.hands) {
     if (h.id != 0 && h.id != 1) continue;
     const std::array<float, 3> col = h.id == 0 ? std::array<float, 3>{0.15f, 0.65f, 0.65f}

@@ -72,6 +72,13 @@ struct DrawOptions {
   // Live hands (see HandOverlay). A hand given here replaces the snapshot's proxy of the same
   // id; the candidate highlight of that hand is joined to its pointer by a thin line.
   std::vector<HandOverlay> hands;
+  // Marked points to touch (the app's tracker calibration): unlit spheres of this colour, 1.5 cm
+  // in radius, drawn with the hands.
+  struct Marker {
+    Eigen::Vector3f at = Eigen::Vector3f::Zero();  // stage space (m)
+    std::array<float, 3> colour{1.0f, 0.2f, 0.8f};
+  };
+  std::vector<Marker> markers;
 };
 
 // Level of detail of the drawn form for a view whose pixels subtend `rad_per_pixel` (radians):

@@ -47,7 +47,19 @@ HandShape hand_shape(const HandFrame& f) {
 }
 
 void GestureRecognizer::lose(const HandFrame& f, State& s, std::vector<Trigger>& out) {
-  // Lost hand: end whatever was active (a lost pinch must not stay latched).
+  // Lost hand: end whatever was active (a lost pinch must not stay latched); a palm push that
+  // waited for the other hand's is given now, the two hands' together state ends.
+  const int h = static_cast<int>(f.hand);
+  if (pending_push_[h] >= 0) {
+    out.push_back(Trigger{"palm_push", "gesture", pending_push_[h], f.hand, true});
+    pending_push_[h] = -1;
+  }
+  if (together_.on()) {
+    HandFrame right = f;
+    right.hand = Hand::Right;
+    emit(together_.update(false, f.time, 0.0), "hands_together", right, out);
+    together_ended_ = f.time;
+  }
   for (int k = 0; k < 4; ++k) emit(s.pinch[k].update(false, f.time, 0.0), kPinchNames[k], f, out);
   emit(s.grab.update(false, f.time, 0.0), "grab", f, out);
   emit(s.flat.update(false, f.time, 0.0), "flat", f, out);
@@ -59,6 +71,7 @@ void GestureRecognizer::lose(const HandFrame& f, State& s, std::vector<Trigger>&
 
 void GestureRecognizer::update(const HandFrame& f, std::vector<Trigger>& out) {
   State& s = st_[static_cast<int>(f.hand)];
+  flush_pushes(f.time, out);
   if (!f.tracked) return lose(f, s, out);
   s.history.emplace_back(f.time, f.palm.position);
   const double keep = std::max(p_.dwell_time, p_.push_time) + 0.1;
@@ -123,7 +136,8 @@ void GestureRecognizer::update_palm_only(const HandFrame& f, State& s, std::vect
   for (const auto& [t, q] : s.history)
     if (t >= f.time - p_.dwell_time && (q - p).norm() > p_.dwell_radius) moved = true;
   const bool still = !moved && s.history.front().first <= f.time - p_.dwell_time + 1e-9;
-  if (still && !s.dwell_fired) {
+  // Palms held together are the two hands' gesture, no dwell of either.
+  if (still && !s.dwell_fired && !palms_near_) {
     out.push_back(Trigger{"dwell", "gesture", f.time, f.hand, true});
     s.dwell_fired = true;
   } else if (moved) {
@@ -133,11 +147,70 @@ void GestureRecognizer::update_palm_only(const HandFrame& f, State& s, std::vect
     for (const auto& [t, q] : s.history) {
       if (f.time - t > p_.push_time) continue;
       if ((p - q).dot(p_.push_axis.normalized()) > p_.push_distance) {
-        out.push_back(Trigger{"palm_push", "gesture", f.time, f.hand, true});
+        palm_pushed(f, out);
         s.push_block_until = f.time + p_.push_time;
         break;
       }
     }
+  }
+  update_two_hands(f, out);
+}
+
+// Whether the other hand's palm (palm-only) has a sample within pair_stale of f.
+bool GestureRecognizer::other_palm_seen(const HandFrame& f) const {
+  const State& o = st_[1 - static_cast<int>(f.hand)];
+  return !o.history.empty() && std::abs(f.time - o.history.back().first) <= p_.pair_stale;
+}
+
+// A palm push of f's hand: with one hand seen, "palm_push" at once; with both, a push of the
+// other hand waiting within both_push_window makes the pair a "both_push", else this one waits.
+void GestureRecognizer::palm_pushed(const HandFrame& f, std::vector<Trigger>& out) {
+  const int h = static_cast<int>(f.hand);
+  if (!other_palm_seen(f)) {
+    out.push_back(Trigger{"palm_push", "gesture", f.time, f.hand, true});
+    return;
+  }
+  if (pending_push_[1 - h] >= 0) {
+    pending_push_[1 - h] = -1;
+    out.push_back(Trigger{"both_push", "gesture", f.time, Hand::Right, true});
+    return;
+  }
+  pending_push_[h] = f.time;
+}
+
+// Palm pushes that waited past both_push_window without the other hand's: each a "palm_push".
+void GestureRecognizer::flush_pushes(double t, std::vector<Trigger>& out) {
+  for (int h = 0; h < 2; ++h)
+    if (pending_push_[h] >= 0 && t - pending_push_[h] > p_.both_push_window) {
+      out.push_back(Trigger{"palm_push", "gesture", pending_push_[h], static_cast<Hand>(h), true});
+      pending_push_[h] = -1;
+    }
+}
+
+// Both palms: together (held) and spread apart quickly.
+void GestureRecognizer::update_two_hands(const HandFrame& f, std::vector<Trigger>& out) {
+  palms_near_ = false;
+  if (!other_palm_seen(f)) return;
+  const State& o = st_[1 - static_cast<int>(f.hand)];
+  const double d = (f.palm.position - o.history.back().second).norm();
+  palms_near_ = d < p_.together_leave;
+  HandFrame right = f;
+  right.hand = Hand::Right;
+  const bool near = together_.on() ? d < p_.together_leave : d < p_.together_enter;
+  const int edge = together_.update(near, f.time, p_.together_hold);
+  emit(edge, "hands_together", right, out);
+  if (edge < 0) together_ended_ = f.time;
+  if (together_.on() || d <= p_.apart_to || f.time - together_ended_ < p_.apart_quiet) return;
+  // Spread: the palms' distance, paired sample by sample over apart_time, was under apart_from.
+  const State& s = st_[static_cast<int>(f.hand)];
+  for (const auto& [t, q] : s.history) {
+    if (f.time - t > p_.apart_time) continue;
+    for (const auto& [u, r] : o.history)
+      if (std::abs(u - t) <= p_.pair_stale * 0.5 && (q - r).norm() < p_.apart_from) {
+        out.push_back(Trigger{"hands_apart", "gesture", f.time, Hand::Right, true});
+        together_ended_ = f.time;  // once per spread (apart_quiet)
+        return;
+      }
   }
 }
 

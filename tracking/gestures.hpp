@@ -3,7 +3,8 @@
 // the finger clearly the thumb's nearest), the fist ("grab"), the flat hand with the fingers
 // together and the palm down ("flat"), the open hand with the palm up ("palm_up") and the open
 // palm thrust forward ("push"); every held one debounced by a minimum duration, and a resting
-// open hand fires nothing. From palm-only sources (Kinect, UDP): "dwell" and "palm_push".
+// open hand fires nothing. From palm-only sources (Kinect, UDP): "dwell" and "palm_push", and
+// from both palms together: "hands_together" (held), "hands_apart" and "both_push".
 // Controller buttons: ButtonMapper.
 #pragma once
 #include <deque>
@@ -29,7 +30,19 @@ struct GestureParams {
   double push_distance = 0.12;  // m: forward motion (palm-only: along push_axis; joints: along
   double push_time = 0.35;      // s: the palm's normal) within this time -> "push"
   Vec3 push_axis = Vec3(0, 0, -1);
-  Vec3 up = Vec3(0, 1, 0);  // the source's up (OpenXR reference spaces: +y)
+  // Palm-only, both hands (the triggers carry the right hand: its palm is the operation's point):
+  double together_enter = 0.10;    // m: palms closer than this ...
+  double together_leave = 0.15;    // m: ... (apart again beyond this) ...
+  double together_hold = 0.3;      // s: ... this long -> "hands_together" (begin; end when apart)
+  double apart_from = 0.25;        // m: palms from closer than this ...
+  double apart_to = 0.55;          // m: ... to farther than this ...
+  double apart_time = 0.5;         // s: ... within this -> "hands_apart" (not within
+  double apart_quiet = 1.0;        // s: this after "hands_together" ended)
+  double both_push_window = 0.15;  // s: both palms pushed within this -> "both_push" (and no
+                                   // "palm_push": while both hands are seen, a palm push
+                                   // waits this long for the other's)
+  double pair_stale = 0.2;         // s: the other palm's newest sample older than this: one hand
+  Vec3 up = Vec3(0, 1, 0);         // the source's up (OpenXR reference spaces: +y)
 };
 
 // A boolean state with hysteresis already applied, debounced by a minimum duration.
@@ -72,10 +85,20 @@ class GestureRecognizer {
   void update_pinch_finger(const HandShape& shape, State& s) const;
   bool joint_push(const HandFrame& f, const HandShape& shape, State& s) const;
   void update_palm_only(const HandFrame& f, State& s, std::vector<Trigger>& out);
+  void palm_pushed(const HandFrame& f, std::vector<Trigger>& out);
+  void update_two_hands(const HandFrame& f, std::vector<Trigger>& out);
+  void flush_pushes(double t, std::vector<Trigger>& out);
+  bool other_palm_seen(const HandFrame& f) const;
   void lose(const HandFrame& f, State& s, std::vector<Trigger>& out);
   void emit(int edge, const char* name, const HandFrame& f, std::vector<Trigger>& out);
   GestureParams p_;
   State st_[2];
+  // Both palms (palm-only): the together state, when it last ended, and each hand's palm push
+  // waiting for the other's (time < 0: none).
+  Debounced together_;
+  double together_ended_ = -1e9;
+  bool palms_near_ = false;  // the palms within together_leave (no dwell then)
+  double pending_push_[2] = {-1, -1};
 };
 
 // Controller buttons -> triggers: edges of named buttons ("trigger", "grip", "a", "b", ...).

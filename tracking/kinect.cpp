@@ -140,9 +140,12 @@ struct KinectSource::Impl {
   SourceStatus status{SourceState::NoData, "kinect: starting"};
   std::atomic<uint64_t> frames{0};
   std::atomic<bool> running{false};
+  std::string recording;   // the fakenect recording replayed ("" = a device)
+  double last_frame = -1;  // steady clock (s) of the newest depth frame, under mu
 };
 
 namespace {
+constexpr double kStallSeconds = 1.0;  // no depth frame for this long: a stalled stream
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -152,6 +155,7 @@ void depth_cb(freenect_device* dev, void* data, uint32_t) {
   auto frames = impl->seg.process_raw11(static_cast<const uint16_t*>(data), 640, 480, now_s());
   ++impl->frames;
   std::lock_guard lk(impl->mu);
+  impl->last_frame = now_s();
   for (auto& f : frames) impl->pending.push_back(f);
   if (impl->pending.size() > 64)
     impl->pending.erase(impl->pending.begin(), impl->pending.end() - 64);
@@ -163,6 +167,7 @@ KinectSource::KinectSource(SegmenterParams p, int device_index,
                            const std::string& fakenect_recording)
     : impl_(std::make_unique<Impl>()) {
   impl_->seg = HandSegmenter(p);
+  impl_->recording = fakenect_recording;
   auto set = [&](SourceState s, const std::string& m) {
     std::lock_guard lk(impl_->mu);
     impl_->status = {s, m};
@@ -205,8 +210,13 @@ KinectSource::KinectSource(SegmenterParams p, int device_index,
   impl_->thread = std::thread([this] {
     while (!impl_->stop) {
       if (freenect_process_events(impl_->ctx) < 0) {
+        // fakenect (loop off) returns an error at the recording's end; a device on a USB error
+        // (unplugged).
         std::lock_guard lk(impl_->mu);
-        impl_->status = {SourceState::Error, "kinect: stream ended or USB error"};
+        impl_->status = {SourceState::Error,
+                         impl_->recording.empty()
+                             ? "kinect: the device went away (USB error or unplugged)"
+                             : "kinect: the recording " + impl_->recording + " ended"};
         break;
       }
     }
@@ -238,6 +248,10 @@ std::vector<HandFrame> KinectSource::poll() {
 
 SourceStatus KinectSource::status() const {
   std::lock_guard lk(impl_->mu);
+  // A stream that stalls without an error (a device that stops sending) says so.
+  if (impl_->status.state == SourceState::Ok && impl_->last_frame >= 0 &&
+      now_s() - impl_->last_frame > kStallSeconds)
+    return {SourceState::NoData, "kinect: no depth frame for over 1 s"};
   return impl_->status;
 }
 

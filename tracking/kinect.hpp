@@ -63,7 +63,9 @@ class HandSegmenter {
 };
 
 // Live Kinect via libfreenect on its own thread. A missing device or library error gives a
-// clear status (Unavailable) and the other sources keep working. Under fakenect
+// clear status (Unavailable) and the other sources keep working; the stream's end (a recording's
+// last frame, a device gone) is an Error status naming which, a stream that stalls for over 1 s
+// a NoData status. Under fakenect
 // (FAKENECT_PATH + LD_LIBRARY_PATH, see docs/tracking.md) it replays a recording.
 // `fakenect_recording`: the recording's directory when the program runs under fakenect (the
 // executable passes on the FAKENECT_PATH that libfreenect's replay library reads itself). It is

@@ -543,7 +543,7 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
   cli.add_option("--every", o.every, "write every K-th frame's screenshot (live default: 90)")
       ->check(CLI::Range(1, 1000000));
   drape::app::add_voice_option(cli, o.voice);
-  drape::app::add_hands_options(cli, o.hands, o.calibration);
+  drape::app::add_hands_options(cli, o.hands, o.calibration, o.app);
   cli.add_option("--form", o.form,
                  "the dress form: a standard size (7AR, 9AR, 11AR, 13AR) or a measurements file "
                  "(JSON, as assets/forms/9AR.json)");

@@ -144,7 +144,7 @@ int cmd_xr(int argc, char** argv) {
   app::add_voice_option(cli, voice);
   std::vector<std::string> hands;
   std::string calibration;
-  app::add_hands_options(cli, hands, calibration);
+  app::add_hands_options(cli, hands, calibration, opt);
   cli.add_option("--pose-wait-ms", opt.pose_wait_ms,
                  "free sim: how long a frame waits for the tick that took its hand pose")
       ->check(CLI::Range(0.0, 1000.0));

@@ -1,9 +1,15 @@
 // The executable's side of the OpenXR app (see xr_launch.hpp).
 #include "xr_app/xr_launch.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "xr_app/paths.hpp"
 
@@ -16,6 +22,10 @@ std::string env(const char* name) {
   const char* v = std::getenv(name);
   return v ? v : "";
 }
+
+// select_runtime pointed XR_RUNTIME_JSON at the simulated runtime itself (a re-run of the program
+// must see the environment it was started with).
+bool runtime_json_set_here = false;
 
 std::vector<std::string> split(const std::string& s, const char* separators) {
   std::vector<std::string> out;
@@ -45,6 +55,7 @@ std::string select_runtime(bool* simulated) {
   const fs::path mock = mock_runtime_manifest();
   if (mock.empty()) return "";
   setenv("XR_RUNTIME_JSON", mock.c_str(), 1);
+  runtime_json_set_here = true;
   if (simulated) *simulated = true;
   return mock.string();
 }
@@ -137,22 +148,45 @@ bool resolve_voice(const char* command, const std::string& given, bool live, std
   return resolve_input_file(command, "--voice", out);
 }
 
-void add_hands_options(CLI::App& cli, std::vector<std::string>& hands, std::string& calibration) {
+void add_hands_options(CLI::App& cli, std::vector<std::string>& hands, std::string& calibration,
+                       XrAppOptions& opt) {
   cli.add_option("--hands", hands,
                  "where the hands come from: xr (the runtime's), udp[:ADDR:PORT] (a skeleton "
-                 "stream, docs/tracking.md; default 127.0.0.1:9740) or trace FILE (a recorded "
-                 "trace played from the first frame)")
+                 "stream, docs/tracking.md; default 127.0.0.1:9740), trace FILE (a recorded "
+                 "trace played from the first frame) or kinect (a Kinect v1 through libfreenect)")
       ->expected(1, 2)
       ->default_str("xr");
+  cli.add_option("--kinect-record", opt.kinect_record,
+                 "with --hands kinect: replay this fakenect recording directory (DIR/INDEX.txt, "
+                 "libfreenect's fakenect-record) instead of the device; its end is the Kinect "
+                 "going away")
+      ->always_capture_default(false);
   cli.add_option("--calibration", calibration,
                  "tracker-to-stage calibration file (tracking/calibration's JSON) for --hands "
-                 "udp or trace (default: identity)")
+                 "udp, trace or kinect (default: the source's saved calibration, "
+                 "$XDG_CONFIG_HOME/drape/calibration-<source>.json, when there is one; else "
+                 "identity)")
       ->always_capture_default(false);
+  cli.add_flag("--calibrate", opt.calibrate,
+               "calibrate --hands udp, trace or kinect: touch the 4 marked points in turn, "
+               "holding the palm still 1 s on each; the result is saved as the source's "
+               "calibration");
+}
+
+std::string saved_calibration_file(const std::string& source) {
+  fs::path dir;
+  if (std::string x = env("XDG_CONFIG_HOME"); !x.empty())
+    dir = x;
+  else if (std::string h = env("HOME"); !h.empty())
+    dir = fs::path(h) / ".config";
+  else
+    return "";
+  return (dir / "drape" / ("calibration-" + source + ".json")).string();
 }
 
 namespace {
 bool hands_usage(const char* command, const std::string& why) {
-  std::fprintf(stderr, "%s: --hands: %s (xr, udp[:ADDR:PORT] or trace FILE)\n", command,
+  std::fprintf(stderr, "%s: --hands: %s (xr, udp[:ADDR:PORT], trace FILE or kinect)\n", command,
                why.c_str());
   return false;
 }
@@ -172,6 +206,55 @@ bool parse_udp(const char* command, const std::string& v, XrAppOptions& opt) {
   opt.hands_port = static_cast<int>(p);
   return true;
 }
+// This program's arguments as it was started (/proc/self/cmdline).
+std::vector<std::string> own_arguments() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  const std::string all{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::vector<std::string> args;
+  size_t p = 0;
+  while (p < all.size()) {
+    const size_t q = all.find('\0', p);
+    args.push_back(all.substr(p, q == std::string::npos ? std::string::npos : q - p));
+    if (q == std::string::npos) break;
+    p = q + 1;
+  }
+  return args;
+}
+
+// --kinect-record DIR: checks the recording, then runs this program again under libfreenect's
+// `fakenect DIR` wrapper unless it already runs under it (FAKENECT_PATH is DIR).
+bool replay_kinect_record(const char* command, XrAppOptions& opt) {
+  std::error_code ec;
+  const fs::path dir = fs::absolute(opt.kinect_record, ec);
+  if (!fs::is_regular_file(dir / "INDEX.txt", ec)) {
+    std::fprintf(stderr, "%s: --kinect-record: no fakenect recording in %s (no INDEX.txt)\n",
+                 command, opt.kinect_record.c_str());
+    return false;
+  }
+  opt.kinect_record = dir.string();
+  if (env("FAKENECT_PATH") == opt.kinect_record) return true;
+  char exe[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n <= 0) {
+    std::fprintf(stderr, "%s: --kinect-record: cannot find this program to run it under fakenect\n",
+                 command);
+    return false;
+  }
+  exe[n] = '\0';
+  std::vector<std::string> args = {"fakenect", opt.kinect_record, exe};
+  const std::vector<std::string> own = own_arguments();
+  if (own.size() > 1) args.insert(args.end(), own.begin() + 1, own.end());
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  setenv("FAKENECT_LOOP", "0", 0);
+  if (runtime_json_set_here) unsetenv("XR_RUNTIME_JSON");
+  std::fflush(nullptr);
+  ::execvp("fakenect", argv.data());
+  std::fprintf(stderr, "%s: --kinect-record: cannot run libfreenect's fakenect wrapper: %s\n",
+               command, std::strerror(errno));
+  return false;
+}
 }  // namespace
 
 bool resolve_hands(const char* command, const std::vector<std::string>& hands,
@@ -189,12 +272,41 @@ bool resolve_hands(const char* command, const std::vector<std::string>& hands,
   } else if (kind == "udp" || kind.rfind("udp:", 0) == 0) {
     opt.hands = "udp";
     if (!parse_udp(command, kind, opt)) return false;
+  } else if (kind == "kinect") {
+    opt.hands = "kinect";
   } else {
     return hands_usage(command, "unknown source '" + kind + "'");
   }
   opt.calibration_path = calibration;
-  if (calibration.empty()) return true;
-  return resolve_input_file(command, "--calibration", opt.calibration_path);
+  if (!calibration.empty() && !resolve_input_file(command, "--calibration", opt.calibration_path))
+    return false;
+  if (opt.calibrate) {
+    if (opt.hands == "xr") {
+      std::fprintf(stderr, "%s: --calibrate: needs --hands udp, trace or kinect\n", command);
+      return false;
+    }
+    opt.calibration_save = saved_calibration_file(opt.hands);
+    if (opt.calibration_save.empty()) {
+      std::fprintf(stderr,
+                   "%s: --calibrate: no config directory to save to (neither XDG_CONFIG_HOME "
+                   "nor HOME is set)\n",
+                   command);
+      return false;
+    }
+  } else if (calibration.empty() && opt.hands != "xr") {
+    std::error_code ec;
+    const std::string saved = saved_calibration_file(opt.hands);
+    if (!saved.empty() && fs::is_regular_file(saved, ec)) {
+      opt.calibration_path = saved;
+      opt.calibration_saved = true;
+    }
+  }
+  if (opt.kinect_record.empty()) return true;
+  if (opt.hands != "kinect") {
+    std::fprintf(stderr, "%s: --kinect-record: needs --hands kinect\n", command);
+    return false;
+  }
+  return replay_kinect_record(command, opt);
 }
 
 std::string commands_file(const std::string& given) {

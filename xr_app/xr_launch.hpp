@@ -68,12 +68,26 @@ void add_voice_option(CLI::App& cli, std::string& voice);
 // missing file prints its message and returns false; a malformed one is the session's message).
 bool resolve_voice(const char* command, const std::string& given, bool live, std::string& out);
 
-// --hands xr|udp[:ADDR:PORT]|trace FILE and --calibration FILE (both commands).
-void add_hands_options(CLI::App& cli, std::vector<std::string>& hands, std::string& calibration);
+// --hands xr|udp[:ADDR:PORT]|trace FILE|kinect, --kinect-record DIR (into opt.kinect_record),
+// --calibration FILE and --calibrate (into opt.calibrate) (both commands).
+void add_hands_options(CLI::App& cli, std::vector<std::string>& hands, std::string& calibration,
+                       XrAppOptions& opt);
+
+// The file a source's calibration is saved to and loaded from by default:
+// $XDG_CONFIG_HOME/drape/calibration-<source>.json (else ~/.config/drape/...; "" when neither
+// variable is set).
+std::string saved_calibration_file(const std::string& source);
 
 // After parsing: the hands' options into opt (hands, hands_address, hands_port, hands_trace,
-// calibration_path). A bad value or a missing file prints "<command>: <option>: ..." and returns
-// false (the caller exits with the usage status 2).
+// calibration_path; opt.kinect_record is --kinect-record's value). A bad value or a missing file
+// prints "<command>: <option>: ..." and returns false (the caller exits with the usage status 2).
+// `--hands kinect --kinect-record DIR`: DIR must hold a fakenect recording (DIR/INDEX.txt); the
+// process then runs itself again under libfreenect's `fakenect DIR` wrapper (its replay library
+// must be loaded in place of libfreenect before the program starts), with FAKENECT_LOOP=0 unless
+// set (the recording's end is the Kinect going away); it does not return on success.
+// --calibrate (udp, trace or kinect only): opt.calibration_save = saved_calibration_file(source).
+// Without --calibration (and not calibrating), an existing saved_calibration_file(source) is
+// used (opt.calibration_saved).
 bool resolve_hands(const char* command, const std::vector<std::string>& hands,
                    const std::string& calibration, XrAppOptions& opt);
 

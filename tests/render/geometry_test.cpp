@@ -97,6 +97,23 @@ TEST(Geometry, DecorationsForEveryElement) {
 // Live hands (DrawOptions::hands): the 26-joint skeleton around its joints, the pointer marker
 // at the pointer, a line to the hand's candidate particle; the snapshot's proxy of the same hand
 // is not drawn twice; a non-finite pose is skipped.
+// DrawOptions::markers (the app's calibration points): a sphere of the marker's colour, 1.5 cm in
+// radius, around each finite marker; a non-finite one is skipped.
+TEST(Geometry, MarkersAreSpheresOfTheirColour) {
+  sim::SceneSnapshot s;
+  DrawOptions opt;
+  const Eigen::Vector3f at(0.3f, 0.0f, 0.4f);
+  opt.markers = {{at, {0.2f, 0.9f, 0.3f}}, {Eigen::Vector3f(NAN, 0.0f, 0.0f), {1.0f, 1.0f, 1.0f}}};
+  Mesh m;
+  append_hand_overlays(s, opt, m);
+  ASSERT_GT(m.vertices.size(), 0u);
+  for (const Vertex& v : m.vertices) {
+    const Eigen::Vector3f p(v.pos[0], v.pos[1], v.pos[2]);
+    EXPECT_NEAR((p - at).norm(), 0.015f, 1e-4f);
+    EXPECT_FLOAT_EQ(v.color[1], 0.9f);
+  }
+}
+
 TEST(Geometry, HandOverlaysDrawSkeletonPointerAndCandidateLine) {
   sim::SceneSnapshot s;
   s.positions = {{0.0f, 1.0f, 0.2f}, {0.1f, 1.0f, 0.2f}, {0.0f, 1.1f, 0.2f}};

@@ -1,7 +1,8 @@
 // Gestures (tracking/gestures.cpp) on synthetic joint frames: the thumb's pinch with each
 // finger, the fist, the flat hand palm down, the palm up and the push, each with its hysteresis
 // and minimum duration; the resting open hand fires nothing and each gesture's neighbours do
-// not cross-fire. Palm-only sources' dwell and push; controller button edges.
+// not cross-fire. Palm-only sources' dwell and push, and their two-hand triggers (together,
+// apart, both pushed); controller button edges.
 #include "tracking/gestures.hpp"
 
 #include <gtest/gtest.h>
@@ -297,6 +298,152 @@ TEST(Gestures, DwellFiresOnceWhenSamplesComeInBursts) {
     g.update(f, out);
   }
   EXPECT_EQ(count(out, "dwell", true), 2);
+}
+
+namespace {
+// Both palms (palm-only) at 30 Hz for `secs` from t: left(u) and right(u), u in [0, 1].
+template <class Left, class Right>
+void two_palms(GestureRecognizer& g, double& t, double secs, Left left, Right right,
+               std::vector<Trigger>& out) {
+  const int n = static_cast<int>(std::lround(secs * 30));
+  for (int i = 0; i < n; ++i, t += 1 / 30.0) {
+    const double u = (i + 1.0) / n;
+    HandFrame f;
+    f.tracked = true;
+    f.confidence = 1;
+    f.time = t;
+    f.hand = Hand::Left;
+    f.palm.position = left(u);
+    g.update(f, out);
+    f.hand = Hand::Right;
+    f.palm.position = right(u);
+    g.update(f, out);
+  }
+}
+Vec3 at(double x, double z = -0.6) {
+  return Vec3(x, 1.2, z);
+}
+// Both palms held at x = -x_apart and +x_apart for `secs`.
+void hold(GestureRecognizer& g, double& t, double secs, double x_apart, std::vector<Trigger>& out) {
+  two_palms(
+      g, t, secs, [=](double) { return at(-x_apart); }, [=](double) { return at(x_apart); }, out);
+}
+Vec3 mix(const Vec3& a, const Vec3& b, double u) {
+  return a + (b - a) * u;
+}
+const Trigger* find(const std::vector<Trigger>& v, const std::string& c) {
+  for (auto& t : v)
+    if (t.command == c) return &t;
+  return nullptr;
+}
+}  // namespace
+
+// Palms brought within 10 cm and held 0.3 s: "hands_together" (the right hand's), held while
+// together, ended when apart; a slow separation afterwards is no "hands_apart", and the palms
+// held still together fire no dwell.
+TEST(Gestures, HandsTogetherHeldAndEnded) {
+  GestureRecognizer g;
+  std::vector<Trigger> out;
+  double t = 0;
+  hold(g, t, 0.5, 0.3, out);  // apart, seen
+  two_palms(
+      g, t, 0.8, [](double u) { return mix(at(-0.3), at(-0.03), u); },
+      [](double u) { return mix(at(0.3), at(0.03), u); }, out);   // brought together (6 cm)
+  EXPECT_EQ(find(out, "hands_together"), nullptr) << names(out);  // not held long enough yet
+  hold(g, t, 1.5, 0.03, out);
+  ASSERT_EQ(count(out, "hands_together", true), 1) << names(out);
+  EXPECT_EQ(find(out, "hands_together")->hand, Hand::Right);
+  EXPECT_EQ(count(out, "dwell", true), 0) << names(out);
+  EXPECT_EQ(count(out, "hands_together", false), 0);
+  two_palms(
+      g, t, 2.0, [](double u) { return mix(at(-0.03), at(-0.35), u); },
+      [](double u) { return mix(at(0.03), at(0.35), u); }, out);  // slowly apart (70 cm in 2 s)
+  EXPECT_EQ(count(out, "hands_together", false), 1) << names(out);
+  EXPECT_EQ(count(out, "hands_apart", true), 0) << names(out);
+  EXPECT_EQ(count(out, "palm_push", true), 0);
+}
+
+// A quick spread (from 20 cm to 70 cm in 0.3 s) is "hands_apart", once; the same spread too
+// slowly (1.5 s), or with one hand only, is not.
+TEST(Gestures, HandsApartIsAQuickSpread) {
+  auto run = [](double secs) {
+    GestureRecognizer g;
+    std::vector<Trigger> out;
+    double t = 0;
+    hold(g, t, 0.5, 0.1, out);
+    two_palms(
+        g, t, secs, [](double u) { return mix(at(-0.1), at(-0.35), u); },
+        [](double u) { return mix(at(0.1), at(0.35), u); }, out);
+    hold(g, t, 0.5, 0.35, out);
+    return out;
+  };
+  const auto quick = run(0.3);
+  EXPECT_EQ(count(quick, "hands_apart", true), 1) << names(quick);
+  EXPECT_EQ(find(quick, "hands_apart")->hand, Hand::Right);
+  EXPECT_EQ(count(quick, "hands_together", true), 0) << names(quick);
+  const auto slow = run(1.5);
+  EXPECT_EQ(count(slow, "hands_apart", true), 0) << names(slow);
+  // One hand moving 25 cm quickly: no partner, nothing.
+  GestureRecognizer g;
+  std::vector<Trigger> out;
+  HandFrame f;
+  f.tracked = true;
+  f.confidence = 1;
+  for (int i = 0; i < 30; ++i) {
+    f.time = i / 30.0;
+    f.palm.position = at(0.1 + 0.5 * std::min(1.0, i / 9.0));
+    g.update(f, out);
+  }
+  EXPECT_EQ(find(out, "hands_apart"), nullptr) << names(out);
+}
+
+// Both palms pushed forward (20 cm along -z in 0.3 s) within 0.15 s of each other: one
+// "both_push" (the right hand's) and no "palm_push"; one palm pushed while the other is seen: its
+// "palm_push" after the pairing window; the other hand lost meanwhile: the push at once.
+TEST(Gestures, BothPushedIsOneTriggerAndASinglePushStillWorks) {
+  auto push = [](double u) { return std::min(1.0, u * 2.0) * -0.2; };  // in the first half
+  {
+    GestureRecognizer g;
+    std::vector<Trigger> out;
+    double t = 0;
+    hold(g, t, 0.5, 0.25, out);
+    two_palms(
+        g, t, 0.6, [&](double u) { return at(-0.25, -0.6 + push(u)); },
+        [&](double u) { return at(0.25, -0.6 + push(u)); }, out);
+    EXPECT_EQ(count(out, "both_push", true), 1) << names(out);
+    EXPECT_EQ(count(out, "palm_push", true), 0) << names(out);
+    ASSERT_NE(find(out, "both_push"), nullptr);
+    EXPECT_EQ(find(out, "both_push")->hand, Hand::Right);
+  }
+  {
+    GestureRecognizer g;
+    std::vector<Trigger> out;
+    double t = 0;
+    hold(g, t, 0.5, 0.25, out);
+    two_palms(
+        g, t, 0.6, [](double) { return at(-0.25); },
+        [&](double u) { return at(0.25, -0.6 + push(u)); }, out);
+    EXPECT_EQ(count(out, "palm_push", true), 1) << names(out);  // (and the left's dwell)
+    EXPECT_EQ(find(out, "palm_push")->hand, Hand::Right);
+    EXPECT_EQ(find(out, "both_push"), nullptr) << names(out);
+  }
+  {
+    GestureRecognizer g;
+    std::vector<Trigger> out;
+    double t = 0;
+    hold(g, t, 0.5, 0.25, out);
+    HandFrame f;
+    f.tracked = true;
+    f.confidence = 1;
+    f.hand = Hand::Right;
+    for (int i = -10; i < 9; ++i, t += 1 / 30.0) {  // the left not seen; the right pushes
+      f.time = t;
+      f.palm.position = at(0.25, -0.6 - 0.2 * std::max(0, i + 1) / 9.0);
+      g.update(f, out);
+    }
+    EXPECT_EQ(count(out, "palm_push", true), 1) << names(out);  // (and the rest's dwell)
+    EXPECT_EQ(find(out, "both_push"), nullptr) << names(out);
+  }
 }
 
 TEST(Gestures, ControllerButtonsGiveEdges) {

@@ -78,15 +78,17 @@ TEST(Kinect, Raw11PathAssignsHandsMirrored) {
   EXPECT_NEAR(frames[0].palm.position.z(), -1.1, 0.02);
 }
 
-// Writes a fakenect recording (INDEX.txt + d-<time>-<timestamp>.pgm, 11-bit raw after a one-line
-// PGM header) and runs the real libfreenect code path through fakenect's library.
-TEST(Kinect, ReplaysThroughFakenect) {
-  const std::string dir = std::string(DRAPE_BINARY_DIR) + "/fakenect_rec";
+namespace {
+// Writes a fakenect recording of 4 frames of one hand at `truth` (INDEX.txt +
+// d-<time>-<timestamp>.pgm, 11-bit raw after a one-line PGM header) and runs the probe on it
+// under fakenect (FAKENECT_LOOP=0) until `frames` frames or the stream's end. Returns the probe's
+// output and sets *rc to its exit status.
+std::string probe_recording(const std::string& dir, const std::array<double, 3>& truth, int frames,
+                            int* rc) {
   ::mkdir(dir.c_str(), 0755);
   std::ofstream index(dir + "/INDEX.txt");
-  const std::vector<std::array<double, 3>> truth = {{300, 220, 1.0}};
   for (int f = 0; f < 4; ++f) {
-    cv::Mat mm = scene(truth, 10 + f);
+    cv::Mat mm = scene({truth}, 10 + f);
     char name[64];
     std::snprintf(name, sizeof name, "d-%.6f-%u.pgm", 1000.0 + f / 30.0, 1000u + 100u * f);
     std::ofstream out(dir + "/" + name, std::ios::binary);
@@ -101,24 +103,49 @@ TEST(Kinect, ReplaysThroughFakenect) {
   }
   index.close();
   const std::string cmd = "FAKENECT_LOOP=0 fakenect " + dir + " " + DRAPE_BINARY_DIR +
-                          "/bin/tracking_kinect_probe 3 2>&1";
+                          "/bin/tracking_kinect_probe " + std::to_string(frames) + " 2>&1";
   FILE* p = ::popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
   std::string all;
+  if (!p) {
+    *rc = -1;
+    return all;
+  }
   char line[512];
+  while (std::fgets(line, sizeof line, p)) all += line;
+  *rc = ::pclose(p);
+  std::printf("%s", all.c_str());
+  return all;
+}
+}  // namespace
+
+// The real libfreenect code path through fakenect's library.
+TEST(Kinect, ReplaysThroughFakenect) {
+  int rc = 0;
+  const std::string all =
+      probe_recording(std::string(DRAPE_BINARY_DIR) + "/fakenect_rec", {300, 220, 1.0}, 3, &rc);
+  ASSERT_EQ(rc, 0) << all;
   std::vector<Vec3> palms;
-  while (std::fgets(line, sizeof line, p)) {
-    all += line;
+  std::istringstream lines(all);
+  for (std::string line; std::getline(lines, line);) {
     char hand[16];
     double x, y, z;
-    if (std::sscanf(line, "%15s %lf %lf %lf", hand, &x, &y, &z) == 4) palms.emplace_back(x, y, z);
+    if (std::sscanf(line.c_str(), "%15s %lf %lf %lf", hand, &x, &y, &z) == 4)
+      palms.emplace_back(x, y, z);
   }
-  const int rc = ::pclose(p);
-  std::printf("%s", all.c_str());
-  ASSERT_EQ(rc, 0) << all;
   ASSERT_GE(palms.size(), 3u) << all;
   const Vec3 expect = DepthIntrinsics{}.unproject(300, 220, 1.0);
   for (const auto& q : palms) EXPECT_LT((q - expect).norm(), 0.015) << q.transpose();
+}
+
+// The recording's end (FAKENECT_LOOP=0) is the stream's end: an Error status naming the
+// recording, the source no longer running.
+TEST(Kinect, RecordingEndIsAStatusNamingIt) {
+  const std::string dir = std::string(DRAPE_BINARY_DIR) + "/fakenect_rec_end";
+  int rc = 0;
+  const std::string all = probe_recording(dir, {300, 220, 1.0}, 100, &rc);
+  ASSERT_EQ(rc, 0) << all;
+  EXPECT_NE(all.find("frames 4\n"), std::string::npos) << all;
+  EXPECT_NE(all.find("status kinect: the recording " + dir + " ended"), std::string::npos) << all;
 }
 
 TEST(Kinect, MissingRecordingGivesStatusNotExit) {

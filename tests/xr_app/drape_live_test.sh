@@ -21,7 +21,8 @@
 #   under the hand; checked in xr_session.txt (pinned vertices added), session_log.json (a pin
 #   trigger) and the golden image live_pin.png; then the left button pinches.
 # scene: the scene's options (--fabric, --form, --mesh, --start, --resolution): bad values exit 2
-#   naming the option and file before a window opens; good ones run 20 live frames.
+#   naming the option and file before a window opens; good ones run 20 live frames; a fakenect
+#   recording as the hands (--hands kinect --kinect-record) runs live to its last frame.
 # --update-golden: the screenshots become the golden images (look at them before committing).
 set -uo pipefail
 EXE="$1" OUT="$2" MODE="${3:-free}"
@@ -86,6 +87,20 @@ if [ "$MODE" = scene ]; then
   good "form $(cd "$(dirname "$0")/../.." && pwd)/assets/forms/7AR.json" \
     --form "$(cd "$(dirname "$0")/../.." && pwd)/assets/forms/7AR.json"
   good "form $OUT/form.obj" --mesh "$OUT/form.obj" --start spread
+  # --hands kinect --kinect-record: the program runs itself again under fakenect and still goes
+  # live in the window; the recording's end is the session's status, and it runs to its last frame.
+  python3 "$(dirname "$0")/kinect_record.py" "$OUT/rec" "$OUT/kinect.json" 0.11 1.15 0.115 \
+    --until 0.6 || fail "the recording writer failed"
+  rm -f "$LOG"
+  "$EXE" run --out "$OUT/kinect" --no-pattern --resolution 12 --eye-size 128 --frames 200 \
+    --hands kinect --kinect-record "$OUT/rec" --calibration "$OUT/kinect.json" \
+    >"$OUT/stdout" 2>"$OUT/stderr" || fail "drape run --hands kinect failed: $(tail -3 "$OUT/stderr")"
+  grep -q "live in the simulated runtime's window" "$OUT/stdout" || fail "--hands kinect: not live"
+  [ "$(lines)" -ge 200 ] || fail "--hands kinect: fewer than 200 window frames"
+  grep -q "hands: kinect: the recording $OUT/rec ended" "$OUT/kinect/xr_session.txt" ||
+    fail "--hands kinect: no status for the recording's end"
+  rm -rf "$OUT/rec"
+  echo "ok: --hands kinect --kinect-record in the window"
   echo PASS
   exit 0
 fi

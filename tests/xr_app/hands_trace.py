@@ -5,7 +5,13 @@ still (dwell: release), pushes again (the pinch off). Writes it as a trace (trac
 format) or sends it over UDP (tracking/udp_source.hpp's packet format) at its timestamps, with
 malformed and out-of-order packets mixed in when asked.
 
+Or both palms' two-hand gestures as a trace (two_hand_path).
+
+Or the right palm touching the app's calibration markers (calibration_path).
+
 usage: hands_trace.py trace FILE PX PY PZ
+       hands_trace.py two FILE PX PY PZ
+       hands_trace.py calib FILE YAW_DEG TX TY TZ [--collinear]
        hands_trace.py udp ADDR PORT PX PY PZ [--noise]
 """
 import socket
@@ -18,6 +24,17 @@ RATE = 60.0  # frames per second
 
 def lerp(a, b, u):
     return tuple(x + (y - x) * u for x, y in zip(a, b))
+
+
+def sample(segments, interp=lerp):
+    """(time, position) at RATE along segments of (from, to, seconds)."""
+    out, t = [], 0.0
+    for a, b, secs in segments:
+        n = int(round(secs * RATE))
+        for i in range(n):
+            out.append((t, interp(a, b, (i + 1) / n)))
+            t += 1.0 / RATE
+    return out
 
 
 def path(p):
@@ -37,13 +54,66 @@ def path(p):
         (moved, pushed, 0.2),          # palm push again: the pinch off
         (pushed, pushed, 0.3),
     ]
-    out, t = [], 0.0
-    for a, b, secs in segments:
-        n = int(round(secs * RATE))
-        for i in range(n):
-            out.append((t, lerp(a, b, (i + 1) / n)))
-            t += 1.0 / RATE
-    return out
+    return sample(segments)
+
+
+def two_hand_path(p):
+    """(time, (left position, right position)) of both palms at RATE: brought together on the
+    cloth at P and held (hands_together: pin), spread slowly (nothing), brought to 20 cm and
+    spread quickly (hands_apart: undo), both pushed forward (both_push: the cut begins), the right
+    palm drawn across the cloth, both pushed again (both_push: the cut ends). No palm rests 1 s
+    (no dwell) except while the palms are together."""
+    px, py, pz = p
+
+    def pair(dx, dz=0.0, dy=0.0, shift=0.0):
+        """The palms dx either side of P (+shift in x), dz in front of it, dy above it."""
+        return ((px + shift - dx, py + dy, pz + dz), (px + shift + dx, py + dy, pz + dz))
+
+    lower = -0.12  # the cut's second stroke end: 12 cm down the cloth
+    segments = [  # (from, to, seconds); each a (left, right) pair
+        (pair(0.3, 0.3), pair(0.3, 0.3), 0.5),
+        (pair(0.3, 0.3), pair(0.03), 1.0),  # together on the cloth (6 cm apart)
+        (pair(0.03), pair(0.03), 0.8),  # held: hands_together after 0.3 s
+        (pair(0.03), pair(0.3, 0.2), 1.5),  # slowly apart and back
+        (pair(0.3, 0.2), pair(0.1, 0.2), 0.8),
+        (pair(0.1, 0.2), pair(0.1, 0.2), 0.3),
+        (pair(0.1, 0.2), pair(0.35, 0.2), 0.25),  # quick spread: hands_apart
+        (pair(0.35, 0.2), pair(0.2, 0.13, 0, -0.2), 0.8),  # the right palm in front of P
+        (pair(0.2, 0.13, 0, -0.2), pair(0.2, 0.13, 0, -0.2), 0.4),
+        (pair(0.2, 0.13, 0, -0.2), pair(0.2, -0.04, 0, -0.2), 0.25),  # both pushed: cut begins
+        (pair(0.2, -0.04, 0, -0.2), pair(0.2, -0.02, lower, -0.2), 0.8),  # the stroke down
+        (pair(0.2, -0.02, lower, -0.2), pair(0.2, 0.13, lower, -0.2), 0.6),
+        (pair(0.2, 0.13, lower, -0.2), pair(0.2, 0.13, lower, -0.2), 0.3),
+        (pair(0.2, 0.13, lower, -0.2), pair(0.2, -0.04, lower, -0.2), 0.25),  # both: cut ends
+        (pair(0.2, -0.04, lower, -0.2), pair(0.2, -0.04, lower, -0.2), 0.3),
+    ]
+    return sample(segments, lambda a, b, u: (lerp(a[0], b[0], u), lerp(a[1], b[1], u)))
+
+
+# The app's marked calibration points (xr_app/app/calibration_mode.cpp), stage metres.
+MARKERS = [(0.0, 1.30, 0.16), (0.12, 0.95, 0.16), (-0.30, 0.0, 0.40), (0.30, 0.0, 0.40)]
+
+
+def calibration_path(yaw_deg, t, collinear):
+    """(time, position) of the right palm in a tracker's frame that the stage sees rotated by
+    yaw_deg about y and moved by t (stage = R tracker + t): it rests 1.5 s on each marker in turn
+    (tracker = R^T (marker - t)) and moves 0.8 s between them. collinear: the four rests on one
+    line of the tracker's frame instead (a broken calibration)."""
+    import math
+    c, s = math.cos(math.radians(yaw_deg)), math.sin(math.radians(yaw_deg))
+
+    def to_tracker(m):
+        d = [m[i] - t[i] for i in range(3)]
+        return (c * d[0] - s * d[2], d[1], s * d[0] + c * d[2])  # R^T d, R = yaw about y
+
+    if collinear:
+        rests = [(0.1 * i, 0.2 * i, -1.0) for i in range(4)]
+    else:
+        rests = [to_tracker(m) for m in MARKERS]
+    segments = [(rests[0], rests[0], 1.5)]
+    for a, b in zip(rests, rests[1:]):
+        segments += [(a, b, 0.8), (b, b, 1.5)]
+    return sample(segments)
 
 
 def write_trace(fname, frames):
@@ -51,6 +121,14 @@ def write_trace(fname, frames):
         f.write("# drape-trace v1\n")
         for t, (x, y, z) in frames:
             f.write(f"{t:.6f},1,1,0.9,{x:.6f},{y:.6f},{z:.6f},0,0,0,1,0\n")
+
+
+def write_two_hand_trace(fname, frames):
+    with open(fname, "w") as f:
+        f.write("# drape-trace v1\n")
+        for t, (left, right) in frames:
+            for hand, (x, y, z) in ((0, left), (1, right)):
+                f.write(f"{t:.6f},{hand},1,0.9,{x:.6f},{y:.6f},{z:.6f},0,0,0,1,0\n")
 
 
 def packet(seq, t, pos):
@@ -79,6 +157,11 @@ def main():
     a = sys.argv[1:]
     if len(a) >= 5 and a[0] == "trace":
         write_trace(a[1], path(tuple(map(float, a[2:5]))))
+    elif len(a) >= 6 and a[0] == "calib":
+        t = tuple(map(float, a[3:6]))
+        write_trace(a[1], calibration_path(float(a[2]), t, "--collinear" in a[6:]))
+    elif len(a) >= 5 and a[0] == "two":
+        write_two_hand_trace(a[1], two_hand_path(tuple(map(float, a[2:5]))))
     elif len(a) >= 6 and a[0] == "udp":
         send(a[1], int(a[2]), path(tuple(map(float, a[3:6]))), "--noise" in a[6:])
     else:

@@ -300,6 +300,7 @@ void DrapingSession::draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& 
   }
   render::DrawOptions dopt;
   dopt.hands = overlays_;
+  dopt.markers = markers_;
   // The form's level of detail from the eyes' pixel size (lavapipe is vertex-bound).
   const XrFovf& f0 = eyes[0].view.fov;
   const float rad_per_px = (f0.angleRight - f0.angleLeft) / static_cast<float>(eyes[0].width);

@@ -24,6 +24,7 @@
 #include "tracking/trace.hpp"
 #include "tracking/udp_source.hpp"
 #include "tracking/voice.hpp"
+#include "xr_app/app/calibration_mode.hpp"
 #include "xr_app/app/feedback.hpp"
 #include "xr_app/app/session_content.hpp"
 #include "xr_app/app/voice_input.hpp"
@@ -153,9 +154,13 @@ class DrapingSession : public SessionContent {
     std::array<tracking::HandFrame, 2> last;  // filtered, in the stage
     std::array<double, 2> last_seen{-1e9, -1e9};
     tracking::Calibration calibration;
-    std::string status;  // the status shown ("" = all well)
+    std::string status;                            // the status shown ("" = all well)
+    std::unique_ptr<CalibrationMode> calibrating;  // --calibrate: the marked points' touches
   };
   std::unique_ptr<ExternalHands> ext_;
+  void open_calibration_mode();
+  void calibration_frame(const tracking::HandFrame& raw, const tracking::HandFrame& filtered);
+  std::vector<render::DrawOptions::Marker> markers_;  // drawn in the scene (calibration)
 
   // Each hand's interaction profile family: controller triggers are looked up under it.
   std::string profiles_[2];

@@ -62,12 +62,22 @@ struct XrAppOptions {
   std::string voice_input;
   // The hands: "xr" the runtime's; "udp" a skeleton stream (tracking::UdpSkeletonSource bound to
   // hands_address:hands_port); "trace" a recorded trace (hands_trace, played from the session's
-  // first frame). udp and trace replace the runtime's hands (palm-only gestures, filtered, brought
-  // into the stage by the calibration file `calibration_path`, "" = identity).
+  // first frame); "kinect" a Kinect v1 (tracking::KinectSource; `kinect_record` names the fakenect
+  // recording the process replays instead of the device, "" = the device). udp, trace and kinect
+  // replace the runtime's hands (palm-only gestures, filtered, brought into the stage by the
+  // calibration file `calibration_path`, "" = identity).
   std::string hands = "xr";
   std::string hands_address = "127.0.0.1";
   int hands_port = 9740;
-  std::string hands_trace, calibration_path;
+  std::string hands_trace, calibration_path, kinect_record;
+  // `calibration_path` is the source's saved calibration (calibration_save's file), found when no
+  // file was given: the session's status says so.
+  bool calibration_saved = false;
+  // Calibration mode (udp, trace, kinect): the hands touch the marked points (app/
+  // calibration_mode.hpp) instead of draping; the result is written to `calibration_save` (the
+  // source's file in the user's config directory, chosen by the executable).
+  bool calibrate = false;
+  std::string calibration_save;
   // The API layers the loader enables (its XR_ENABLE_API_LAYERS): their instance extensions are
   // offered too (the core validation layer's XR_EXT_debug_utils).
   std::vector<std::string> api_layers;
