@@ -47,13 +47,26 @@ void apply_order(std::vector<T>& items, const std::vector<int>& order) {
 }  // namespace
 
 void XpbdSolver::cook(const Cloth& cloth) {
+  // Each part's wall time (last_cook(): what a re-cook after a cut costs, and where).
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point& t) {
+    const auto now = Clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+    return ms;
+  };
+  auto t = Clock::now();
+  CookStats st;
   // XPBD projects the bending rows and never evaluates P (EnergyOptions::bending_matrix).
   EnergyOptions eo = opt_.energy;
   eo.bending_matrix = false;
   energy_.build(cloth, eo, pool_.get());
+  st.energy_ms = since(t);
   const int n = cloth.num_vertices();
   cook_triangles(cloth);
+  st.triangles_ms = since(t);
   cook_bending(n);
+  st.bending_ms = since(t);
   cook_hinges_springs(n);
   const int S = scratch_slots_;
   lambda_tri_.assign(3 * tris_.size(), 0.0);
@@ -65,10 +78,16 @@ void XpbdSolver::cook(const Cloth& cloth) {
   anchors_.clear();  // renewed at the next step
   tri_anchor8_.assign(static_cast<size_t>(6 * tlanes_) * float_tri_packs(), 0.0f);
   row_anchor8_.assign(72 * static_cast<size_t>(row_packs8_.packs()), 0.0f);
+  st.other_ms = since(t);
   build_sweep(n);
+  st.sweep_ms = since(t);
   w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
   w0_.assign(n, -1.0);
   cook_pieces(n);
+  st.other_ms += since(t);
+  st.total_ms = st.energy_ms + st.triangles_ms + st.bending_ms + st.sweep_ms + st.other_ms;
+  st.cooks = last_cook_.cooks + 1;
+  last_cook_ = st;
 }
 
 // The triangles' constraint data, sorted by colour and packed for the kernels.

@@ -49,6 +49,15 @@ class XpbdSolver : public Solver {
   long sweep_takeovers() const { return sweep_takeovers_; }
   // Vertices tested again for contact in the sweep (XpbdOptions::retest_contacts).
   long contact_retests() const { return contact_retests_; }
+  // The last cook of a topology (the first step, and the step after a cut, slit or sew): wall ms
+  // of its parts (the energy's build, the triangles' packs, the bending blocks and their packs,
+  // the sweep's plan, the rest) and the cooks so far.
+  struct CookStats {
+    double energy_ms = 0, triangles_ms = 0, bending_ms = 0, sweep_ms = 0, other_ms = 0,
+           total_ms = 0;
+    int cooks = 0;
+  };
+  const CookStats& last_cook() const { return last_cook_; }
   // The energy as the solver cooked it (its contacts: those of the last step).
   const ClothEnergy& energy() const { return energy_; }
   // The bending energy of positions x as the cooked blocks state it (1/2 sum_r |V_r x|^2 k_r;
@@ -253,6 +262,7 @@ class XpbdSolver : public Solver {
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
   std::vector<Vec3> x_det_;      // each vertex's position at its last contact test
   SelfCollision self_;
+  CookStats last_cook_;
   int detections_ = 0;  // contact detections so far (for tests and the bench)
   double fresh_penetration_ = 0;
 };

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "sim/ops/cut.hpp"
 #include "sim/solvers/xpbd/solver_xpbd.hpp"
 #include "sim/testbeds/testbed.hpp"
 
@@ -118,4 +119,40 @@ TEST(XpbdSweep, TheDrapeFallsAsleepAsOnOneThread) {
   EXPECT_GT(one.frozen, 0);
   EXPECT_EQ(one.frozen, two.frozen);
   EXPECT_EQ(max_diff(one.x, two.x), 0.0);
+}
+
+// A cut in the middle of the drape: the solver re-cooks the new topology (its cook counted and
+// timed, last_cook()) and the sweep on four threads goes on giving the drape of one thread.
+TEST(XpbdSweep, AfterACutTheSweepStillGivesTheDrapeOfOneThread) {
+  DrapeRun runs[2];
+  XpbdSolver::CookStats cook;
+  for (int k = 0; k < 2; ++k) {
+    Testbed sc = make_scene("form", 24);
+    XpbdOptions o;
+    o.air_drag = sc.air_drag;
+    o.threads = k == 0 ? 1 : 4;
+    o.min_parallel_triangles = 0;
+    XpbdSolver s(o);
+    for (int f = 0; f < 30; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+    ASSERT_EQ(s.last_cook().cooks, 1);
+    double vmin = 1e9, vmax = -1e9, umin = 1e9, umax = -1e9;
+    for (const Vec2& m : sc.cloth.topo.material) {
+      umin = std::min(umin, m.x()), umax = std::max(umax, m.x());
+      vmin = std::min(vmin, m.y()), vmax = std::max(vmax, m.y());
+    }
+    const double v = 0.5 * (vmin + vmax) + 0.01 * (vmax - vmin);
+    ASSERT_TRUE(cut_along_material(sc.cloth, {Vec2(umin - 0.01, v), Vec2(umax + 0.01, v)}).ok);
+    for (int f = 0; f < 30; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+    cook = s.last_cook();
+    EXPECT_EQ(cook.cooks, 2);
+    runs[k] = DrapeRun{sc.cloth.state.x, sc.cloth.state.v, s.sweeps(), s.sweep_takeovers()};
+  }
+  std::printf("24^2 re-cook after the cut: %.2f ms (energy %.2f, bending %.2f, sweep plan %.2f)\n",
+              cook.total_ms, cook.energy_ms, cook.bending_ms, cook.sweep_ms);
+  EXPECT_GT(cook.total_ms, 0.0);
+  EXPECT_GE(cook.total_ms, cook.energy_ms + cook.bending_ms + cook.sweep_ms);
+  EXPECT_EQ(runs[1].sweeps, 60 * 10);
+  ASSERT_EQ(runs[0].x.size(), runs[1].x.size());
+  EXPECT_EQ(max_diff(runs[0].x, runs[1].x), 0.0);
+  EXPECT_EQ(max_diff(runs[0].v, runs[1].v), 0.0);
 }
