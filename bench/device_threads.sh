@@ -6,14 +6,14 @@
 #       here: DIR/solvers_bench (stripped, from build/bin), and BASELINE_BIN stripped as
 #       DIR/solvers_bench_base when given (an earlier build to compare with), the libraries both
 #       load, the dynamic loader included, in DIR/lib.tgz.
-#   bench/device_threads.sh run DIR OUT [solvers_bench flags]
+#   bench/device_threads.sh run DIR OUT [--base-res "128 256"] [--base-threads "1 2 4 8 16"]
+#                                       [--two-cores] [-- solvers_bench flags]
 #       there: the thread rows (solvers_bench --threads-only --threads-default-only, 1/2/4/8/16
-#       threads at 128^2 and 256^2 unless the flags say otherwise) run in a scratch directory;
-#       OUT/solvers_threads.csv, OUT/threads.log, OUT/machine.txt (cores, CPU model). With a
-#       baseline: its probe (--probe form RES xpbd 10 1 --no-polish --no-ref --frames 270) at
-#       the same thread counts, OUT/baseline.log. BASE_RES and BASE_THREADS (space-separated)
-#       choose them (default "128 256", "1 2 4 8 16"); BASE_RES="" skips the baseline. TWO_CORES=1:
-#       also 128^2 on two threads pinned to two cores (taskset), OUT/two_cores.log.
+#       threads at 128^2 and 256^2 unless the flags after -- say otherwise) run in a scratch
+#       directory; OUT/solvers_threads.csv, OUT/threads.log, OUT/machine.txt (cores, CPU model).
+#       With a baseline: its probe (--probe form RES xpbd 10 1 --no-polish --no-ref --frames 270)
+#       at --base-res x --base-threads (--base-res "" skips it), OUT/baseline.log. --two-cores:
+#       also 128^2 on two threads pinned to two cores (taskset), both builds, OUT/two_cores.log.
 set -euo pipefail
 mode="${1:-}"
 case "$mode" in
@@ -39,6 +39,16 @@ case "$mode" in
     dir="$(cd "$2" && pwd)"
     out="$3"
     shift 3
+    base_res="128 256" base_threads="1 2 4 8 16" two_cores=""
+    while [ $# -gt 0 ]; do
+      case "$1" in
+        --base-res) base_res="$2"; shift 2 ;;
+        --base-threads) base_threads="$2"; shift 2 ;;
+        --two-cores) two_cores=1; shift ;;
+        --) shift; break ;;
+        *) echo "device_threads.sh: unknown option '$1' (solvers_bench flags go after --)" >&2; exit 2 ;;
+      esac
+    done
     mkdir -p "$out"
     out="$(cd "$out" && pwd)"
     work="$(mktemp -d)"
@@ -55,9 +65,9 @@ case "$mode" in
     cd "$work"
     run_bin "$dir/solvers_bench" --threads-only --threads-default-only "$@" 2>&1 | tee "$out/threads.log"
     cp out/bench/solvers_threads.csv "$out/"
-    if [ -x "$dir/solvers_bench_base" ] && [ -n "${BASE_RES-128 256}" ]; then
-      for res in ${BASE_RES-128 256}; do
-        for t in ${BASE_THREADS:-1 2 4 8 16}; do
+    if [ -x "$dir/solvers_bench_base" ] && [ -n "$base_res" ]; then
+      for res in $base_res; do
+        for t in $base_threads; do
           echo "== baseline $res^2, $t threads"
           run_bin "$dir/solvers_bench_base" --probe form "$res" xpbd 10 1 --no-polish --no-ref \
             --frames 270 --threads "$t" 2>&1 | grep -E '^form .* wall'
@@ -65,7 +75,7 @@ case "$mode" in
       done 2>&1 | tee "$out/baseline.log"
     fi
     # Two cores of the machine (taskset), 128^2 on two threads, this build and the baseline.
-    if command -v taskset >/dev/null && [ -n "${TWO_CORES:-}" ]; then
+    if command -v taskset >/dev/null && [ -n "$two_cores" ]; then
       for b in solvers_bench solvers_bench_base; do
         [ -x "$dir/$b" ] || continue
         echo "== $b, cores 0-1, 128^2, 2 threads"
@@ -75,7 +85,7 @@ case "$mode" in
     fi
     ;;
   *)
-    sed -n '2,21p' "$0"
+    sed -n '2,16p' "$0"
     exit 2
     ;;
 esac
