@@ -33,8 +33,8 @@ class SweepPlan {
   static constexpr int kMaxSlots = 64;  // (a run's wait list is a 64-bit mask)
   // How long a thread waits for a slot nobody has claimed before it takes the slot over: a
   // worker spinning between sweeps claims its own within it, one that is not scheduled does not
-  // (the caller then runs both, as with no wait; on a loaded two-core machine that is most
-  // sweeps).
+  // (the waiting thread then runs both; on a loaded two-core machine that is most sweeps). Not
+  // tuned on a many-core machine.
   static constexpr std::chrono::microseconds kClaimGrace{5};
   struct Phase {
     int kind;  // the caller's kind of items
@@ -218,7 +218,7 @@ void SweepPlan::drive(int first, int worker, Items& items) {
     // worker asleep between two sweeps wakes within it; one not scheduled does not).
     if (spin == 0) blocked_at = std::chrono::steady_clock::now();
     bool took = false;
-    if ((++spin & 63) == 0 && std::chrono::steady_clock::now() - blocked_at > kClaimGrace)
+    if ((++spin & 7) == 0 && std::chrono::steady_clock::now() - blocked_at > kClaimGrace)
       for (int k = 0; k < count && !took; ++k)
         if (waits[k] >= 0) took = take(waits[k]);
     if (took) {
