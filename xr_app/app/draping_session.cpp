@@ -3,12 +3,15 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <thread>
 
 #include "render/camera.hpp"
@@ -310,8 +313,15 @@ void DrapingSession::draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& 
   }
   if (opt_.pointer_probe && ops_) record_pointer_probe(frame, vt[0]);
   if (opt_.feedback_panel) prepare_panel(frame, eyes);
+  // A lost device is said once: the renderer refuses every later frame, while the sim, the
+  // hands and the outputs go on.
+  const bool was_lost = renderer_->device_lost();
   auto st = renderer_->render_views(*snap_, vt, 2, dopt);
-  if (!st) rep_.note("render: " + st.error);
+  if (!st && !was_lost)
+    rep_.note("render: " + st.error +
+              (renderer_->device_lost()
+                   ? "; the cloth is no longer drawn, the session goes on and saves its work"
+                   : ""));
   laps.lap("render");
   const render::FrameStats& rs = renderer_->last_frame();
   laps.add("render.build", rs.build_ms);
@@ -411,32 +421,88 @@ void DrapingSession::finish() {
   if (ops_ && !opt_.out_dir.empty()) write_outputs(w);
 }
 
+namespace {
+// Writes one output through `write` into a hidden folder next to it (out_dir/.partial/, same
+// file name, so a glTF's own buffer file keeps the name the glTF gives it) and moves what it
+// wrote over the outputs only when every byte was written: a failed write (a full disk) leaves
+// the previous file whole. Returns "" or the error, naming the file.
+std::string write_whole(const std::string& path,
+                        const std::function<std::string(const std::string&)>& write) {
+  namespace fs = std::filesystem;
+  const fs::path final_path(path);
+  const fs::path partial = final_path.parent_path() / ".partial";
+  std::error_code ec;
+  fs::remove_all(partial, ec);
+  fs::create_directories(partial, ec);
+  if (ec) return partial.string() + ": cannot create: " + ec.message();
+  const std::string partial_file = (partial / final_path.filename()).string();
+  std::string e = write(partial_file);
+  // The message names the file the user knows.
+  if (const size_t at = e.find(partial_file); at != std::string::npos)
+    e.replace(at, partial_file.size(), path);
+  if (e.empty()) {
+    for (const auto& f : fs::directory_iterator(partial, ec)) {
+      fs::rename(f.path(), final_path.parent_path() / f.path().filename(), ec);
+      if (ec) {
+        e = f.path().string() + ": cannot move into place: " + ec.message();
+        break;
+      }
+    }
+  }
+  fs::remove_all(partial, ec);
+  return e;
+}
+
+// The message of a failed output, also on stderr (the session's own log may be the file that
+// could not be written).
+void not_saved(Report& rep, const std::string& what, const std::string& error) {
+  const std::string m = what + " not saved: " + error + " (the previous file, if any, is kept)";
+  std::fprintf(stderr, "drape: %s\n", m.c_str());
+  rep.note(m);
+}
+}  // namespace
+
 // out_dir: session_log.json (the operations as the sim received them), drape_cloth.gltf and
-// xr_session.txt (the log, the triggers, the sim's messages and the outcome).
+// xr_session.txt (the log, the triggers, the sim's messages and the outcome), each written whole
+// or not at all (write_whole).
 void DrapingSession::write_outputs(sim::World& w) {
   XrAppResult& r = rep_.r;
   std::error_code ec;
   std::filesystem::create_directories(opt_.out_dir, ec);
   sim::SessionLog log = ops_->stop_recording(w);
   const std::string lp = opt_.out_dir + "/session_log.json";
-  if (std::string e = sim::save_session(lp, log); e.empty())
+  if (std::string e =
+          write_whole(lp, [&](const std::string& p) { return sim::save_session(p, log); });
+      e.empty())
     r.written.push_back(lp);
   else
-    rep_.note("session log: " + e);
+    not_saved(rep_, "session log", e);
   const std::string cp = opt_.out_dir + "/drape_cloth.gltf";
-  if (std::string e = sim::write_meshes(cp, {sim::cloth_to_mesh(w.cloth, "cloth")}); e.empty())
+  if (std::string e = write_whole(cp,
+                                  [&](const std::string& p) {
+                                    return sim::write_meshes(
+                                        p, {sim::cloth_to_mesh(w.cloth, "cloth")});
+                                  });
+      e.empty())
     r.written.push_back(cp);
   else
-    rep_.note("glTF: " + e);
+    not_saved(rep_, "glTF", e);
   const std::string tp = opt_.out_dir + "/xr_session.txt";
-  std::ofstream o(tp);
-  for (const auto& l : r.log) o << l << "\n";
-  for (const auto& l : r.triggers) o << "trigger " << l << "\n";
-  for (const auto& l : r.sim_messages) o << "sim: " << l << "\n";
-  o << "frames " << r.frames << " pinched_frames " << r.frames_pinched << " pinned_added "
-    << r.pinned_added << " cuts " << r.cuts_ok << " components " << r.components_before << " -> "
-    << r.components_after << "\n";
-  if (o) r.written.push_back(tp);
+  std::string e = write_whole(tp, [&](const std::string& p) -> std::string {
+    std::ofstream o(p);
+    for (const auto& l : r.log) o << l << "\n";
+    for (const auto& l : r.triggers) o << "trigger " << l << "\n";
+    for (const auto& l : r.sim_messages) o << "sim: " << l << "\n";
+    o << "frames " << r.frames << " pinched_frames " << r.frames_pinched << " pinned_added "
+      << r.pinned_added << " cuts " << r.cuts_ok << " components " << r.components_before << " -> "
+      << r.components_after << "\n";
+    o.close();
+    return o ? std::string() : p + ": write failed: " + std::strerror(errno);
+  });
+  if (e.empty())
+    r.written.push_back(tp);
+  else
+    not_saved(rep_, "session text", e);
 }
 
 }  // namespace drape::app
