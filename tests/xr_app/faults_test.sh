@@ -5,8 +5,9 @@
 #                reordered, duplicated, and garbage mixed in (faulty_hands.py): the pinch, the
 #                release and the pinch's end still happen; the log counts the bad packets.
 #   session_loss the runtime loses the XR session while the right hand holds a pinch (scenario
-#                event session_loss): the session is re-created, the run ends normally, the
-#                cloth and its outputs are kept (the sim is not reset: the same tick count).
+#                event session_loss): the pinch ends at the loss where the hand held it (not
+#                where the next session puts the hand), the session is re-created, the run ends
+#                normally, the cloth and its outputs are kept (the same tick count).
 #   mic_gone     --voice mic through ALSA (a `file` PCM reading a tone) unplugged after 0.5 s:
 #                snd_pcm_readi returns -ENODEV (fault_inject.so): a voice message naming the
 #                microphone, the session goes on, the cloth the same as with --voice off.
@@ -105,7 +106,16 @@ JSON
     check_complete lost
     grep -q "sessions 2 (lost 1)" "$work/lost.txt" || fail "the session was not lost and re-created"
     grep -q "pinch: right hand took particle" "$work/lost/xr_session.txt" || fail "no pinch before the loss"
-    grep "sessions 2\|pinch: right hand" "$work/lost.txt" "$work/lost/xr_session.txt" | head -5
+    s=$work/lost/xr_session.txt
+    grep -q "^session lost: the operations in progress end here (stop); the cloth is kept" "$s" ||
+      fail "no message about the operations ended at the loss"
+    # The pinch ends where the hand held it, not where the next session puts the hand.
+    let_go=$(sed -n '/^session lost: /,$p' "$s" | grep -m1 "pinch: right hand let particle .* go") ||
+      fail "the pinch was not let go after the loss"
+    echo "$let_go"
+    mm=$(sed -n 's/.*(moved \([0-9.]*\) mm).*/\1/p' <<<"$let_go")
+    python3 -c "import sys; sys.exit(0 if float('$mm') < 50 else 1)" ||
+      fail "the pinched particle moved $mm mm: carried across the loss"
     scenario 300 true
     run reference
     check_complete reference

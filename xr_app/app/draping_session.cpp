@@ -409,6 +409,18 @@ void DrapingSession::forget_targets() {
   if (renderer_) renderer_->forget_targets();
 }
 
+// What the hands were doing ends where the cloth is now, as a "stop" does: the next session
+// reports the hands elsewhere, and a pinch held across the loss would pull the cloth there.
+void DrapingSession::session_lost() {
+  if (!sim_ || !ops_) return;
+  rep_.note("session lost: the operations in progress end here (stop); the cloth is kept");
+  feedback_.refused(0, "XR session lost: operations in progress ended, the cloth is kept");
+  auto ops = ops_;
+  std::shared_ptr<Said> said = said_;
+  const std::vector<Op> stop = {{"stop", sim::TriggerPhase::kBegin, 1}};
+  sim_->post([ops, stop, said](sim::World& w) { apply_triggers(w, stop, *ops, *said); });
+}
+
 void DrapingSession::finish() {
   if (!sim_) return;
   rep_.r.thread_cpu_s = threads_.seconds();  // before the sim's threads end
