@@ -17,6 +17,9 @@
 #   disk_full    the outputs' folder full (ENOSPC from the first byte, and after 3000 bytes)
 #                while the session log, the glTF and xr_session.txt are written: a message
 #                naming each file, exit 0, the previous run's files there byte for byte.
+#   disk_full_pattern  `drape pattern --out DIR` over an earlier pattern with the disk full (from
+#                the first byte, and after 100000 bytes): exit 1, a message naming the file and
+#                saying the earlier files are kept; they are, byte for byte.
 # usage: faults_test.sh DRAPE_EXE FAULT_INJECT_SO MODE WORKDIR [PORT]
 set -u
 exe=$1 inject=$2 mode=$3 work=$4 port=${5:-0}
@@ -190,6 +193,30 @@ EOF
     cmp -s "$work/kept/xr_session.txt" "$work/before/xr_session.txt" && fail "the run with room did not replace the outputs"
     grep -q "^frames 140 " "$work/before/xr_session.txt" || fail "the run with room: not its outputs"
     echo "with room again, the outputs are replaced"
+    ;;
+  disk_full_pattern)
+    pattern() { "$exe" pattern --design tight-skirt --form 9AR --out "$work/pattern" "$@"; }
+    pattern >"$work/first.txt" 2>&1 || { cat "$work/first.txt" >>"$log"; fail "first pattern: exit $?"; }
+    cp -r "$work/pattern" "$work/kept"
+    for after in 0 100000; do
+      DRAPE_FAULT_ENOSPC_MATCH="$work/pattern/" DRAPE_FAULT_ENOSPC_AFTER=$after LD_PRELOAD=$inject \
+        pattern --ease 30 >"$work/full.txt" 2>&1
+      rc=$?
+      cat "$work/full.txt" >>"$log"
+      [ $rc -eq 1 ] || fail "disk full after $after bytes: exit $rc, expected 1"
+      grep -q "fault_inject: ENOSPC" "$work/full.txt" || fail "the disk was never full"
+      line=$(grep "^drape pattern: $work/pattern/[a-z0-9_]*\.[a-z]*: .* (the pattern files already in $work/pattern are kept)" "$work/full.txt") ||
+        fail "disk full after $after bytes: no message naming the file"
+      echo "$line"
+      for f in "$work"/kept/*; do
+        cmp -s "$f" "$work/pattern/$(basename "$f")" || fail "disk full after $after bytes: $(basename "$f") changed"
+      done
+      [ "$(ls -A "$work/pattern" | wc -l)" -eq "$(ls -A "$work/kept" | wc -l)" ] || fail "files left behind"
+      echo "disk full after $after bytes: the earlier pattern kept byte for byte"
+    done
+    pattern --ease 30 >"$work/room.txt" 2>&1 || { cat "$work/room.txt" >>"$log"; fail "pattern with room: exit $?"; }
+    cmp -s "$work/kept/report.json" "$work/pattern/report.json" && fail "the run with room did not replace the pattern"
+    echo "with room again, the pattern is replaced"
     ;;
   *) fail "unknown mode $mode" ;;
 esac

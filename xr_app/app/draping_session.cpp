@@ -11,7 +11,6 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <thread>
 
 #include "render/camera.hpp"
@@ -19,6 +18,7 @@
 #include "sim/solvers/solver_factory.hpp"
 #include "sim/testbeds/testbed.hpp"
 #include "xr_app/app/desk_scene.hpp"
+#include "xr_app/output_files.hpp"
 
 namespace drape::app {
 
@@ -434,37 +434,6 @@ void DrapingSession::finish() {
 }
 
 namespace {
-// Writes one output through `write` into a hidden folder next to it (out_dir/.partial/, same
-// file name, so a glTF's own buffer file keeps the name the glTF gives it) and moves what it
-// wrote over the outputs only when every byte was written: a failed write (a full disk) leaves
-// the previous file whole. Returns "" or the error, naming the file.
-std::string write_whole(const std::string& path,
-                        const std::function<std::string(const std::string&)>& write) {
-  namespace fs = std::filesystem;
-  const fs::path final_path(path);
-  const fs::path partial = final_path.parent_path() / ".partial";
-  std::error_code ec;
-  fs::remove_all(partial, ec);
-  fs::create_directories(partial, ec);
-  if (ec) return partial.string() + ": cannot create: " + ec.message();
-  const std::string partial_file = (partial / final_path.filename()).string();
-  std::string e = write(partial_file);
-  // The message names the file the user knows.
-  if (const size_t at = e.find(partial_file); at != std::string::npos)
-    e.replace(at, partial_file.size(), path);
-  if (e.empty()) {
-    for (const auto& f : fs::directory_iterator(partial, ec)) {
-      fs::rename(f.path(), final_path.parent_path() / f.path().filename(), ec);
-      if (ec) {
-        e = f.path().string() + ": cannot move into place: " + ec.message();
-        break;
-      }
-    }
-  }
-  fs::remove_all(partial, ec);
-  return e;
-}
-
 // The message of a failed output, also on stderr (the session's own log may be the file that
 // could not be written).
 void not_saved(Report& rep, const std::string& what, const std::string& error) {
@@ -483,24 +452,27 @@ void DrapingSession::write_outputs(sim::World& w) {
   std::filesystem::create_directories(opt_.out_dir, ec);
   sim::SessionLog log = ops_->stop_recording(w);
   const std::string lp = opt_.out_dir + "/session_log.json";
-  if (std::string e =
-          write_whole(lp, [&](const std::string& p) { return sim::save_session(p, log); });
+  if (std::string e = write_whole(
+          opt_.out_dir,
+          [&](const std::string& d) { return sim::save_session(d + "/session_log.json", log); });
       e.empty())
     r.written.push_back(lp);
   else
     not_saved(rep_, "session log", e);
   const std::string cp = opt_.out_dir + "/drape_cloth.gltf";
-  if (std::string e = write_whole(cp,
-                                  [&](const std::string& p) {
+  if (std::string e = write_whole(opt_.out_dir,
+                                  [&](const std::string& d) {
                                     return sim::write_meshes(
-                                        p, {sim::cloth_to_mesh(w.cloth, "cloth")});
+                                        d + "/drape_cloth.gltf",
+                                        {sim::cloth_to_mesh(w.cloth, "cloth")});
                                   });
       e.empty())
     r.written.push_back(cp);
   else
     not_saved(rep_, "glTF", e);
   const std::string tp = opt_.out_dir + "/xr_session.txt";
-  std::string e = write_whole(tp, [&](const std::string& p) -> std::string {
+  std::string e = write_whole(opt_.out_dir, [&](const std::string& d) -> std::string {
+    const std::string p = d + "/xr_session.txt";
     std::ofstream o(p);
     for (const auto& l : r.log) o << l << "\n";
     for (const auto& l : r.triggers) o << "trigger " << l << "\n";
