@@ -11,6 +11,8 @@
  *               its (N+1)-th call on.
  *
  * Each fault it injects is said once on stderr ("fault_inject: ..."), so the test's log shows it.
+ * Its counters are not locked: in the tests each fault hits the calls of one thread (the writes
+ * at the end of a run, the voice thread's captures, the frame loop's fence waits).
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
