@@ -1,12 +1,14 @@
 // `drape pattern`: the geometric draping pipeline from a design file to printable patterns.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "sim/core/fabric.hpp"
 #include "sim/draping/pattern_pipeline.hpp"
 #include "sim/form/dress_form.hpp"
 #include "xr_app/command.hpp"
+#include "xr_app/output_files.hpp"
 #include "xr_app/paths.hpp"
 
 namespace {
@@ -81,13 +83,20 @@ int run_pattern(int argc, char** argv) {
     fabric = *f;
   else
     std::fprintf(stderr, "drape pattern: note: %s; using the default muslin\n", f.error().c_str());
-  opt.out_dir = out;
-  auto r = drape::sim::run_pattern_pipeline(*d, *form, fabric, opt);
-  if (!r) {
-    std::fprintf(stderr, "drape pattern: %s\n", r.error().c_str());
+  // The pattern's files replace those of an earlier run only when every one was written: a full
+  // disk leaves the earlier pattern whole (output_files.hpp).
+  std::optional<drape::sim::Result<drape::sim::PipelineResult>> r;
+  const std::string failed = drape::app::write_whole(out, [&](const std::string& dir) {
+    opt.out_dir = dir;
+    r = drape::sim::run_pattern_pipeline(*d, *form, fabric, opt);
+    return *r ? std::string() : r->error();
+  });
+  if (!failed.empty()) {
+    std::fprintf(stderr, "drape pattern: %s (the pattern files already in %s are kept)\n",
+                 failed.c_str(), out.c_str());
     return 1;
   }
-  const auto& rep = r->report;
+  const auto& rep = (*r)->report;
   std::printf("design %s on form %s (ease %.1f mm), relaxation: %s\n", rep.design.c_str(),
               rep.form.c_str(), rep.ease_mm, rep.relax_backend.c_str());
   std::printf("  outline error before relaxation  %8.4f mm\n", rep.outline_error_before_relax_mm);

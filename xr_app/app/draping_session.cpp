@@ -3,9 +3,11 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +18,7 @@
 #include "sim/solvers/solver_factory.hpp"
 #include "sim/testbeds/testbed.hpp"
 #include "xr_app/app/desk_scene.hpp"
+#include "xr_app/output_files.hpp"
 
 namespace drape::app {
 
@@ -311,8 +314,15 @@ void DrapingSession::draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& 
   }
   if (opt_.pointer_probe && ops_) record_pointer_probe(frame, vt[0]);
   if (opt_.feedback_panel) prepare_panel(frame, eyes);
+  // A lost device is said once: the renderer refuses every later frame, while the sim, the
+  // hands and the outputs go on.
+  const bool was_lost = renderer_->device_lost();
   auto st = renderer_->render_views(*snap_, vt, 2, dopt);
-  if (!st) rep_.note("render: " + st.error);
+  if (!st && !was_lost)
+    rep_.note("render: " + st.error +
+              (renderer_->device_lost()
+                   ? "; the cloth is no longer drawn, the session goes on and saves its work"
+                   : ""));
   laps.lap("render");
   const render::FrameStats& rs = renderer_->last_frame();
   laps.add("render.build", rs.build_ms);
@@ -400,6 +410,18 @@ void DrapingSession::forget_targets() {
   if (renderer_) renderer_->forget_targets();
 }
 
+// What the hands were doing ends where the cloth is now, as a "stop" does: the next session
+// reports the hands elsewhere, and a pinch held across the loss would pull the cloth there.
+void DrapingSession::session_lost() {
+  if (!sim_ || !ops_) return;
+  rep_.note("session lost: the operations in progress end here (stop); the cloth is kept");
+  feedback_.refused(0, "XR session lost: operations in progress ended, the cloth is kept");
+  auto ops = ops_;
+  std::shared_ptr<Said> said = said_;
+  const std::vector<Op> stop = {{"stop", sim::TriggerPhase::kBegin, 1}};
+  sim_->post([ops, stop, said](sim::World& w) { apply_triggers(w, stop, *ops, *said); });
+}
+
 void DrapingSession::finish() {
   if (!sim_) return;
   rep_.r.thread_cpu_s = threads_.seconds();  // before the sim's threads end
@@ -412,32 +434,60 @@ void DrapingSession::finish() {
   if (ops_ && !opt_.out_dir.empty()) write_outputs(w);
 }
 
+namespace {
+// The message of a failed output, also on stderr (the session's own log may be the file that
+// could not be written).
+void not_saved(Report& rep, const std::string& what, const std::string& error) {
+  const std::string m = what + " not saved: " + error + " (the previous file, if any, is kept)";
+  std::fprintf(stderr, "drape: %s\n", m.c_str());
+  rep.note(m);
+}
+}  // namespace
+
 // out_dir: session_log.json (the operations as the sim received them), drape_cloth.gltf and
-// xr_session.txt (the log, the triggers, the sim's messages and the outcome).
+// xr_session.txt (the log, the triggers, the sim's messages and the outcome), each written whole
+// or not at all (write_whole).
 void DrapingSession::write_outputs(sim::World& w) {
   XrAppResult& r = rep_.r;
   std::error_code ec;
   std::filesystem::create_directories(opt_.out_dir, ec);
   sim::SessionLog log = ops_->stop_recording(w);
   const std::string lp = opt_.out_dir + "/session_log.json";
-  if (std::string e = sim::save_session(lp, log); e.empty())
+  if (std::string e = write_whole(
+          opt_.out_dir,
+          [&](const std::string& d) { return sim::save_session(d + "/session_log.json", log); });
+      e.empty())
     r.written.push_back(lp);
   else
-    rep_.note("session log: " + e);
+    not_saved(rep_, "session log", e);
   const std::string cp = opt_.out_dir + "/drape_cloth.gltf";
-  if (std::string e = sim::write_meshes(cp, {sim::cloth_to_mesh(w.cloth, "cloth")}); e.empty())
+  if (std::string e = write_whole(opt_.out_dir,
+                                  [&](const std::string& d) {
+                                    return sim::write_meshes(
+                                        d + "/drape_cloth.gltf",
+                                        {sim::cloth_to_mesh(w.cloth, "cloth")});
+                                  });
+      e.empty())
     r.written.push_back(cp);
   else
-    rep_.note("glTF: " + e);
+    not_saved(rep_, "glTF", e);
   const std::string tp = opt_.out_dir + "/xr_session.txt";
-  std::ofstream o(tp);
-  for (const auto& l : r.log) o << l << "\n";
-  for (const auto& l : r.triggers) o << "trigger " << l << "\n";
-  for (const auto& l : r.sim_messages) o << "sim: " << l << "\n";
-  o << "frames " << r.frames << " pinched_frames " << r.frames_pinched << " pinned_added "
-    << r.pinned_added << " cuts " << r.cuts_ok << " components " << r.components_before << " -> "
-    << r.components_after << "\n";
-  if (o) r.written.push_back(tp);
+  std::string e = write_whole(opt_.out_dir, [&](const std::string& d) -> std::string {
+    const std::string p = d + "/xr_session.txt";
+    std::ofstream o(p);
+    for (const auto& l : r.log) o << l << "\n";
+    for (const auto& l : r.triggers) o << "trigger " << l << "\n";
+    for (const auto& l : r.sim_messages) o << "sim: " << l << "\n";
+    o << "frames " << r.frames << " pinched_frames " << r.frames_pinched << " pinned_added "
+      << r.pinned_added << " cuts " << r.cuts_ok << " components " << r.components_before << " -> "
+      << r.components_after << "\n";
+    o.close();
+    return o ? std::string() : p + ": write failed: " + std::strerror(errno);
+  });
+  if (e.empty())
+    r.written.push_back(tp);
+  else
+    not_saved(rep_, "session text", e);
 }
 
 }  // namespace drape::app

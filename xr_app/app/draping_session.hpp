@@ -45,6 +45,7 @@ class DrapingSession : public SessionContent {
   void draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& laps) override;
   void frame_ended(Clock::time_point end) override;
   void forget_targets() override;
+  void session_lost() override;
   void finish() override;
 
  private:

@@ -44,6 +44,8 @@ class SessionContent {
   virtual void frame_ended(Clock::time_point end) = 0;  // xrEndFrame returned
   // Before the swapchains are destroyed (the session ends).
   virtual void forget_targets() = 0;
+  // The runtime lost the session (LOSS_PENDING); a new one follows, with the hands elsewhere.
+  virtual void session_lost() {}
   // The run ends: outcomes into the result, files into out_dir.
   virtual void finish() = 0;
 };

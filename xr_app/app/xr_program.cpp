@@ -247,6 +247,7 @@ bool XrProgram::on_session_state(XrSessionState s) {
     case XR_SESSION_STATE_LOSS_PENDING:  // the session is re-created
       ++rep_.r.sessions_lost;
       set_state(XrAppState::kSessionLost);
+      if (content_) content_->session_lost();
       destroy_session();
       if (rep_.r.sessions_lost > opt_.max_session_restarts) {
         rep_.r.error = "session lost too often";
