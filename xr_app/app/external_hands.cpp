@@ -3,9 +3,13 @@
 // frames below its confidence threshold count as untracked), then the calibration into the stage,
 // then the palm-only gestures (palm_push, dwell); the runtime still gives the head and the frame
 // loop. The source's troubles (no packets yet, dropped packets, an unreadable trace) are log
-// lines and the feedback panel's "hands" status, never a failed session.
+// lines and the feedback panel's "hands" status, never a failed session. With a pairing key the
+// UDP source accepts signed packets only; forged and replayed ones are counted in that status.
+#include <algorithm>
 #include <chrono>
+#include <optional>
 
+#include "tracking/udp_auth.hpp"
 #include "xr_app/app/draping_session.hpp"
 
 namespace drape::app {
@@ -26,14 +30,20 @@ void DrapingSession::open_external_hands() {
     ext_->trace = trace.get();
     ext_->source = std::move(trace);
   } else {
+    std::optional<tracking::UdpKey> key;
+    if (opt_.hands_key.size() == tracking::UdpKey().size()) {
+      key.emplace();
+      std::copy(opt_.hands_key.begin(), opt_.hands_key.end(), key->begin());
+    }
     auto udp = std::make_unique<tracking::UdpSkeletonSource>(static_cast<uint16_t>(opt_.hands_port),
-                                                             opt_.hands_address);
+                                                             opt_.hands_address, key);
     ext_->udp = udp.get();
     ext_->source = std::move(udp);
   }
   rep_.note("hands: " + opt_.hands + " source " +
             (opt_.hands == "trace" ? opt_.hands_trace
-                                   : opt_.hands_address + ":" + std::to_string(opt_.hands_port)));
+                                   : opt_.hands_address + ":" + std::to_string(opt_.hands_port) +
+                                         (opt_.hands_key.empty() ? "" : " (signed packets only)")));
   if (!opt_.calibration_path.empty()) {
     std::string error;
     if (auto c = tracking::load_calibration(opt_.calibration_path, &error)) {
@@ -53,11 +63,14 @@ void DrapingSession::note_external_status() {
   std::string shown = st.state == tracking::SourceState::Ok ? "" : st.message;
   if (ext_->udp && st.state != tracking::SourceState::Unavailable) {
     const tracking::UdpStats& s = ext_->udp->stats();
-    const uint64_t dropped = s.malformed + s.stale;
-    if (dropped > 0)
-      shown = "udp: " + std::to_string(dropped) + " packets dropped (" +
+    if (s.dropped() > 0)
+      shown = "udp: " + std::to_string(s.dropped()) + " packets dropped (" +
               std::to_string(s.malformed) + " malformed, " + std::to_string(s.stale) +
-              " out of order), last: " + s.last_error;
+              " out of order" +
+              (ext_->udp->authenticated() ? ", " + std::to_string(s.forged) + " forged, " +
+                                                std::to_string(s.replayed) + " replayed"
+                                          : "") +
+              "), last: " + s.last_error;
     else if (st.state == tracking::SourceState::NoData)
       shown =
           "udp: no packets yet on " + opt_.hands_address + ":" + std::to_string(ext_->udp->port());

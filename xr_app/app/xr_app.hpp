@@ -68,6 +68,9 @@ struct XrAppOptions {
   std::string hands_address = "127.0.0.1";
   int hands_port = 9740;
   std::string hands_trace, calibration_path;
+  // The UDP stream's pairing key (32 bytes; empty: unsigned packets, loopback only): with it only
+  // signed packets are accepted (tracking/udp_auth.hpp).
+  std::vector<uint8_t> hands_key;
   // The API layers the loader enables (its XR_ENABLE_API_LAYERS): their instance extensions are
   // offered too (the core validation layer's XR_EXT_debug_utils).
   std::vector<std::string> api_layers;

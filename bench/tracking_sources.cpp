@@ -1,0 +1,363 @@
+// The hand sources as the app's frame loop runs them (xr_app/app/external_hands.cpp): each frame
+// the source is polled, each new palm goes through HandFilter, and the hand overlay is drawn at the
+// latest filtered palm. The loop runs on a virtual 90 Hz clock so that every source sees the same
+// palm path: rests of 2 s and instantaneous 10 cm steps, at the source's own rate (UDP 60 Hz, a
+// trace file 60 Hz, the Kinect 30 Hz) with its own noise (2 mm per axis for the UDP and trace
+// samples; for the Kinect, depth frames synthesized with 2.5 mm pixel noise and a hand outline
+// that moves 1 px and 2 mm per frame, segmented by HandSegmenter as KinectSource's thread does;
+// the frames are handed to the segmenter directly, not read back through libfreenect/fakenect).
+//   latency: frames from the frame in which the source first delivers a sample after the step
+//            to the first frame whose overlay has covered 10 % (onset) and 50 % of the step; the
+//            app draws a frame's overlay from that frame's pose (pose-to-photon 0 frames,
+//            `./drape bench xr`), so these are source-to-photon frames;
+//   jitter:  RMS distance (mm) from the window's mean over the last 1.3 s of each rest, of the
+//            source's samples (before the filter) and of the overlay per frame (after it);
+//   CPU:     thread CPU time per frame of poll + segmentation (Kinect) + filter.
+#include "bench/tracking_sources.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "tracking/kinect.hpp"
+#include "tracking/one_euro.hpp"
+#include "tracking/trace.hpp"
+#include "tracking/udp_source.hpp"
+
+namespace drape::bench {
+
+using namespace drape::tracking;
+
+namespace {
+
+constexpr double kFrameRate = 90;
+constexpr double kRest = 2.0;    // s between steps
+constexpr int kSteps = 8;        // the path: kSteps + 1 rests
+constexpr double kStepM = 0.10;  // m
+constexpr double kSettle = 0.7;  // s after a step before the rest counts for the jitter
+constexpr double kOnset = 0.10;  // share of the step that counts as "shown"
+constexpr double kHalf = 0.50;
+
+// The palm (camera frame of the Kinect: in front at z = -1.1 m, left of the image centre so
+// that the segmenter always labels it the same hand): steps between two points along x.
+Vec3 truth(double t) {
+  const int rest = std::min(kSteps, static_cast<int>(t / kRest));
+  return Vec3(rest % 2 == 0 ? -0.25 : -0.25 + kStepM, 0.0, -1.1);
+}
+double duration() {
+  return kRest * (kSteps + 1);
+}
+
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+HandFrame palm_frame(double t, const Vec3& p) {
+  HandFrame f;
+  f.hand = Hand::Right;
+  f.time = t;
+  f.tracked = true;
+  f.confidence = 0.9;
+  f.palm.position = p;
+  return f;
+}
+
+// A source under test: deliver(t) makes every sample due by t available (outside the timed
+// part: it is the tracker's or the sender's work), poll(t) is the app's side (timed).
+struct Source {
+  std::string name;
+  double rate = 0;  // samples per second
+  std::function<void(double)> deliver;
+  std::function<std::vector<HandFrame>(double)> poll;
+  std::vector<double> sample_times;  // when each sample became available
+  std::vector<Vec3> samples;         // what the source measured (before the filter)
+};
+
+struct Result {
+  std::string name;
+  double rate = 0;
+  double onset_median = -1, onset_max = -1, half_median = -1, half_max = -1;
+  double jitter_raw_mm = 0, jitter_filtered_mm = 0;
+  double cpu_us_per_frame = 0;
+  int steps_seen = 0;
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return -1;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+double rms_about_mean(const std::vector<Vec3>& v) {
+  if (v.size() < 2) return 0;
+  Vec3 mean = Vec3::Zero();
+  for (const auto& p : v) mean += p;
+  mean /= static_cast<double>(v.size());
+  double s = 0;
+  for (const auto& p : v) s += (p - mean).squaredNorm();
+  return std::sqrt(s / static_cast<double>(v.size()));
+}
+
+// The frame loop of external_hands.cpp on a virtual clock; the figures of one source.
+Result run(Source& src) {
+  Result r;
+  r.name = src.name;
+  r.rate = src.rate;
+  HandFilter filter;
+  const int frames = static_cast<int>(duration() * kFrameRate);
+  std::vector<Vec3> overlay(frames, Vec3::Constant(NAN));
+  std::vector<double> frame_t(frames);
+  Vec3 shown = Vec3::Constant(NAN);
+  double cpu = 0;
+  for (int k = 0; k < frames; ++k) {
+    const double t = k / kFrameRate;
+    frame_t[k] = t;
+    src.deliver(t);
+    const double c0 = thread_cpu_s();
+    for (const HandFrame& raw : src.poll(t)) {
+      const HandFrame f = filter.update(raw);
+      if (f.tracked) shown = f.palm.position;
+    }
+    cpu += thread_cpu_s() - c0;
+    overlay[k] = shown;
+  }
+  r.cpu_us_per_frame = 1e6 * cpu / frames;
+  // Latency per step: from the frame of the first sample after the step.
+  std::vector<double> onset, half;
+  for (int s = 1; s <= kSteps; ++s) {
+    const double T = s * kRest;
+    const Vec3 a = truth(T - 1e-6), b = truth(T + 1e-6);
+    size_t first = 0;
+    while (first < src.sample_times.size() && src.sample_times[first] < T - 1e-9) ++first;
+    if (first == src.sample_times.size()) continue;
+    const int k0 = static_cast<int>(std::ceil(src.sample_times[first] * kFrameRate - 1e-9));
+    int k_onset = -1, k_half = -1;
+    for (int k = k0; k < frames && frame_t[k] < T + kRest; ++k) {
+      if (!overlay[k].allFinite()) continue;
+      const double covered = (overlay[k] - a).dot(b - a) / (b - a).squaredNorm();
+      if (k_onset < 0 && covered >= kOnset) k_onset = k;
+      if (k_half < 0 && covered >= kHalf) k_half = k;
+    }
+    if (k_onset < 0 || k_half < 0) continue;
+    onset.push_back(k_onset - k0);
+    half.push_back(k_half - k0);
+    ++r.steps_seen;
+  }
+  r.onset_median = median(onset);
+  r.half_median = median(half);
+  r.onset_max = onset.empty() ? -1 : *std::max_element(onset.begin(), onset.end());
+  r.half_max = half.empty() ? -1 : *std::max_element(half.begin(), half.end());
+  // Jitter at rest: the last part of each rest.
+  double raw2 = 0, filt2 = 0;
+  int nraw = 0, nfilt = 0;
+  for (int s = 0; s <= kSteps; ++s) {
+    const double from = s * kRest + kSettle, to = (s + 1) * kRest;
+    std::vector<Vec3> raw, filt;
+    for (size_t i = 0; i < src.samples.size(); ++i)
+      if (src.sample_times[i] >= from && src.sample_times[i] < to && src.samples[i].allFinite())
+        raw.push_back(src.samples[i]);
+    for (int k = 0; k < frames; ++k)
+      if (frame_t[k] >= from && frame_t[k] < to && overlay[k].allFinite())
+        filt.push_back(overlay[k]);
+    const double jr = rms_about_mean(raw), jf = rms_about_mean(filt);
+    raw2 += jr * jr * static_cast<double>(raw.size());
+    nraw += static_cast<int>(raw.size());
+    filt2 += jf * jf * static_cast<double>(filt.size());
+    nfilt += static_cast<int>(filt.size());
+  }
+  r.jitter_raw_mm = nraw ? 1e3 * std::sqrt(raw2 / nraw) : -1;
+  r.jitter_filtered_mm = nfilt ? 1e3 * std::sqrt(filt2 / nfilt) : -1;
+  return r;
+}
+
+// Noisy palm samples at `rate` along the path.
+void noisy_samples(double rate, uint32_t seed, std::vector<double>& times, std::vector<Vec3>& pos) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0, 0.002);
+  for (int i = 0; i / rate < duration(); ++i) {
+    const double t = i / rate;
+    times.push_back(t);
+    pos.push_back(truth(t) + Vec3(noise(rng), noise(rng), noise(rng)));
+  }
+}
+
+// The UDP stream: packets sent on loopback as their samples fall due, received by
+// UdpSkeletonSource (frames stamped with the frame's time, as the app's receive time is).
+struct UdpBench {
+  UdpSkeletonSource source{0};
+  int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  size_t next = 0;
+  uint32_t seq = 1;
+  ~UdpBench() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// A Kinect depth frame (640x480 raw 11-bit): a wall at 2.6 m, a torso at 1.6 m and the palm, a
+// disc of 8 cm radius at its depth, with per-pixel noise (as tests/tracking/kinect_test.cpp's
+// scenes). The sensor's frame-to-frame noise of a hand's outline and depth is modelled by moving
+// the disc by a random 1 px (s.d.) across the image and 2 mm in depth in each frame.
+std::vector<uint16_t> depth_frame(const Vec3& palm, std::mt19937& rng) {
+  const DepthIntrinsics k;
+  std::normal_distribution<double> noise(0, 0.0025), outline(0, 1.0), depth(0, 0.002);
+  const double z = -palm.z() + depth(rng);
+  const double hu = k.cx + palm.x() * k.fx / z + outline(rng);
+  const double hv = k.cy - palm.y() * k.fy / z + outline(rng);
+  const double r = 0.08 * k.fx / z;
+  std::vector<uint16_t> f(640 * 480);
+  for (int v = 0; v < 480; ++v)
+    for (int u = 0; u < 640; ++u) {
+      double d = 2.6;
+      if (u > 300 && u < 500 && v > 150) d = 1.6;
+      if (std::hypot(u - hu, v - hv) < r) d = z;
+      f[v * 640 + u] = kinect_m_to_raw(d + noise(rng));
+    }
+  return f;
+}
+
+}  // namespace
+
+nlohmann::json run_source_benchmarks(const std::string& work_dir, const std::string& csv_path) {
+  std::vector<Result> results;
+
+  {  // UDP stream, 60 Hz
+    Source s;
+    s.name = "udp (60 Hz)";
+    s.rate = 60;
+    noisy_samples(s.rate, 11, s.sample_times, s.samples);
+    auto u = std::make_shared<UdpBench>();
+    u->to.sin_family = AF_INET;
+    u->to.sin_port = htons(u->source.port());
+    ::inet_pton(AF_INET, "127.0.0.1", &u->to.sin_addr);
+    s.deliver = [u, &s](double t) {
+      while (u->next < s.sample_times.size() && s.sample_times[u->next] <= t + 1e-9) {
+        const auto b = encode_udp_packet(u->seq++, s.sample_times[u->next],
+                                         {palm_frame(s.sample_times[u->next], s.samples[u->next])});
+        ::sendto(u->fd, b.data(), b.size(), 0, reinterpret_cast<const sockaddr*>(&u->to),
+                 sizeof u->to);
+        ++u->next;
+      }
+    };
+    s.poll = [u](double t) {
+      auto frames = u->source.poll();
+      for (auto& f : frames) f.time = t;
+      return frames;
+    };
+    results.push_back(run(s));
+    if (u->source.stats().dropped() > 0)
+      std::printf("udp: %s\n", u->source.status().message.c_str());
+  }
+
+  {  // Kinect depth frames, 30 Hz, segmented as KinectSource's thread does
+    Source s;
+    s.name = "kinect (30 Hz depth)";
+    s.rate = 30;
+    std::mt19937 rng(5);
+    std::vector<std::vector<uint16_t>> depth;
+    for (int i = 0; i / s.rate < duration(); ++i) {
+      s.sample_times.push_back(i / s.rate);
+      depth.push_back(depth_frame(truth(i / s.rate), rng));
+    }
+    auto seg = std::make_shared<HandSegmenter>();
+    auto next = std::make_shared<size_t>(0);
+    auto pending = std::make_shared<std::vector<size_t>>();
+    s.deliver = [next, pending, &s](double t) {
+      while (*next < s.sample_times.size() && s.sample_times[*next] <= t + 1e-9)
+        pending->push_back((*next)++);
+    };
+    s.samples.assign(s.sample_times.size(), Vec3::Constant(NAN));
+    s.poll = [seg, pending, &depth, &s](double) {
+      std::vector<HandFrame> out;
+      for (size_t i : *pending)
+        for (const HandFrame& f :
+             seg->process_raw11(depth[i].data(), 640, 480, s.sample_times[i])) {
+          s.samples[i] = f.palm.position;
+          out.push_back(f);
+        }
+      pending->clear();
+      return out;
+    };
+    results.push_back(run(s));
+    // Depth frames in which the segmenter found no palm (left out of the raw jitter).
+    const auto found = std::count_if(s.samples.begin(), s.samples.end(),
+                                     [](const Vec3& p) { return p.allFinite(); });
+    if (found != static_cast<long>(s.samples.size()))
+      std::printf("kinect: the palm found in %ld of %zu depth frames\n", static_cast<long>(found),
+                  s.samples.size());
+  }
+
+  {  // A trace file, 60 Hz
+    Source s;
+    s.name = "trace file (60 Hz)";
+    s.rate = 60;
+    noisy_samples(s.rate, 13, s.sample_times, s.samples);
+    const std::string path = work_dir + "/tracking_sources_trace.csv";
+    {
+      TraceRecorder rec(path);
+      for (size_t i = 0; i < s.samples.size(); ++i)
+        rec.write(palm_frame(s.sample_times[i], s.samples[i]));
+    }
+    auto trace = std::make_shared<TraceSource>(path);
+    s.deliver = [](double) {};  // the file is the source: nothing to send
+    s.poll = [trace](double t) {
+      trace->set_time(t);
+      return trace->poll();
+    };
+    results.push_back(run(s));
+    if (trace->status().state == SourceState::Error)
+      std::printf("trace: %s\n", trace->status().message.c_str());
+  }
+
+  std::printf(
+      "\nHand sources in the app's frame loop (virtual 90 Hz; %d steps of %.0f cm, rests of %.0f "
+      "s)\n",
+      kSteps, kStepM * 100, kRest);
+  std::printf("%-22s %16s %16s %12s %12s %14s\n", "source", "onset (frames)", "50 % (frames)",
+              "jitter raw", "filtered", "CPU/frame");
+  std::printf("%-22s %16s %16s %12s %12s %14s\n", "", "median / max", "median / max", "(mm RMS)",
+              "(mm RMS)", "(us)");
+  nlohmann::json j = nlohmann::json::array();
+  std::ofstream csv(csv_path);
+  csv << "source,rate_hz,steps_seen,onset_frames_median,onset_frames_max,half_frames_median,"
+         "half_frames_max,jitter_raw_mm,jitter_filtered_mm,cpu_us_per_frame\n";
+  for (const Result& r : results) {
+    std::printf("%-22s %9.0f / %-4.0f %9.0f / %-4.0f %12.2f %12.2f %14.1f\n", r.name.c_str(),
+                r.onset_median, r.onset_max, r.half_median, r.half_max, r.jitter_raw_mm,
+                r.jitter_filtered_mm, r.cpu_us_per_frame);
+    csv << '"' << r.name << '"' << ',' << r.rate << ',' << r.steps_seen << ',' << r.onset_median
+        << ',' << r.onset_max << ',' << r.half_median << ',' << r.half_max << ',' << r.jitter_raw_mm
+        << ',' << r.jitter_filtered_mm << ',' << r.cpu_us_per_frame << '\n';
+    j.push_back({{"source", r.name},
+                 {"rate_hz", r.rate},
+                 {"steps_seen", r.steps_seen},
+                 {"steps", kSteps},
+                 {"onset_frames_median", r.onset_median},
+                 {"onset_frames_max", r.onset_max},
+                 {"half_frames_median", r.half_median},
+                 {"half_frames_max", r.half_max},
+                 {"jitter_raw_mm", r.jitter_raw_mm},
+                 {"jitter_filtered_mm", r.jitter_filtered_mm},
+                 {"cpu_us_per_frame", r.cpu_us_per_frame}});
+  }
+  std::printf(
+      "onset / 50 %%: frames from the first sample after the step to the overlay covering 10 / 50 "
+      "%% of it (the app's pose-to-photon adds 0 frames); wrote %s\n",
+      csv_path.c_str());
+  return j;
+}
+
+}  // namespace drape::bench
