@@ -14,7 +14,8 @@
 #   signed  --hands udp:0.0.0.0:PORT without a key: exit 2 saying how to pair; `drape hands pair`
 #           writes the key (0600); the app (the default key file) accepts the signed packets and
 #           drops and counts the forged and replayed ones mixed in: still the pinch.
-#   sendkey `drape hands send --key` to an app listening on 0.0.0.0 with --hands-key FILE.
+#   sendkey `drape hands send --key --rate 75` (signed, resampled) to an app listening on 0.0.0.0
+#           with --hands-key FILE.
 #   missing --hands trace with no such file: exit 2 naming the file; a bad --hands value: exit 2
 #           naming the option; a malformed trace: the session runs (exit 0), its status logged.
 # usage: drape_hands_test.sh DRAPE_EXE MODE WORKDIR PORT
@@ -110,7 +111,7 @@ JSON
       udp|sendkey)
         python3 "$here/hands_trace.py" trace "$work/hands.csv" $P || { kill "$app"; fail "trace writer"; }
         send_key=()
-        [ "$mode" = sendkey ] && send_key=(--key "$work/sender.key")
+        [ "$mode" = sendkey ] && send_key=(--key "$work/sender.key" --rate 75)  # resampled
         "$exe" hands send "$work/hands.csv" --to "127.0.0.1:$port" "${send_key[@]}" >"$work/send.txt" 2>&1 ||
           { kill "$app"; cat "$work/send.txt"; fail "drape hands send: exit code"; }
         cat "$work/send.txt"
