@@ -16,6 +16,8 @@
 #           drops and counts the forged and replayed ones mixed in: still the pinch.
 #   sendkey `drape hands send --key --rate 75` (signed, resampled) to an app listening on 0.0.0.0
 #           with --hands-key FILE.
+#   loop    `drape hands send --loop` of a short trace: more than two laps, sequence numbers
+#           consecutive and timestamps increasing across laps.
 #   missing --hands trace with no such file: exit 2 naming the file; a bad --hands value: exit 2
 #           naming the option; a malformed trace: the session runs (exit 0), its status logged.
 # usage: drape_hands_test.sh DRAPE_EXE MODE WORKDIR PORT
@@ -154,6 +156,37 @@ JSON
         ! grep -q "packets dropped" "$log" || fail "signed packets dropped: $(grep -m1 'packets dropped' "$log")"
         ;;
     esac
+    ;;
+  loop)  # `drape hands send --loop` of a 0.1 s trace: laps with growing numbers and times
+    printf '# drape-trace v1\n' >"$work/tiny.csv"
+    for t in 0.00 0.02 0.04 0.06 0.08 0.10; do echo "$t,1,1,0.9,0.1,1.2,0.3,0,0,0,1,0" >>"$work/tiny.csv"; done
+    python3 - "$port" >"$work/received.txt" 2>&1 <<'PY' &
+import socket, struct, sys
+s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+s.bind(("127.0.0.1", int(sys.argv[1])))
+s.settimeout(3.0)
+got = []
+try:
+    while True:
+        d = s.recv(2048)
+        magic, version, _, seq, t = struct.unpack("<IHHId", d[:20])
+        got.append((seq, t))
+except socket.timeout:
+    pass
+seqs = [q for q, _ in got]
+times = [t for _, t in got]
+ok = len(got) > 12 and all(b == (a + 1) % 2**32 for a, b in zip(seqs, seqs[1:])) \
+    and all(b > a for a, b in zip(times, times[1:])) and times[-1] > 0.2
+print(f"received {len(got)} packets, last timestamp {times[-1] if times else -1:.3f} s")
+sys.exit(0 if ok else 1)
+PY
+    rx=$!
+    sleep 0.5
+    timeout 1.5 "$exe" hands send "$work/tiny.csv" --loop --to "127.0.0.1:$port" >"$log" 2>&1
+    rc=$?
+    [ $rc -eq 124 ] || fail "--loop ended by itself (exit $rc) before the timeout"
+    wait "$rx" || { cat "$work/received.txt"; fail "the laps' packets: too few, or numbers/times not increasing"; }
+    cat "$work/received.txt"
     ;;
   missing)
     "$exe" xr --frames 5 --hands trace "$work/none.csv" >"$log" 2>&1
