@@ -19,7 +19,9 @@
 #   loop    `drape hands send --loop` of a short trace: more than two laps, sequence numbers
 #           consecutive and timestamps increasing across laps.
 #   missing --hands trace with no such file: exit 2 naming the file; a bad --hands value: exit 2
-#           naming the option; a malformed trace: the session runs (exit 0), its status logged.
+#           naming the option; --hands-key without udp or with a key file others may read, and
+#           bad `drape hands` values: exit 2 naming the option or the file; a malformed trace: the
+#           session runs (exit 0), its status logged.
 # usage: drape_hands_test.sh DRAPE_EXE MODE WORKDIR PORT
 set -u
 exe=$1 mode=$2 work=$3 port=${4:-0}
@@ -200,6 +202,29 @@ PY
     "$exe" xr --frames 5 --hands udp:127.0.0.1:99999 >"$log" 2>&1
     [ $? -eq 2 ] || fail "bad port: not exit 2"
     grep -q "drape xr: --hands: bad port '99999'" "$log" || fail "no message naming the port"
+    # --hands-key: only with --hands udp; a key file others may read is refused naming the file.
+    "$exe" xr --frames 5 --hands-key "$work/none.key" >"$log" 2>&1
+    [ $? -eq 2 ] || fail "--hands-key without --hands udp: not exit 2"
+    grep -q "drape xr: --hands-key: only with --hands udp" "$log" || fail "no message naming --hands-key"
+    "$exe" hands pair --key "$work/open.key" >/dev/null 2>&1 || fail "pair --key"
+    chmod 644 "$work/open.key"
+    "$exe" xr --frames 5 --hands udp:0.0.0.0:$port --hands-key "$work/open.key" >"$log" 2>&1
+    [ $? -eq 2 ] || fail "a readable key file: not exit 2"
+    grep -q "drape xr: --hands-key: .*open.key: permissions 644 .*chmod 600" "$log" || fail "no message naming the key file"
+    # drape hands send: its options, and bad values naming the option or the file.
+    "$exe" hands send --help >"$log" 2>&1 || fail "hands send --help: exit $?"
+    for o in --to --rate --loop --key; do grep -q -- "$o" "$log" || fail "hands send --help lacks $o"; done
+    "$exe" hands send "$work/none.csv" >"$log" 2>&1
+    [ $? -eq 2 ] && grep -q "drape hands send: .*none.csv: cannot open" "$log" || fail "hands send: missing trace"
+    printf '# drape-trace v1\n0.0,1,1,0.9,0.1,1.3,0.5,0,0,0,1,0\n' >"$work/one.csv"
+    "$exe" hands send "$work/one.csv" --to nowhere:1 >"$log" 2>&1
+    [ $? -eq 2 ] && grep -q "drape hands send: --to: not an IPv4 address: 'nowhere'" "$log" || fail "hands send: bad --to"
+    "$exe" hands send "$work/one.csv" --rate 0.5x >"$log" 2>&1
+    [ $? -eq 2 ] && grep -q -- "--rate" "$log" || fail "hands send: bad --rate"
+    "$exe" hands send "$work/one.csv" --key "$work/open.key" >"$log" 2>&1
+    [ $? -eq 2 ] && grep -q "drape hands send: --key: .*open.key: permissions 644" "$log" || fail "hands send: readable key"
+    "$exe" hands nosuch >"$log" 2>&1
+    [ $? -eq 2 ] && grep -q "drape hands: unknown tool 'nosuch'" "$log" || fail "hands: unknown tool"
     printf '# drape-trace v1\n0.0,1,1,0.9,0.1,1.3,0.5,0,0,0,1,0\n0.1,7,1,0.9,0.1,1.3,0.5,0,0,0,1,0\n' >"$work/bad.csv"
     scenario 30 true
     xr --hands trace "$work/bad.csv" >"$log" 2>&1 || fail "malformed trace: exit code $?"
