@@ -74,7 +74,12 @@ int main(int argc, char** argv) {
       "One-Euro jitter vs lag, the Kinect pipeline's frames per second, and per hand source "
       "the step-to-overlay latency, jitter and CPU per frame (out/bench/tracking.json, "
       "out/bench/tracking_sources.csv)."};
+  std::string replay;
+  app.add_option("--kinect-replay", replay,
+                 "internal: the child of the fakenect replay, run under `fakenect DIR` by the "
+                 "benchmark itself");
   CLI11_PARSE(app, argc, argv);
+  if (!replay.empty()) return drape::bench::run_kinect_replay_child(replay);
   // Noisy trace (also written as a trace file to exercise record/replay).
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0, 0.005);
