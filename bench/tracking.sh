@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# ./drape bench tracking: One-Euro jitter vs lag and Kinect pipeline fps on one core.
+# ./drape bench tracking: One-Euro jitter vs lag, Kinect pipeline fps, and per hand source (UDP,
+# Kinect depth, trace file) latency, jitter and CPU per frame; on one core.
 set -euo pipefail
 ROOT="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
 shift || true  # the rest: tracking_bench's flags

@@ -1,6 +1,9 @@
 // Tracking benchmark (./drape bench tracking): One-Euro jitter reduction vs added lag on a noisy
-// hand trace (30 Hz, 5 mm Kinect-like noise), and the Kinect depth pipeline's frames per second
-// on 640x480 (run on one core by bench/tracking.sh). Writes out/bench/tracking.json.
+// hand trace (30 Hz, 5 mm Kinect-like noise), the Kinect depth pipeline's frames per second
+// on 640x480, and per hand source (UDP stream, Kinect depth frames, trace file) the latency from a
+// step of the palm to the overlay, the jitter at rest before and after the filter and the CPU
+// time per frame (bench/tracking_sources.cpp). Run on one core by bench/tracking.sh. Writes
+// out/bench/tracking.json and out/bench/tracking_sources.csv.
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -10,6 +13,7 @@
 #include <random>
 #include <vector>
 
+#include "bench/tracking_sources.hpp"
 #include "tracking/kinect.hpp"
 #include "tracking/one_euro.hpp"
 #include "tracking/trace.hpp"
@@ -67,9 +71,15 @@ Score evaluate(const std::vector<double>& ts, const std::vector<Vec3>& y) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "One-Euro jitter vs lag and the Kinect pipeline's frames per second "
-      "(out/bench/tracking.json)."};
+      "One-Euro jitter vs lag, the Kinect pipeline's frames per second, and per hand source "
+      "the step-to-overlay latency, jitter and CPU per frame (out/bench/tracking.json, "
+      "out/bench/tracking_sources.csv)."};
+  std::string replay;
+  app.add_option("--kinect-replay", replay,
+                 "internal: the child of the fakenect replay, run under `fakenect DIR` by the "
+                 "benchmark itself");
   CLI11_PARSE(app, argc, argv);
+  if (!replay.empty()) return drape::bench::run_kinect_replay_child(replay);
   // Noisy trace (also written as a trace file to exercise record/replay).
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0, 0.005);
@@ -155,6 +165,7 @@ int main(int argc, char** argv) {
       fps, 1000 / fps, double(found) / processed);
   j["kinect_fps"] = fps;
   j["kinect_ms_per_frame"] = 1000 / fps;
+  j["sources"] = drape::bench::run_source_benchmarks("out/bench", "out/bench/tracking_sources.csv");
   std::ofstream("out/bench/tracking.json") << j.dump(2) << "\n";
   std::printf("wrote out/bench/tracking.json\n");
   return 0;

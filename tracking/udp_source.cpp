@@ -8,7 +8,10 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+
+#include "tracking/udp_auth.hpp"
 
 namespace drape::tracking {
 
@@ -33,13 +36,16 @@ double now_s() {
 }
 }  // namespace
 
-bool parse_udp_packet(const uint8_t* d, size_t n, UdpPacket& out, std::string* why) {
+bool parse_udp_packet(const uint8_t* d, size_t n, UdpPacket& out, std::string* why,
+                      uint16_t version) {
   static_assert(sizeof(float) == 4 && sizeof(double) == 8);
   if (n < kUdpHeaderSize) return fail(why, "truncated header (" + std::to_string(n) + " bytes)");
   if (n > kUdpMaxPacket) return fail(why, "oversized packet (" + std::to_string(n) + " bytes)");
   if (rd<uint32_t>(d) != kUdpMagic) return fail(why, "bad magic");
-  if (rd<uint16_t>(d + 4) != kUdpVersion)
-    return fail(why, "unsupported version " + std::to_string(rd<uint16_t>(d + 4)));
+  if (const uint16_t v = rd<uint16_t>(d + 4); v != version)
+    return fail(why, v == 2 && version == 1
+                         ? "signed packet (version 2) but no pairing key here (--hands-key)"
+                         : "unsupported version " + std::to_string(v));
   out.sequence = rd<uint32_t>(d + 8);
   out.timestamp = rd<double>(d + 12);
   if (!std::isfinite(out.timestamp)) return fail(why, "timestamp not finite");
@@ -115,7 +121,14 @@ std::vector<uint8_t> encode_udp_packet(uint32_t seq, double ts,
   return b;
 }
 
-UdpSkeletonSource::UdpSkeletonSource(uint16_t port, const std::string& address) {
+UdpSkeletonSource::UdpSkeletonSource(uint16_t port, const std::string& address,
+                                     std::optional<std::array<uint8_t, 32>> key)
+    : key_(key) {
+  if (!key_ && !is_loopback_address(address)) {
+    error_ = "udp: listening on " + address +
+             " needs a pairing key (drape hands pair; --hands-key FILE): only loopback is open";
+    return;
+  }
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd_ < 0) {
     error_ = std::string("udp: socket: ") + std::strerror(errno);
@@ -149,24 +162,51 @@ std::vector<HandFrame> UdpSkeletonSource::poll() {
   std::vector<HandFrame> frames;
   if (fd_ < 0) return frames;
   uint8_t buf[2048];
+  auto drop = [this](uint64_t& counter, std::string why) {
+    ++counter;
+    stats_.last_error = std::move(why);
+  };
   for (;;) {
-    const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+    // MSG_TRUNC: the datagram's real length, so that an oversized one is named as such.
+    const ssize_t n = ::recv(fd_, buf, sizeof buf, MSG_TRUNC);
     if (n < 0) break;  // EAGAIN: drained (other errors: nothing more to read either)
     ++stats_.received;
+    const size_t size = static_cast<size_t>(n);
     UdpPacket p;
     std::string why;
-    if (!parse_udp_packet(buf, static_cast<size_t>(n), p, &why)) {
-      ++stats_.malformed;
-      stats_.last_error = why;
+    if (size > sizeof buf) {
+      drop(stats_.malformed, "oversized packet (" + std::to_string(size) + " bytes)");
       continue;
     }
-    // Sequence numbers: drop duplicates and reordered (older) packets; wrap-around safe.
+    if (key_) {
+      const UdpAuth a = verify_signed_udp_packet(buf, size, *key_, p, &why);
+      if (a == UdpAuth::Forged) drop(stats_.forged, why);
+      if (a == UdpAuth::Malformed) drop(stats_.malformed, why);
+      if (a != UdpAuth::Ok) continue;
+    } else if (!parse_udp_packet(buf, size, p, &why)) {
+      drop(stats_.malformed, why);
+      continue;
+    }
+    // Sequence numbers: drop duplicates and reordered (older) packets; wrap-around safe. With a
+    // key this is the replay check: a signed packet seen before never counts twice.
     if (have_seq_ && static_cast<int32_t>(p.sequence - last_seq_) <= 0) {
-      ++stats_.stale;
+      drop(key_ ? stats_.replayed : stats_.stale,
+           (key_ ? "replayed sequence number " : "out-of-order sequence number ") +
+               std::to_string(p.sequence) + " (last " + std::to_string(last_seq_) + ")");
+      continue;
+    }
+    // Timestamps: a packet must not be older than the last accepted one (a sender that resends
+    // old poses under new sequence numbers, or a stream mixed from two senders).
+    if (have_seq_ && p.timestamp < last_timestamp_) {
+      char b[96];
+      std::snprintf(b, sizeof b, "old timestamp %.3f s (last accepted %.3f s)", p.timestamp,
+                    last_timestamp_);
+      drop(stats_.stale, b);
       continue;
     }
     have_seq_ = true;
     last_seq_ = p.sequence;
+    last_timestamp_ = p.timestamp;
     ++stats_.accepted;
     const double t = now_s();
     for (auto& f : p.hands) {
@@ -179,9 +219,13 @@ std::vector<HandFrame> UdpSkeletonSource::poll() {
 
 SourceStatus UdpSkeletonSource::status() const {
   if (fd_ < 0) return {SourceState::Unavailable, error_};
-  std::string m = "udp: port " + std::to_string(port_) + ", " + std::to_string(stats_.accepted) +
-                  " accepted, " + std::to_string(stats_.malformed) + " malformed, " +
-                  std::to_string(stats_.stale) + " stale";
+  std::string m = "udp: port " + std::to_string(port_) + (key_ ? " (signed)" : "") + ", " +
+                  std::to_string(stats_.accepted) + " accepted, " +
+                  std::to_string(stats_.malformed) + " malformed, " + std::to_string(stats_.stale) +
+                  " stale";
+  if (key_)
+    m += ", " + std::to_string(stats_.forged) + " forged, " + std::to_string(stats_.replayed) +
+         " replayed";
   if (!stats_.last_error.empty()) m += " (last: " + stats_.last_error + ")";
   return {stats_.accepted ? SourceState::Ok : SourceState::NoData, m};
 }

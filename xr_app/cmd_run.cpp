@@ -26,6 +26,7 @@
 #include "sim/solvers/verlet_solver.hpp"
 #include "tracking/command_map.hpp"
 #include "xr_app/command.hpp"
+#include "xr_app/hands_key.hpp"
 #include "xr_app/paths.hpp"
 #ifdef DRAPE_HAVE_XR_APP
 #include <nlohmann/json.hpp>
@@ -222,6 +223,7 @@ struct XrRunOptions {
   std::string voice;               // --voice as given ("" = the default of the session's kind)
   std::vector<std::string> hands;  // --hands as given (resolved into app by resolve_hands)
   std::string calibration;         // --calibration as given
+  std::string hands_key;           // --hands-key as given
   bool pattern = true;
   int every = 30;
   bool scenario_given = false;   // --scenario: always the scripted run
@@ -476,6 +478,9 @@ int run_xr(XrRunOptions& o) {
   const bool headset = !app::simulated_runtime(manifest, simulated);
   if (!app::resolve_voice("drape run", o.voice, window || headset, o.app.voice_input)) return 2;
   if (!app::resolve_hands("drape run", o.hands, o.calibration, o.app)) return 2;
+  if (!app::resolve_hands_key("drape run", o.app.hands == "udp", o.hands_key, o.app.hands_address,
+                              o.app.hands_key))
+    return 2;
   if (window || (headset && !o.scenario_given)) {
     if (!o.cloth_res_given) o.app.cloth_res = kLiveClothRes;
     if (!o.eye_size_given && !simulated) o.app.eye_size = 0;  // the headset's own size
@@ -544,6 +549,7 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
       ->check(CLI::Range(1, 1000000));
   drape::app::add_voice_option(cli, o.voice);
   drape::app::add_hands_options(cli, o.hands, o.calibration, o.app);
+  drape::app::add_hands_key_option(cli, o.hands_key);
   cli.add_option("--form", o.form,
                  "the dress form: a standard size (7AR, 9AR, 11AR, 13AR) or a measurements file "
                  "(JSON, as assets/forms/9AR.json)");

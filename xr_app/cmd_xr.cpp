@@ -9,6 +9,7 @@
 #include "xr_app/command.hpp"
 #ifdef DRAPE_HAVE_XR_APP
 #include "xr_app/app/xr_app.hpp"
+#include "xr_app/hands_key.hpp"
 #include "xr_app/xr_launch.hpp"
 #endif
 
@@ -143,8 +144,9 @@ int cmd_xr(int argc, char** argv) {
                  "audio cues are the voice input");
   app::add_voice_option(cli, voice);
   std::vector<std::string> hands;
-  std::string calibration;
+  std::string calibration, hands_key;
   app::add_hands_options(cli, hands, calibration, opt);
+  app::add_hands_key_option(cli, hands_key);
   cli.add_option("--pose-wait-ms", opt.pose_wait_ms,
                  "free sim: how long a frame waits for the tick that took its hand pose")
       ->check(CLI::Range(0.0, 1000.0));
@@ -187,6 +189,9 @@ int cmd_xr(int argc, char** argv) {
   if (live) opt.voice = false;
   if (!app::resolve_voice("drape xr", voice, live, opt.voice_input)) return 2;
   if (!app::resolve_hands("drape xr", hands, calibration, opt)) return 2;
+  if (!app::resolve_hands_key("drape xr", opt.hands == "udp", hands_key, opt.hands_address,
+                              opt.hands_key))
+    return 2;
   std::fprintf(stderr, "drape xr: runtime manifest: %s\n",
                manifest.empty() ? "(system active runtime)" : manifest.c_str());
   std::fprintf(stderr, "drape xr: live voice: %s\n",

@@ -1,14 +1,11 @@
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <thread>
 
+#include "tests/tracking/udp_test_sender.hpp"
 #include "tracking/udp_source.hpp"
 
 using namespace drape::tracking;
@@ -87,14 +84,8 @@ TEST(UdpSource, LoopbackCountsMalformedAndStale) {
   UdpSkeletonSource src(0);  // 127.0.0.1, free port
   ASSERT_NE(src.status().state, SourceState::Unavailable) << src.status().message;
   ASSERT_GT(src.port(), 0);
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(src.port());
-  ::inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
-  auto send = [&](const std::vector<uint8_t>& b) {
-    ::sendto(fd, b.data(), b.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  };
+  const test_support::LoopbackSender sender(src.port());
+  auto send = [&](const std::vector<uint8_t>& b) { sender.send(b); };
   send(encode_udp_packet(10, 1.0, {sample_hand(Hand::Right, true)}));
   auto trunc = encode_udp_packet(11, 1.0, {sample_hand(Hand::Right, true)});
   trunc.resize(30);
@@ -107,7 +98,6 @@ TEST(UdpSource, LoopbackCountsMalformedAndStale) {
     for (auto& f : src.poll()) got.push_back(f);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  ::close(fd);
   ASSERT_EQ(got.size(), 2u);
   EXPECT_EQ(got[0].hand, Hand::Right);
   EXPECT_EQ(got[1].hand, Hand::Left);
@@ -121,4 +111,25 @@ TEST(UdpSource, BadAddressGivesStatus) {
   UdpSkeletonSource src(0, "not-an-address");
   EXPECT_EQ(src.status().state, SourceState::Unavailable);
   EXPECT_TRUE(src.poll().empty());
+}
+
+TEST(UdpSource, DropsOldTimestampsAndHugeDatagrams) {
+  UdpSkeletonSource src(0);
+  ASSERT_NE(src.status().state, SourceState::Unavailable) << src.status().message;
+  const test_support::LoopbackSender sender(src.port());
+  auto send = [&](const std::vector<uint8_t>& b) { sender.send(b); };
+  send(encode_udp_packet(1, 5.0, {sample_hand(Hand::Right, false)}));
+  send(encode_udp_packet(2, 4.0, {sample_hand(Hand::Right, false)}));  // a new number, old time
+  send(std::vector<uint8_t>(9000, 0x44));                              // beyond the read buffer
+  send(encode_udp_packet(3, 5.0, {sample_hand(Hand::Right, false)}));  // the same time: kept
+  std::vector<HandFrame> got;
+  for (int i = 0; i < 100 && src.stats().received < 4; ++i) {
+    for (auto& f : src.poll()) got.push_back(f);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(got.size(), 2u);
+  EXPECT_EQ(src.stats().stale, 1u);
+  EXPECT_EQ(src.stats().malformed, 1u);
+  EXPECT_NE(src.stats().last_error.find("oversized packet (9000 bytes)"), std::string::npos)
+      << src.stats().last_error;
 }

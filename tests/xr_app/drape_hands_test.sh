@@ -4,7 +4,8 @@
 #           pinch on), a move, a dwell (release), a second palm push (the pinch off) -> the log
 #           shows the pinch taking a particle, the release and the pinch letting it go.
 #   calibrated the same trace 0.5 m lower, lifted into the stage by --calibration FILE.
-#   udp     the same poses sent over UDP at their timestamps (--hands udp:127.0.0.1:PORT).
+#   udp     the same trace sent over UDP at its timestamps by `drape hands send`
+#           (--hands udp:127.0.0.1:PORT).
 #   noisy   the same with malformed and out-of-order packets mixed in: a message, still the pinch.
 #   two     --hands trace FILE of both palms: together (pin), spread slowly (nothing), spread
 #           quickly (undo), both pushed twice (the cut's start and end).
@@ -17,10 +18,23 @@
 #           the stage by its --calibration file -> the same pinch, move, release and pinch off.
 #   kinect_end the recording ends mid-pinch (the Kinect going away): its message, the pinch held
 #           for the grace and let go, the session runs on to its last frame (exit 0).
+#   bad     oversized, malformed, out-of-order and stale (old timestamp) packets mixed in: each
+#           kind counted in the message, still the pinch.
+#   lowconf the palm's confidence drops below the threshold during the move, briefly (the pinch
+#           holds) and then for 0.9 s: the hand is lost, its pinch held for the grace, then let go.
+#   signed  --hands udp:0.0.0.0:PORT without a key: exit 2 saying how to pair; `drape hands pair`
+#           writes the key (0600); the app (the default key file) accepts the signed packets and
+#           drops and counts the forged and replayed ones mixed in: still the pinch.
+#   sendkey `drape hands send --key --rate 75` (signed, resampled) to an app listening on 0.0.0.0
+#           with --hands-key FILE.
+#   loop    `drape hands send --loop` of a short trace: more than two laps, sequence numbers
+#           consecutive and timestamps increasing across laps.
 #   missing --hands trace with no such file: exit 2 naming the file; a bad --hands value: exit 2
-#           naming the option; a malformed trace: the session runs (exit 0), its status logged;
-#           --kinect-record with no recording, or without --hands kinect: exit 2 naming it;
-#           --hands kinect with no device: its status, the session runs (exit 0).
+#           naming the option; --hands-key without udp or with a key file others may read, and
+#           bad `drape hands` values: exit 2 naming the option or the file; a malformed trace: the
+#           session runs (exit 0), its status logged; --kinect-record with no recording, or
+#           without --hands kinect: exit 2 naming it; --hands kinect with no device: its status,
+#           the session runs (exit 0).
 # usage: drape_hands_test.sh DRAPE_EXE MODE WORKDIR PORT
 set -u
 exe=$1 mode=$2 work=$3 port=${4:-0}
@@ -41,6 +55,17 @@ scenario() {  # frames fast
 JSON
 }
 xr() { "$exe" xr --eye-size 64 --cloth-res 12 --scenario "$work/scenario.json" --out "$work/out" -v "$@"; }
+# The last "packets dropped" message: the counts of the kinds $1 and $2 (e.g. malformed, forged)
+# both above 0.
+both_counted() {
+  local last a b
+  last=$(grep -o "hands: udp: [0-9]* packets dropped ([^)]*)" "$log" | tail -1)
+  [ -n "$last" ] || fail "no message about the dropped packets"
+  echo "$last"
+  a=$(echo "$last" | grep -o "[0-9]* $1" | cut -d' ' -f1)
+  b=$(echo "$last" | grep -o "[0-9]* $2" | cut -d' ' -f1)
+  [ "${a:-0}" -gt 0 ] && [ "${b:-0}" -gt 0 ] || fail "$1 ${a:-none}, $2 ${b:-none}: expected both > 0"
+}
 check_pinch() {
   local s=$work/out/xr_session.txt
   [ -f "$s" ] || fail "no xr_session.txt"
@@ -72,23 +97,111 @@ JSON
     grep -q "hands: calibration .*calibration.json" "$log" || fail "the calibration not loaded"
     check_pinch
     ;;
-  udp|noisy)
+  udp|noisy|bad|lowconf|signed|sendkey)
+    addr=127.0.0.1
+    key_args=()
+    if [ "$mode" = signed ]; then
+      "$exe" xr --frames 5 --hands "udp:0.0.0.0:$port" >"$log" 2>&1
+      rc=$?
+      [ $rc -eq 2 ] || fail "0.0.0.0 without a key: exit $rc, expected 2"
+      grep -q "drape xr: --hands udp:0.0.0.0:...: listening beyond this machine needs a pairing key; run .drape hands pair." "$log" ||
+        fail "no message saying how to pair"
+      "$exe" hands pair >"$work/key.hex" 2>"$work/pair.txt" || fail "drape hands pair: exit $?"
+      keyfile=$XDG_CONFIG_HOME/drape/hands.key
+      [ "$(stat -c %a "$keyfile")" = 600 ] || fail "the key file is not 0600"
+      grep -Eqx "[0-9a-f]{64}" "$work/key.hex" || fail "pair did not print 64 hex digits"
+      "$exe" hands pair >"$work/key2.hex" 2>/dev/null || fail "second pair: exit $?"
+      cmp -s "$work/key.hex" "$work/key2.hex" || fail "a second pair changed the key"
+    fi
+    if [ "$mode" = sendkey ]; then
+      "$exe" hands pair --key "$work/sender.key" >/dev/null 2>&1 || fail "pair --key"
+      addr=0.0.0.0
+      key_args=(--hands-key "$work/sender.key")
+    fi
     scenario 1000 false
     : >"$log"
-    xr --hands "udp:127.0.0.1:$port" >"$log" 2>&1 &
+    xr --hands "udp:$addr:$port" "${key_args[@]}" >"$log" 2>&1 &
     app=$!
     for _ in $(seq 1 300); do grep -q "hands: udp: no packets yet" "$log" && break; sleep 0.1; done
-    grep -q "hands: udp: no packets yet on 127.0.0.1:$port" "$log" || { kill "$app"; fail "no 'no packets yet' status"; }
-    noise=""
-    [ "$mode" = noisy ] && noise=--noise
-    python3 "$here/hands_trace.py" udp 127.0.0.1 "$port" $P $noise || { kill "$app"; fail "sender"; }
+    grep -q "hands: udp: no packets yet on $addr:$port" "$log" || { kill "$app"; fail "no 'no packets yet' status"; }
+    case $mode in
+      udp|sendkey)
+        python3 "$here/hands_trace.py" trace "$work/hands.csv" $P || { kill "$app"; fail "trace writer"; }
+        send_key=()
+        [ "$mode" = sendkey ] && send_key=(--key "$work/sender.key" --rate 75)  # resampled
+        "$exe" hands send "$work/hands.csv" --to "127.0.0.1:$port" "${send_key[@]}" >"$work/send.txt" 2>&1 ||
+          { kill "$app"; cat "$work/send.txt"; fail "drape hands send: exit code"; }
+        cat "$work/send.txt"
+        ;;
+      signed) python3 "$here/hands_trace.py" udp 127.0.0.1 "$port" $P --key "$(cat "$work/key.hex")" --attack || { kill "$app"; fail "sender"; } ;;
+      *)
+        flag=--$mode
+        [ "$mode" = noisy ] && flag=--noise
+        python3 "$here/hands_trace.py" udp 127.0.0.1 "$port" $P "$flag" || { kill "$app"; fail "sender"; }
+        ;;
+    esac
     wait "$app" || fail "exit code $?"
-    check_pinch
-    if [ "$mode" = noisy ]; then
-      grep -q "hands: udp: .* packets dropped (.* malformed, .* out of order), last: " "$log" ||
-        fail "no message about the dropped packets"
-      grep -m2 "packets dropped" "$log"
+    if [ "$mode" = lowconf ]; then
+      s=$work/out/xr_session.txt
+      [ "$(grep -c "pinch: right hand took particle" "$s")" = 1 ] || fail "not exactly one pinch taken"
+      grep -q "right hand lost: holding the pinch" "$s" || fail "no 'lost: holding the pinch'"
+      [ "$(grep -c "^pinch: right hand lost for .*: let go of particle" "$s")" = 1 ] ||
+        fail "the pinch not let go exactly once after the grace"
+      grep "pinch: right hand\|lost" "$s"
+    else
+      check_pinch
     fi
+    case $mode in
+      noisy|bad)
+        grep -q "hands: udp: [0-9]* packets dropped (.*), last: " "$log" || fail "no reason given for the dropped packets"
+        both_counted malformed "out of order"
+        if [ "$mode" = bad ]; then
+          grep -q "last: oversized packet (30[0-9][0-9] bytes)" "$log" || fail "no oversized packet named"
+          grep -q "last: old timestamp" "$log" || fail "no stale (old timestamp) packet named"
+        fi
+        ;;
+      signed)
+        grep -q "hands: udp source 127.0.0.1:$port (signed packets only)" "$log" || fail "the key not used"
+        grep -q "packets dropped (0 malformed, 0 out of order, " "$log" || fail "signed packets dropped as malformed or out of order"
+        both_counted forged replayed
+        ;;
+      sendkey)
+        grep -q "hands: udp source 0.0.0.0:$port (signed packets only)" "$log" || fail "the key not used"
+        grep -q "packets (.* hand frames, signed) to 127.0.0.1:$port" "$work/send.txt" || fail "the sender did not sign"
+        ! grep -q "packets dropped" "$log" || fail "signed packets dropped: $(grep -m1 'packets dropped' "$log")"
+        ;;
+    esac
+    ;;
+  loop)  # `drape hands send --loop` of a 0.1 s trace: laps with growing numbers and times
+    printf '# drape-trace v1\n' >"$work/tiny.csv"
+    for t in 0.00 0.02 0.04 0.06 0.08 0.10; do echo "$t,1,1,0.9,0.1,1.2,0.3,0,0,0,1,0" >>"$work/tiny.csv"; done
+    python3 - "$port" >"$work/received.txt" 2>&1 <<'PY' &
+import socket, struct, sys
+s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+s.bind(("127.0.0.1", int(sys.argv[1])))
+s.settimeout(3.0)
+got = []
+try:
+    while True:
+        d = s.recv(2048)
+        magic, version, _, seq, t = struct.unpack("<IHHId", d[:20])
+        got.append((seq, t))
+except socket.timeout:
+    pass
+seqs = [q for q, _ in got]
+times = [t for _, t in got]
+ok = len(got) > 12 and all(b == (a + 1) % 2**32 for a, b in zip(seqs, seqs[1:])) \
+    and all(b > a for a, b in zip(times, times[1:])) and times[-1] > 0.2
+print(f"received {len(got)} packets, last timestamp {times[-1] if times else -1:.3f} s")
+sys.exit(0 if ok else 1)
+PY
+    rx=$!
+    sleep 0.5
+    timeout 1.5 "$exe" hands send "$work/tiny.csv" --loop --to "127.0.0.1:$port" >"$log" 2>&1
+    rc=$?
+    [ $rc -eq 124 ] || fail "--loop ended by itself (exit $rc) before the timeout"
+    wait "$rx" || { cat "$work/received.txt"; fail "the laps' packets: too few, or numbers/times not increasing"; }
+    cat "$work/received.txt"
     ;;
   kinect|kinect_end)
     until=""
@@ -211,6 +324,29 @@ PY
     "$exe" xr --frames 5 --hands udp:127.0.0.1:99999 >"$log" 2>&1
     [ $? -eq 2 ] || fail "bad port: not exit 2"
     grep -q "drape xr: --hands: bad port '99999'" "$log" || fail "no message naming the port"
+    # --hands-key: only with --hands udp; a key file others may read is refused naming the file.
+    "$exe" xr --frames 5 --hands-key "$work/none.key" >"$log" 2>&1
+    [ $? -eq 2 ] || fail "--hands-key without --hands udp: not exit 2"
+    grep -q "drape xr: --hands-key: only with --hands udp" "$log" || fail "no message naming --hands-key"
+    "$exe" hands pair --key "$work/open.key" >/dev/null 2>&1 || fail "pair --key"
+    chmod 644 "$work/open.key"
+    "$exe" xr --frames 5 --hands udp:0.0.0.0:$port --hands-key "$work/open.key" >"$log" 2>&1
+    [ $? -eq 2 ] || fail "a readable key file: not exit 2"
+    grep -q "drape xr: --hands-key: .*open.key: permissions 644 .*chmod 600" "$log" || fail "no message naming the key file"
+    # drape hands send: its options, and bad values naming the option or the file.
+    "$exe" hands send --help >"$log" 2>&1 || fail "hands send --help: exit $?"
+    for o in --to --rate --loop --key; do grep -q -- "$o" "$log" || fail "hands send --help lacks $o"; done
+    "$exe" hands send "$work/none.csv" >"$log" 2>&1
+    [ $? -eq 2 ] && grep -q "drape hands send: .*none.csv: cannot open" "$log" || fail "hands send: missing trace"
+    printf '# drape-trace v1\n0.0,1,1,0.9,0.1,1.3,0.5,0,0,0,1,0\n' >"$work/one.csv"
+    "$exe" hands send "$work/one.csv" --to nowhere:1 >"$log" 2>&1
+    [ $? -eq 2 ] && grep -q "drape hands send: --to: not an IPv4 address: 'nowhere'" "$log" || fail "hands send: bad --to"
+    "$exe" hands send "$work/one.csv" --rate 0.5x >"$log" 2>&1
+    [ $? -eq 2 ] && grep -q -- "--rate" "$log" || fail "hands send: bad --rate"
+    "$exe" hands send "$work/one.csv" --key "$work/open.key" >"$log" 2>&1
+    [ $? -eq 2 ] && grep -q "drape hands send: --key: .*open.key: permissions 644" "$log" || fail "hands send: readable key"
+    "$exe" hands nosuch >"$log" 2>&1
+    [ $? -eq 2 ] && grep -q "drape hands: unknown tool 'nosuch'" "$log" || fail "hands: unknown tool"
     printf '# drape-trace v1\n0.0,1,1,0.9,0.1,1.3,0.5,0,0,0,1,0\n0.1,7,1,0.9,0.1,1.3,0.5,0,0,0,1,0\n' >"$work/bad.csv"
     scenario 30 true
     xr --hands trace "$work/bad.csv" >"$log" 2>&1 || fail "malformed trace: exit code $?"

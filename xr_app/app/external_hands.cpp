@@ -5,12 +5,16 @@
 // the frame loop. The source's troubles (no packets yet, dropped packets, an unreadable trace, a
 // Kinect that is missing or goes away) are log lines and the feedback panel's "hands" status, never
 // a failed session: a hand that stops coming is untracked after kExternalStale, and the sim holds
-// its operation for its tracking grace, then ends it.
+// its operation for its tracking grace, then ends it. With a pairing key the UDP source accepts
+// signed packets only; forged and replayed ones are counted in that status.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "tracking/kinect.hpp"
+#include "tracking/udp_auth.hpp"
 #include "xr_app/app/draping_session.hpp"
 
 namespace drape::app {
@@ -39,11 +43,17 @@ void DrapingSession::open_external_hands() {
                                                             opt_.kinect_record);
     where = opt_.kinect_record.empty() ? "device 0" : "recording " + opt_.kinect_record;
   } else {
+    std::optional<tracking::UdpKey> key;
+    if (opt_.hands_key.size() == tracking::UdpKey().size()) {
+      key.emplace();
+      std::copy(opt_.hands_key.begin(), opt_.hands_key.end(), key->begin());
+    }
     auto udp = std::make_unique<tracking::UdpSkeletonSource>(static_cast<uint16_t>(opt_.hands_port),
-                                                             opt_.hands_address);
+                                                             opt_.hands_address, key);
     ext_->udp = udp.get();
     ext_->source = std::move(udp);
-    where = opt_.hands_address + ":" + std::to_string(opt_.hands_port);
+    where = opt_.hands_address + ":" + std::to_string(opt_.hands_port) +
+            (opt_.hands_key.empty() ? "" : " (signed packets only)");
   }
   rep_.note("hands: " + opt_.hands + " source " + where);
   if (!opt_.calibration_path.empty()) {
@@ -69,11 +79,14 @@ void DrapingSession::note_external_status() {
   std::string shown = st.state == tracking::SourceState::Ok ? "" : st.message;
   if (ext_->udp && st.state != tracking::SourceState::Unavailable) {
     const tracking::UdpStats& s = ext_->udp->stats();
-    const uint64_t dropped = s.malformed + s.stale;
-    if (dropped > 0)
-      shown = "udp: " + std::to_string(dropped) + " packets dropped (" +
+    if (s.dropped() > 0)
+      shown = "udp: " + std::to_string(s.dropped()) + " packets dropped (" +
               std::to_string(s.malformed) + " malformed, " + std::to_string(s.stale) +
-              " out of order), last: " + s.last_error;
+              " out of order" +
+              (ext_->udp->authenticated() ? ", " + std::to_string(s.forged) + " forged, " +
+                                                std::to_string(s.replayed) + " replayed"
+                                          : "") +
+              "), last: " + s.last_error;
     else if (st.state == tracking::SourceState::NoData)
       shown =
           "udp: no packets yet on " + opt_.hands_address + ":" + std::to_string(ext_->udp->port());

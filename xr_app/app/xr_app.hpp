@@ -78,6 +78,9 @@ struct XrAppOptions {
   // source's file in the user's config directory, chosen by the executable).
   bool calibrate = false;
   std::string calibration_save;
+  // The UDP stream's pairing key (32 bytes; empty: unsigned packets, loopback only): with it only
+  // signed packets are accepted (tracking/udp_auth.hpp).
+  std::vector<uint8_t> hands_key;
   // The API layers the loader enables (its XR_ENABLE_API_LAYERS): their instance extensions are
   // offered too (the core validation layer's XR_EXT_debug_utils).
   std::vector<std::string> api_layers;
