@@ -345,6 +345,25 @@ std::vector<int> PatternPiece::seam_points(const std::string& label) const {
   return pts;
 }
 
+double polyline_fairness(const std::vector<Vec2>& pts) {
+  constexpr double kDegPerRad = 180.0 / kPi;
+  double worst = 0;
+  for (size_t i = 1; i + 1 < pts.size(); ++i) {
+    const Vec2 a = pts[i] - pts[i - 1], b = pts[i + 1] - pts[i];
+    const double la = a.norm(), lb = b.norm();
+    if (la < 1e-9 || lb < 1e-9) continue;  // a repeated point turns nothing
+    const double turn = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+    worst = std::max(worst, std::abs(turn) * kDegPerRad / (0.5 * (la + lb) * 1000.0));
+  }
+  return worst;
+}
+
+double seam_fairness(const PatternPiece& piece, const std::string& label) {
+  std::vector<Vec2> pts;
+  for (int i : piece.seam_points(label)) pts.push_back(piece.outline[i]);
+  return polyline_fairness(pts);
+}
+
 bool inside_polygon(const std::vector<Vec2>& poly, const Vec2& p) {
   bool in = false;
   const size_t n = poly.size();
