@@ -16,6 +16,7 @@
 #include "sim/solvers/solver_factory.hpp"
 #include "sim/testbeds/testbed.hpp"
 #include "xr_app/app/desk_scene.hpp"
+#include "xr_app/app/session_pattern_export.hpp"
 
 namespace drape::app {
 
@@ -428,6 +429,11 @@ void DrapingSession::write_outputs(sim::World& w) {
     r.written.push_back(cp);
   else
     rep_.note("glTF: " + e);
+  if (opt_.export_pattern) {
+    const SessionPatternExport pe = export_session_pattern(w, ops_->state(), opt_.out_dir, 1);
+    r.log.push_back(pe.summary);
+    for (const auto& f : pe.files) r.written.push_back(f);
+  }
   const std::string tp = opt_.out_dir + "/xr_session.txt";
   std::ofstream o(tp);
   for (const auto& l : r.log) o << l << "\n";
