@@ -118,6 +118,12 @@ TEST(PatternPipeline, WritesReportAndFiles) {
         "garment_hip_girth_error_pct", "outline_error_before_relax_mm", "pipeline_ms"})
     EXPECT_TRUE(j.contains(k) && j[k].is_number()) << k;
   EXPECT_DOUBLE_EQ(j["hip_width_error_mm"].get<double>(), r->report.hip_width_error_mm);
+  // The fairness of every seam line, per piece, as the report computed it.
+  ASSERT_EQ(j["pieces"].size(), r->report.pieces.size());
+  for (size_t i = 0; i < r->report.pieces.size(); ++i)
+    for (const auto& [label, fair] : r->report.pieces[i].fairness_deg_per_mm)
+      EXPECT_DOUBLE_EQ(j["pieces"][i]["fairness_deg_per_mm"][label].get<double>(), fair) << label;
+  EXPECT_TRUE(j["pieces"][0]["fairness_deg_per_mm"].contains("side"));
   for (const char* file : {"pattern.svg", "pattern.dxf", "pattern_a4.pdf", "pattern_letter.pdf",
                            "draped_panels.gltf", "garment.gltf"})
     EXPECT_TRUE(std::ifstream(opt.out_dir + "/" + file).good()) << file;
