@@ -141,8 +141,9 @@ std::pair<int, int> rows_of_line(const Panel& panel, const PieceMapping& pm, dou
 // on their meridian planes but free to slide up or down: pinned at their mapped heights the
 // warp threads between waist and hip stay stretched by the form's slope, eq. 2-1 maps by height
 // not by surface distance; left free the cloth bridges the waist hollow and the waist widths grow
-// by ~18 mm), the centre column, the node nearest the side line in every row. Returns per-vertex
-// role: 1 pinned, 2 centre, 3 side, 4 waist.
+// by ~18 mm), the centre column, the node nearest the side line in every row (pinned by the
+// static solver; the Gauss-Seidel relaxation holds the side line between nodes instead,
+// side_line_ties). Returns per-vertex role: 1 pinned, 2 centre, 3 side, 4 waist.
 std::vector<uint8_t> fixed_line_roles(const Panel& panel, const MappingSurface& surf,
                                       const PieceMapping& pm) {
   const auto& topo = panel.cloth.topo;
