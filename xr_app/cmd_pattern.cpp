@@ -115,6 +115,9 @@ int run_pattern(int argc, char** argv) {
     std::printf("  vs (hip-waist)/4 = %.1f mm; grain tilt near darts %.2f deg, kink %.2f deg\n",
                 rep.quarter_difference_mm, p.grain_after.max_tilt_near_darts_deg,
                 p.grain_after.max_kink_near_darts_deg);
+    std::printf("  %-6s fairness (largest turn per mm):", p.name.c_str());
+    for (const auto& [label, f] : p.fairness_deg_per_mm) std::printf(" %s %.2f", label.c_str(), f);
+    std::printf(" deg/mm\n");
   }
   std::printf(
       "  time: mapping+extraction %.1f ms, relax %.1f ms, remesh %.1f ms, sew %.1f ms, "

@@ -19,7 +19,6 @@
 #include <thread>
 #include <vector>
 
-#include "sim/draping/pattern_pipeline.hpp"
 #include "sim/form/dress_form.hpp"
 #include "sim/io/mesh_io.hpp"
 #include "sim/runtime/sim_thread.hpp"
@@ -235,8 +234,6 @@ struct XrRunOptions {
   bool lock_step = false;    // --sim-lock-step: live with one sim tick per frame
 };
 
-int export_pattern(const std::string& out);
-
 // A live session's cloth resolution, eye size in the simulated runtime's window (swapchain edge:
 // shown 1.4x in a 720 px high window; lavapipe renders 2 x 720^2 at about half the frame rate of
 // 2 x 512^2, ./drape bench desk --eye-size) and screenshot interval unless the options say
@@ -318,6 +315,7 @@ int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
            1);
   }
   o.app.out_dir = o.out;
+  o.app.export_pattern = o.pattern;
   o.app.scenario_path.clear();
   o.app.voice = false;  // no scenario: no audio cues
   o.app.sim_lock_step = o.lock_step;
@@ -344,7 +342,7 @@ int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
   auto r = app::run_xr_app(o.app);
   for (const auto& l : r.log)
     if (l.rfind("pinch:", 0) == 0 || l.rfind("depth:", 0) == 0 || l.rfind("cut", 0) == 0 ||
-        l.rfind("voice", 0) == 0)
+        l.rfind("voice", 0) == 0 || l.rfind("pattern", 0) == 0)
       std::printf("  %s\n", l.c_str());
   for (const auto& t : r.triggers) std::printf("  trigger %s\n", t.c_str());
   const double secs =
@@ -367,8 +365,6 @@ int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
   if (r.exit_code != 0) return r.exit_code;
   for (const auto& w : r.written) std::printf("wrote %s\n", std::filesystem::absolute(w).c_str());
   if (!o.json.empty() && !write_live_json(o.json, r, o.app)) return 1;
-  if (o.pattern)
-    if (int rc = export_pattern(o.out); rc != 0) return rc;
   std::printf("drape run: done in %.1f s\n", secs);
   return 0;
 }
@@ -408,39 +404,6 @@ std::string prepare_scenario(const XrRunOptions& o) {
   const std::string sc_path = std::filesystem::absolute(o.out + "/scenario.json").string();
   std::ofstream(sc_path) << sc.dump(2) << "\n";
   return sc_path;
-}
-
-// The pattern export of the bundled design on the same form (sim/draping/pattern_pipeline.hpp).
-int export_pattern(const std::string& out) {
-  auto d = load_design(drape::app::user_or_asset("assets/designs/tight-skirt.json").string());
-  auto m = measurements_for_size("9AR");
-  if (!d || !m) {
-    std::fprintf(stderr, "drape run: pattern: %s\n", !d ? d.error().c_str() : m.error().c_str());
-    return 1;
-  }
-  auto form = DressForm::from_measurements(*m);
-  auto fab = load_fabric(fabrics_path(), d->fabric);
-  if (!form || !fab) {
-    std::fprintf(stderr, "drape run: pattern: %s\n",
-                 !form ? form.error().c_str() : fab.error().c_str());
-    return 1;
-  }
-  PipelineOptions po;
-  po.out_dir = out + "/pattern";
-  auto pr = run_pattern_pipeline(*d, *form, *fab, po);
-  if (!pr) {
-    // The pattern pipeline is another module: its failure is reported, the session's outputs
-    // stand.
-    std::printf("drape run: pattern export failed (skipped): %s\n", pr.error().c_str());
-    return 0;
-  }
-  for (const auto& f : pr->report.files) {
-    const std::filesystem::path fp = std::filesystem::exists(f)
-                                         ? std::filesystem::path(f)
-                                         : std::filesystem::path(po.out_dir) / f;
-    std::printf("wrote %s\n", std::filesystem::absolute(fp).c_str());
-  }
-  return 0;
 }
 
 // Resolves --form (a standard size, else a measurements file), --mesh and the fabrics file, then
@@ -502,6 +465,7 @@ int run_xr(XrRunOptions& o) {
   setenv("DRAPE_MOCK_WRITE_FRAMES", frames_dir.c_str(), 1);
   setenv("DRAPE_MOCK_WRITE_EVERY", std::to_string(o.every).c_str(), 1);
   o.app.out_dir = o.out;
+  o.app.export_pattern = o.pattern;
   o.app.scenario_path = sc_path;
   o.app.commands_path = app::commands_file("");
   o.app.api_layers = app::loader_api_layers();
@@ -510,7 +474,8 @@ int run_xr(XrRunOptions& o) {
               o.app.voice_input.empty() ? "off" : o.app.voice_input.c_str());
   auto r = app::run_xr_app(o.app);
   for (const auto& l : r.log)
-    if (l.rfind("voice", 0) == 0 || l.rfind("cut", 0) == 0) std::printf("  %s\n", l.c_str());
+    if (l.rfind("voice", 0) == 0 || l.rfind("cut", 0) == 0 || l.rfind("pattern", 0) == 0)
+      std::printf("  %s\n", l.c_str());
   for (const auto& t : r.triggers) std::printf("  trigger %s\n", t.c_str());
   std::printf(
       "drape run: %s, runtime '%s', %lld frames (%lld rendered), pinched in %lld frames, "
@@ -524,8 +489,6 @@ int run_xr(XrRunOptions& o) {
   for (const auto& e : std::filesystem::directory_iterator(frames_dir, ec))
     std::printf("wrote %s\n", e.path().c_str());
   for (const auto& w : r.written) std::printf("wrote %s\n", std::filesystem::absolute(w).c_str());
-  if (o.pattern)
-    if (int rc = export_pattern(o.out); rc != 0) return rc;
   std::printf("drape run: done in %.1f s\n",
               std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count());
   return 0;
@@ -540,8 +503,10 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
   cli.add_option("--scenario", o.scenario,
                  "the draping scenario the simulated runtime plays (given: the scripted run even "
                  "with a display)");
-  drape::app::add_off_switches(cli, {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
-                                     {"--no-pattern", &o.pattern, "skip the pattern export"}});
+  drape::app::add_off_switches(
+      cli,
+      {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
+       {"--no-pattern", &o.pattern, "skip the pattern of the draped cloth (pattern/session-1/)"}});
   cli.add_option("--json", o.json,
                  "live: write the session's frame rate, sim step and pose-to-photon probes "
                  "(frames) as JSON to this file");
@@ -654,8 +619,8 @@ int run(int argc, char** argv) {
       "Runs the OpenXR app on a draping scenario (--scenario; without it on the simulated "
       "runtime when no headset runtime is configured and there is no display): pinch, pin (a "
       "spoken 'pin here' made with espeak-ng), a cut stroke; "
-      "then the pattern export. Writes DIR/frames/*.png, DIR/session_log.json, "
-      "DIR/xr_session.txt, DIR/drape_cloth.gltf, DIR/pattern/.\n"
+      "then the pattern of the cloth as draped. Writes DIR/frames/*.png, DIR/session_log.json, "
+      "DIR/xr_session.txt, DIR/drape_cloth.gltf, DIR/pattern/session-1/.\n"
       "At a desk (DISPLAY or WAYLAND_DISPLAY set, no headset runtime configured, no --scenario): "
       "the simulated runtime's window instead; drape live with mouse and keyboard until Escape "
       "(docs/mock-window.md); on a headset with no --scenario, live the same way. Live: a 128^2 "

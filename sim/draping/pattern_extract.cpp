@@ -345,6 +345,40 @@ std::vector<int> PatternPiece::seam_points(const std::string& label) const {
   return pts;
 }
 
+double polyline_fairness(const std::vector<Vec2>& pts) {
+  constexpr double kDegPerRad = 180.0 / kPi;
+  double worst = 0;
+  for (size_t i = 1; i + 1 < pts.size(); ++i) {
+    const Vec2 a = pts[i] - pts[i - 1], b = pts[i + 1] - pts[i];
+    const double la = a.norm(), lb = b.norm();
+    if (la < 1e-9 || lb < 1e-9) continue;  // a repeated point turns nothing
+    const double turn = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+    worst = std::max(worst, std::abs(turn) * kDegPerRad / (0.5 * (la + lb) * 1000.0));
+  }
+  return worst;
+}
+
+double seam_fairness(const PatternPiece& piece, const std::string& label) {
+  const int li = piece.label_index(label), n = static_cast<int>(piece.outline.size());
+  double worst = 0;
+  for (int i = 0; li >= 0 && i < n; ++i) {
+    if (piece.seg_label[i] != li || piece.seg_label[(i + n - 1) % n] == li) continue;
+    std::vector<Vec2> run{piece.outline[i]};  // one run of the label, from its first point
+    for (int k = i; piece.seg_label[k % n] == li && static_cast<int>(run.size()) <= n; ++k)
+      run.push_back(piece.outline[(k + 1) % n]);
+    worst = std::max(worst, polyline_fairness(run));
+  }
+  if (li >= 0 && n >= 3 &&
+      std::all_of(piece.seg_label.begin(), piece.seg_label.end(), [&](int l) { return l == li; })) {
+    std::vector<Vec2> loop = piece.outline;  // the whole closed outline: every point counts
+    loop.push_back(piece.outline[0]);
+    loop.push_back(piece.outline[1]);
+    loop.insert(loop.begin(), piece.outline[n - 1]);
+    worst = polyline_fairness(loop);
+  }
+  return worst;
+}
+
 bool inside_polygon(const std::vector<Vec2>& poly, const Vec2& p) {
   bool in = false;
   const size_t n = poly.size();

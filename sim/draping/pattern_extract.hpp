@@ -72,6 +72,18 @@ double draped_area(const PatternPiece& piece, const Panel& panel);
 // inserted; notches follow). extract_piece calls it; returns the number of loops removed.
 int remove_outline_loops(PatternPiece& piece);
 
+// Fairness of one seam line of the outline: the largest turning angle per millimetre along it
+// (deg/mm). At each interior point of the seam the angle between the incoming and the outgoing
+// segment is divided by the mean length of the two; the seam's end points (its corners with
+// the neighbouring seams) are not counted. A label in several runs (the waist between darts,
+// two cut edges) gives the worst run. A fair curve of radius R gives about 57.3 / R(mm);
+// a bump a pattern maker would redraw shows as a spike well above that. 0 for a seam of fewer
+// than three points or a label the piece lacks.
+double seam_fairness(const PatternPiece& piece, const std::string& label);
+
+// The same over a polyline (metres): interior points only.
+double polyline_fairness(const std::vector<Vec2>& pts);
+
 // Point-in-polygon by crossing parity.
 bool inside_polygon(const std::vector<Vec2>& poly, const Vec2& p);
 

@@ -243,6 +243,8 @@ std::string PipelineReport::to_json() const {
                    {"max_strain", p.relax.max_strain},
                    {"rms_strain", p.relax.rms_strain},
                    {"ms", p.relax.ms}};
+    pj["fairness_deg_per_mm"] = json::object();
+    for (const auto& [label, f] : p.fairness_deg_per_mm) pj["fairness_deg_per_mm"][label] = f;
     pj["remesh"] = {{"vertices", p.remesh_vertices},
                     {"triangles", p.remesh_triangles},
                     {"min_angle_deg", p.remesh_min_angle_deg},
@@ -328,6 +330,8 @@ Result<PipelineResult> run_pattern_pipeline(const Design& design_in, const Dress
       pr.dart_intake_wanted_mm.push_back(panel->slits[k].intake * 1000);
       pr.waist_width_mm += piece->darts[k].intake * 1000;
     }
+    for (const std::string& label : piece->labels)
+      pr.fairness_deg_per_mm.emplace_back(label, seam_fairness(*piece, label));
     const double a3 = draped_area(*piece, *panel), a2 = std::abs(piece->area());
     pr.area_piece_cm2 = a2 * 1e4;
     pr.area_draped_cm2 = a3 * 1e4;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/draping/mapping.hpp"
@@ -68,6 +69,8 @@ struct PieceReport {
   RelaxStats relax;
   int remesh_vertices = 0, remesh_triangles = 0;
   double remesh_min_angle_deg = 0, remesh_max_edge_mm = 0;
+  // Per seam line of the exported outline: the largest turning angle per mm (seam_fairness).
+  std::vector<std::pair<std::string, double>> fairness_deg_per_mm;
 };
 
 struct PipelineReport {

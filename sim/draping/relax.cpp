@@ -87,6 +87,14 @@ RelaxStats relax_gauss_seidel(RelaxProblem& p, const MappingSurface& surf,
       x[g[1]] += 0.5 * ((0.5 * (x[g[0]] + x[g[2]]) - x[g[1]]).dot(t)) * t;
     }
     for (const PlaneTie& pl : p.planes) x[pl.v] -= pl.n.dot(x[pl.v] - pl.p) * pl.n;
+    for (const EdgePlaneTie& pl : p.edge_planes) {
+      const double wa = w[pl.a] * (1 - pl.t), wb = w[pl.b] * pl.t;
+      const double ws = wa * (1 - pl.t) + wb * pl.t;
+      if (ws < 1e-12) continue;
+      const double c = pl.n.dot((1 - pl.t) * x[pl.a] + pl.t * x[pl.b] - pl.p);
+      x[pl.a] -= wa / ws * c * pl.n;
+      x[pl.b] -= wb / ws * c * pl.n;
+    }
     for (int i : p.on_surface) {
       const Vec2 c = surf.centre(x[i].y());
       const double dx = x[i].x() - c.x(), dz = x[i].z() - c.y();
@@ -133,8 +141,9 @@ std::pair<int, int> rows_of_line(const Panel& panel, const PieceMapping& pm, dou
 // on their meridian planes but free to slide up or down: pinned at their mapped heights the
 // warp threads between waist and hip stay stretched by the form's slope, eq. 2-1 maps by height
 // not by surface distance; left free the cloth bridges the waist hollow and the waist widths grow
-// by ~18 mm), the centre column, the node nearest the side line in every row. Returns per-vertex
-// role: 1 pinned, 2 centre, 3 side, 4 waist.
+// by ~18 mm), the centre column, the node nearest the side line in every row (pinned by the
+// static solver; the Gauss-Seidel relaxation holds the side line between nodes instead,
+// side_line_ties). Returns per-vertex role: 1 pinned, 2 centre, 3 side, 4 waist.
 std::vector<uint8_t> fixed_line_roles(const Panel& panel, const MappingSurface& surf,
                                       const PieceMapping& pm) {
   const auto& topo = panel.cloth.topo;
@@ -163,6 +172,37 @@ std::vector<uint8_t> fixed_line_roles(const Panel& panel, const MappingSurface& 
     if (!role[v]) role[v] = 3;
   }
   return role;
+}
+
+// The side line held where the mapping puts it: in every row between the hip and the top, the
+// point of the row at the side line's weft distance (between two grid nodes, interpolated) on
+// the vertical plane through the section centre at the side line's angle. Holding the nearest
+// node instead (up to half a spacing off the line, on its own meridian) jumps by a column
+// wherever the line crosses one, and the cloth between those rows shows it as a bump on the
+// side seam.
+std::vector<EdgePlaneTie> side_line_ties(const Panel& panel, const MappingSurface& surf,
+                                         const PieceMapping& pm) {
+  std::vector<EdgePlaneTie> ties;
+  const int last_zone = panel.num_zones() - 1;
+  const auto node = [&](int i, int j) {
+    // On a slit column above its tip the far-side twin belongs to the last zone.
+    for (const PanelSlit& s : panel.slits)
+      if (s.column == i && j > s.tip_row) return s.far_nodes[j - s.tip_row - 1];
+    return j * panel.nx + i;
+  };
+  for (int j = 0; j < panel.ny; ++j) {
+    const double y = pm.y_of_v(j * panel.dy);
+    const ArcTable T = ArcTable::build(surf, y, pm.theta_centre, pm.dir);
+    const double f = pm.l_at(last_zone, y, pm.theta_side, T) / panel.dx;
+    const int l0 = static_cast<int>(std::floor(f));
+    if (l0 < 0 || l0 + 1 >= panel.nx) continue;
+    const bool left = panel.design.centre_edge_left;
+    const int i0 = left ? l0 : panel.nx - 1 - l0, i1 = left ? l0 + 1 : panel.nx - 2 - l0;
+    const Vec2 c = surf.centre(y);
+    ties.push_back({node(i0, j), node(i1, j), f - l0, Vec3(c.x(), 0, c.y()),
+                    Vec3(std::cos(pm.theta_side), 0, -std::sin(pm.theta_side))});
+  }
+  return ties;
 }
 
 }  // namespace
@@ -211,13 +251,14 @@ RelaxStats relax_panel(Panel& panel, const MappingSurface& surf, const PieceMapp
   for (int i = 0; i < nv; ++i) {
     if (role[i] == 1) p.fixed[i] = 1;
     if (role[i] == 4) p.on_surface.push_back(i);
-    if (role[i] >= 2) {
+    if (role[i] == 2 || role[i] == 4) {
       const Vec3& xi = p.x[i];
       const Vec2 c = surf.centre(xi.y());
       const double th = std::atan2(xi.x() - c.x(), xi.z() - c.y());
       p.planes.push_back({i, Vec3(c.x(), 0, c.y()), Vec3(std::cos(th), 0, -std::sin(th))});
     }
   }
+  p.edge_planes = side_line_ties(panel, surf, pm);
   if (opt.grain_control) {
     const int nx = panel.nx;
     for (const PanelSlit& s : panel.slits)

@@ -25,12 +25,21 @@ struct PlaneTie {
   Vec3 p, n;
 };
 
+// Keeps the point (1 - t) x_a + t x_b of an edge on the plane n . (x - p) = 0: a reference
+// line that runs between grid columns, held where it is rather than at the nearest node.
+struct EdgePlaneTie {
+  int a = 0, b = 0;
+  double t = 0;
+  Vec3 p, n;
+};
+
 struct RelaxProblem {
   std::vector<Vec3> x;
   std::vector<std::array<int, 2>> edges;
   std::vector<double> rest;
   std::vector<uint8_t> fixed;
   std::vector<PlaneTie> planes;
+  std::vector<EdgePlaneTie> edge_planes;
   std::vector<SeamTie> seams;
   std::vector<std::array<int, 3>> grain;  // consecutive warp nodes kept straight tangentially
   std::vector<int> on_surface;  // vertices held on the mapping surface (pulled in and pushed out)

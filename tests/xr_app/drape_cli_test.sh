@@ -55,11 +55,20 @@ case $mode in
     n=$(ls "$work/out/frames"/frame_*.png 2>/dev/null | wc -l)
     echo "$n screenshots"
     [ "$n" -ge 5 ] || fail "only $n screenshots"
-    # The pattern export writes every file it names.
-    grep -q "pattern export failed" "$log" && fail "the pattern export failed"
+    # The pattern of the cloth as draped (pinned and cut): every file it names, the cut's two
+    # pieces.
+    grep -q "pattern: 2 piece(s), 1 cut edge(s)" "$log" || fail "the session pattern: $(grep pattern: "$log")"
     for f in pattern.svg pattern.dxf pattern_a4.pdf report.json; do
-      grep -q "wrote .*/pattern/$f" "$log" && [ -s "$work/out/pattern/$f" ] || fail "no pattern/$f"
+      grep -q "wrote .*/pattern/session-1/$f" "$log" && [ -s "$work/out/pattern/session-1/$f" ] ||
+        fail "no pattern/session-1/$f"
     done
+    # Read back: the PDF by poppler, the SVG by librsvg, the DXF's two piece blocks.
+    pat="$work/out/pattern/session-1"
+    pages=$(pdfinfo "$pat/pattern_a4.pdf" | awk '/^Pages:/ {print $2}')
+    [ "${pages:-0}" -ge 2 ] || fail "pattern_a4.pdf does not read (pages: ${pages:-none})"
+    rsvg-convert "$pat/pattern.svg" -o "$work/pattern.png" && [ -s "$work/pattern.png" ] ||
+      fail "pattern.svg does not render"
+    [ "$(grep -c "^Piece Name: Piece" "$pat/pattern.dxf")" -eq 2 ] || fail "pattern.dxf: not 2 pieces"
     summary=$(grep "^drape run: exiting" "$log") || fail "no summary"
     echo "$summary"
     grep -q "voice commands 1" <<<"$summary" || fail "voice pin not heard"

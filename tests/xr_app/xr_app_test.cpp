@@ -233,6 +233,12 @@ TEST(XrApp, DefaultScenarioPinchesPinsAndCutsTheCloth) {
   EXPECT_EQ(r.components_after, 2);
   for (const char* f : {"session_log.json", "drape_cloth.gltf", "xr_session.txt"})
     EXPECT_TRUE(fs::exists(dir / f)) << f;
+  // The pattern of the cloth as draped: the cut's two pieces.
+  for (const char* f : {"pattern.svg", "pattern.dxf", "pattern_a4.pdf", "report.json"})
+    EXPECT_TRUE(fs::exists(dir / "pattern/session-1" / f)) << f;
+  EXPECT_TRUE(std::any_of(r.log.begin(), r.log.end(), [](const std::string& l) {
+    return l.rfind("pattern: 2 piece(s), 1 cut edge(s)", 0) == 0;
+  }));
   // The session log holds the operations as the sim received them.
   std::ifstream lf(dir / "session_log.json");
   const std::string log((std::istreambuf_iterator<char>(lf)), std::istreambuf_iterator<char>());

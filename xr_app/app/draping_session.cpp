@@ -19,6 +19,7 @@
 #include "sim/testbeds/testbed.hpp"
 #include "xr_app/app/desk_scene.hpp"
 #include "xr_app/output_files.hpp"
+#include "xr_app/app/session_pattern_export.hpp"
 
 namespace drape::app {
 
@@ -471,6 +472,11 @@ void DrapingSession::write_outputs(sim::World& w) {
     r.written.push_back(cp);
   else
     not_saved(rep_, "glTF", e);
+  if (opt_.export_pattern) {
+    const SessionPatternExport pe = export_session_pattern(w, ops_->state(), opt_.out_dir, 1);
+    r.log.push_back(pe.summary);
+    for (const auto& f : pe.files) r.written.push_back(f);
+  }
   const std::string tp = opt_.out_dir + "/xr_session.txt";
   std::string e = write_whole(opt_.out_dir, [&](const std::string& d) -> std::string {
     const std::string p = d + "/xr_session.txt";

@@ -54,6 +54,8 @@ struct XrAppOptions {
   bool voice = true;          // decode the scenario's audio cues (scenario_path)
   bool sim_lock_step = true;  // one sim tick per rendered frame; false: sim on its own 90 Hz clock
   std::string out_dir;        // when set: session_log.json and drape_cloth.gltf written there
+  // At the session's end, the pattern of the cloth as draped into out_dir/pattern/session-1/.
+  bool export_pattern = true;
   // The scenario file the simulated runtime plays ("" = none): its audio cues are the voice
   // input (docs/xr.md).
   std::string scenario_path;

@@ -146,3 +146,31 @@ TEST(PatternExtract, SelfCrossingLoopIsCut) {
   EXPECT_EQ(pc.notches[1], 5);
   EXPECT_EQ(remove_outline_loops(pc), 0);  // simple now
 }
+
+TEST(PatternExtract, FairnessOfAnArcAndOfABump) {
+  // A circular arc of radius 200 mm sampled every ~5 mm turns 57.3 / 200 deg per mm everywhere.
+  constexpr double kPi = 3.141592653589793, R = 0.2;
+  std::vector<Vec2> arc;
+  for (int k = 0; k <= 40; ++k) {
+    const double a = k * 0.025;
+    arc.emplace_back(R * std::cos(a), R * std::sin(a));
+  }
+  const double fair = polyline_fairness(arc);
+  std::printf("arc R = 200 mm: %.4f deg/mm (expected %.4f)\n", fair, 180 / kPi / 200);
+  EXPECT_NEAR(fair, 180 / kPi / 200, 1e-3);
+  // The same seam with one point pushed out by 1 mm (a bump a pattern maker would redraw).
+  std::vector<Vec2> bump = arc;
+  bump[20] *= (R + 0.001) / R;
+  const double fb = polyline_fairness(bump);
+  std::printf("with a 1 mm bump: %.4f deg/mm\n", fb);
+  EXPECT_GT(fb, 2.0);
+  // As a seam of a piece: only that label's points, corners with the other seams excluded.
+  PatternPiece pc;
+  pc.outline = {{0, 0}, {0.1, 0}, {0.1, 0.05}, {0.1, 0.1}, {0, 0.1}};
+  pc.labels = {"hem", "side", "rest"};
+  pc.seg_label = {0, 1, 1, 2, 2};
+  EXPECT_EQ(seam_fairness(pc, "side"), 0.0);  // straight; the right-angle corners not counted
+  pc.outline[2].x() = 0.101;
+  EXPECT_GT(seam_fairness(pc, "side"), 0.0);
+  EXPECT_EQ(seam_fairness(pc, "missing"), 0.0);
+}
