@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -20,6 +21,9 @@ struct SewInput {
   const PatternPiece* piece = nullptr;
   const RemeshedPiece* mesh = nullptr;
   const Panel* panel = nullptr;
+  // When set, the 3D start position of each remeshed vertex from its material point instead of
+  // the panel (pieces changed flat after draping, such as a spread block: sim/draping/blocks.hpp).
+  std::function<Vec3(const Vec2&)> place;
 };
 
 struct Garment {
