@@ -204,3 +204,19 @@ TEST(Blocks, FlaredSkirtMeetsItsFitChecks) {
   EXPECT_DOUBLE_EQ(j["hem_sweep_mm"].get<double>(), rep.hem_sweep_mm);
   check_files(dir, 2, 0);
 }
+
+TEST(Blocks, UnknownFlareIsNamed) {
+  std::ifstream f(std::string(DRAPE_SOURCE_DIR) + "/assets/designs/flared-skirt.json");
+  auto j = nlohmann::json::parse(f);
+  ASSERT_EQ(j["flare"], "close_darts");
+  j["flare"] = "bell";
+  auto d = parse_design(j.dump(), "bad.json");
+  ASSERT_FALSE(d.ok());
+  std::printf("%s\n", d.error().c_str());
+  EXPECT_NE(d.error().find("bad.json.flare: unknown 'bell' (known: none, close_darts)"),
+            std::string::npos);
+  j["flare"] = 3;
+  d = parse_design(j.dump(), "bad.json");
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.error().find("bad.json.flare: must be a string"), std::string::npos) << d.error();
+}
