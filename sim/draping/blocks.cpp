@@ -208,38 +208,33 @@ Result<SpreadPiece> slash_and_spread(const PatternPiece& block, double arc_step)
   return sp;
 }
 
-Vec2 unspread_point(const SpreadPiece& sp, const Vec2& m_in, double* lift) {
+Vec2 unspread_arc(const SpreadPiece& sp, const Vec2& m_in, double* extra_arc) {
   Vec2 m = m_in;
-  double up = 0;
+  double extra = 0;
   for (auto it = sp.steps.rbegin(); it != sp.steps.rend(); ++it) {
     const SpreadStep& st = *it;
     const double s = st.angle < 0 ? -1.0 : 1.0, a = std::abs(st.angle);
     const Vec2 v = m - st.tip;
     double phi = s * std::atan2(cross2(st.dir, v), st.dir.dot(v));
-    // Angles from the centre part's edge of the slash: (-pi + a, 0) centre part, [0, a] the
-    // wedge, (a, pi + a] the turned side part.
     if (phi <= -kPi + a) phi += 2 * kPi;
     if (phi < 0) continue;
     if (phi <= a) {
-      const double rho = v.norm(), psi = std::min(phi, a - phi);
-      m = st.tip + rho * std::cos(psi) * st.dir;
-      up += rho * std::sin(psi);
+      m = st.tip + v.norm() * st.dir;
+      extra += v.norm() * phi;
     } else {
       m = st.tip + rotate(v, -st.angle);
+      extra += std::max(0.0, (m - st.tip).dot(st.dir)) * a;
     }
   }
-  if (lift) *lift = up;
+  if (extra_arc) *extra_arc = extra;
   return m;
 }
 
-std::function<Vec3(const Vec2&)> spread_placement(const SpreadPiece& sp,
-                                                  std::function<Vec3(const Vec2&)> block_position,
-                                                  std::function<Vec3(const Vec3&)> outward) {
-  return [sp, block_position, outward](const Vec2& m) {
-    double lift = 0;
-    const Vec3 p = block_position(unspread_point(sp, m, &lift));
-    return lift > 0 ? Vec3(p + lift * outward(p)) : p;
-  };
+double spread_arc_at_row(const SpreadPiece& sp, double v) {
+  double extra = 0;
+  for (const SpreadStep& st : sp.steps)
+    if (st.dir.y() < 0) extra += std::max(0.0, (st.tip.y() - v) / -st.dir.y()) * std::abs(st.angle);
+  return extra;
 }
 
 }  // namespace drape::sim

@@ -1,10 +1,9 @@
 // Pattern blocks derived from a draped block by flat pattern manipulation: the A-line / flared
 // skirt by slash and spread (each dart closed by turning the part of the piece beyond it about
-// the dart tip, which opens a wedge at the hem under the tip), and the 3D placement of the
-// spread piece on the form for sewing.
+// the dart tip, which opens a wedge at the hem under the tip), and the way back from the spread
+// piece to the block for placing it on the form.
 #pragma once
 
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -37,15 +36,12 @@ struct SpreadPiece {
 // not reach the hem.
 Result<SpreadPiece> slash_and_spread(const PatternPiece& block, double arc_step = 0.005);
 
-// Where a point of the spread piece lies in the block before spreading. A point in a wedge (new
-// cloth) is folded onto the slash line: `lift` receives how far it stands off that line (the
-// wedge hangs as a pleat standing out from the form), else 0.
-Vec2 unspread_point(const SpreadPiece& sp, const Vec2& m, double* lift);
-
-// A placement for sewing: 3D position of a spread-piece point given the block's 3D position
-// function (material -> draped position) and the outward direction at a 3D point.
-std::function<Vec3(const Vec2&)> spread_placement(const SpreadPiece& sp,
-                                                  std::function<Vec3(const Vec2&)> block_position,
-                                                  std::function<Vec3(const Vec3&)> outward);
+// Where a point of the spread piece lies in the block before spreading (the side parts turned
+// back; a point in a wedge, new cloth, goes onto its slash at its distance from the tip), and in
+// `extra_arc` how much cloth the wedges it lies in or beyond add before it along its row (wedge
+// angle x the row's distance down the slash): the pipeline spreads the flare round the form by it.
+Vec2 unspread_arc(const SpreadPiece& sp, const Vec2& m, double* extra_arc);
+// The cloth all of the piece's wedges add along the material row v (m).
+double spread_arc_at_row(const SpreadPiece& sp, double v);
 
 }  // namespace drape::sim
