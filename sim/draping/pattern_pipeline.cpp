@@ -1,4 +1,5 @@
-// The tight-skirt pipeline of method chapter 2, end to end, with its measured report.
+// The geometric draping pipeline of method chapter 2 end to end (the draped block, and the
+// blocks derived from it by slash and spread), with its measured report.
 #include "sim/draping/pattern_pipeline.hpp"
 
 #include <Eigen/Geometry>
