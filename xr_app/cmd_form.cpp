@@ -7,6 +7,7 @@
 #include <string>
 
 #include "sim/form/dress_form.hpp"
+#include "sim/form/vit_measurements.hpp"
 #include "sim/io/mesh_io.hpp"
 #include "xr_app/command.hpp"
 #include "xr_app/paths.hpp"
@@ -69,7 +70,7 @@ bool parse_front(const std::string& s, drape::sim::Vec3& f) {
 }
 
 int run(int argc, char** argv) {
-  std::string size, measurements, mesh, export_path, units, up, front;
+  std::string size, measurements, mesh, vit, export_path, units, up, front;
   bool report = false;
   double spacing = 0.0025;
   MeshImportOptions opt;
@@ -86,8 +87,12 @@ int run(int argc, char** argv) {
           ->type_name("FILE.json");
   auto* o_mesh = cli.add_option("--mesh", mesh, "a scanned or modelled form (glTF, OBJ, ...)")
                      ->type_name("FILE");
-  o_size->excludes(o_meas)->excludes(o_mesh);
-  o_meas->excludes(o_mesh);
+  auto* o_vit = cli.add_option("--vit", vit,
+                               "Seamly2D/Valentina individual measurements (docs/dress-form.md)")
+                    ->type_name("FILE.vit");
+  o_size->excludes(o_meas)->excludes(o_mesh)->excludes(o_vit);
+  o_meas->excludes(o_mesh)->excludes(o_vit);
+  o_mesh->excludes(o_vit);
   cli.add_option("--units", units, "--mesh: the file's units (default: detected)")
       ->check(CLI::IsMember({"m", "cm", "mm", "in", "auto"}));
   cli.add_option("--up", up, "--mesh: the file's up axis (default: detected)")
@@ -106,7 +111,7 @@ int run(int argc, char** argv) {
     parse_front(front, opt.front_axis);
     opt.front_auto = false;
   }
-  if (size.empty() && measurements.empty() && mesh.empty()) size = "9AR";
+  if (size.empty() && measurements.empty() && mesh.empty() && vit.empty()) size = "9AR";
   if (export_path.empty()) report = true;
 
   drape::sim::Result<DressForm> form = drape::sim::Error{"no form"};
@@ -122,7 +127,8 @@ int run(int argc, char** argv) {
     form = DressForm::from_triangles(*m, opt, mesh, &info);
     what = "mesh " + mesh;
   } else {
-    auto meas = measurements.empty()
+    auto meas = !vit.empty() ? drape::sim::load_vit(vit)
+                : measurements.empty()
                     ? drape::sim::measurements_for_size(size, drape::app::asset("forms"))
                     : drape::sim::load_measurements(measurements);
     if (!meas) {
@@ -130,7 +136,9 @@ int run(int argc, char** argv) {
       return 1;
     }
     form = DressForm::from_measurements(*meas, spacing);
-    what = measurements.empty() ? "size " + size : "measurements " + measurements;
+    what = !vit.empty()           ? "individual measurements " + vit
+           : measurements.empty() ? "size " + size
+                                  : "measurements " + measurements;
     if (form && report) {
       std::printf("requested: bust %.1f mm, waist %.1f mm, hip %.1f mm\n", meas->bust_girth * 1000,
                   meas->waist_girth * 1000, meas->hip_girth * 1000);

@@ -1,12 +1,15 @@
 // `drape pattern`: the geometric draping pipeline from a design file to printable patterns.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 #include <string>
 
 #include "sim/core/fabric.hpp"
 #include "sim/draping/pattern_pipeline.hpp"
 #include "sim/form/dress_form.hpp"
+#include "sim/form/vit_measurements.hpp"
+#include "sim/io/mesh_io.hpp"
 #include "xr_app/command.hpp"
 #include "xr_app/output_files.hpp"
 #include "xr_app/paths.hpp"
@@ -14,7 +17,7 @@
 namespace {
 
 int run_pattern(int argc, char** argv) {
-  std::string design = "tight-skirt", form_name = "9AR", out = "out/pattern";
+  std::string design = "tight-skirt", form_name = "9AR", out = "out/pattern", mesh, vit;
   drape::sim::PipelineOptions opt;
   double ease_mm = 0, seam_mm = 0, spacing_mm = 0;
   CLI::App cli{
@@ -25,8 +28,16 @@ int run_pattern(int argc, char** argv) {
   cli.option_defaults()->always_capture_default();
   cli.add_option("--design", design, "a design of assets/designs/ by name, or a design file")
       ->type_name("NAME|FILE.json");
-  cli.add_option("--form", form_name, "standard size or measurements file")
-      ->type_name("9AR|FILE.json");
+  auto* o_form = cli.add_option("--form", form_name, "standard size or measurements file")
+                     ->type_name("9AR|FILE.json");
+  auto* o_mesh = cli.add_option("--mesh", mesh,
+                                "a scanned or modelled form (OBJ, PLY, STL, glTF; as drape form)")
+                     ->type_name("FILE");
+  auto* o_vit =
+      cli.add_option("--vit", vit, "a form from Seamly2D/Valentina individual measurements")
+          ->type_name("FILE.vit");
+  o_form->excludes(o_mesh)->excludes(o_vit);
+  o_mesh->excludes(o_vit);
   cli.add_option("--out", out, "output directory")->type_name("DIR");
   // Without these the design's own values apply.
   auto* o_ease = cli.add_option("--ease", ease_mm, "ease in mm (default: the design's)")
@@ -65,19 +76,38 @@ int run_pattern(int argc, char** argv) {
     std::fprintf(stderr, "drape pattern: %s\n", d.error().c_str());
     return 1;
   }
-  auto m = form_name.find(".json") != std::string::npos
-               ? drape::sim::load_measurements(form_name)
-               : drape::sim::measurements_for_size(form_name, drape::app::asset("forms"));
-  if (!m) {
-    std::fprintf(stderr, "drape pattern: --form: %s\n", m.error().c_str());
-    return 1;
+  drape::sim::Result<drape::sim::DressForm> form = drape::sim::Error{"no form"};
+  if (!mesh.empty()) {
+    // A scanned form: its reference lines are found on it (docs/dress-form.md) and checked
+    // before any cloth is draped.
+    form = drape::sim::form_from_mesh_file(mesh);
+    if (!form) {
+      std::fprintf(stderr, "drape pattern: --mesh: %s\n", form.error().c_str());
+      return 1;
+    }
+    if (std::string e = drape::sim::check_reference_lines(*form, mesh); !e.empty()) {
+      std::fprintf(stderr, "drape pattern: --mesh: %s\n", e.c_str());
+      return 1;
+    }
+    d->form = std::filesystem::path(mesh).stem().string();
+  } else {
+    auto m = !vit.empty() ? drape::sim::load_vit(vit)
+             : form_name.find(".json") != std::string::npos
+                 ? drape::sim::load_measurements(form_name)
+                 : drape::sim::measurements_for_size(form_name, drape::app::asset("forms"));
+    if (!m) {
+      std::fprintf(stderr, "drape pattern: %s: %s\n", vit.empty() ? "--form" : "--vit",
+                   m.error().c_str());
+      return 1;
+    }
+    form = drape::sim::DressForm::from_measurements(*m);
+    if (!form) {
+      std::fprintf(stderr, "drape pattern: %s: %s\n", vit.empty() ? "--form" : "--vit",
+                   form.error().c_str());
+      return 1;
+    }
+    d->form = m->size;
   }
-  auto form = drape::sim::DressForm::from_measurements(*m);
-  if (!form) {
-    std::fprintf(stderr, "drape pattern: --form: %s\n", form.error().c_str());
-    return 1;
-  }
-  d->form = m->size;
   drape::sim::FabricParams fabric;
   if (auto f = drape::sim::load_fabric(drape::app::asset("fabrics.json").string(), d->fabric))
     fabric = *f;
@@ -108,6 +138,20 @@ int run_pattern(int argc, char** argv) {
   std::printf("  piece area vs draped area: worst %.3f %%\n", rep.area_error_pct);
   std::printf("  sewn garment hip girth %.2f mm: error %+.3f %%\n", rep.garment_hip_girth_mm,
               rep.garment_hip_girth_error_pct);
+  std::printf("  sewn garment waist girth %.2f mm: error %+.3f %%\n", rep.garment_waist_girth_mm,
+              rep.garment_waist_girth_error_pct);
+  std::printf(
+      "  pattern hip girth %.2f mm (hip widths + slash openings) vs sewn hip line along the "
+      "cloth %.2f mm: %+.3f %%\n",
+      rep.pattern_hip_girth_mm, rep.garment_hip_line_mm, rep.garment_hip_girth_vs_pattern_pct);
+  std::printf("  hem sweep %.1f mm\n", rep.hem_sweep_mm);
+  if (rep.flare != "none")
+    for (const auto& p : rep.pieces) {
+      std::printf("  %-6s slash and spread (%s): darts closed, hem opened by", p.name.c_str(),
+                  rep.flare.c_str());
+      for (double a : p.spread_deg) std::printf(" %.2f deg", a);
+      std::printf("; hem %.1f mm\n", p.hem_mm);
+    }
   for (const auto& p : rep.pieces) {
     std::printf("  %-6s darts:", p.name.c_str());
     for (size_t k = 0; k < p.dart_intake_mm.size(); ++k)

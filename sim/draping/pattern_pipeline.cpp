@@ -1,11 +1,14 @@
-// The tight-skirt pipeline of method chapter 2, end to end, with its measured report.
+// The geometric draping pipeline of method chapter 2 end to end (the draped block, and the
+// blocks derived from it by slash and spread), with its measured report.
 #include "sim/draping/pattern_pipeline.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -39,6 +42,125 @@ double line_theta(const std::string& name, const FormLandmarks& lm) {
   if (name == "centre_back") return lm.centre_back_theta;
   if (name == "left_side") return lm.left_side_theta;
   return lm.right_side_theta;
+}
+
+// The draped panel's position at a material point (the nearest node where the point falls
+// just outside every flat triangle).
+std::function<Vec3(const Vec2&)> block_position(const Panel& panel) {
+  return [&panel](const Vec2& m) {
+    const auto& px = panel.cloth.state.x;
+    Vec3 b;
+    const int t = panel.locate(m, &b);
+    if (t >= 0) {
+      const auto& tri = panel.cloth.topo.triangles[t];
+      return Vec3(b[0] * px[tri[0]] + b[1] * px[tri[1]] + b[2] * px[tri[2]]);
+    }
+    const auto& mat = panel.cloth.topo.material;
+    size_t best = 0;
+    for (size_t v = 1; v < mat.size(); ++v)
+      if ((mat[v] - m).squaredNorm() < (mat[best] - m).squaredNorm()) best = v;
+    return px[best];
+  };
+}
+
+// 3D area of the garment triangles of one piece copy (m^2): those whose three vertices belong to
+// it (a mirrored copy shares its centre seam's vertices with the right one).
+double garment_piece_area(const Garment& g, int piece) {
+  double a = 0;
+  for (const auto& t : g.triangles)
+    if (g.vertex_piece[t[0]] == piece && g.vertex_piece[t[1]] == piece &&
+        g.vertex_piece[t[2]] == piece)
+      a += 0.5 * (g.x[t[1]] - g.x[t[0]]).cross(g.x[t[2]] - g.x[t[0]]).norm();
+  return a;
+}
+
+// Length on the sewn garment of a line drawn on a pattern piece (flat points, right-half
+// material coordinates): each segment subdivided every 2 mm, each point found in the piece
+// copy's triangles by its material coordinates (x mirrored for the left copy) and taken to 3D.
+// Across folds and pleats this follows the cloth, as a tape laid along the line would.
+double garment_line_length(const Garment& g, int piece, const std::vector<Vec2>& line,
+                           bool mirrored) {
+  std::vector<const std::array<int32_t, 3>*> tris;
+  for (const auto& t : g.triangles) {
+    int own = 0;
+    for (int k = 0; k < 3; ++k) own += g.vertex_piece[t[k]] == piece;
+    if (own == 3 || (mirrored && own > 0)) tris.push_back(&t);
+  }
+  const auto at = [&](Vec2 m, Vec3* out) {
+    if (mirrored) m.x() = -m.x();
+    double best = -1e300;
+    for (const auto* t : tris) {
+      const Vec2 &a = g.material[(*t)[0]], &b = g.material[(*t)[1]], &c = g.material[(*t)[2]];
+      const double den = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+      if (std::abs(den) < 1e-18) continue;
+      const double u = ((m - a).x() * (c - a).y() - (m - a).y() * (c - a).x()) / den;
+      const double v = ((b - a).x() * (m - a).y() - (b - a).y() * (m - a).x()) / den;
+      const double w = std::min({1 - u - v, u, v});
+      if (w > best) {  // inside (w >= 0) or, on the outline, the nearest triangle
+        best = w;
+        *out = (1 - u - v) * g.x[(*t)[0]] + u * g.x[(*t)[1]] + v * g.x[(*t)[2]];
+      }
+      if (w >= 0) return;
+    }
+  };
+  double len = 0;
+  Vec3 prev;
+  bool first = true;
+  for (size_t i = 0; i + 1 < line.size(); ++i) {
+    const int n = std::max(1, static_cast<int>(std::ceil((line[i + 1] - line[i]).norm() / 0.002)));
+    for (int k = first ? 0 : 1; k <= n; ++k) {
+      Vec3 p = Vec3::Zero();
+      at(line[i] + (line[i + 1] - line[i]) * (static_cast<double>(k) / n), &p);
+      if (!first) len += (p - prev).norm();
+      prev = p;
+      first = false;
+    }
+  }
+  return len;
+}
+
+// Where a spread piece's point starts the garment relaxation: the flare spread evenly round the
+// form. The point goes back to the draped block (block_position of its unspread point, height
+// y, arc s0 from the piece's centre line); at height y all wedges of all pieces (both halves) add
+// dG of girth, so the section is scaled by k = (G + dG) / G about its centre and the point sits
+// at arc (s0 + the wedges before it) / k of the unscaled section, keeping its offset from the
+// surface.
+std::function<Vec3(const Vec2&)> cone_placement(const PipelineResult& R, size_t i,
+                                                const MappingSurface& surf) {
+  const auto added_girth = [&R](double y) {
+    double dg = 0;
+    for (size_t k = 0; k < R.spread.size(); ++k)
+      dg += 2 * spread_arc_at_row(R.spread[k], R.mappings[k].v_of_y(y));
+    return dg;
+  };
+  // The flare slopes outward (its radius grows by dG / 2 pi), so a meridian of the cone is longer
+  // than its height: heights below the waist are drawn up so that each millimetre of cloth down
+  // the meridian drops cos(slope) (else the placed cloth is stretched by ~1.3 % down the grain).
+  const double y_top = R.mappings[i].y_top, step = 0.001;
+  std::vector<double> drop{0.0};  // drop[j]: placed depth of the height y_top - j * step
+  for (double y = y_top; y > y_top - 1.5; y -= step) {
+    const double slope = (added_girth(y - step) - added_girth(y)) / (2 * 3.141592653589793 * step);
+    drop.push_back(drop.back() + step / std::sqrt(1 + slope * slope));
+  }
+  return [&R, i, &surf, added_girth, drop, y_top, step,
+          block = block_position(R.panels[i])](const Vec2& m) {
+    const SpreadPiece& sp = R.spread[i];
+    const PieceMapping& pm = R.mappings[i];
+    double extra = 0;
+    const Vec3 p0 = block(unspread_arc(sp, m, &extra));
+    const double f = std::clamp((y_top - p0.y()) / step, 0.0, drop.size() - 1.001);
+    const size_t j = static_cast<size_t>(f);
+    const double y = y_top - (drop[j] + (f - j) * (drop[j + 1] - drop[j]));
+    const Vec2 c = surf.centre(p0.y());
+    const double th0 = std::atan2(p0.x() - c.x(), p0.z() - c.y());
+    const double off = std::hypot(p0.x() - c.x(), p0.z() - c.y()) - surf.radius(p0.y(), th0);
+    const ArcTable T = ArcTable::build(surf, p0.y(), pm.theta_centre, pm.dir);
+    const double g = surf.girth(p0.y()), k = (g + added_girth(p0.y())) / g;
+    const double th = T.theta_at((T.arc_at(th0) + extra) / k);
+    const double r = k * surf.radius(p0.y(), th) + off;
+    const Vec2 cy = surf.centre(y);
+    return Vec3(cy.x() + r * std::sin(th), y, cy.y() + r * std::cos(th));
+  };
 }
 
 TriMesh panel_mesh(const Panel& p, const std::string& name) {
@@ -81,7 +203,10 @@ Result<Design> parse_design(const std::string& text, const std::string& src) {
   check(get_num(j, "remesh_edge", src, &d.remesh_edge));
   double it = d.relax_iterations;
   check(get_num(j, "relax_iterations", src, &it));
+  check(get_str(j, "flare", src, &d.flare));
   if (!err.empty()) return Error{err};
+  if (d.flare != "none" && d.flare != "close_darts")
+    return Error{src + ".flare: unknown '" + d.flare + "' (known: none, close_darts)"};
   d.ease = ease_mm / 1000;
   d.seam_allowance = sa_mm / 1000;
   d.relax_iterations = static_cast<int>(it);
@@ -198,6 +323,13 @@ std::string PipelineReport::to_json() const {
   j["area_error_pct"] = area_error_pct;
   j["garment_hip_girth_mm"] = garment_hip_girth_mm;
   j["garment_hip_girth_error_pct"] = garment_hip_girth_error_pct;
+  j["garment_waist_girth_mm"] = garment_waist_girth_mm;
+  j["garment_waist_girth_error_pct"] = garment_waist_girth_error_pct;
+  j["flare"] = flare;
+  j["hem_sweep_mm"] = hem_sweep_mm;
+  j["pattern_hip_girth_mm"] = pattern_hip_girth_mm;
+  j["garment_hip_line_mm"] = garment_hip_line_mm;
+  j["garment_hip_girth_vs_pattern_pct"] = garment_hip_girth_vs_pattern_pct;
   j["outline_error_before_relax_mm"] = outline_error_before_relax_mm;
   j["quarter_difference_mm"] = quarter_difference_mm;
   j["relax_backend"] = relax_backend;
@@ -249,6 +381,8 @@ std::string PipelineReport::to_json() const {
                     {"triangles", p.remesh_triangles},
                     {"min_angle_deg", p.remesh_min_angle_deg},
                     {"max_edge_mm", p.remesh_max_edge_mm}};
+    pj["hem_mm"] = p.hem_mm;
+    pj["spread_deg"] = p.spread_deg;
     j["pieces"].push_back(pj);
   }
   return j.dump(2);
@@ -275,6 +409,7 @@ Result<PipelineResult> run_pattern_pipeline(const Design& design_in, const Dress
   rep.design = d.name;
   rep.form = d.form;
   rep.ease_mm = d.ease * 1000;
+  rep.flare = d.flare;
   rep.form_hip_girth_mm = form.girth_at(lm.hip_y) * 1000;
   rep.form_waist_girth_mm = form.girth_at(lm.waist_y) * 1000;
   rep.quarter_difference_mm = (rep.form_hip_girth_mm - rep.form_waist_girth_mm) / 4;
@@ -330,9 +465,27 @@ Result<PipelineResult> run_pattern_pipeline(const Design& design_in, const Dress
       pr.dart_intake_wanted_mm.push_back(panel->slits[k].intake * 1000);
       pr.waist_width_mm += piece->darts[k].intake * 1000;
     }
+    double a3 = draped_area(*piece, *panel);
+    if (d.flare == "close_darts") {
+      // Slash and spread: the widths are measured on the spread piece (the darts are closed,
+      // so the waist seam is the whole waist width); its draped area comes from the sewn
+      // garment below.
+      auto sp = slash_and_spread(*piece, d.extraction_step);
+      if (!sp) return Error{d.name + ": pieces[" + std::to_string(i) + "]: " + sp.error()};
+      for (const SpreadStep& st : sp->steps) pr.spread_deg.push_back(st.angle * 180 / kPi);
+      pr.hip_width_mm = sp->hip_width * 1000;
+      for (const SpreadStep& st : sp->steps) rep.pattern_hip_girth_mm += 2 * st.hip_gap * 1000;
+      pr.hem_mm = sp->hem_length * 1000;
+      *piece = sp->piece;
+      pr.waist_seam_mm = piece->seam_length("waist") * 1000;
+      R.spread.push_back(std::move(*sp));
+    } else {
+      pr.hem_mm = piece->seam_length("hem") * 1000;
+    }
+    rep.hem_sweep_mm += 2 * pr.hem_mm;
     for (const std::string& label : piece->labels)
       pr.fairness_deg_per_mm.emplace_back(label, seam_fairness(*piece, label));
-    const double a3 = draped_area(*piece, *panel), a2 = std::abs(piece->area());
+    const double a2 = std::abs(piece->area());
     pr.area_piece_cm2 = a2 * 1e4;
     pr.area_draped_cm2 = a3 * 1e4;
     pr.area_error_pct = a3 > 0 ? std::abs(a2 - a3) / a3 * 100 : 100;
@@ -358,18 +511,24 @@ Result<PipelineResult> run_pattern_pipeline(const Design& design_in, const Dress
     rep.pieces.push_back(pr);
   }
   rep.hip_width_sum_mm = hip_sum;
+  rep.pattern_hip_girth_mm += hip_sum;
   rep.hip_width_error_mm = hip_sum - (rep.form_hip_girth_mm + rep.ease_mm);
   rep.waist_width_minus_intakes_sum_mm = waist_sum;
   rep.waist_width_error_mm = waist_sum - (rep.form_waist_girth_mm + rep.ease_mm);
   // Mirror, sew, relax the garment.
   const auto t_sew = Clock::now();
   std::vector<SewInput> in;
-  for (size_t i = 0; i < R.pieces.size(); ++i)
-    in.push_back({&R.pieces[i], &R.meshes[i], &R.panels[i]});
+  for (size_t i = 0; i < R.pieces.size(); ++i) {
+    in.push_back({&R.pieces[i], &R.meshes[i], &R.panels[i], {}});
+    if (!R.spread.empty()) in.back().place = cone_placement(R, i, surf);
+  }
   SewOptions so;
   so.mirror_x = surf.centre(lm.waist_y).x();
   so.relax_iterations = d.relax_iterations;
   so.waist_y = lm.waist_y;
+  // The flare hangs: no pressure pulls a spread garment onto the form (it stands away below the
+  // dart tips; measured with the pressure: sewn hip line -3.4 % of the pattern's).
+  if (!R.spread.empty()) so.pressure_step = 0;
   auto garment = sew_garment(in, surf, so);
   if (!garment) return Error{garment.error()};
   R.garment = std::move(*garment);
@@ -377,6 +536,30 @@ Result<PipelineResult> run_pattern_pipeline(const Design& design_in, const Dress
   rep.garment_hip_girth_mm = garment_girth(R.garment, surf, lm.hip_y) * 1000;
   const double target = rep.form_hip_girth_mm + rep.ease_mm;
   rep.garment_hip_girth_error_pct = (rep.garment_hip_girth_mm - target) / target * 100;
+  for (size_t i = 0; i < R.pieces.size(); ++i)
+    for (int half = 0; half < 2; ++half)
+      rep.garment_hip_line_mm += garment_line_length(R.garment, static_cast<int>(2 * i + half),
+                                                     R.pieces[i].hip_line, half == 1) *
+                                 1000;
+  rep.garment_hip_girth_vs_pattern_pct =
+      (rep.garment_hip_line_mm - rep.pattern_hip_girth_mm) / rep.pattern_hip_girth_mm * 100;
+  rep.garment_waist_girth_mm = garment_girth(R.garment, surf, lm.waist_y) * 1000;
+  const double waist_target = rep.form_waist_girth_mm + rep.ease_mm;
+  rep.garment_waist_girth_error_pct =
+      (rep.garment_waist_girth_mm - waist_target) / waist_target * 100;
+  if (!R.spread.empty()) {
+    // A spread piece's draped area: its right half in the sewn, relaxed garment.
+    rep.area_error_pct = 0;
+    for (size_t i = 0; i < R.pieces.size(); ++i) {
+      PieceReport& pr = rep.pieces[i];
+      pr.area_draped_cm2 = garment_piece_area(R.garment, static_cast<int>(2 * i)) * 1e4;
+      pr.area_error_pct =
+          pr.area_draped_cm2 > 0
+              ? std::abs(pr.area_piece_cm2 - pr.area_draped_cm2) / pr.area_draped_cm2 * 100
+              : 100;
+      rep.area_error_pct = std::max(rep.area_error_pct, pr.area_error_pct);
+    }
+  }
   // Files.
   if (!opt.out_dir.empty()) {
     const auto t_ex = Clock::now();

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/draping/blocks.hpp"
 #include "sim/draping/mapping.hpp"
 #include "sim/draping/panel.hpp"
 #include "sim/draping/pattern_export.hpp"
@@ -39,6 +40,9 @@ struct Design {
   double extraction_step = 0.005;    // m between extracted points
   double remesh_edge = 0.012;        // m: size bound of the remeshed pieces
   int relax_iterations = 200;
+  // Flat manipulation after draping: "none" (the draped block as is) or "close_darts" (slash
+  // and spread: every dart closed, the hem opened under each dart tip; sim/draping/blocks.hpp).
+  std::string flare = "none";
   std::vector<PieceDesign> pieces;
 };
 
@@ -71,6 +75,9 @@ struct PieceReport {
   double remesh_min_angle_deg = 0, remesh_max_edge_mm = 0;
   // Per seam line of the exported outline: the largest turning angle per mm (seam_fairness).
   std::vector<std::pair<std::string, double>> fairness_deg_per_mm;
+  // Slash and spread (flare "close_darts"): the angle each slash opened, the hem's length.
+  std::vector<double> spread_deg;
+  double hem_mm = 0;
 };
 
 struct PipelineReport {
@@ -81,6 +88,13 @@ struct PipelineReport {
   double waist_width_minus_intakes_sum_mm = 0, waist_width_error_mm = 0;
   double area_error_pct = 0;  // worst piece
   double garment_hip_girth_mm = 0, garment_hip_girth_error_pct = 0;
+  double garment_waist_girth_mm = 0, garment_waist_girth_error_pct = 0;
+  std::string flare = "none";
+  double hem_sweep_mm = 0;  // the whole hem (every piece and its mirror image), flat
+  // The cut pattern's girth along the hip line (the hip widths plus what the slashes opened
+  // there), the sewn garment's hip line measured along the cloth (through folds and pleats),
+  // and the difference in per cent of the pattern's.
+  double pattern_hip_girth_mm = 0, garment_hip_line_mm = 0, garment_hip_girth_vs_pattern_pct = 0;
   double outline_error_before_relax_mm = 0;
   double quarter_difference_mm = 0;  // (hip - waist) / 4
   double mapping_extraction_ms = 0, relax_ms = 0, remesh_ms = 0, sew_ms = 0, export_ms = 0;
@@ -97,6 +111,7 @@ struct PipelineResult {
   std::vector<PieceMapping> mappings;
   std::vector<PatternPiece> pieces;
   std::vector<RemeshedPiece> meshes;
+  std::vector<SpreadPiece> spread;  // per piece, when the design closes its darts
   Garment garment;
   PipelineReport report;
 };

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -20,6 +21,9 @@ struct SewInput {
   const PatternPiece* piece = nullptr;
   const RemeshedPiece* mesh = nullptr;
   const Panel* panel = nullptr;
+  // When set, the 3D start position of each remeshed vertex from its material point instead of
+  // the panel (pieces changed flat after draping, such as a spread block: sim/draping/blocks.hpp).
+  std::function<Vec3(const Vec2&)> place;
 };
 
 struct Garment {
@@ -38,6 +42,9 @@ struct SewOptions {
   double mirror_x = 0.0;  // the mirror plane x = mirror_x (the form's centre plane)
   int relax_iterations = 200;
   double waist_y = std::numeric_limits<double>::quiet_NaN();  // waist height (NaN: start heights)
+  // m per iteration toward the section centre: a tight skirt lies on the form (see sew.cpp); a
+  // flared one stands away from it below the dart tips, where this would pull the flare in.
+  double pressure_step = 1e-4;
 };
 
 Result<Garment> sew_garment(const std::vector<SewInput>& right, const MappingSurface& surf,

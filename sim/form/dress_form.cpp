@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "sim/core/mesh.hpp"
@@ -346,6 +347,41 @@ TriMesh DressForm::to_mesh() const {
     m.triangles.push_back({top, idx(ns - 1, n), idx(ns - 1, n + 1)});
   }
   return m;
+}
+
+std::string check_reference_lines(const DressForm& form, const std::string& name) {
+  const FormLandmarks& lm = form.landmarks();
+  const double h = lm.top_y - lm.bottom_y, pi = 3.14159265358979323846;
+  const double gw = form.girth_at(lm.waist_y), gh = form.girth_at(lm.hip_y);
+  std::string missing;
+  const auto add = [&](const std::string& s) { missing += (missing.empty() ? "" : "; ") + s; };
+  char buf[256];
+  const double band_lo = lm.bottom_y + 0.3 * h, band_hi = lm.bottom_y + 0.7 * h;
+  if (gw > 0.97 * gh || lm.waist_y < band_lo + 0.01 || lm.waist_y > band_hi - 0.01) {
+    std::snprintf(buf, sizeof buf,
+                  "waist (no narrowing: the smallest girth between 30 %% and 70 %% of the height "
+                  "is %.1f mm at %.3f m, the hip below it %.1f mm; a waist needs a girth at least "
+                  "3 %% below the hip's, inside that band)",
+                  gw * 1000, lm.waist_y, gh * 1000);
+    add(buf);
+  }
+  if (lm.waist_y - lm.hip_y < 0.08) {
+    std::snprintf(buf, sizeof buf,
+                  "hip (the widest section below the waist is at %.3f m, %.0f mm below the "
+                  "waist; at least 80 mm needed)",
+                  lm.hip_y, (lm.waist_y - lm.hip_y) * 1000);
+    add(buf);
+  }
+  const double tol = 30 * pi / 180;
+  if (std::abs(lm.left_side_theta - pi / 2) > tol ||
+      std::abs(lm.right_side_theta - 1.5 * pi) > tol) {
+    std::snprintf(buf, sizeof buf,
+                  "side lines (the widest points of the waist section are at %.1f and %.1f deg "
+                  "from centre front, not within 30 deg of 90 and 270)",
+                  lm.left_side_theta * 180 / pi, lm.right_side_theta * 180 / pi);
+    add(buf);
+  }
+  return missing.empty() ? "" : name + ": reference lines not found on the form: " + missing;
 }
 
 }  // namespace drape::sim

@@ -189,4 +189,11 @@ class DressForm {
   FormLandmarks landmarks_;
 };
 
+// Checks that the reference lines a skirt's pattern needs are really on the form (a form from a
+// scan gets them from its girth profile, which any shape has): a waist that narrows (its girth
+// at least 3 % below the hip's and not at the end of its search band), a hip at least 8 cm below
+// it, side lines within 30 degrees of the sides. Returns "" or an error naming `name` and every
+// line that cannot be found.
+std::string check_reference_lines(const DressForm& form, const std::string& name);
+
 }  // namespace drape::sim
