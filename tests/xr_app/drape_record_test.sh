@@ -1,0 +1,112 @@
+#!/usr/bin/env bash
+# The session journal end to end (docs/sessions.md): `drape xr --record DIR` plays the scenario
+# assets/scenarios/record_replay.json (pinch and pull, pin, cut, undo) on the simulated runtime,
+# then `drape replay DIR` rebuilds the World from the journal's header, feeds each recorded input
+# at its tick in lock step and must print exactly the final state hash the recorded run printed.
+#   free  the recorded run's sim free-running on its own 90 Hz clock (--sim-free)
+#   lock  the recorded run in lock step (one tick per frame)
+#   kill  lock step: recording runs killed with SIGKILL at 5 random moments; each journal replays
+#         to the state the uninterrupted run's journal replays to at the same tick
+#         (drape replay --until-tick), which is the recorded run's own state (free, lock).
+# free and lock also check that a journal cut off mid-record replays up to its last whole
+# record with a message naming the byte offset, and that a bad header is an error naming the
+# file and the field.
+# usage: drape_record_test.sh DRAPE_EXE MODE WORKDIR
+set -u
+exe=$1 mode=$2 work=$3
+rm -rf "$work" && mkdir -p "$work"
+log=$work/log.txt
+fail() { echo "FAIL: $*"; echo "--- log:"; cat "$log"; exit 1; }
+unset XR_RUNTIME_JSON DRAPE_MOCK_SCENARIO DRAPE_MOCK_END_AFTER_FRAMES DRAPE_MOCK_WRITE_FRAMES
+export HOME=$work/home XDG_CONFIG_HOME=$work/home/.config XDG_CONFIG_DIRS=$work/none
+case $mode in
+  free) sim=(--sim-free) ;;
+  lock | kill) sim=() ;;
+  *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill WORKDIR"; exit 2 ;;
+esac
+rec=$work/rec
+start=$(date +%s.%N)
+"$exe" xr --scenario assets/scenarios/record_replay.json --eye-size 64 --cloth-res 16 \
+  --record "$rec" "${sim[@]}" >"$log" 2>&1
+rc=$?
+[ $rc -eq 0 ] || fail "drape xr exited with $rc"
+run_secs=$(echo "$(date +%s.%N) - $start" | bc)
+for f in journal.bin meta.json session.txt; do
+  [ -s "$rec/$f" ] || fail "missing $rec/$f"
+done
+recorded=$(sed -n 's/^drape xr: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$log")
+[ -n "$recorded" ] || fail "the recorded run printed no final state hash"
+read -r rhash rtick <<<"$recorded"
+echo "recorded: state hash $rhash at tick $rtick"
+# The session did what the scenario asks: a pin, a cut, an undo.
+grep -q "pinned_added [1-9]" "$rec/session.txt" || fail "no pin in $rec/session.txt"
+grep -q "^sim: cut: .* pieces" "$rec/session.txt" || fail "no cut in $rec/session.txt"
+grep -q -- "-> undo" "$rec/session.txt" || fail "no undo trigger in $rec/session.txt"
+grep -q "\"final_state_hash\": \"$rhash\"" "$rec/meta.json" || fail "meta.json lacks the final hash"
+
+"$exe" replay "$rec" >"$work/replay.out" 2>"$work/replay.err"
+rc=$?
+cat "$work/replay.err" "$work/replay.out" >>"$log"
+[ $rc -eq 0 ] || fail "drape replay exited with $rc"
+replayed=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/replay.out")
+echo "replayed: state hash $replayed"
+[ "$replayed" = "$rhash $rtick" ] || fail "replay gave '$replayed', the recorded run '$rhash $rtick'"
+grep -q "\"final_state_hash\": \"$rhash\"" "$rec/replay.json" || fail "replay.json lacks the hash"
+
+if [ "$mode" = kill ]; then
+  # Kill recording runs at random moments within the uninterrupted run's duration.
+  killed=0 tries=0
+  while [ $killed -lt 5 ] && [ $tries -lt 12 ]; do
+    tries=$((tries + 1))
+    k=$work/kill$tries
+    delay=$(awk -v t="$run_secs" -v r="$RANDOM" 'BEGIN { printf "%.2f", t * (0.15 + 0.7 * r / 32768) }')
+    "$exe" xr --scenario assets/scenarios/record_replay.json --eye-size 64 --cloth-res 16 \
+      --record "$k" >"$work/kill$tries.log" 2>&1 &
+    pid=$!
+    sleep "$delay"
+    kill -KILL $pid 2>/dev/null
+    wait $pid 2>/dev/null
+    grep -q "^drape xr: final state hash" "$work/kill$tries.log" && continue  # ended first
+    [ -f "$k/journal.bin" ] || continue  # killed before the journal was opened
+    "$exe" replay "$k" >"$work/kill$tries.out" 2>"$work/kill$tries.err"
+    rc=$?
+    [ $rc -eq 0 ] || fail "replay of the journal killed after $delay s exited with $rc: $(cat "$work/kill$tries.err")"
+    got=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/kill$tries.out")
+    read -r khash ktick <<<"$got"
+    [ -n "$ktick" ] || fail "no hash from the killed journal's replay"
+    [ "$ktick" -gt 0 ] || continue  # killed before its first input record: nothing to compare
+    "$exe" replay "$rec" --until-tick "$ktick" --out "$work/until$tries.json" >"$work/until$tries.out" 2>&1 ||
+      fail "replay --until-tick $ktick exited with $?"
+    want=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/until$tries.out")
+    echo "killed after $delay s: journal to tick $ktick: $khash; uninterrupted at that tick: $want"
+    [ "$want" = "$khash $ktick" ] || fail "killed journal's state $khash at $ktick != uninterrupted $want"
+    killed=$((killed + 1))
+  done
+  [ $killed -ge 5 ] || fail "only $killed of $tries runs were killed mid-session"
+  echo "PASS"
+  exit 0
+fi
+
+# A journal cut off mid-record: the replay loads its whole records and says where it stops.
+cut=$work/cut
+mkdir -p "$cut"
+size=$(stat -c %s "$rec/journal.bin")
+head -c $((size - 13)) "$rec/journal.bin" >"$cut/journal.bin"
+"$exe" replay "$cut" >"$work/cut.out" 2>"$work/cut.err"
+rc=$?
+cat "$work/cut.err" >>"$log"
+[ $rc -eq 0 ] || fail "the cut-off journal's replay exited with $rc"
+grep -q "$cut/journal.bin: byte [0-9]*: .*cut off" "$work/cut.err" ||
+  fail "no cut-off message naming the byte offset: $(cat "$work/cut.err")"
+grep -q "^final state hash [0-9a-f]* at tick [0-9]*$" "$work/cut.out" || fail "no hash for the cut journal"
+
+# A bad header: an error naming the file and the field, exit 2.
+bad=$work/bad
+mkdir -p "$bad"
+printf 'NOTAJRNL\001\000\000\000' >"$bad/journal.bin"
+"$exe" replay "$bad" >/dev/null 2>"$work/bad.err"
+rc=$?
+cat "$work/bad.err" >>"$log"
+[ $rc -eq 2 ] || fail "a bad header's replay exited with $rc, not 2"
+grep -q "$bad/journal.bin: header field 'magic'" "$work/bad.err" || fail "bad header message: $(cat "$work/bad.err")"
+echo "PASS"
