@@ -371,7 +371,7 @@ int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
   auto r = app::run_xr_app(o.app);
   for (const auto& l : r.log)
     if (l.rfind("pinch:", 0) == 0 || l.rfind("depth:", 0) == 0 || l.rfind("cut", 0) == 0 ||
-        l.rfind("voice", 0) == 0)
+        l.rfind("voice", 0) == 0 || l.rfind("resume", 0) == 0 || l.rfind("record", 0) == 0)
       std::printf("  %s\n", l.c_str());
   for (const auto& t : r.triggers) std::printf("  trigger %s\n", t.c_str());
   const double secs =

@@ -8,6 +8,10 @@
 #   kill  lock step: recording runs killed with SIGKILL at 5 random moments; each journal replays
 #         to the state the uninterrupted run's journal replays to at the same tick
 #         (drape replay --until-tick), which is the recorded run's own state (free, lock).
+#   resume lock step: `drape run --resume DIR` (live, the simulated runtime's window under Xvfb,
+#         --frames 40) replays the recording, goes on live and appends to its journal: the
+#         journal then replays to the resumed run's final state at tick 300 + 40; a copy cut off
+#         mid-record resumes with the cut-off message.
 # free and lock also check that a journal cut off mid-record replays up to its last whole
 # record with a message naming the byte offset, and that a bad header is an error naming the
 # file and the field.
@@ -21,8 +25,8 @@ unset XR_RUNTIME_JSON DRAPE_MOCK_SCENARIO DRAPE_MOCK_END_AFTER_FRAMES DRAPE_MOCK
 export HOME=$work/home XDG_CONFIG_HOME=$work/home/.config XDG_CONFIG_DIRS=$work/none
 case $mode in
   free) sim=(--sim-free) ;;
-  lock | kill) sim=() ;;
-  *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill WORKDIR"; exit 2 ;;
+  lock | kill | resume) sim=() ;;
+  *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill|resume WORKDIR"; exit 2 ;;
 esac
 rec=$work/rec
 start=$(date +%s.%N)
@@ -52,6 +56,38 @@ replayed=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p
 echo "replayed: state hash $replayed"
 [ "$replayed" = "$rhash $rtick" ] || fail "replay gave '$replayed', the recorded run '$rhash $rtick'"
 grep -q "\"final_state_hash\": \"$rhash\"" "$rec/replay.json" || fail "replay.json lacks the hash"
+
+if [ "$mode" = resume ]; then
+  command -v xvfb-run >/dev/null || fail "xvfb-run is not installed (Debian xvfb)"
+  resume_run() {  # resume_run DIR LOG: drape run --resume DIR, 40 live lock-step frames
+    xvfb-run -a "$exe" run --resume "$1" --frames 40 --sim-lock-step --no-pattern --voice off \
+      --out "$work/live" >"$2" 2>&1
+  }
+  cut=$work/cut_resume
+  cp -r "$rec" "$work/resumed" && cp -r "$rec" "$cut"
+  resume_run "$work/resumed" "$work/resume.log"
+  rc=$?
+  cat "$work/resume.log" >>"$log"
+  [ $rc -eq 0 ] || fail "drape run --resume exited with $rc"
+  grep -q "resume: replayed 300 input records, 300 ticks" "$work/resume.log" || fail "no replay line"
+  live=$(sed -n 's/^drape run: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/resume.log")
+  read -r lhash ltick <<<"$live"
+  [ "$ltick" = 340 ] || fail "the resumed run ended at tick '$ltick', not 300 + 40"
+  "$exe" replay "$work/resumed" >"$work/resumed.out" 2>&1 || fail "replay of the resumed journal exited with $?"
+  again=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/resumed.out")
+  echo "resumed run: $live; its journal replayed: $again"
+  [ "$again" = "$lhash $ltick" ] || fail "the resumed journal replays to '$again', the run ended at '$live'"
+  size=$(stat -c %s "$cut/journal.bin")
+  head -c $((size - 40)) "$rec/journal.bin" >"$cut/journal.bin"  # the end record and part of the last tick's
+  resume_run "$cut" "$work/cut_resume.log"
+  rc=$?
+  cat "$work/cut_resume.log" >>"$log"
+  [ $rc -eq 0 ] || fail "drape run --resume of a cut-off journal exited with $rc"
+  grep -q "$cut/journal.bin: byte [0-9]*: .*cut off" "$work/cut_resume.log" || fail "no cut-off message"
+  grep -q "resume: replayed 299 input records, 299 ticks" "$work/cut_resume.log" || fail "the cut journal did not replay to its last whole record"
+  echo "PASS"
+  exit 0
+fi
 
 if [ "$mode" = kill ]; then
   # Kill recording runs at random moments within the uninterrupted run's duration.

@@ -423,9 +423,9 @@ void DrapingSession::write_outputs(sim::World& w) {
 }
 
 // The session's text log: the log, the triggers, the sim's messages and the outcome.
-void DrapingSession::write_session_text(const std::string& tp) {
+void DrapingSession::write_session_text(const std::string& tp, bool append) {
   XrAppResult& r = rep_.r;
-  std::ofstream o(tp);
+  std::ofstream o(tp, append ? std::ios::app : std::ios::trunc);
   for (const auto& l : r.log) o << l << "\n";
   for (const auto& l : r.triggers) o << "trigger " << l << "\n";
   for (const auto& l : r.sim_messages) o << "sim: " << l << "\n";

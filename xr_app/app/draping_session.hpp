@@ -112,7 +112,7 @@ class DrapingSession : public SessionContent {
   void prepare_panel(int64_t frame, const EyeTarget (&eyes)[2]);
   void record_pointer_probe(int64_t frame, const render::ViewTarget& left_eye);
   void write_outputs(sim::World& w);
-  void write_session_text(const std::string& path);
+  void write_session_text(const std::string& path, bool append = false);
   // --record (session_record.cpp): the journal opened and meta.json written before the sim
   // starts; at the end the end record, meta.json again and session.txt.
   void open_record();

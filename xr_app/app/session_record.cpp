@@ -253,7 +253,7 @@ void DrapingSession::close_record() {
     rep_.note("record: " + m);
   const std::string tp = opt_.record_dir + "/session.txt";
   r.written.push_back(opt_.record_dir + "/journal.bin");
-  write_session_text(tp);
+  write_session_text(tp, !opt_.resume_dir.empty());  // a resumed session's log goes after its own
 }
 
 }  // namespace drape::app
