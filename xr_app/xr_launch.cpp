@@ -207,7 +207,8 @@ std::string commands_file(const std::string& given) {
 void add_record_option(CLI::App& cli, std::string& dir) {
   cli.add_option("--record", dir,
                  "record the session into DIR: journal.bin (the sim's inputs, for drape replay "
-                 "and --resume), meta.json, session.txt");
+                 "and --resume), meta.json, session.txt, audio.wav (live voice), hands.csv "
+                 "(external hands)");
 }
 
 bool prepare_record_dir(const char* command, const std::string& dir) {

@@ -8,6 +8,9 @@
 #   kill  lock step: recording runs killed with SIGKILL at 5 random moments; each journal replays
 #         to the state the uninterrupted run's journal replays to at the same tick
 #         (drape replay --until-tick), which is the recorded run's own state (free, lock).
+#   tee   --record with --voice FILE.wav and --hands trace FILE: audio.wav holds the audio as
+#         captured (a prefix of the recording, sample for sample) and hands.csv the external
+#         tracker's frames as received (a prefix of the trace, in its format).
 #   resume lock step: `drape run --resume DIR` (live, the simulated runtime's window under Xvfb,
 #         --frames 40) replays the recording, goes on live and appends to its journal: the
 #         journal then replays to the resumed run's final state at tick 300 + 40; a copy cut off
@@ -26,7 +29,41 @@ export HOME=$work/home XDG_CONFIG_HOME=$work/home/.config XDG_CONFIG_DIRS=$work/
 case $mode in
   free) sim=(--sim-free) ;;
   lock | kill | resume) sim=() ;;
-  *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill|resume WORKDIR"; exit 2 ;;
+  tee)
+    here=$(cd "$(dirname "$0")" && pwd)
+    cd "$work" || exit 1
+    python3 "$here/hands_trace.py" trace in.csv 0.11 0.65 0.115 || fail "trace writer"
+    python3 - <<'PY' || fail "wav writer"
+import random, struct, wave
+random.seed(1)
+w = wave.open("in.wav", "wb")
+w.setnchannels(1); w.setsampwidth(2); w.setframerate(16000)
+w.writeframes(b"".join(struct.pack("<h", random.randint(-40, 40)) for _ in range(16000 * 4)))
+w.close()
+PY
+    "$exe" xr --frames 120 --eye-size 64 --cloth-res 12 --voice in.wav --hands trace in.csv \
+      --record rec >"$log" 2>&1 || fail "drape xr exited with $?"
+    python3 - <<'PY' || fail "the tees differ from their inputs"
+import sys, wave
+a, b = wave.open("rec/audio.wav"), wave.open("in.wav")
+n = a.getnframes()
+assert (a.getframerate(), a.getnchannels(), a.getsampwidth()) == (16000, 1, 2), "audio.wav format"
+assert n > 16000 // 2, f"only {n} samples in audio.wav"
+assert a.readframes(n) == b.readframes(n), "audio.wav is not the recording's start"
+rec = open("rec/hands.csv").read().splitlines()
+src = [l for l in open("in.csv").read().splitlines() if not l.startswith("#")]
+assert rec[0] == "# drape-trace v1", rec[0]
+assert len(rec) > 10, f"only {len(rec) - 1} frames in hands.csv"
+for i, line in enumerate(rec[1:]):
+    got = [float(x) for x in line.split(",")]
+    want = [float(x) for x in src[i].split(",")]
+    assert len(got) == len(want) and all(abs(g - w) < 1e-5 for g, w in zip(got, want)), (line, src[i])
+print(f"audio.wav: {n} samples; hands.csv: {len(rec) - 1} frames, as received")
+PY
+    echo "PASS"
+    exit 0
+    ;;
+  *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill|resume|tee WORKDIR"; exit 2 ;;
 esac
 rec=$work/rec
 start=$(date +%s.%N)

@@ -116,6 +116,8 @@ class DrapingSession : public SessionContent {
   // --record (session_record.cpp): the journal opened and meta.json written before the sim
   // starts; at the end the end record, meta.json again and session.txt.
   void open_record();
+  // --record with external hands: their frames as received into hands.csv (a trace).
+  void record_hand_frames(const std::vector<tracking::HandFrame>& frames);
   // --resume: the World and the operations from the replay of opt_.resume_dir's journal to its
   // last whole record; `first_tick` the ticks it ran.
   sim::Result<sim::World> resume_world(uint64_t& first_tick);
@@ -169,7 +171,8 @@ class DrapingSession : public SessionContent {
   // The session's journal (opt_.record_dir): written by the sim thread inside the posted
   // commands while it runs, by finish() after it stopped.
   std::shared_ptr<sim::JournalWriter> journal_;
-  uint64_t resume_inputs_end_ = 0;  // a resumed journal: append from this byte
+  uint64_t resume_inputs_end_ = 0;                      // a resumed journal: append from this byte
+  std::unique_ptr<tracking::TraceRecorder> hands_csv_;  // --record, external hands
 
   // Each hand's interaction profile family: controller triggers are looked up under it.
   std::string profiles_[2];

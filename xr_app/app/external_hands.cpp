@@ -78,6 +78,7 @@ void DrapingSession::read_external_hands(double t, std::array<sim::HandProxy, 2>
     now = t - ext_->start;
   }
   std::vector<tracking::HandFrame> frames = ext_->source->poll();
+  record_hand_frames(frames);  // --record: hands.csv (session_record.cpp)
   note_external_status();
   for (auto& raw : frames) {
     const int h = static_cast<int>(raw.hand);

@@ -209,6 +209,21 @@ void DrapingSession::open_record() {
   if (std::string m = write_meta(opt_.record_dir, opt_, "running", 0, 0); !m.empty())
     rep_.note("record: " + m);
   rep_.note("record: journal " + opt_.record_dir + "/journal.bin");
+  if (opt_.hands != "xr") {
+    // A resumed session's frames go to a file of their own: a trace starts at its own time 0.
+    const std::string hp =
+        opt_.record_dir + (resume_inputs_end_ > 0 ? "/hands_resumed.csv" : "/hands.csv");
+    hands_csv_ = std::make_unique<tracking::TraceRecorder>(hp);
+    if (!hands_csv_->ok()) {
+      rep_.note("record: " + hp + ": cannot write (hands not recorded)");
+      hands_csv_.reset();
+    }
+  }
+}
+
+void DrapingSession::record_hand_frames(const std::vector<tracking::HandFrame>& frames) {
+  if (!hands_csv_) return;
+  for (const auto& f : frames) hands_csv_->write(f);
 }
 
 sim::Result<sim::World> DrapingSession::resume_world(uint64_t& first_tick) {
