@@ -182,4 +182,28 @@ rc=$?
 cat "$work/bad.err" >>"$log"
 [ $rc -eq 2 ] || fail "a bad header's replay exited with $rc, not 2"
 grep -q "$bad/journal.bin: header field 'magic'" "$work/bad.err" || fail "bad header message: $(cat "$work/bad.err")"
+# A whole header whose field cannot describe a session: the file and the field named, exit 2.
+python3 - "$rec/journal.bin" "$bad/journal.bin" <<'PY' || fail "journal rewriter"
+import struct, sys, zlib
+d = open(sys.argv[1], "rb").read()
+n, = struct.unpack_from("<I", d, 12)
+p = d[20:20 + n]
+count, = struct.unpack_from("<I", p, 1)
+fields, i = {}, 5
+for _ in range(count):
+    kl, = struct.unpack_from("<I", p, i); k = p[i + 4:i + 4 + kl].decode(); i += 4 + kl
+    vl, = struct.unpack_from("<I", p, i); v = p[i + 4:i + 4 + vl].decode(); i += 4 + vl
+    fields[k] = v
+fields["resolution"] = "9999"
+q = bytes([1]) + struct.pack("<I", len(fields))
+for k, v in sorted(fields.items()):
+    q += struct.pack("<I", len(k)) + k.encode() + struct.pack("<I", len(v)) + v.encode()
+open(sys.argv[2], "wb").write(d[:12] + struct.pack("<II", len(q), zlib.crc32(q)) + q + d[20 + n:])
+PY
+"$exe" replay "$bad" >/dev/null 2>"$work/field.err"
+rc=$?
+cat "$work/field.err" >>"$log"
+[ $rc -eq 2 ] || fail "a bad header field's replay exited with $rc, not 2"
+grep -q "$bad/journal.bin: header field 'resolution': '9999'" "$work/field.err" ||
+  fail "bad field message: $(cat "$work/field.err")"
 echo "PASS"
