@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -31,6 +32,7 @@
 #include <nlohmann/json.hpp>
 
 #include "xr_app/app/desk_scene.hpp"
+#include "xr_app/app/session_record.hpp"
 #include "xr_app/app/xr_app.hpp"
 #include "xr_app/xr_launch.hpp"
 #endif
@@ -232,7 +234,30 @@ struct XrRunOptions {
   std::string form;          // --form: a size or a measurements file
   std::string json;          // --json: the live session's figures
   bool lock_step = false;    // --sim-lock-step: live with one sim tick per frame
+  bool record = true;        // --no-record: a live session without its default recording
+  std::string resume;        // --resume [DIR]
+  CLI::Option* resume_opt = nullptr;
 };
+
+// A live session's default recording: OUT/sessions/<UTC date and time>, a crash loses nothing
+// of it (docs/sessions.md).
+std::string default_record_dir(const std::string& out) {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%dT%H%M%SZ", &utc);
+  return out + "/sessions/" + stamp;
+}
+
+// The sim's ticks and the cloth's state hash at the end: what `drape replay` of the session's
+// recording reproduces.
+void print_final_state(const drape::app::XrAppResult& r) {
+  if (r.has_final_state)
+    std::printf("drape run: final state hash %016llx at tick %llu\n",
+                static_cast<unsigned long long>(r.final_state_hash),
+                static_cast<unsigned long long>(r.final_ticks));
+}
 
 // A live session's cloth resolution, eye size in the simulated runtime's window (swapchain edge:
 // shown 1.4x in a 720 px high window; lavapipe renders 2 x 720^2 at about half the frame rate of
@@ -321,6 +346,10 @@ int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
   o.app.sim_lock_step = o.lock_step;
   o.app.commands_path = app::commands_file("");
   o.app.api_layers = app::loader_api_layers();
+  if (o.app.record_dir.empty() && o.record) o.app.record_dir = default_record_dir(o.out);
+  if (!app::prepare_record_dir("drape run", o.app.record_dir)) return 2;
+  if (!o.app.record_dir.empty())
+    std::printf("drape run: recording the session into %s\n", o.app.record_dir.c_str());
   std::printf("drape run: live, %d x %d %s cloth, start %s, form %s, eyes %d px\n", o.app.cloth_res,
               o.app.cloth_res, o.app.fabric.c_str(), o.app.start.c_str(),
               !o.app.form_mesh.empty()           ? o.app.form_mesh.c_str()
@@ -342,7 +371,8 @@ int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
   auto r = app::run_xr_app(o.app);
   for (const auto& l : r.log)
     if (l.rfind("pinch:", 0) == 0 || l.rfind("depth:", 0) == 0 || l.rfind("cut", 0) == 0 ||
-        l.rfind("voice", 0) == 0 || l.rfind("pattern", 0) == 0)
+        l.rfind("voice", 0) == 0 || l.rfind("pattern", 0) == 0 || l.rfind("resume", 0) == 0 ||
+        l.rfind("record", 0) == 0)
       std::printf("  %s\n", l.c_str());
   for (const auto& t : r.triggers) std::printf("  trigger %s\n", t.c_str());
   const double secs =
@@ -361,6 +391,7 @@ int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
       app::to_string(r.final_state), r.runtime_name.c_str(), static_cast<long long>(r.frames),
       static_cast<long long>(r.frames_rendered), fps, p50, median(r.profile_ms["sim.step_wall"]),
       static_cast<long long>(r.frames_pinched), r.pinned_added, o.app.cloth_res, o.app.cloth_res);
+  print_final_state(r);
   if (!r.error.empty()) std::fprintf(stderr, "drape run: error: %s\n", r.error.c_str());
   if (r.exit_code != 0) return r.exit_code;
   for (const auto& w : r.written) std::printf("wrote %s\n", std::filesystem::absolute(w).c_str());
@@ -430,6 +461,42 @@ bool check_scene(XrRunOptions& o) {
   return scene.ok();
 }
 
+// --resume [DIR]: the session directory (default: the newest under OUT/sessions/), its journal's
+// scene options into o.app, recording appended to that journal.
+bool resume_options(XrRunOptions& o) {
+  namespace fs = std::filesystem;
+  std::string dir = o.resume;
+  if (dir.empty()) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(o.out + "/sessions", ec))
+      if (e.is_directory() && fs::exists(e.path() / "journal.bin") &&
+          e.path().filename().string() > fs::path(dir).filename().string())
+        dir = e.path().string();
+    if (dir.empty()) {
+      std::fprintf(stderr, "drape run: --resume: no recorded session under %s/sessions/\n",
+                   o.out.c_str());
+      return false;
+    }
+  }
+  const std::string path = dir + "/journal.bin";
+  drape::sim::JournalContents j;
+  std::string err = drape::sim::load_journal(path, j);
+  if (err.empty()) {
+    const bool lock_step = o.app.sim_lock_step;
+    err = drape::app::options_from_header(j.header, path, o.app);
+    o.app.sim_lock_step = lock_step;  // the mode of this run (run_live sets it from the options)
+  }
+  if (!err.empty()) {
+    std::fprintf(stderr, "drape run: --resume %s: %s\n", dir.c_str(), err.c_str());
+    return false;
+  }
+  if (!j.cut_message.empty()) std::printf("drape run: --resume: %s\n", j.cut_message.c_str());
+  o.app.resume_dir = dir;
+  o.app.record_dir = dir;
+  std::printf("drape run: resuming %s (%zu input records)\n", dir.c_str(), j.ticks.size());
+  return true;
+}
+
 int run_xr(XrRunOptions& o) {
   namespace app = drape::app;
   bool simulated = false;
@@ -449,7 +516,14 @@ int run_xr(XrRunOptions& o) {
     if (!o.eye_size_given && !simulated) o.app.eye_size = 0;  // the headset's own size
     if (o.app.start.empty()) o.app.start = kLiveStart;
     if (!check_scene(o)) return 2;
+    if (o.resume_opt->count() > 0 && !resume_options(o)) return 2;
     return run_live(o, manifest, simulated);
+  }
+  if (o.resume_opt->count() > 0) {
+    std::fprintf(stderr,
+                 "drape run: --resume: needs a live session (a headset, or a display for the "
+                 "simulated runtime's window) and no --scenario\n");
+    return 2;
   }
   if (headset) o.app.voice = false;
   if (o.scene_given && o.app.start.empty()) o.app.start = kLiveStart;
@@ -469,6 +543,7 @@ int run_xr(XrRunOptions& o) {
   o.app.scenario_path = sc_path;
   o.app.commands_path = app::commands_file("");
   o.app.api_layers = app::loader_api_layers();
+  if (!app::prepare_record_dir("drape run", o.app.record_dir)) return 2;
   std::printf("drape run: runtime manifest %s, scenario %s, live voice %s\n",
               manifest.empty() ? "(system active runtime)" : manifest.c_str(), o.scenario.c_str(),
               o.app.voice_input.empty() ? "off" : o.app.voice_input.c_str());
@@ -484,6 +559,7 @@ int run_xr(XrRunOptions& o) {
       static_cast<long long>(r.frames_rendered), static_cast<long long>(r.frames_pinched),
       r.pinned_added, r.cuts_ok, r.cut_new_vertices, r.components_before, r.components_after,
       r.voice_commands.size());
+  print_final_state(r);
   if (!r.error.empty()) std::fprintf(stderr, "drape run: error: %s\n", r.error.c_str());
   if (r.exit_code != 0) return r.exit_code;
   for (const auto& e : std::filesystem::directory_iterator(frames_dir, ec))
@@ -506,7 +582,13 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
   drape::app::add_off_switches(
       cli,
       {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
-       {"--no-pattern", &o.pattern, "skip the pattern of the draped cloth (pattern/session-1/)"}});
+       {"--no-pattern", &o.pattern, "skip the pattern of the draped cloth (pattern/session-1/)"},
+       {"--no-record", &o.record, "live: do not record the session into OUT/sessions/"}});
+  drape::app::add_record_option(cli, o.app.record_dir);
+  o.resume_opt = cli.add_option("--resume", o.resume,
+                                "live: resume the session recorded in DIR (default: the newest "
+                                "under OUT/sessions/): its journal replayed, then live, appending")
+                     ->expected(0, 1);
   cli.add_option("--json", o.json,
                  "live: write the session's frame rate, sim step and pose-to-photon probes "
                  "(frames) as JSON to this file");
@@ -531,9 +613,10 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
   cli.add_option("--start", o.app.start,
                  std::string("the cloth's start state: ") + drape::app::desk_start_names() +
                      " (default: pinned-top live; the scenario's scene when scripted)");
-  for (const char* name : {"--frames", "--eye-size", "--cloth-res", "--verbose", "--scenario",
-                           "--no-voice", "--no-pattern", "--every", "--form", "--mesh", "--start",
-                           "--json", "--sim-lock-step", "--state-hashes", "--voice"})
+  for (const char* name :
+       {"--frames", "--eye-size", "--cloth-res", "--verbose", "--scenario", "--no-voice",
+        "--no-pattern", "--every", "--form", "--mesh", "--start", "--json", "--sim-lock-step",
+        "--state-hashes", "--voice", "--record", "--no-record", "--resume"})
     cli.get_option(name)->excludes(headless);
 }
 #endif

@@ -93,6 +93,10 @@ void print_summary(const XrAppResult& r, const Summary& s) {
   for (const auto& [group, sec] : r.thread_cpu_s)
     std::fprintf(stderr, "drape xr: cpu %-34s %8.2f s (%.2f ms per frame)\n", group.c_str(), sec,
                  r.frames ? 1e3 * sec / static_cast<double>(r.frames) : 0.0);
+  if (r.has_final_state)
+    std::fprintf(stderr, "drape xr: final state hash %016llx at tick %llu\n",
+                 static_cast<unsigned long long>(r.final_state_hash),
+                 static_cast<unsigned long long>(r.final_ticks));
   for (const auto& w : r.written) std::fprintf(stderr, "wrote %s\n", w.c_str());
 }
 
@@ -154,6 +158,7 @@ int cmd_xr(int argc, char** argv) {
                  "the command map: triggers -> operations (default: assets/commands.json)");
   cli.add_option("--out", opt.out_dir,
                  "write session_log.json, drape_cloth.gltf and xr_session.txt there");
+  app::add_record_option(cli, opt.record_dir);
   cli.add_option("--json", json_path,
                  "write frame-time percentiles, pose-to-photon frames, sim tick jitter and the "
                  "per-stage profile there");
@@ -192,6 +197,7 @@ int cmd_xr(int argc, char** argv) {
   if (!app::resolve_hands_key("drape xr", opt.hands == "udp", hands_key, opt.hands_address,
                               opt.hands_key))
     return 2;
+  if (!app::prepare_record_dir("drape xr", opt.record_dir)) return 2;
   std::fprintf(stderr, "drape xr: runtime manifest: %s\n",
                manifest.empty() ? "(system active runtime)" : manifest.c_str());
   std::fprintf(stderr, "drape xr: live voice: %s\n",

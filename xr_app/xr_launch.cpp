@@ -316,4 +316,27 @@ std::string commands_file(const std::string& given) {
   return fs::exists(bundled, ec) ? bundled.string() : "";
 }
 
+void add_record_option(CLI::App& cli, std::string& dir) {
+  cli.add_option("--record", dir,
+                 "record the session into DIR: journal.bin (the sim's inputs, for drape replay "
+                 "and --resume), meta.json, session.txt, audio.wav (live voice), hands.csv "
+                 "(external hands)");
+}
+
+bool prepare_record_dir(const char* command, const std::string& dir) {
+  if (dir.empty()) return true;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  const fs::path probe = fs::path(dir) / ".write_test";
+  std::FILE* f = ec ? nullptr : std::fopen(probe.c_str(), "wb");
+  if (!f) {
+    std::fprintf(stderr, "%s: --record %s: cannot write there%s%s\n", command, dir.c_str(),
+                 ec ? ": " : "", ec ? ec.message().c_str() : "");
+    return false;
+  }
+  std::fclose(f);
+  fs::remove(probe, ec);
+  return true;
+}
+
 }  // namespace drape::app

@@ -95,4 +95,10 @@ bool resolve_hands(const char* command, const std::vector<std::string>& hands,
 // working directory, else the assets directory) when present, else "" (the built-in defaults).
 std::string commands_file(const std::string& given);
 
+// --record DIR (both commands): record the session there (docs/sessions.md).
+void add_record_option(CLI::App& cli, std::string& dir);
+// After parsing: creates `dir` (when set) and checks that a file can be written there; else
+// prints "<command>: --record DIR: ..." and returns false.
+bool prepare_record_dir(const char* command, const std::string& dir);
+
 }  // namespace drape::app

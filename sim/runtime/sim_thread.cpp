@@ -41,6 +41,8 @@ SimThread::SimThread(World world, SimThreadOptions opt) : world_(std::move(world
   local_timing_.tick_rate_hz = opt_.tick_rate_hz;
   local_timing_.substeps = opt_.substeps;
   timing_ = local_timing_;
+  ticks_done_.store(opt_.first_tick);
+  requested_ = opt_.first_tick;
 }
 
 SimThread::~SimThread() {
@@ -143,6 +145,7 @@ void SimThread::tick() {
     std::lock_guard<std::mutex> lk(cmd_mu_);
     running_cmds_.swap(pending_);
   }
+  world_.tick = ticks_done_.load();
   for (auto& cmd : running_cmds_) {
     try {
       cmd(world_);

@@ -48,6 +48,7 @@ struct SimThreadOptions {
   int substeps = 1;          // solver steps per tick, each of 1 / (tick_rate_hz * substeps)
   bool lock_step = false;    // ticks only when advance() asks for them
   int timing_window = 1024;  // step times kept for the percentiles
+  uint64_t first_tick = 0;   // ticks counted as done at the start (a resumed session's)
 };
 
 class SimThread;

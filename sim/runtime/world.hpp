@@ -19,6 +19,9 @@ struct World {
   SceneObjects scene;
   std::unique_ptr<Solver> solver;
   bool paused = false;  // geometric work in progress: no dynamics
+  // Ticks completed before the one running now (SimThread sets it before the tick's commands):
+  // the tick index a command's input is journaled under (journal.hpp).
+  uint64_t tick = 0;
 
   // Hooks set by higher-level modules (e.g. operations): run on the sim thread.
   std::function<void(World&, double dt)> before_step;

@@ -18,8 +18,9 @@
 #include "sim/solvers/solver_factory.hpp"
 #include "sim/testbeds/testbed.hpp"
 #include "xr_app/app/desk_scene.hpp"
-#include "xr_app/output_files.hpp"
 #include "xr_app/app/session_pattern_export.hpp"
+#include "xr_app/app/session_record.hpp"
+#include "xr_app/output_files.hpp"
 
 namespace drape::app {
 
@@ -92,11 +93,6 @@ void hash_outcomes(sim::World& w) {
   };
 }
 
-// The scene: the default scenario's, or the desk scene of the options (desk_scene.hpp).
-sim::Result<sim::Testbed> make_scene(const XrAppOptions& opt) {
-  if (opt.start.empty()) return sim::make_form_drape(opt.cloth_res);
-  return make_desk_scene(opt);
-}
 }  // namespace
 
 std::unique_ptr<SessionContent> make_draping_session(const VulkanDevice& device,
@@ -126,28 +122,16 @@ bool DrapingSession::create(const VulkanDevice& device) {
   }
   renderer_ = std::move(rr.value());
   threads_.mark_before_sim();
-  auto scene = make_scene(opt_);
-  if (!scene) {
-    rep_.r.error = "scene: " + scene.error();
-    return false;
-  }
-  sim::SolverConfig solver_cfg;
-  solver_cfg.freeze = true;  // pieces at rest sleep until a hand, pin or cut disturbs them
-  // A lock-step run replays bit for bit: the static finish of a sleeping piece then runs one
-  // cycle per tick instead of landing whenever its thread ends.
-  solver_cfg.finish_thread = !opt_.sim_lock_step;
-  auto solver = sim::make_solver("default", solver_cfg);
-  if (!solver) {
-    rep_.r.error = "solver: " + solver.error();
-    return false;
-  }
-  sim::World w;
-  w.cloth = std::move(scene->cloth);
-  w.scene = std::move(scene->objects);
-  w.solver = std::move(solver.value());
   sim::SimThreadOptions so;
   so.lock_step = opt_.sim_lock_step;
-  sim_ = std::make_unique<sim::SimThread>(std::move(w), so);
+  // A resumed session (--resume) starts from its journal's replay (session_record.cpp).
+  auto w = opt_.resume_dir.empty() ? make_session_world(opt_, opt_.sim_lock_step)
+                                   : resume_world(so.first_tick);
+  if (!w) {
+    rep_.r.error = w.error();
+    return false;
+  }
+  sim_ = std::make_unique<sim::SimThread>(std::move(w.value()), so);
   reader_ = sim_->make_reader();
   start_sim();
   return rep_.r.error.empty();
@@ -157,8 +141,10 @@ void DrapingSession::start_sim() {
   sim::World& w = sim_->world();  // the thread is not started yet
   pinned_at_start_ = count_pinned(w.cloth);
   if (opt_.operations) {
-    ops_ = std::make_shared<sim::OperationController>();
-    ops_->install(w);
+    if (!ops_) {  // a resumed session has the replay's, installed
+      ops_ = std::make_shared<sim::OperationController>();
+      ops_->install(w);
+    }
     grace_frames_ = static_cast<int>(std::ceil(ops_->params().tracking_grace * 90.0));
     ops_->start_recording(w);
     load_cues();
@@ -169,6 +155,7 @@ void DrapingSession::start_sim() {
     if (opt_.log_state_hashes) hash_outcomes(w);
   }
   profile_ticks(w);
+  if (!opt_.record_dir.empty()) open_record();
   // Lock step: the ticks run on the frame loop's thread inside advance() (no hand-off per frame).
   if (!opt_.sim_lock_step) sim_->start();
 }
@@ -432,6 +419,10 @@ void DrapingSession::finish() {
   rep_.r.pinned_added = count_pinned(w.cloth) - pinned_at_start_;
   for (const auto& m : w.messages) rep_.r.sim_messages.push_back(m);
   ticks_.write(rep_.r);
+  rep_.r.final_ticks = sim_->ticks();
+  rep_.r.final_state_hash = sim::state_hash(w.cloth);
+  rep_.r.has_final_state = true;
+  if (journal_) close_record();
   if (ops_ && !opt_.out_dir.empty()) write_outputs(w);
 }
 
@@ -477,10 +468,15 @@ void DrapingSession::write_outputs(sim::World& w) {
     r.log.push_back(pe.summary);
     for (const auto& f : pe.files) r.written.push_back(f);
   }
-  const std::string tp = opt_.out_dir + "/xr_session.txt";
-  std::string e = write_whole(opt_.out_dir, [&](const std::string& d) -> std::string {
-    const std::string p = d + "/xr_session.txt";
-    std::ofstream o(p);
+  write_session_text(opt_.out_dir + "/xr_session.txt");
+}
+
+// The session's text log: the log, the triggers, the sim's messages and the outcome. Written
+// whole (a failed write keeps the previous file), or appended after a resumed session's own.
+void DrapingSession::write_session_text(const std::string& tp, bool append) {
+  XrAppResult& r = rep_.r;
+  auto write = [&r](const std::string& p, std::ios::openmode mode) -> std::string {
+    std::ofstream o(p, mode);
     for (const auto& l : r.log) o << l << "\n";
     for (const auto& l : r.triggers) o << "trigger " << l << "\n";
     for (const auto& l : r.sim_messages) o << "sim: " << l << "\n";
@@ -489,7 +485,13 @@ void DrapingSession::write_outputs(sim::World& w) {
       << r.components_after << "\n";
     o.close();
     return o ? std::string() : p + ": write failed: " + std::strerror(errno);
-  });
+  };
+  const std::filesystem::path path(tp);
+  const std::string e = append
+                            ? write(tp, std::ios::app)
+                            : write_whole(path.parent_path().string(), [&](const std::string& d) {
+                                return write(d + "/" + path.filename().string(), std::ios::trunc);
+                              });
   if (e.empty())
     r.written.push_back(tp);
   else

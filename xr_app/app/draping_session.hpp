@@ -15,6 +15,7 @@
 
 #include "render/renderer.hpp"
 #include "sim/ops/operation_controller.hpp"
+#include "sim/runtime/journal.hpp"
 #include "sim/runtime/sim_thread.hpp"
 #include "tracking/calibration.hpp"
 #include "tracking/command_map.hpp"
@@ -113,6 +114,16 @@ class DrapingSession : public SessionContent {
   void prepare_panel(int64_t frame, const EyeTarget (&eyes)[2]);
   void record_pointer_probe(int64_t frame, const render::ViewTarget& left_eye);
   void write_outputs(sim::World& w);
+  void write_session_text(const std::string& path, bool append = false);
+  // --record (session_record.cpp): the journal opened and meta.json written before the sim
+  // starts; at the end the end record, meta.json again and session.txt.
+  void open_record();
+  // --record with external hands: their frames as received into hands.csv (a trace).
+  void record_hand_frames(const std::vector<tracking::HandFrame>& frames);
+  // --resume: the World and the operations from the replay of opt_.resume_dir's journal to its
+  // last whole record; `first_tick` the ticks it ran.
+  sim::Result<sim::World> resume_world(uint64_t& first_tick);
+  void close_record();
 
   const XrAppOptions opt_;
   Report& rep_;
@@ -162,6 +173,12 @@ class DrapingSession : public SessionContent {
   void open_calibration_mode();
   void calibration_frame(const tracking::HandFrame& raw, const tracking::HandFrame& filtered);
   std::vector<render::DrawOptions::Marker> markers_;  // drawn in the scene (calibration)
+
+  // The session's journal (opt_.record_dir): written by the sim thread inside the posted
+  // commands while it runs, by finish() after it stopped.
+  std::shared_ptr<sim::JournalWriter> journal_;
+  uint64_t resume_inputs_end_ = 0;                      // a resumed journal: append from this byte
+  std::unique_ptr<tracking::TraceRecorder> hands_csv_;  // --record, external hands
 
   // Each hand's interaction profile family: controller triggers are looked up under it.
   std::string profiles_[2];

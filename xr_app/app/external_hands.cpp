@@ -107,6 +107,7 @@ void DrapingSession::read_external_hands(double t, std::array<sim::HandProxy, 2>
     now = t - ext_->start;
   }
   std::vector<tracking::HandFrame> frames = ext_->source->poll();
+  record_hand_frames(frames);  // --record: hands.csv (session_record.cpp)
   note_external_status();
   const bool calibrating = ext_->calibrating && !ext_->calibrating->done();
   for (auto& raw : frames) {

@@ -53,7 +53,25 @@ void DrapingSession::interact(int64_t frame, const HandInput& in) {
     auto ops = ops_;
     std::shared_ptr<FreeOutcomes> free = free_;  // the pinches taken and let go, both modes
     std::shared_ptr<Said> said = said_;
-    sim_->post([ops, hands, use, free, said](sim::World& w) {
+    // The journal's record of this input (--record), written on the sim thread before it is
+    // applied, under the tick that applies it.
+    std::shared_ptr<sim::JournalWriter> journal = journal_;
+    sim::JournalTick rec;
+    if (journal) {
+      rec.hands = hands;
+      for (const auto& op : use)
+        rec.ops.push_back({op.name, static_cast<uint8_t>(op.phase), static_cast<int8_t>(op.hand)});
+      for (const auto& tr : trig)
+        if (tr.source == "voice" && tr.begin) rec.phrases.push_back(tr.command);
+    }
+    sim_->post([ops, hands, use, free, said, journal, rec](sim::World& w) mutable {
+      if (journal && journal->is_open()) {
+        rec.tick = w.tick;
+        if (std::string e = journal->write(rec); !e.empty()) {
+          w.report("journal: " + e + " (recording stopped)");
+          journal->close();
+        }
+      }
       ops->set_hands(w, hands);
       w.scene.hands.assign(hands.begin(), hands.end());  // into the snapshot (latency probe)
       apply_triggers(w, use, *ops, *said);

@@ -20,8 +20,17 @@ std::string shown_phrase(const tracking::VoiceResult& vr) {
 
 void DrapingSession::load_cues() {
   if (!opt_.voice_input.empty()) {
-    live_voice_ = std::make_unique<VoiceInput>(opt_.voice_input);
+    // --record: the audio as captured into audio.wav (a resumed session's into a file of its own).
+    const std::string tee = opt_.record_dir.empty()   ? ""
+                            : opt_.resume_dir.empty() ? opt_.record_dir + "/audio.wav"
+                                                      : opt_.record_dir + "/audio_resumed.wav";
+    if (!tee.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(opt_.record_dir, ec);
+    }
+    live_voice_ = std::make_unique<VoiceInput>(opt_.voice_input, tee);
     rep_.note("voice: live input: " + live_voice_->name());
+    if (!live_voice_->tee_error().empty()) rep_.note("record: " + live_voice_->tee_error());
   }
   if (!opt_.voice || opt_.scenario_path.empty()) return;
   std::ifstream in(opt_.scenario_path);

@@ -36,15 +36,19 @@ class AudioClock {
 class VoiceInput {
  public:
   // spec: "mic" (the default ALSA capture device) or the path of a WAV file (16 kHz mono 16-bit).
-  explicit VoiceInput(const std::string& spec);
+  // tee_wav: when set, the audio as captured is also written there (--record's audio.wav).
+  explicit VoiceInput(const std::string& spec, const std::string& tee_wav = "");
   // Any audio input (tests: a device that fails mid-stream); `name` is used in messages.
-  VoiceInput(std::string name, std::unique_ptr<tracking::AudioInput> input);
+  VoiceInput(std::string name, std::unique_ptr<tracking::AudioInput> input,
+             const std::string& tee_wav = "");
   ~VoiceInput();
   VoiceInput(const VoiceInput&) = delete;
   VoiceInput& operator=(const VoiceInput&) = delete;
 
   // What is listened to, for messages: "microphone (ALSA 'default')" or "recording 'F.wav'".
   const std::string& name() const { return name_; }
+  // Why the tee file could not be written ("" when it is, or none was asked for).
+  const std::string& tee_error() const { return tee_error_; }
 
   struct Heard {
     tracking::VoiceResult result;
@@ -66,6 +70,7 @@ class VoiceInput {
   std::unique_ptr<tracking::VoiceSource> source_;
   std::deque<std::pair<int64_t, double>> frames_;  // (frame, when polled), the last minute
   std::string last_status_ = "(none)";             // the last status reported; none yet
+  std::string tee_error_;
 };
 
 }  // namespace drape::app

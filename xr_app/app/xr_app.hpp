@@ -102,6 +102,12 @@ struct XrAppOptions {
   // Draw the feedback panel (the hands' operations, voice, refusals, help) over the scene;
   // false: the scene alone (screenshots compared with golden images of the scene).
   bool feedback_panel = true;
+  // When set: the session is recorded there (docs/sessions.md): journal.bin (the sim's inputs,
+  // written from the sim thread), meta.json and, at the end, session.txt.
+  std::string record_dir;
+  // When set: the session resumes the one recorded there (its scene options are the journal's):
+  // its journal replayed to its last whole record, then the session goes on, appending to it.
+  std::string resume_dir;
 };
 
 struct XrAppResult {
@@ -169,6 +175,10 @@ struct XrAppResult {
   // Live voice (XrAppOptions::voice_input): per decoded utterance, the frames from the frame
   // during which its last voiced sample was read to the frame that received it.
   std::vector<int> voice_latency_frames;
+  // The sim's ticks and the cloth's state hash at the end (sessions with a sim), as a replay of
+  // the session's journal reproduces them.
+  uint64_t final_ticks = 0, final_state_hash = 0;
+  bool has_final_state = false;
 };
 
 XrAppResult run_xr_app(const XrAppOptions& opt);

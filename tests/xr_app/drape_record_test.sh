@@ -1,0 +1,209 @@
+#!/usr/bin/env bash
+# The session journal end to end (docs/sessions.md): `drape xr --record DIR` plays the scenario
+# assets/scenarios/record_replay.json (pinch and pull, pin, cut, undo) on the simulated runtime,
+# then `drape replay DIR` rebuilds the World from the journal's header, feeds each recorded input
+# at its tick in lock step and must print exactly the final state hash the recorded run printed.
+#   free  the recorded run's sim free-running on its own 90 Hz clock (--sim-free)
+#   lock  the recorded run in lock step (one tick per frame)
+#   kill  lock step: recording runs killed with SIGKILL at 5 random moments; each journal replays
+#         to the state the uninterrupted run's journal replays to at the same tick
+#         (drape replay --until-tick), which is the recorded run's own state (free, lock).
+#   tee   --record with --voice FILE.wav and --hands trace FILE: audio.wav holds the audio as
+#         captured (a prefix of the recording, sample for sample) and hands.csv the external
+#         tracker's frames as received (a prefix of the trace, in its format).
+#   resume lock step: `drape run --resume DIR` (live, the simulated runtime's window under Xvfb,
+#         --frames 40) replays the recording, goes on live and appends to its journal: the
+#         journal then replays to the resumed run's final state at tick 300 + 40; a copy cut off
+#         mid-record resumes with the cut-off message.
+# free and lock also check that a journal cut off mid-record replays up to its last whole
+# record with a message naming the byte offset, and that a bad header is an error naming the
+# file and the field.
+# usage: drape_record_test.sh DRAPE_EXE MODE WORKDIR
+set -u
+exe=$1 mode=$2 work=$3
+rm -rf "$work" && mkdir -p "$work"
+log=$work/log.txt
+fail() { echo "FAIL: $*"; echo "--- log:"; cat "$log"; exit 1; }
+unset XR_RUNTIME_JSON DRAPE_MOCK_SCENARIO DRAPE_MOCK_END_AFTER_FRAMES DRAPE_MOCK_WRITE_FRAMES
+export HOME=$work/home XDG_CONFIG_HOME=$work/home/.config XDG_CONFIG_DIRS=$work/none
+case $mode in
+  free) sim=(--sim-free) ;;
+  lock | kill | resume) sim=() ;;
+  tee)
+    here=$(cd "$(dirname "$0")" && pwd)
+    cd "$work" || exit 1
+    python3 "$here/hands_trace.py" trace in.csv 0.11 0.65 0.115 || fail "trace writer"
+    python3 - <<'PY' || fail "wav writer"
+import random, struct, wave
+random.seed(1)
+w = wave.open("in.wav", "wb")
+w.setnchannels(1); w.setsampwidth(2); w.setframerate(16000)
+w.writeframes(b"".join(struct.pack("<h", random.randint(-40, 40)) for _ in range(16000 * 4)))
+w.close()
+PY
+    "$exe" xr --frames 120 --eye-size 64 --cloth-res 12 --voice in.wav --hands trace in.csv \
+      --record rec >"$log" 2>&1 || fail "drape xr exited with $?"
+    python3 - <<'PY' || fail "the tees differ from their inputs"
+import sys, wave
+a, b = wave.open("rec/audio.wav"), wave.open("in.wav")
+n = a.getnframes()
+assert (a.getframerate(), a.getnchannels(), a.getsampwidth()) == (16000, 1, 2), "audio.wav format"
+assert n > 16000 // 2, f"only {n} samples in audio.wav"
+assert a.readframes(n) == b.readframes(n), "audio.wav is not the recording's start"
+rec = open("rec/hands.csv").read().splitlines()
+src = [l for l in open("in.csv").read().splitlines() if not l.startswith("#")]
+assert rec[0] == "# drape-trace v1", rec[0]
+assert len(rec) > 10, f"only {len(rec) - 1} frames in hands.csv"
+for i, line in enumerate(rec[1:]):
+    got = [float(x) for x in line.split(",")]
+    want = [float(x) for x in src[i].split(",")]
+    assert len(got) == len(want) and all(abs(g - w) < 1e-5 for g, w in zip(got, want)), (line, src[i])
+print(f"audio.wav: {n} samples; hands.csv: {len(rec) - 1} frames, as received")
+PY
+    echo "PASS"
+    exit 0
+    ;;
+  *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill|resume|tee WORKDIR"; exit 2 ;;
+esac
+rec=$work/rec
+start=$(date +%s.%N)
+"$exe" xr --scenario assets/scenarios/record_replay.json --eye-size 64 --cloth-res 16 \
+  --record "$rec" "${sim[@]}" >"$log" 2>&1
+rc=$?
+[ $rc -eq 0 ] || fail "drape xr exited with $rc"
+run_secs=$(echo "$(date +%s.%N) - $start" | bc)
+for f in journal.bin meta.json session.txt; do
+  [ -s "$rec/$f" ] || fail "missing $rec/$f"
+done
+recorded=$(sed -n 's/^drape xr: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$log")
+[ -n "$recorded" ] || fail "the recorded run printed no final state hash"
+read -r rhash rtick <<<"$recorded"
+echo "recorded: state hash $rhash at tick $rtick"
+# The session did what the scenario asks: a pin, a cut, an undo.
+grep -q "pinned_added [1-9]" "$rec/session.txt" || fail "no pin in $rec/session.txt"
+grep -q "^sim: cut: .* pieces" "$rec/session.txt" || fail "no cut in $rec/session.txt"
+grep -q -- "-> undo" "$rec/session.txt" || fail "no undo trigger in $rec/session.txt"
+grep -q "\"final_state_hash\": \"$rhash\"" "$rec/meta.json" || fail "meta.json lacks the final hash"
+
+"$exe" replay "$rec" >"$work/replay.out" 2>"$work/replay.err"
+rc=$?
+cat "$work/replay.err" "$work/replay.out" >>"$log"
+[ $rc -eq 0 ] || fail "drape replay exited with $rc"
+replayed=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/replay.out")
+echo "replayed: state hash $replayed"
+[ "$replayed" = "$rhash $rtick" ] || fail "replay gave '$replayed', the recorded run '$rhash $rtick'"
+grep -q "\"final_state_hash\": \"$rhash\"" "$rec/replay.json" || fail "replay.json lacks the hash"
+
+if [ "$mode" = resume ]; then
+  command -v xvfb-run >/dev/null || fail "xvfb-run is not installed (Debian xvfb)"
+  resume_run() {  # resume_run DIR LOG: drape run --resume DIR, 40 live lock-step frames
+    xvfb-run -a "$exe" run --resume "$1" --frames 40 --sim-lock-step --no-pattern --voice off \
+      --out "$work/live" >"$2" 2>&1
+  }
+  cut=$work/cut_resume
+  cp -r "$rec" "$work/resumed" && cp -r "$rec" "$cut"
+  resume_run "$work/resumed" "$work/resume.log"
+  rc=$?
+  cat "$work/resume.log" >>"$log"
+  [ $rc -eq 0 ] || fail "drape run --resume exited with $rc"
+  grep -q "resume: replayed 300 input records, 300 ticks" "$work/resume.log" || fail "no replay line"
+  live=$(sed -n 's/^drape run: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/resume.log")
+  read -r lhash ltick <<<"$live"
+  [ "$ltick" = 340 ] || fail "the resumed run ended at tick '$ltick', not 300 + 40"
+  "$exe" replay "$work/resumed" >"$work/resumed.out" 2>&1 || fail "replay of the resumed journal exited with $?"
+  again=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/resumed.out")
+  echo "resumed run: $live; its journal replayed: $again"
+  [ "$again" = "$lhash $ltick" ] || fail "the resumed journal replays to '$again', the run ended at '$live'"
+  size=$(stat -c %s "$cut/journal.bin")
+  head -c $((size - 40)) "$rec/journal.bin" >"$cut/journal.bin"  # the end record and part of the last tick's
+  resume_run "$cut" "$work/cut_resume.log"
+  rc=$?
+  cat "$work/cut_resume.log" >>"$log"
+  [ $rc -eq 0 ] || fail "drape run --resume of a cut-off journal exited with $rc"
+  grep -q "$cut/journal.bin: byte [0-9]*: .*cut off" "$work/cut_resume.log" || fail "no cut-off message"
+  grep -q "resume: replayed 299 input records, 299 ticks" "$work/cut_resume.log" || fail "the cut journal did not replay to its last whole record"
+  echo "PASS"
+  exit 0
+fi
+
+if [ "$mode" = kill ]; then
+  # Kill recording runs at random moments within the uninterrupted run's duration.
+  killed=0 tries=0
+  while [ $killed -lt 5 ] && [ $tries -lt 12 ]; do
+    tries=$((tries + 1))
+    k=$work/kill$tries
+    delay=$(awk -v t="$run_secs" -v r="$RANDOM" 'BEGIN { printf "%.2f", t * (0.15 + 0.7 * r / 32768) }')
+    "$exe" xr --scenario assets/scenarios/record_replay.json --eye-size 64 --cloth-res 16 \
+      --record "$k" >"$work/kill$tries.log" 2>&1 &
+    pid=$!
+    sleep "$delay"
+    kill -KILL $pid 2>/dev/null
+    wait $pid 2>/dev/null
+    grep -q "^drape xr: final state hash" "$work/kill$tries.log" && continue  # ended first
+    [ -f "$k/journal.bin" ] || continue  # killed before the journal was opened
+    "$exe" replay "$k" >"$work/kill$tries.out" 2>"$work/kill$tries.err"
+    rc=$?
+    [ $rc -eq 0 ] || fail "replay of the journal killed after $delay s exited with $rc: $(cat "$work/kill$tries.err")"
+    got=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/kill$tries.out")
+    read -r khash ktick <<<"$got"
+    [ -n "$ktick" ] || fail "no hash from the killed journal's replay"
+    [ "$ktick" -gt 0 ] || continue  # killed before its first input record: nothing to compare
+    "$exe" replay "$rec" --until-tick "$ktick" --out "$work/until$tries.json" >"$work/until$tries.out" 2>&1 ||
+      fail "replay --until-tick $ktick exited with $?"
+    want=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/until$tries.out")
+    echo "killed after $delay s: journal to tick $ktick: $khash; uninterrupted at that tick: $want"
+    [ "$want" = "$khash $ktick" ] || fail "killed journal's state $khash at $ktick != uninterrupted $want"
+    killed=$((killed + 1))
+  done
+  [ $killed -ge 5 ] || fail "only $killed of $tries runs were killed mid-session"
+  echo "PASS"
+  exit 0
+fi
+
+# A journal cut off mid-record: the replay loads its whole records and says where it stops.
+cut=$work/cut
+mkdir -p "$cut"
+size=$(stat -c %s "$rec/journal.bin")
+head -c $((size - 13)) "$rec/journal.bin" >"$cut/journal.bin"
+"$exe" replay "$cut" >"$work/cut.out" 2>"$work/cut.err"
+rc=$?
+cat "$work/cut.err" >>"$log"
+[ $rc -eq 0 ] || fail "the cut-off journal's replay exited with $rc"
+grep -q "$cut/journal.bin: byte [0-9]*: .*cut off" "$work/cut.err" ||
+  fail "no cut-off message naming the byte offset: $(cat "$work/cut.err")"
+grep -q "^final state hash [0-9a-f]* at tick [0-9]*$" "$work/cut.out" || fail "no hash for the cut journal"
+
+# A bad header: an error naming the file and the field, exit 2.
+bad=$work/bad
+mkdir -p "$bad"
+printf 'NOTAJRNL\001\000\000\000' >"$bad/journal.bin"
+"$exe" replay "$bad" >/dev/null 2>"$work/bad.err"
+rc=$?
+cat "$work/bad.err" >>"$log"
+[ $rc -eq 2 ] || fail "a bad header's replay exited with $rc, not 2"
+grep -q "$bad/journal.bin: header field 'magic'" "$work/bad.err" || fail "bad header message: $(cat "$work/bad.err")"
+# A whole header whose field cannot describe a session: the file and the field named, exit 2.
+python3 - "$rec/journal.bin" "$bad/journal.bin" <<'PY' || fail "journal rewriter"
+import struct, sys, zlib
+d = open(sys.argv[1], "rb").read()
+n, = struct.unpack_from("<I", d, 12)
+p = d[20:20 + n]
+count, = struct.unpack_from("<I", p, 1)
+fields, i = {}, 5
+for _ in range(count):
+    kl, = struct.unpack_from("<I", p, i); k = p[i + 4:i + 4 + kl].decode(); i += 4 + kl
+    vl, = struct.unpack_from("<I", p, i); v = p[i + 4:i + 4 + vl].decode(); i += 4 + vl
+    fields[k] = v
+fields["resolution"] = "9999"
+q = bytes([1]) + struct.pack("<I", len(fields))
+for k, v in sorted(fields.items()):
+    q += struct.pack("<I", len(k)) + k.encode() + struct.pack("<I", len(v)) + v.encode()
+open(sys.argv[2], "wb").write(d[:12] + struct.pack("<II", len(q), zlib.crc32(q)) + q + d[20 + n:])
+PY
+"$exe" replay "$bad" >/dev/null 2>"$work/field.err"
+rc=$?
+cat "$work/field.err" >>"$log"
+[ $rc -eq 2 ] || fail "a bad header field's replay exited with $rc, not 2"
+grep -q "$bad/journal.bin: header field 'resolution': '9999'" "$work/field.err" ||
+  fail "bad field message: $(cat "$work/field.err")"
+echo "PASS"
