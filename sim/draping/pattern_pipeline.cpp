@@ -104,7 +104,7 @@ double garment_line_length(const Garment& g, int piece, const std::vector<Vec2>&
     }
   };
   double len = 0;
-  Vec3 prev;
+  Vec3 prev = Vec3::Zero();
   bool first = true;
   for (size_t i = 0; i + 1 < line.size(); ++i) {
     const int n = std::max(1, static_cast<int>(std::ceil((line[i + 1] - line[i]).norm() / 0.002)));
