@@ -44,7 +44,9 @@ TEST(Feedback, HelpFromTheCommandMapAndForTheFirstSeconds) {
   Feedback f;
   const auto help = drape::app::help_lines(drape::tracking::CommandMap::defaults());
   ASSERT_GT(help.size(), 5u);
-  EXPECT_TRUE(contains(help, "pin: right: thumb-middle pinch | thumbstick up | \"pin here\""))
+  EXPECT_TRUE(contains(help,
+                       "pin: right: thumb-middle pinch, palms together for 0.3 s (palm-only "
+                       "trackers) | thumbstick up | \"pin here\""))
       << help[3];
   EXPECT_TRUE(contains(help,
                        "help: left: palm up (held) | left: controller rolled palm up (held) | "
