@@ -229,7 +229,7 @@ const std::vector<std::string>& stress_case_names() {
 namespace {
 struct StepEnergy {
   double kinetic = 0, total = 0;  // J/kg: kinetic; kinetic + gravitational
-  double penetration = 0;         // m: the deepest vertex past the objects' offset
+  double penetration = 0;         // m: the deepest vertex below an object's surface
 };
 
 // A stress step's energies per unit mass and its deepest penetration; sets `why` when a vertex
@@ -239,7 +239,6 @@ struct StepEnergy {
 StepEnergy step_energy(const Cloth& cloth, const SceneObjects& obj, const char** why) {
   StepEnergy e;
   double m = 0;
-  const double off = obj.offset;
   for (int i = 0; i < cloth.num_vertices(); ++i) {
     const Vec3& x = cloth.state.x[i];
     if (x.norm() > 10.0) *why = "vertex beyond 10 m";
@@ -252,7 +251,7 @@ StepEnergy step_energy(const Cloth& cloth, const SceneObjects& obj, const char**
     if (obj.floor) depth = std::max(depth, -x.y());
     if (obj.form) {
       const double d = obj.form->signed_distance(x);
-      if (std::isfinite(d)) depth = std::max(depth, -d - off);
+      if (std::isfinite(d)) depth = std::max(depth, -d);
     }
     for (const Plate& p : obj.plates)  // a slab from centre.y - thickness up to centre.y
       if (std::abs(x.x() - p.centre.x()) < p.half_x && std::abs(x.z() - p.centre.z()) < p.half_z)

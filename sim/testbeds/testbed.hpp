@@ -63,9 +63,8 @@ double elastica_rigidity_for_drop(double l, double q, double tip_drop);
 // jerked at 10 m/s), "cuts" (random cuts on a dense cloth), "crush" (cloth between the form and
 // a rising plate). `scale` 1 = test size, larger = benchmark size (more steps, cuts, vertices).
 // A step fails when, after the solver (with its watchdog), a position is non-finite, a vertex
-// is beyond 10 m, or the kinetic energy exceeds 1e3 J/kg.
-// A stress case's outcome. `failures` counts steps with a non-finite state, a vertex beyond
-// 10 m or a kinetic energy above 1e3 J/kg; the other figures are what the tests bound.
+// is beyond 10 m, or the kinetic energy exceeds 1e3 J/kg; the other figures of the outcome are
+// what the tests bound.
 struct StressResult {
   int steps = 0;
   int failures = 0;
@@ -73,9 +72,9 @@ struct StressResult {
   int vertices = 0;
   double max_kinetic = 0;      // J/kg: the largest kinetic energy per unit mass
   double energy_growth = 0;    // J/kg: the largest rise of kinetic + gravitational energy per
-                               // unit mass over the lowest it had been, outside driven steps
+                               // unit mass over the lowest since the last driven step
   double max_penetration = 0;  // m: the deepest a vertex went below the floor, into the form or
-                               // into a plate, past the cloth's offset
+                               // into a plate (below its surface)
   std::string note;
 };
 StressResult run_stress_case(const std::string& name, const std::string& solver, int scale);

@@ -69,6 +69,18 @@ case $mode in
     rsvg-convert "$pat/pattern.svg" -o "$work/pattern.png" && [ -s "$work/pattern.png" ] ||
       fail "pattern.svg does not render"
     [ "$(grep -c "^Piece Name: Piece" "$pat/pattern.dxf")" -eq 2 ] || fail "pattern.dxf: not 2 pieces"
+    # ezdxf (Debian's python3-ezdxf, hence the system interpreter): two piece blocks inserted, each
+    # with one closed boundary polyline on layer 1.
+    /usr/bin/python3 - "$pat/pattern.dxf" <<'PY' || fail "pattern.dxf does not read back with ezdxf"
+import sys, ezdxf
+doc = ezdxf.readfile(sys.argv[1])
+inserts = [e for e in doc.modelspace() if e.dxftype() == "INSERT"]
+assert len(inserts) == 2, len(inserts)
+for ins in inserts:
+    bounds = [e for e in doc.blocks[ins.dxf.name] if e.dxftype() == "POLYLINE" and e.dxf.layer == "1"]
+    assert len(bounds) == 1 and bounds[0].is_closed, ins.dxf.name
+print("ezdxf: 2 pieces, each with a closed boundary")
+PY
     summary=$(grep "^drape run: exiting" "$log") || fail "no summary"
     echo "$summary"
     grep -q "voice commands 1" <<<"$summary" || fail "voice pin not heard"

@@ -30,7 +30,7 @@ TEST(Stress, DefaultSolverAndVbdHaveNoFailures) {
       // what the drag put in (its peak kinetic energy).
       const double bound = name == "jerk" ? r.max_kinetic : 2.0;
       EXPECT_LT(r.energy_growth, bound) << solver << " " << name;
-      // No vertex deeper than 5 mm into the floor, the form or the plate past the offset.
+      // No vertex deeper than 5 mm below the surface of the floor, the form or the plate.
       EXPECT_LT(r.max_penetration, 5e-3) << solver << " " << name;
     }
 }
