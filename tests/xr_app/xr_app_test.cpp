@@ -728,6 +728,29 @@ TEST(XrApp, EachGestureBindingReachesItsOperation) {
   EXPECT_TRUE(said("redo: pinch"));
 }
 
+namespace {
+// A scenario key of a hand at height 1.02 m, 0.21 m in front of the form, x across, pinching
+// (1) or open (0) at frame f.
+std::string palm_key(double x, int f, double pinch) {
+  char b[160];
+  std::snprintf(b, sizeof b,
+                "{\"frame\": %d, \"palm\": {\"position\": [%.2f, 1.02, 0.21]}, \"pinch\": %.1f}", f,
+                x, pinch);
+  return std::string(b);
+}
+
+// The session's triggers without their "frame N: " prefix, in order.
+std::vector<std::string> triggers_without_frames(const drape::app::XrAppResult& r) {
+  std::vector<std::string> got;
+  for (const auto& t : r.triggers) {
+    long long f = -1;
+    char rest[256] = {};
+    if (std::sscanf(t.c_str(), "frame %lld: %255[^\n]", &f, rest) == 2) got.push_back(rest);
+  }
+  return got;
+}
+}  // namespace
+
 // A hand whose controller is held: the runtime's joints for it (here a thumb-index pinch) make
 // no gesture, so only the controller's trigger pinches (no button fires twice); the other,
 // bare hand's pinch is a gesture as usual.
@@ -735,13 +758,7 @@ TEST(XrApp, HeldControllersJointsMakeNoGestures) {
   base_env();
   const fs::path dir = fresh_out_dir("app_held_controller");
   const std::string sc = (dir / "scenario.json").string();
-  auto hand = [](double x, int f, double pinch) {
-    char b[160];
-    std::snprintf(b, sizeof b,
-                  "{\"frame\": %d, \"palm\": {\"position\": [%.2f, 1.02, 0.21]}, \"pinch\": %.1f}",
-                  f, x, pinch);
-    return std::string(b);
-  };
+  const auto hand = palm_key;
   auto grip = [](int f, bool pulled) {
     return "{\"frame\": " + std::to_string(f) +
            ", \"grip\": {\"position\": [0.12, 1.02, 0.21]}, \"inputs\": {\"trigger/value\": " +
@@ -765,12 +782,7 @@ TEST(XrApp, HeldControllersJointsMakeNoGestures) {
   auto r = drape::app::run_xr_app(o);
   print(r);
   ASSERT_EQ(r.exit_code, 0) << r.error;
-  std::vector<std::string> got;
-  for (const auto& t : r.triggers) {
-    long long f = -1;
-    char rest[256] = {};
-    if (std::sscanf(t.c_str(), "frame %lld: %255[^\n]", &f, rest) == 2) got.push_back(rest);
-  }
+  const std::vector<std::string> got = triggers_without_frames(r);
   const std::vector<std::string> want = {
       "gesture pinch begin hand left -> pinch begin", "gesture pinch end hand left -> pinch end",
       "controller button.trigger begin hand right -> pinch begin",
@@ -787,13 +799,7 @@ TEST(XrApp, LostHandHoldsThePinchForTheGrace) {
   base_env();
   const fs::path dir = fresh_out_dir("app_tracking_loss");
   const std::string sc = (dir / "scenario.json").string();
-  auto hand = [](double x, int f, double pinch) {
-    char b[160];
-    std::snprintf(b, sizeof b,
-                  "{\"frame\": %d, \"palm\": {\"position\": [%.2f, 1.02, 0.21]}, \"pinch\": %.1f}",
-                  f, x, pinch);
-    return std::string(b);
-  };
+  const auto hand = palm_key;
   auto lost = [](int f) { return "{\"frame\": " + std::to_string(f) + ", \"tracked\": false}"; };
   // Right: pinch from frame 10; lost 31..40 (10 frames); back pinching 41..70; lost 71..130
   // (60 frames); back open from 131.
@@ -815,12 +821,7 @@ TEST(XrApp, LostHandHoldsThePinchForTheGrace) {
   for (const auto& m : r.log) std::printf("log: %s\n", m.c_str());
   ASSERT_EQ(r.exit_code, 0) << r.error;
   // One pinch begin (the gesture), no end: neither loss ends it from the app's side.
-  std::vector<std::string> got;
-  for (const auto& t : r.triggers) {
-    long long f = -1;
-    char rest[256] = {};
-    if (std::sscanf(t.c_str(), "frame %lld: %255[^\n]", &f, rest) == 2) got.push_back(rest);
-  }
+  const std::vector<std::string> got = triggers_without_frames(r);
   EXPECT_EQ(got, std::vector<std::string>{"gesture pinch begin hand right -> pinch begin"});
   auto count = [&](const std::string& m) {
     return std::count_if(r.log.begin(), r.log.end(),
