@@ -29,3 +29,13 @@ if(TARGET bullet_peer_bench)
            WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
   set_tests_properties(bench_bullet_peer_smoke PROPERTIES LABELS "bench")
 endif()
+# Smoke check of the thread rows (ctest, label "bench"): a tiny drape on 1 and 3 threads writes
+# out/bench/solvers_threads.csv with the columns and rows the many-core figures use
+# (bench/checks/thread_rows.cmake).
+if(TARGET solvers_bench)
+  add_test(NAME bench_solvers_thread_rows_smoke
+           COMMAND ${CMAKE_COMMAND} -DBIN=$<TARGET_FILE:solvers_bench>
+                   -DDIR=${CMAKE_BINARY_DIR}/bench_thread_rows -P
+                   ${CMAKE_CURRENT_SOURCE_DIR}/checks/thread_rows.cmake)
+  set_tests_properties(bench_solvers_thread_rows_smoke PROPERTIES LABELS "bench")
+endif()

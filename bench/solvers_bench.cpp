@@ -96,12 +96,22 @@ double cpu_ms() {
   return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
+// The thread rows' settings (flags --thread-counts, --thread-res, --thread-rounds,
+// --threads-default-only).
+struct ThreadRowsConfig {
+  std::vector<int> counts{1, 2, 4, 8, 16};  // threads of the default configuration
+  std::vector<int> res{128, 256};
+  std::optional<int> rounds;  // default: 3 up to 128^2, 1 above
+  bool default_only = false;  // no double-precision or AVX2 rows
+};
+
 // The benchmark grid's and the probe's knobs (command-line flags; `solvers_bench --help` lists
 // them). Unset optionals take the default named in their help: the solver's own or the scene's
 // value, or one that depends on where the knob is used.
 struct Knobs {
   // The benchmark grid (and the probe, where they apply).
   bool quick = false, sleep_only = false, threads_only = false;
+  ThreadRowsConfig thread_rows;
   int max_res = 64;
   std::optional<int> threads;    // solver threads: grid 1, probe 2, the probe's --finish pool 1
   std::optional<int> ref_iters;  // Newton iterations: polish 300, contact scenes' reference 150
@@ -871,89 +881,116 @@ void sleep_rows(const Knobs& kn, int sres) {
     std::printf("    cost at rest without / with freezing = %.1fx\n", rest[0] / rest[1]);
 }
 
-void thread_rows(int max_res) {
-  // Threads and precision: the default solver 10x1 on the form scene with 1 and 2 threads
-  // (colour-parallel, same result), wall and CPU ms per frame at 128^2 and 256^2, with XPBD's
-  // kernels in single precision (the default) and in double, side by side; on a CPU with AVX-512
-  // also the single precision kernels of the AVX2 build (what a CPU without AVX-512 runs). The
-  // benchmark's other rows are CPU time of one thread (the machine may be shared); these are the
-  // wall time one frame takes on one and two cores. A shared host's speed drifts by tens of %
-  // within minutes, so at 128^2 the configurations run interleaved in three rounds and each row is
-  // the median of its three (256^2: one round).
+// The machine's CPU model (Linux: /proc/cpuinfo's first "model name"; empty elsewhere).
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
+      std::string m = line.substr(line.find(':') + 1);
+      m.erase(0, m.find_first_not_of(' '));
+      return m;
+    }
+  return "";
+}
+
+// One timed drape for the thread rows: wall ms for all frames, CPU ms, the first frame's ms.
+struct ThreadRun {
+  double wall = 0, cpu = 0, steady = 0, first = 0;
+  std::string kernels;
+};
+ThreadRun timed_drape(int res, int threads, bool dbl, const std::string& kernels,
+                      std::optional<int> frames_cap) {
+  Testbed sc = make_scene("form", res);
+  SolverConfig cfg;
+  cfg.substeps = 10;
+  cfg.threads = threads;
+  cfg.air_drag = sc.air_drag;
+  auto s = make_solver("default", cfg);
+  if (auto* xp = xpbd_of(s->get())) {
+    xp->options().single_precision = !dbl;
+    xp->options().kernels = kernels;
+  }
+  const int frames =
+      std::max(2, frames_cap.value_or(static_cast<int>(std::lround(sc.duration * 90))));
+  const double c0 = cpu_ms();
+  const auto w0 = std::chrono::steady_clock::now();
+  (*s)->step(sc.cloth, sc.objects, 1.0 / 90);  // the first frame cooks the solver
+  const auto w1 = std::chrono::steady_clock::now();
+  for (int f = 1; f < frames; ++f) (*s)->step(sc.cloth, sc.objects, 1.0 / 90);
+  const auto w2 = std::chrono::steady_clock::now();
+  auto ms = [](auto d) { return std::chrono::duration<double, std::milli>(d).count(); };
+  ThreadRun r{ms(w2 - w0) / frames, (cpu_ms() - c0) / frames, ms(w2 - w1) / (frames - 1),
+              ms(w1 - w0), ""};
+  if (auto* xp = xpbd_of(s->get())) r.kernels = xp->kernels().name;
+  return r;
+}
+
+void thread_rows(int max_res, const ThreadRowsConfig& tr, std::optional<int> frames_cap) {
+  // Threads and precision: the default solver 10x1 on the form scene (the 3-s drape) with 1, 2,
+  // 4, 8 and 16 threads (the element sweep in one share per thread, the same result), wall and
+  // CPU ms per frame at 128^2 and 256^2, with XPBD's kernels in single precision (the default);
+  // at 1 and 2 threads also the double kernels and, on a CPU with AVX-512, the single precision
+  // kernels of the AVX2 build (what a CPU without AVX-512 runs). The wall time is what one frame
+  // takes; threads beyond the machine's cores (the file's `cores`) take turns on them. A shared
+  // host's speed drifts by tens of % within minutes, so the configurations run interleaved in
+  // rounds (3 up to 128^2, 1 above, unless --thread-rounds) and each row is the median of its
+  // rounds. Speed-up and parallel efficiency are against the same configuration on one thread.
+  const unsigned cores = std::thread::hardware_concurrency();
+  const std::string cpu = cpu_model();
   std::ofstream tc("out/bench/solvers_threads.csv");
-  tc << "scene,solver,resolution,substeps,threads,precision,kernels,runs,wall_ms_per_frame,"
-        "cpu_ms_per_frame,steady_wall_ms_per_frame,first_frame_ms\n";
+  tc << "scene,solver,resolution,substeps,threads,cores,precision,kernels,runs,ms_per_frame,"
+        "cpu_ms_per_frame,steady_ms_per_frame,first_frame_ms,speedup,efficiency,cpu\n";
+  std::printf("threads  machine: %u cores, %s\n", cores, cpu.c_str());
   struct Config {
     bool dbl;
     std::string kernels;  // XpbdOptions::kernels ("": the fastest build)
+    std::vector<int> threads;
   };
-  std::vector<Config> configs{{false, ""}};
-  if (std::string(xpbd::kernels().name) == "avx512") configs.push_back({false, "avx2"});
-  configs.push_back({true, ""});
-  const int nc = static_cast<int>(configs.size());
-  for (int res : {128, 256}) {
+  std::vector<Config> configs{{false, "", tr.counts}};
+  if (!tr.default_only) {
+    if (std::string(xpbd::kernels().name) == "avx512") configs.push_back({false, "avx2", {1, 2}});
+    configs.push_back({true, "", {1, 2}});
+  }
+  for (int res : tr.res) {
     if (res > max_res) continue;
-    const int rounds = res <= 128 ? 3 : 1;
-    // [2 c + threads - 1]
-    std::vector<std::vector<double>> wall_runs(2 * nc), cpu_runs(2 * nc), steady_runs(2 * nc),
-        first_runs(2 * nc);
-    std::vector<std::string> used(nc);
+    const int rounds = tr.rounds.value_or(res <= 128 ? 3 : 1);
+    std::map<std::pair<int, int>, std::vector<ThreadRun>> runs;  // (config, threads)
     for (int round = 0; round < rounds; ++round)
-      for (int c = 0; c < nc; ++c)
-        for (int threads : {1, 2}) {
-          Testbed sc = make_scene("form", res);
-          SolverConfig cfg;
-          cfg.substeps = 10;
-          cfg.threads = threads;
-          cfg.air_drag = sc.air_drag;
-          auto s = make_solver("default", cfg);
-          if (auto* xp = xpbd_of(s->get())) {
-            xp->options().single_precision = !configs[c].dbl;
-            xp->options().kernels = configs[c].kernels;
-          }
-          const int frames = static_cast<int>(std::lround(sc.duration * 90));
-          const double c0 = cpu_ms();
-          const auto w0 = std::chrono::steady_clock::now();
-          (*s)->step(sc.cloth, sc.objects, 1.0 / 90);  // the first frame cooks the solver
-          const auto w1 = std::chrono::steady_clock::now();
-          for (int f = 1; f < frames; ++f) (*s)->step(sc.cloth, sc.objects, 1.0 / 90);
-          const auto w2 = std::chrono::steady_clock::now();
-          auto ms = [](auto d) { return std::chrono::duration<double, std::milli>(d).count(); };
-          wall_runs[2 * c + threads - 1].push_back(ms(w2 - w0) / frames);
-          steady_runs[2 * c + threads - 1].push_back(ms(w2 - w1) / (frames - 1));
-          first_runs[2 * c + threads - 1].push_back(ms(w1 - w0));
-          cpu_runs[2 * c + threads - 1].push_back((cpu_ms() - c0) / frames);
-          if (auto* xp = xpbd_of(s->get())) used[c] = xp->kernels().name;
-        }
-    auto median = [](std::vector<double> v) {
-      std::sort(v.begin(), v.end());
-      return v[v.size() / 2];
+      for (size_t c = 0; c < configs.size(); ++c)
+        for (int threads : configs[c].threads)
+          runs[{static_cast<int>(c), threads}].push_back(
+              timed_drape(res, threads, configs[c].dbl, configs[c].kernels, frames_cap));
+    auto median = [](const std::vector<ThreadRun>& v, double ThreadRun::*f) {
+      std::vector<double> x;
+      for (const ThreadRun& r : v) x.push_back(r.*f);
+      std::sort(x.begin(), x.end());
+      return x[x.size() / 2];
     };
-    std::vector<double> wall_of(2 * nc);
-    for (int c = 0; c < nc; ++c)
-      for (int threads : {1, 2}) {
-        const double wall = median(wall_runs[2 * c + threads - 1]);
-        const double cpu = median(cpu_runs[2 * c + threads - 1]);
-        const double steady = median(steady_runs[2 * c + threads - 1]);
-        const double first = median(first_runs[2 * c + threads - 1]);
-        wall_of[2 * c + threads - 1] = wall;
+    std::printf("threads  %4d^2 %s 10x1: %-7s %-6s %7s %10s %10s %10s %10s %8s %6s\n", res,
+                kDefaultSolver, "prec", "simd", "threads", "ms/frame", "CPU ms", "steady",
+                "first ms", "speedup", "eff");
+    for (size_t c = 0; c < configs.size(); ++c) {
+      const double one = runs.count({static_cast<int>(c), 1})
+                             ? median(runs[{static_cast<int>(c), 1}], &ThreadRun::wall)
+                             : 0.0;
+      for (int threads : configs[c].threads) {
+        const auto& v = runs[{static_cast<int>(c), threads}];
+        const double wall = median(v, &ThreadRun::wall);
+        const double speedup = one > 0 ? one / wall : 0.0, eff = speedup / threads;
         const char* prec = configs[c].dbl ? "double" : "single";
         std::printf(
-            "threads  %4d %s 10x1 %s (%s), %d thread%s: %8.3f ms/frame wall, %8.3f ms CPU; "
-            "steady %8.3f ms/frame wall (first frame, with the setup: %.1f ms) (median of %d)\n",
-            res, kDefaultSolver, prec, used[c].c_str(), threads, threads > 1 ? "s" : "", wall, cpu,
-            steady, first, rounds);
-        tc << "form," << kDefaultSolver << "," << res << ",10," << threads << "," << prec << ","
-           << used[c] << "," << rounds << "," << wall << "," << cpu << "," << steady << "," << first
+            "threads  %4d^2 %s 10x1: %-7s %-6s %7d %10.3f %10.3f %10.3f %10.1f %7.2fx %5.0f%%\n",
+            res, kDefaultSolver, prec, v[0].kernels.c_str(), threads, wall,
+            median(v, &ThreadRun::cpu), median(v, &ThreadRun::steady), median(v, &ThreadRun::first),
+            speedup, 100 * eff);
+        tc << "form," << kDefaultSolver << "," << res << ",10," << threads << "," << cores << ","
+           << prec << "," << v[0].kernels << "," << rounds << "," << wall << ","
+           << median(v, &ThreadRun::cpu) << "," << median(v, &ThreadRun::steady) << ","
+           << median(v, &ThreadRun::first) << "," << speedup << "," << eff << ",\"" << cpu << "\""
            << std::endl;
       }
-    const int d = nc - 1;  // the double row
-    std::printf("    ratio double / single precision = %.2fx (1 thread), %.2fx (2 threads)\n",
-                wall_of[2 * d] / wall_of[0], wall_of[2 * d + 1] / wall_of[1]);
-    if (nc == 3)
-      std::printf(
-          "    ratio avx2 / avx512 kernels (single) = %.2fx (1 thread), %.2fx (2 threads)\n",
-          wall_of[2] / wall_of[0], wall_of[3] / wall_of[1]);
+    }
   }
 }
 
@@ -983,6 +1020,18 @@ void add_knobs(CLI::App& app, Knobs& kn, std::string& simd) {
                "only the sleeping rows (out/bench/solvers_sleep.csv)");
   app.add_flag("--threads-only", kn.threads_only,
                "only the thread and precision rows (out/bench/solvers_threads.csv)");
+  app.add_option("--thread-counts", kn.thread_rows.counts,
+                 "the thread rows' thread counts (the default configuration; 1,2,4)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 64));
+  app.add_option("--thread-res", kn.thread_rows.res, "the thread rows' form resolutions (128,256)")
+      ->delimiter(',')
+      ->check(CLI::Range(2, 1024));
+  app.add_option("--thread-rounds", kn.thread_rows.rounds,
+                 "the thread rows' rounds, each row the median (default: 3 up to 128^2, 1 above)")
+      ->check(CLI::Range(1, 100));
+  app.add_flag("--threads-default-only", kn.thread_rows.default_only,
+               "the thread rows without the double-precision and AVX2 rows");
   app.add_option("--simd", simd,
                  "the widest SIMD build XPBD's kernels may use: none (portable), avx2, widest "
                  "(the CPU's widest: avx512 where it has it)")
@@ -1172,7 +1221,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (kn.threads_only) {  // the thread and precision rows alone (out/bench/solvers_threads.csv)
-    thread_rows(std::max(max_res, 256));
+    thread_rows(std::max(max_res, 256), kn.thread_rows, kn.frames);
     return 0;
   }
   std::vector<Row> rows;
@@ -1309,7 +1358,7 @@ int main(int argc, char** argv) {
          << det << "," << pairs << std::endl;
     }
   }
-  if (!quick && max_res >= 128) thread_rows(max_res);
+  if (!quick && max_res >= 128) thread_rows(max_res, kn.thread_rows, kn.frames);
   int top = 0;  // the chart: the finest form resolution that is scored (not time only)
   for (const auto& j : jobs)
     if (j.scene == "form" && j.error) top = std::max(top, j.res);

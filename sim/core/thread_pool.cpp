@@ -125,11 +125,12 @@ void ThreadPool::run(int n, Thunk thunk, void* ctx, int chunks) {
 
 // Chunk k's start: each half of the range is split in chunks that halve toward the middle
 // (1/2, 1/4, ... of the half, the last two equal), so that the threads, taking chunks from
-// opposite ends, meet on small ones.
+// opposite ends, meet on small ones. With as many chunks as items (parallel_slots: one slot per
+// thread) each chunk is one item.
 int ThreadPool::chunk_start(int k) const {
   const int m = chunks_.load(std::memory_order_relaxed);
   const int64_t n = n_;
-  if (m < 4 || m % 2) return static_cast<int>(n * k / m);
+  if (m < 4 || m % 2 || m == n) return static_cast<int>(n * k / m);  // (one item per chunk)
   const int c = m / 2;
   const int64_t h1 = n / 2, h2 = n - h1;
   if (k <= c) return static_cast<int>(k == c ? h1 : h1 - (h1 >> k));

@@ -47,13 +47,26 @@ void apply_order(std::vector<T>& items, const std::vector<int>& order) {
 }  // namespace
 
 void XpbdSolver::cook(const Cloth& cloth) {
+  // Each part's wall time (last_cook(): what a re-cook after a cut costs, and where).
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point& t) {
+    const auto now = Clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+    return ms;
+  };
+  auto t = Clock::now();
+  CookStats st;
   // XPBD projects the bending rows and never evaluates P (EnergyOptions::bending_matrix).
   EnergyOptions eo = opt_.energy;
   eo.bending_matrix = false;
   energy_.build(cloth, eo, pool_.get());
+  st.energy_ms = since(t);
   const int n = cloth.num_vertices();
   cook_triangles(cloth);
+  st.triangles_ms = since(t);
   cook_bending(n);
+  st.bending_ms = since(t);
   cook_hinges_springs(n);
   const int S = scratch_slots_;
   lambda_tri_.assign(3 * tris_.size(), 0.0);
@@ -65,10 +78,16 @@ void XpbdSolver::cook(const Cloth& cloth) {
   anchors_.clear();  // renewed at the next step
   tri_anchor8_.assign(static_cast<size_t>(6 * tlanes_) * float_tri_packs(), 0.0f);
   row_anchor8_.assign(72 * static_cast<size_t>(row_packs8_.packs()), 0.0f);
+  st.other_ms = since(t);
   build_sweep(n);
+  st.sweep_ms = since(t);
   w_.assign(n, -1.0);  // no valid inverse mass: the first set_w() marks w changed
   w0_.assign(n, -1.0);
   cook_pieces(n);
+  st.other_ms += since(t);
+  st.total_ms = st.energy_ms + st.triangles_ms + st.bending_ms + st.sweep_ms + st.other_ms;
+  st.cooks = last_cook_.cooks + 1;
+  last_cook_ = st;
 }
 
 // The triangles' constraint data, sorted by colour and packed for the kernels.
@@ -319,24 +338,25 @@ double XpbdSolver::cooked_bending_energy(const std::vector<Vec3>& x) const {
   return e;
 }
 
+// The sweep's phases (xpbd_sweep.hpp): the prediction with the packing over vertex blocks, each
+// triangle colour's packs, each bending colour's packs, the unpacking over vertex blocks; split
+// in one share per pool thread (the packs' padding shares, scratch_slots_).
 void XpbdSolver::build_sweep(int n) {
   sweep_.clear();
   const bool padded = !tris_.empty() || row_off_.size() > 1;
   if (!cooked_f32_ || !padded) return;
   const int blocks = (n + kSweepBlock - 1) / kSweepBlock;
-  auto add = [&](int kind, int b, int e) {
-    sweep_.push_back(SweepPhase{kind, b, e, xpbd::share_begin(e - b, 1, 2), {0, 0}});
-  };
-  add(kSweepPack, 0, blocks);
+  sweep_.add_phase(kSweepPack, 0, blocks);
   for (size_t c = 0; c + 1 < tpack8_col_.size(); ++c)
-    add(kSweepTris, tpack8_col_[c], tpack8_col_[c + 1]);
+    sweep_.add_phase(kSweepTris, tpack8_col_[c], tpack8_col_[c + 1]);
   for (size_t c = 0; c + 1 < rpack8_col_.size(); ++c)
-    add(kSweepRows, rpack8_col_[c], rpack8_col_[c + 1]);
-  add(kSweepUnpack, 0, blocks);
-  // The vertices of item i of a phase (the scratch vertices n, n + 1 of padding lanes left out:
-  // each half of a phase's packs has its own).
-  auto for_vertices = [&](const SweepPhase& P, int i, auto&& fn) {
-    switch (P.kind) {
+    sweep_.add_phase(kSweepRows, rpack8_col_[c], rpack8_col_[c + 1]);
+  sweep_.add_phase(kSweepUnpack, 0, blocks);
+  // The vertices of item i of a phase (the scratch vertices n, n + 1, ... of padding lanes left
+  // out: each share of a phase's packs has its own).
+  const auto& phases = sweep_.phases();
+  sweep_.plan(scratch_slots_, n, [&](int p, int i, auto&& fn) {
+    switch (phases[p].kind) {
       case kSweepPack:
       case kSweepUnpack:
         for (int v = i * kSweepBlock; v < std::min(n, (i + 1) * kSweepBlock); ++v) fn(v);
@@ -355,33 +375,7 @@ void XpbdSolver::build_sweep(int n) {
             if (v < n) fn(v);
           }
     }
-  };
-  std::vector<int> mark(n, -1);
-  for (size_t p = 0; p < sweep_.size(); ++p) {
-    SweepPhase& P = sweep_[p];
-    const int cnt[2] = {P.half, P.e - P.b - P.half};
-    if (p == 0) {  // (the sweep starts after a barrier)
-      P.safe[0] = cnt[0];
-      P.safe[1] = cnt[1];
-      continue;
-    }
-    const SweepPhase& Q = sweep_[p - 1];
-    for (int t = 0; t < 2; ++t) {
-      // The vertices of the other slot's half of the previous phase ...
-      const int stamp = static_cast<int>(2 * p + t);
-      const int ob = t == 0 ? Q.b + Q.half : Q.b, oe = t == 0 ? Q.e : Q.b + Q.half;
-      for (int i = ob; i < oe; ++i) for_vertices(Q, i, [&](int v) { mark[v] = stamp; });
-      // ... and this slot's items from its outer end up to the first one touching them.
-      int safe = 0;
-      for (; safe < cnt[t]; ++safe) {
-        const int i = t == 0 ? P.b + safe : P.e - 1 - safe;
-        bool hit = false;
-        for_vertices(P, i, [&](int v) { hit = hit || mark[v] == stamp; });
-        if (hit) break;
-      }
-      P.safe[t] = safe;
-    }
-  }
+  });
 }
 
 bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
@@ -701,12 +695,12 @@ void XpbdSolver::plan_substep(Step& c) {
   const EnergyOptions& eo = energy_.options();
   c.gravity_only = !(eo.pressure > 0 && c.scene.form);
   c.gk = eo.gravity ? eo.g : Vec3::Zero();
-  // The whole substep in one sweep (SweepPhase: the prediction with the packing, the elements,
+  // The whole substep in one sweep (xpbd_sweep.hpp: the prediction with the packing, the elements,
   // the unpacking with the contacts, velocities and motion sums) where it applies: single
   // precision, one iteration, no warm start, no self-collision, bending in this substep.
-  c.fused = c.padded && cooked_f32_ && !sweep_.empty() && pool_->size() <= 2 &&
-            opt_.iterations == 1 && !c.warm && !c.scene.self_collision && hinges_.empty() &&
-            springs_.empty() && c.bending();
+  c.fused = c.padded && cooked_f32_ && !sweep_.empty() &&
+            pool_->size() <= xpbd::SweepPlan::kMaxSlots && opt_.iterations == 1 && !c.warm &&
+            !c.scene.self_collision && hinges_.empty() && springs_.empty() && c.bending();
   // With contacts reused, the sweep tests again each vertex that moved more than half the margin
   // since its own last test (a detection of all vertices happens only at a frame's start);
   // otherwise such a vertex makes the next substep detect all of them again. (Only when every
@@ -714,10 +708,11 @@ void XpbdSolver::plan_substep(Step& c) {
   // contact list, which lists the tested contacts only at the step's end.)
   c.retest = c.fused && c.be == 1 && opt_.reuse_contacts && opt_.retest_contacts && c.s + 1 < c.ns;
   c.test_moved = opt_.reuse_contacts && c.s + 1 < c.ns && !c.retest;
-  moved_part_.assign(pool_->size(), 0);
+  const int slots = std::max(pool_->size(), scratch_slots_);  // pool threads or sweep slots
+  moved_part_.assign(slots, 0);
   if (c.retest) {
-    retest_part_.assign(2, RetestPart{});
-    unsettle_mark_.assign(2 * static_cast<size_t>(rest_.num_pieces()), 0);
+    retest_part_.assign(slots, RetestPart{});
+    unsettle_mark_.assign(static_cast<size_t>(slots) * rest_.num_pieces(), 0);
   }
   c.settle_check = opt_.settle && rest_.settle_scale() > 1.0;
   if (c.fused && (opt_.settle || opt_.freeze))
@@ -1054,8 +1049,9 @@ void XpbdSolver::block_motion(const Step& c, int k, int b, int e) {
   }
 }
 
-// The element sweep (SweepPhase): items [b, e) of phase P.
-void XpbdSolver::sweep_items(const Step& c, const SweepPhase& P, int b, int e, int slot) {
+// The element sweep (xpbd_sweep.hpp): items [b, e) of phase P, run by sweep slot `slot`.
+void XpbdSolver::sweep_items(const Step& c, const xpbd::SweepPlan::Phase& P, int b, int e,
+                             int slot) {
   if (b >= e) return;
   const int n = c.n;
   const xpbd::Kernels& K = c.K;
@@ -1087,87 +1083,39 @@ void XpbdSolver::sweep_items(const Step& c, const SweepPhase& P, int b, int e, i
 }
 
 void XpbdSolver::sweep(const Step& c) {
-  const int np = static_cast<int>(sweep_.size());
+  auto items = [&](const xpbd::SweepPlan::Phase& P, int b, int e, int slot) {
+    sweep_items(c, P, b, e, slot);
+  };
   if (!sweep_parallel_) {
-    for (const SweepPhase& P : sweep_) sweep_items(c, P, P.b, P.e, 0);
+    for (const auto& P : sweep_.phases()) items(P, P.b, P.e, 0);
     return;
   }
   ++sweeps_;
-  sweep_done_[0].store(0, std::memory_order_relaxed);
-  sweep_done_[1].store(0, std::memory_order_relaxed);
-  sweep_owner_.store(-1, std::memory_order_relaxed);
-  int phase[2] = {0, 0}, stage[2] = {0, 0};  // where each slot is
-  bool taken_over = false;
-  // Runs slot t until it is done, or (wait = false) until it would wait for the other slot.
-  // With wait, slot 0 takes slot 1 over when nobody has claimed it (a worker not scheduled).
-  auto run_slot = [&](int t, bool wait) {
-    const int o = 1 - t;
-    auto ready = [&](int q) {
-      if (q <= 0 || sweep_done_[o].load(std::memory_order_acquire) >= q) return true;
-      if (!wait) return false;
-      for (int spin = 0;; ++spin) {
-        if (sweep_done_[o].load(std::memory_order_acquire) >= q) return true;
-        if (t == 0) {
-          int nobody = -1;
-          if (sweep_owner_.load(std::memory_order_relaxed) == -1 &&
-              sweep_owner_.compare_exchange_strong(nobody, 0, std::memory_order_acq_rel)) {
-            taken_over = true;
-            return false;
-          }
-        }
-        if (spin > 256) std::this_thread::yield();
-      }
-    };
-    while (phase[t] < np) {
-      const SweepPhase& P = sweep_[phase[t]];
-      const int mb = P.b + P.half;  // slot 1's first item
-      if (stage[t] == 0) {
-        if (!ready(phase[t] - 1)) return;
-        if (t == 0)
-          sweep_items(c, P, P.b, P.b + P.safe[0], t);
-        else
-          sweep_items(c, P, P.e - P.safe[1], P.e, t);
-        stage[t] = 1;
-      }
-      const int rb = t == 0 ? P.b + P.safe[0] : mb, re = t == 0 ? mb : P.e - P.safe[1];
-      if (rb < re) {
-        if (!ready(phase[t])) return;
-        sweep_items(c, P, rb, re, t);
-      }
-      stage[t] = 0;
-      sweep_done_[t].store(++phase[t], std::memory_order_release);
-    }
+  // A pool thread other than the caller claims its share unless a test plays it absent.
+  auto claims = [&](int wk) {
+    return wk == 0 || (opt_.sweep_worker && wk != opt_.sweep_absent_worker);
   };
-  pool_->parallel_slots([&](int slot, int wk) {
-    if (slot == 1) {
-      int nobody = -1;
-      if ((opt_.sweep_worker || wk == 0) &&
-          sweep_owner_.compare_exchange_strong(nobody, wk, std::memory_order_acq_rel))
-        run_slot(1, true);
-      return;
-    }
-    if (slot != 0) return;
-    run_slot(0, true);
-    if (!taken_over) return;
-    // Both slots on this thread: alternate, each up to where it needs the other.
-    while (phase[0] < np || phase[1] < np) {
-      run_slot(1, false);
-      run_slot(0, false);
-    }
-    ++sweep_takeovers_;
-  });
+  if (sweep_.run(*pool_, items, claims)) ++sweep_takeovers_;
 }
 
 // The sweep's contact retests: counted, their deepest penetration, the settling they end.
 void XpbdSolver::collect_retests(Step& c) {
-  if (!c.retest || retest_part_[0].count + retest_part_[1].count == 0) return;
+  if (!c.retest) return;
+  long count = 0;
+  for (const RetestPart& rp : retest_part_) {
+    count += rp.count;
+    c.st.max_penetration = std::max(c.st.max_penetration, rp.deepest);
+  }
+  if (count == 0) return;
   contacts_unlisted_ = true;  // (listed after the last substep)
-  contact_retests_ += retest_part_[0].count + retest_part_[1].count;
-  c.st.max_penetration =
-      std::max({c.st.max_penetration, retest_part_[0].deepest, retest_part_[1].deepest});
-  const int pieces = rest_.num_pieces();
-  for (int p = 0; p < pieces; ++p)
-    if (unsettle_mark_[p] || unsettle_mark_[static_cast<size_t>(pieces) + p]) rest_.unsettle(p);
+  contact_retests_ += count;
+  const size_t pieces = rest_.num_pieces();
+  for (size_t p = 0; p < pieces; ++p)
+    for (size_t k = p; k < unsettle_mark_.size(); k += pieces)
+      if (unsettle_mark_[k]) {
+        rest_.unsettle(static_cast<int>(p));
+        break;
+      }
 }
 
 void XpbdSolver::update_pieces(Step& c) {

@@ -6,10 +6,10 @@
 // contacts are projected.
 // The element data are cooked once per topology into flat arrays sorted by colour (elements
 // of one colour share no vertex); a substep runs on the thread pool as one element sweep
-// (SweepPhase) or, in the configurations the sweep does not serve, one pool call per colour.
-// A step runs as named phases on one context (Step): begin_frame (wake, static finish, settling
-// checks) and renew_anchors once per frame; per substep detect_contacts, set_masses,
-// plan_substep, predict, warm_start, then either the sweep or project_triangles and
+// (xpbd::SweepPlan, xpbd_sweep.hpp) or, in the configurations the sweep does not serve, one pool
+// call per colour. A step runs as named phases on one context (Step): begin_frame (wake, static
+// finish, settling checks) and renew_anchors once per frame; per substep detect_contacts,
+// set_masses, plan_substep, predict, warm_start, then either the sweep or project_triangles and
 // project_bending_springs with velocities, and last update_pieces and schedule_rest. The pieces'
 // sleep, settling, coarse correction and finish are xpbd::RestScheduler's (xpbd_rest.hpp).
 #pragma once
@@ -27,6 +27,7 @@
 #include "sim/solvers/xpbd/xpbd_kernels.hpp"
 #include "sim/solvers/xpbd/xpbd_options.hpp"
 #include "sim/solvers/xpbd/xpbd_rest.hpp"
+#include "sim/solvers/xpbd/xpbd_sweep.hpp"
 
 namespace drape::sim {
 
@@ -42,12 +43,21 @@ class XpbdSolver : public Solver {
   int contact_detections() const { return detections_; }
   // Single precision: how many times the anchors were renewed (XpbdOptions::single_precision).
   long anchor_renewals() const { return anchor_renewals_; }
-  // Element sweeps run on two threads, and those in which the caller ran both halves itself
-  // (the worker had not claimed its half when the caller needed it).
+  // Element sweeps run on several threads, and those in which a thread took over the share of
+  // another (a worker had not claimed its share when it was needed).
   long sweeps() const { return sweeps_; }
   long sweep_takeovers() const { return sweep_takeovers_; }
   // Vertices tested again for contact in the sweep (XpbdOptions::retest_contacts).
   long contact_retests() const { return contact_retests_; }
+  // The last cook of a topology (the first step, and the step after a cut, slit or sew): wall ms
+  // of its parts (the energy's build, the triangles' packs, the bending blocks and their packs,
+  // the sweep's plan, the rest) and the cooks so far.
+  struct CookStats {
+    double energy_ms = 0, triangles_ms = 0, bending_ms = 0, sweep_ms = 0, other_ms = 0,
+           total_ms = 0;
+    int cooks = 0;
+  };
+  const CookStats& last_cook() const { return last_cook_; }
   // The energy as the solver cooked it (its contacts: those of the last step).
   const ClothEnergy& energy() const { return energy_; }
   // The bending energy of positions x as the cooked blocks state it (1/2 sum_r |V_r x|^2 k_r;
@@ -97,7 +107,6 @@ class XpbdSolver : public Solver {
   // The names one step shares between its phases (solver_xpbd.cpp): the cloth, the substep's
   // length and what it runs.
   struct Step;
-  struct SweepPhase;  // below
 
   // Cooking: the element data of a new topology (cook() and its parts).
   void cook(const Cloth& cloth);
@@ -116,7 +125,7 @@ class XpbdSolver : public Solver {
   void plan_substep(Step& c);
   void predict(const Step& c, int b, int e);
   void warm_start(Step& c);
-  void sweep(const Step& c);  // the whole substep as one element sweep (SweepPhase)
+  void sweep(const Step& c);  // the whole substep as one element sweep (xpbd_sweep.hpp)
   void collect_retests(Step& c);
   void project_triangles(const Step& c);  // and the bending blocks (packed alike)
   void project_bending_springs(Step& c);  // hinges, springs, contacts, self-collision
@@ -131,7 +140,7 @@ class XpbdSolver : public Solver {
   void warm_hinges(const Step& c, int b, int e);
   void warm_rows(const Step& c, int b, int e);
   void warm_springs(const Step& c, int b, int e);
-  void sweep_items(const Step& c, const SweepPhase& P, int b, int e, int slot);
+  void sweep_items(const Step& c, const xpbd::SweepPlan::Phase& P, int b, int e, int slot);
   void project_tris8(const Step& c, int b, int e);
   void project_rows8(const Step& c, int b, int e);
   void project_hinges(const Step& c, int b, int e);
@@ -216,26 +225,13 @@ class XpbdSolver : public Solver {
     return static_cast<int>(tlanes_ == 16 ? tri_packs16_.size() : tri_packs8_.size());
   }
   // The single-precision element sweep of a substep (pack, the triangle colours, the bending
-  // colours, unpack) as phases that two threads run without a barrier between them: in each
-  // phase slot 0 runs the first half of the items (vertex blocks or packs, which are in mesh
-  // order) and slot 1 the second; a slot runs the items of its half that share no vertex with
-  // the other slot's half of the previous phase (safe, counted from the outer end: slot 0 from
-  // the front, slot 1 from the back) without waiting, and waits for the other slot to finish
-  // the previous phase only before the rest (near the middle). No slot starts a phase before the
-  // other has finished the one before the previous. Every item thus sees what it would see after
-  // a barrier between the phases: the results are those of the phases run one after the other,
-  // bit for bit. Built by build_sweep() in cook(); run by sweep() (step()).
-  struct SweepPhase {
-    int kind;     // kSweepPack, kSweepTris, kSweepRows, kSweepUnpack
-    int b, e;     // items: vertex blocks (kSweepBlock vertices) or packs
-    int half;     // slot 0: [b, b + half), slot 1: [b + half, e)
-    int safe[2];  // slot 0: [b, b + safe[0]); slot 1: [e - safe[1], e)
-  };
+  // colours, unpack) as phases that the pool's threads run without a barrier between them, each
+  // phase split in one share per thread, items in mesh order (xpbd_sweep.hpp: a share waits
+  // only for the shares of the previous phase it touches). The results are those of the phases
+  // run one after the other, bit for bit. Built by build_sweep() in cook(); run by sweep().
   enum { kSweepPack, kSweepTris, kSweepRows, kSweepUnpack };
   static constexpr int kSweepBlock = 256;
-  std::vector<SweepPhase> sweep_;
-  std::atomic<int> sweep_done_[2] = {};  // phases a slot has finished
-  std::atomic<int> sweep_owner_{-1};     // the thread running slot 1 (-1: nobody yet)
+  xpbd::SweepPlan sweep_;
   long sweeps_ = 0, sweep_takeovers_ = 0, contact_retests_ = 0;
   // Per sweep slot: vertices tested again for contact and their deepest penetration; pieces a
   // test ends the settling of (slot * pieces + piece).
@@ -248,9 +244,9 @@ class XpbdSolver : public Solver {
   // projects the tested ones, ClothEnergy::project_tested_contacts): listed at the step's end.
   bool contacts_unlisted_ = false;
   std::vector<char> unsettle_mark_;
-  bool sweep_parallel_ = false;  // two threads (else one runs the phases one after the other)
+  bool sweep_parallel_ = false;  // the pool's threads (else one runs the phases in turn)
   // Shares of a colour's packs, each with its scratch vertex of padding (xpbd::share_begin: n,
-  // n + 1, ...); with two, the sweep's halves.
+  // n + 1, ...): the sweep's shares, one per thread of the pool (at least two).
   int scratch_slots_ = 2;
   std::vector<double> anchors_;  // 3 per vertex, and the scratch vertices' (0)
   std::vector<float> tri_anchor8_, row_anchor8_;
@@ -266,6 +262,7 @@ class XpbdSolver : public Solver {
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
   std::vector<Vec3> x_det_;      // each vertex's position at its last contact test
   SelfCollision self_;
+  CookStats last_cook_;
   int detections_ = 0;  // contact detections so far (for tests and the bench)
   double fresh_penetration_ = 0;
 };

@@ -18,14 +18,16 @@ struct XpbdOptions {
   int iterations = 1;  // per substep (small steps: 1)
   EnergyOptions energy;
   double air_drag = 1.0;  // 1/s: velocities decay as exp(-air_drag t), as in Verlet, VBD and Newton
-  int threads = 2;        // colours projected in parallel (results do not depend on it)
+  int threads = 2;        // the pool's threads, the caller included (results do not depend on it)
   // Cloths with fewer triangles run on the calling thread alone: a colour of a small cloth is
   // too little work to share (on two cores, 32^2 takes 1.49 ms per frame on one thread and 1.83
   // on two).
   int min_parallel_triangles = 4000;
-  // Tests only: false keeps the pool's worker from taking its part of the element sweep (as if
-  // it were never scheduled), so that the caller takes it over (XpbdSolver::SweepPhase).
+  // Tests only: false keeps the pool's workers from taking their shares of the element sweep
+  // (as if they were never scheduled), so that the caller takes them over; sweep_absent_worker
+  // >= 1 does so for that one worker only, whose share the others take over (xpbd_sweep.hpp).
   bool sweep_worker = true;
+  int sweep_absent_worker = -1;
   // With reuse_contacts, in the element sweep: each vertex that moved more than half the margin
   // and its clearance (ClothEnergy::clearance2) since its own last contact test is tested again
   // there, instead of all vertices being tested again in the next substep (the frame's first
