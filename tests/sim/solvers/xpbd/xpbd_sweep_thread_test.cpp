@@ -104,13 +104,17 @@ TEST(XpbdSweepPlan, RunsWaitOnlyForTheSharesTheyTouch) {
     for (int t = 0; t < slots; ++t) {
       bool waited = false;
       for (const SweepPlan::Run* r = plan.runs_begin(p, t); r != plan.runs_end(p, t); ++r) {
-        if (p == 0) EXPECT_EQ(r->wait, 0u);
+        if (p == 0) {
+          EXPECT_EQ(r->wait, 0u);
+        }
         uint64_t allowed = 0;
         if (t > 0) allowed |= uint64_t{1} << (t - 1);
         if (t + 1 < slots) allowed |= uint64_t{1} << (t + 1);
         EXPECT_EQ(r->wait & ~allowed, 0u) << "phase " << p << " share " << t;
         if (r->wait) waited = true;
-        if (waited) EXPECT_NE(r->wait, 0u) << "an item that waits for nobody after one that waits";
+        if (waited) {
+          EXPECT_NE(r->wait, 0u) << "an item that waits for nobody after one that waits";
+        }
       }
     }
 }
