@@ -110,7 +110,7 @@ struct ThreadRowsConfig {
 // value, or one that depends on where the knob is used.
 struct Knobs {
   // The benchmark grid (and the probe, where they apply).
-  bool quick = false, sleep_only = false, threads_only = false;
+  bool quick = false, sleep_only = false, threads_only = false, self_only = false;
   ThreadRowsConfig thread_rows;
   int max_res = 64;
   std::optional<int> threads;    // solver threads: grid 1, probe 2, the probe's --finish pool 1
@@ -994,6 +994,77 @@ void thread_rows(int max_res, const ThreadRowsConfig& tr, std::optional<int> fra
   }
 }
 
+// Self-collision in the app's scene: the live session's solver (the default, pieces at rest
+// sleeping, the static finish one cycle per tick as in a lock-step session, two threads) on the
+// form drape (the muslin panel falling from the chest line, 3 s) with self-collision off and on,
+// interleaved in rounds; per configuration the median over rounds of the mean and the p99 tick
+// (wall ms), the self pairs at the end and the largest during the drape, and the mean share of
+// the cloth's regions the detections tested (SelfCollision's region cull). CSV
+// out/bench/solvers_self.csv.
+void self_rows(const std::vector<int>& resolutions, int rounds, std::optional<int> frames_cap) {
+  std::ofstream sc("out/bench/solvers_self.csv");
+  sc << "scene,solver,resolution,threads,self_collision,rounds,ms_per_frame,p99_ms,ratio,"
+        "self_pairs_end,self_pairs_max,regions_tested_pct\n";
+  std::printf("self     %6s %4s %10s %10s %8s %12s %12s %10s\n", "res", "self", "ms/frame",
+              "p99 ms", "ratio", "pairs (end)", "pairs (max)", "regions %");
+  for (const int res : resolutions) {
+    struct Run {
+      double mean, p99;
+      size_t pairs_end, pairs_max;
+      double tested;
+    };
+    std::vector<Run> runs[2];
+    for (int round = 0; round < rounds; ++round)
+      for (int self = 0; self < 2; ++self) {
+        Testbed t = make_form_drape(res);
+        t.objects.self_collision = self == 1;
+        SolverConfig cfg;
+        cfg.freeze = true;
+        cfg.finish_thread = false;
+        auto solver = make_solver(kDefaultSolver, cfg);
+        Solver* inner = solver.value().get();
+        if (auto* wd = dynamic_cast<WatchdogSolver*>(inner)) inner = &wd->inner();
+        auto* xs = dynamic_cast<XpbdSolver*>(inner);
+        const int frames = frames_cap.value_or(static_cast<int>(std::lround(t.duration * 90)));
+        std::vector<double> ms;
+        size_t most = 0;
+        double tested = 0;  // sum over frames of the share of regions the last detection tested
+        for (int f = 0; f < frames; ++f) {
+          const auto t0 = std::chrono::steady_clock::now();
+          solver.value()->step(t.cloth, t.objects, 1.0 / 90);
+          ms.push_back(
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                  .count());
+          if (xs) most = std::max(most, xs->self_collision().contacts().size());
+          if (xs && xs->self_collision().regions() > 0)
+            tested +=
+                double(xs->self_collision().active_regions()) / xs->self_collision().regions();
+        }
+        double sum = 0;
+        for (double m : ms) sum += m;
+        std::sort(ms.begin(), ms.end());
+        runs[self].push_back({sum / frames, ms[std::min(ms.size() - 1, ms.size() * 99 / 100)],
+                              xs ? xs->self_collision().contacts().size() : 0, most,
+                              100 * tested / frames});
+      }
+    auto median = [](std::vector<Run> v, double Run::*f) {
+      std::sort(v.begin(), v.end(), [f](const Run& a, const Run& b) { return a.*f < b.*f; });
+      return v[v.size() / 2].*f;
+    };
+    const double off = median(runs[0], &Run::mean);
+    for (int self = 0; self < 2; ++self) {
+      const double mean = median(runs[self], &Run::mean), p99 = median(runs[self], &Run::p99);
+      const Run& last = runs[self].back();
+      std::printf("self     %4d^2 %4s %10.3f %10.3f %7.2fx %12zu %12zu %10.1f\n", res,
+                  self ? "on" : "off", mean, p99, mean / off, last.pairs_end, last.pairs_max,
+                  last.tested);
+      sc << "form," << kDefaultSolver << "," << res << ",2," << self << "," << rounds << "," << mean
+         << "," << p99 << "," << mean / off << "," << last.pairs_end << "," << last.pairs_max << ","
+         << last.tested << std::endl;
+    }
+  }
+}
+
 // A flag --name with its negation --no-name (--name=0 works too).
 CLI::Option* switch_flag(CLI::App& app, const std::string& name, bool& value,
                          const std::string& help) {
@@ -1020,6 +1091,9 @@ void add_knobs(CLI::App& app, Knobs& kn, std::string& simd) {
                "only the sleeping rows (out/bench/solvers_sleep.csv)");
   app.add_flag("--threads-only", kn.threads_only,
                "only the thread and precision rows (out/bench/solvers_threads.csv)");
+  app.add_flag("--self-only", kn.self_only,
+               "only the self-collision rows: the app's scene with it off and on, 64^2 and "
+               "--max-res (out/bench/solvers_self.csv)");
   app.add_option("--thread-counts", kn.thread_rows.counts,
                  "the thread rows' thread counts (the default configuration; 1,2,4)")
       ->delimiter(',')
@@ -1218,6 +1292,10 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories("out/bench");
   if (kn.sleep_only) {  // the sleeping rows alone (out/bench/solvers_sleep.csv)
     sleep_rows(kn, quick ? 32 : 128);
+    return 0;
+  }
+  if (kn.self_only) {  // the self-collision rows alone (out/bench/solvers_self.csv)
+    self_rows({64, std::max(max_res, 128)}, kn.thread_rows.rounds.value_or(3), kn.frames);
     return 0;
   }
   if (kn.threads_only) {  // the thread and precision rows alone (out/bench/solvers_threads.csv)

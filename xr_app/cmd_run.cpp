@@ -583,7 +583,9 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
       cli,
       {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
        {"--no-pattern", &o.pattern, "skip the pattern of the draped cloth (pattern/session-1/)"},
-       {"--no-record", &o.record, "live: do not record the session into OUT/sessions/"}});
+       {"--no-record", &o.record, "live: do not record the session into OUT/sessions/"},
+       {"--no-self-collision", &o.app.self_collision,
+        "the cloth does not collide with itself (cheaper; folds may pass through each other)"}});
   drape::app::add_record_option(cli, o.app.record_dir);
   o.resume_opt = cli.add_option("--resume", o.resume,
                                 "live: resume the session recorded in DIR (default: the newest "
@@ -616,7 +618,7 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
   for (const char* name :
        {"--frames", "--eye-size", "--cloth-res", "--verbose", "--scenario", "--no-voice",
         "--no-pattern", "--every", "--form", "--mesh", "--start", "--json", "--sim-lock-step",
-        "--state-hashes", "--voice", "--record", "--no-record", "--resume"})
+        "--state-hashes", "--voice", "--record", "--no-record", "--resume", "--no-self-collision"})
     cli.get_option(name)->excludes(headless);
 }
 #endif

@@ -168,6 +168,8 @@ int cmd_xr(int argc, char** argv) {
        {"--sim-free", &opt.sim_lock_step,
         "the sim on its own 90 Hz clock (default: one tick per frame)"},
        {"--no-ops", &opt.operations, "no interaction: hands and triggers do not drive the sim"},
+       {"--no-self-collision", &opt.self_collision,
+        "the cloth does not collide with itself (cheaper; folds may pass through each other)"},
        {"--full-form", &opt.form_lod,
         "draw the form at full detail (no level of detail from the eye size)"},
        {"--no-malloc-tuning", &opt.tune_malloc, "let glibc trim freed memory every frame"}});

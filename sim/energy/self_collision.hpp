@@ -18,6 +18,7 @@
 // more than 8 hash cells per axis is entered in the first 8 only.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -37,12 +38,20 @@ class SelfCollision {
   // are skipped. Returns the number of pairs.
   int detect(const Cloth& cloth, const std::vector<Vec3>& x, double thickness, double margin);
   // One projection pass over the pairs: pushes apart those closer than `thickness`. w: inverse
-  // mass per vertex (0 = fixed). Returns the largest correction applied (m).
-  double project(const Cloth& cloth, std::vector<Vec3>& x, const double* w, double thickness) const;
+  // mass per vertex (0 = fixed). Returns the largest correction applied (m). moved (optional)
+  // gets the vertices of every pair it corrected appended (repeats included).
+  double project(const Cloth& cloth, std::vector<Vec3>& x, const double* w, double thickness,
+                 std::vector<int>* moved = nullptr) const;
   const std::vector<SelfContact>& contacts() const { return pairs_; }
   // The per-entry bounding-sphere rejection (on by default; off only to measure it: the same
   // pairs are found either way).
   void set_sphere_test(bool on) { sphere_test_ = on; }
+  // The region cull (on by default; off only to measure and test it): see below.
+  void set_region_cull(bool on) { region_cull_ = on; }
+  // Regions and triangles the last detection tested (the others were culled).
+  int regions() const { return std::max(0, static_cast<int>(region_lo_.size()) - 1); }
+  int active_regions() const { return active_regions_; }
+  int active_triangles() const { return active_tris_; }
   // Smallest side-signed distance minus thickness over the pairs at x (< 0: a pair too close
   // or crossed); +infinity when there are no pairs.
   double min_clearance(const Cloth& cloth, const std::vector<Vec3>& x, double thickness) const;
@@ -56,6 +65,25 @@ class SelfCollision {
   };
   std::vector<Sphere> spheres_;  // parallel to entries_
   bool sphere_test_ = true;
+  // The region cull: the cloth is split once per topology into regions (the triangles of one
+  // cell of a material-space grid 8 edges wide that are connected to each other). At each
+  // detection a region whose triangle normals lie within kFlatCone of their mean is flat (a
+  // height field over that axis: none of its vertices is within reach above one of its own
+  // triangles); a flat region whose box, grown by the reach, meets no other region's, or meets
+  // only adjacent regions that are flat together with it, has no pair and is left out of the
+  // hash and the vertex tests. Only the regions that fold, or that lie against another layer,
+  // are tested.
+  bool region_cull_ = true;
+  uint64_t region_version_ = 0;
+  int region_tris_ = -1;
+  std::vector<int32_t> region_of_;         // per triangle
+  std::vector<int32_t> region_lo_;         // per region: its first entry in region_tri_
+  std::vector<int32_t> region_tri_;        // triangles grouped by region
+  std::vector<uint64_t> region_adjacent_;  // (a << 32 | b), a < b: regions sharing a vertex
+  std::vector<char> tri_active_, vertex_active_;
+  int active_regions_ = 0, active_tris_ = 0;
+  void build_regions(const Cloth& cloth);
+  void cull(const Cloth& cloth, const std::vector<Vec3>& x, double reach);
   struct TriFrame {
     Vec3 a, n, g1, g2;  // corner, unit normal, barycentric gradients (detect())
   };

@@ -42,6 +42,7 @@ sim::JournalHeader journal_header(const XrAppOptions& opt) {
   f["tick_rate_hz"] = std::to_string(kTickRateHz);
   f["substeps"] = std::to_string(kSubsteps);
   f["lock_step"] = opt.sim_lock_step ? "1" : "0";
+  f["self_collision"] = opt.self_collision ? "1" : "0";
   return h;
 }
 
@@ -76,6 +77,10 @@ std::string options_from_header(const sim::JournalHeader& h, const std::string& 
   const std::string ls = h.field("lock_step");
   if (ls != "0" && ls != "1") return bad("lock_step", "'" + ls + "' is not 0 or 1");
   opt.sim_lock_step = ls == "1";
+  // (Optional: journals recorded before the field existed ran without self-collision.)
+  const std::string sc = h.fields.count("self_collision") ? h.field("self_collision") : "0";
+  if (sc != "0" && sc != "1") return bad("self_collision", "'" + sc + "' is not 0 or 1");
+  opt.self_collision = sc == "1";
   opt.fabric = h.field("fabric");
   opt.fabrics_path = h.field("fabrics_file");
   opt.form_size = h.field("form_size");
@@ -99,6 +104,7 @@ sim::Result<sim::World> make_session_world(const XrAppOptions& opt, bool finish_
   sim::World w;
   w.cloth = std::move(scene->cloth);
   w.scene = std::move(scene->objects);
+  w.scene.self_collision = opt.self_collision;
   w.solver = std::move(solver.value());
   return w;
 }

@@ -41,6 +41,9 @@ struct XrAppOptions {
   // (measurements read from `forms_dir`, else built in).
   std::string start;
   std::string fabric = "muslin", fabrics_path;
+  // The cloth collides with itself (folds keep their layers apart; XPBD's self-collision,
+  // sim/energy/self_collision.hpp).
+  bool self_collision = true;
   std::string form_size = "9AR", form_measurements, form_mesh, forms_dir;
   // The sim's messages get the cloth's state hash before and after each operation's outcome
   // (tests: an undo restores the hash from before the operation).

@@ -389,6 +389,7 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
   ++detections_;           // (x_det_ is taken at the end, after the snap)
   contacts_fresh_ = true;  // the first substep reuses them (same positions)
   const bool all_frozen = rest_.wake(cloth, energy_);
+  if (scene.self_collision) rest_.skip_rest_of_self_touching(cloth, self_.contacts());
   snap_to_contacts(cloth);
   x_det_ = cloth.state.x;
   return all_frozen;
@@ -565,6 +566,7 @@ void XpbdSolver::substep(Step& c) {
     sweep(c);
     ++c.st.iterations;
   }
+  if (c.fused && c.scene.self_collision) project_self_after_sweep(c);
   collect_retests(c);
   for (int it = 0; it < opt_.iterations && !c.fused; ++it) {
     project_triangles(c);
@@ -592,7 +594,10 @@ void XpbdSolver::detect_contacts(Step& c) {
   const auto t0 = std::chrono::steady_clock::now();
   c.st.max_penetration =
       std::max(c.st.max_penetration, energy_.detect_contacts(c.cloth, c.scene, pool_.get()));
-  if (c.scene.self_collision) self_.detect(c.cloth, c.x, c.scene.offset, c.margin);
+  if (c.scene.self_collision) {
+    self_.detect(c.cloth, c.x, c.scene.offset, c.margin);
+    rest_.skip_rest_of_self_touching(c.cloth, self_.contacts());
+  }
   rest_.unsettle_pushed(c.x, energy_);
   snap_to_contacts(c.cloth);
   x_det_.resize(c.n);
@@ -697,16 +702,19 @@ void XpbdSolver::plan_substep(Step& c) {
   c.gk = eo.gravity ? eo.g : Vec3::Zero();
   // The whole substep in one sweep (xpbd_sweep.hpp: the prediction with the packing, the elements,
   // the unpacking with the contacts, velocities and motion sums) where it applies: single
-  // precision, one iteration, no warm start, no self-collision, bending in this substep.
+  // precision, one iteration, no warm start, bending in this substep. Self-collision pairs are
+  // projected after it (project_self_after_sweep).
   c.fused = c.padded && cooked_f32_ && !sweep_.empty() &&
             pool_->size() <= xpbd::SweepPlan::kMaxSlots && opt_.iterations == 1 && !c.warm &&
-            !c.scene.self_collision && hinges_.empty() && springs_.empty() && c.bending();
+            hinges_.empty() && springs_.empty() && c.bending();
   // With contacts reused, the sweep tests again each vertex that moved more than half the margin
   // since its own last test (a detection of all vertices happens only at a frame's start);
   // otherwise such a vertex makes the next substep detect all of them again. (Only when every
   // substep runs the sweep, bending_every = 1: a substep outside it projects the energy's
-  // contact list, which lists the tested contacts only at the step's end.)
-  c.retest = c.fused && c.be == 1 && opt_.reuse_contacts && opt_.retest_contacts && c.s + 1 < c.ns;
+  // contact list, which lists the tested contacts only at the step's end. Not with
+  // self-collision either: its pairs are found only by a detection of all vertices.)
+  c.retest = c.fused && c.be == 1 && opt_.reuse_contacts && opt_.retest_contacts &&
+             !c.scene.self_collision && c.s + 1 < c.ns;
   c.test_moved = opt_.reuse_contacts && c.s + 1 < c.ns && !c.retest;
   const int slots = std::max(pool_->size(), scratch_slots_);  // pool threads or sweep slots
   moved_part_.assign(slots, 0);
@@ -915,6 +923,19 @@ void XpbdSolver::project_bending_springs(Step& c) {
   by_colour(spring_col_, [&](int b, int e, int) { project_springs(c, b, e); });
   energy_.project_contacts(c.x, &c.S.x_prev, c.scene.friction);
   if (c.scene.self_collision) self_.project(c.cloth, c.x, c.w, c.scene.offset);
+}
+
+// Self-collision in a substep run as one element sweep: the pairs projected once after it (the
+// sweep's unpacking has projected the object contacts), then the velocities of the vertices they
+// moved computed again from their corrected positions, as velocities() does.
+void XpbdSolver::project_self_after_sweep(Step& c) {
+  if (self_.contacts().empty()) return;
+  self_moved_.clear();
+  self_.project(c.cloth, c.x, c.w, c.scene.offset, &self_moved_);
+  for (const int i : self_moved_)
+    if (c.w[i] > 0)
+      c.S.v[i] = ((c.scale[c.piece_of[i]] > 1.0 ? c.damp_settle : c.damp) / c.h) *
+                 (c.x[i] - c.S.x_prev[i]);
 }
 
 void XpbdSolver::project_hinges(const Step& c, int b, int e) {

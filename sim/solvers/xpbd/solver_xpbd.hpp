@@ -129,6 +129,7 @@ class XpbdSolver : public Solver {
   void collect_retests(Step& c);
   void project_triangles(const Step& c);  // and the bending blocks (packed alike)
   void project_bending_springs(Step& c);  // hinges, springs, contacts, self-collision
+  void project_self_after_sweep(Step& c);
   void velocities(const Step& c, int b, int e, int wk);
   void update_pieces(Step& c);  // the pieces' motion sums
   void schedule_rest(Step& c);  // settling and sleep
@@ -262,6 +263,7 @@ class XpbdSolver : public Solver {
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
   std::vector<Vec3> x_det_;      // each vertex's position at its last contact test
   SelfCollision self_;
+  std::vector<int> self_moved_;  // vertices the last self-collision projection moved
   CookStats last_cook_;
   int detections_ = 0;  // contact detections so far (for tests and the bench)
   double fresh_penetration_ = 0;

@@ -36,6 +36,20 @@ void RestScheduler::unsettle(int piece) {
   finish_[piece] = 0;
 }
 
+void RestScheduler::skip_rest_of_self_touching(const Cloth& cloth,
+                                               const std::vector<SelfContact>& pairs) {
+  const auto& tris = cloth.topo.triangles;
+  auto skip = [&](int v) {
+    const int p = piece_of_[v];
+    coarse_done_[p] = std::max(coarse_done_[p], opt_.coarse_frames);
+    finish_[p] = -1;
+  };
+  for (const SelfContact& c : pairs) {
+    skip(c.vertex);
+    for (const int v : tris[c.triangle]) skip(v);
+  }
+}
+
 void RestScheduler::thaw(Cloth& cloth) {
   auto& S = cloth.state;
   const int n = cloth.num_vertices();
@@ -238,7 +252,7 @@ void RestScheduler::freeze_pieces(Cloth& cloth, int s) {
 }
 
 void RestScheduler::coarse_step(Cloth& cloth, const SceneObjects& scene, ClothEnergy& energy) {
-  if (opt_.coarse_factor <= 0 || !opt_.settle || scene.self_collision) return;
+  if (opt_.coarse_factor <= 0 || !opt_.settle) return;
   // A piece is due when it is awake, at the full scale and not yet corrected this episode.
   auto due = [&](int p) {
     return !frozen_[p] && scale_[p] >= opt_.settle_mass_scale &&
@@ -273,7 +287,7 @@ void RestScheduler::coarse_step(Cloth& cloth, const SceneObjects& scene, ClothEn
 }
 
 void RestScheduler::finish_sleeping(Cloth& cloth, const SceneObjects& scene, ThreadPool* pool) {
-  if (!opt_.finish || !opt_.freeze || scene.self_collision) return;
+  if (!opt_.finish || !opt_.freeze) return;
   if (opt_.finish_thread) return finish_on_thread(cloth, scene);
   bool any = false, fresh = false;
   for (int p = 0; p < num_pieces_; ++p)

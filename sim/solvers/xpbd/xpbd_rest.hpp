@@ -12,6 +12,7 @@
 
 #include "sim/core/thread_pool.hpp"
 #include "sim/energy/energy.hpp"
+#include "sim/energy/self_collision.hpp"
 #include "sim/rest/coarse_correction.hpp"
 #include "sim/rest/equilibrium_finisher.hpp"
 #include "sim/rest/finish_thread.hpp"
@@ -56,6 +57,10 @@ class RestScheduler {
 
   // A piece returns to its own mass and its settling episode (coarse correction, finish) ends.
   void unsettle(int piece);
+  // Self-collision pairs found (vertex, triangle's corners): their pieces get neither the coarse
+  // correction nor the static finish in their current settling episode (both solve without the
+  // self pairs and could push one layer through another); the other pieces still do.
+  void skip_rest_of_self_touching(const Cloth& cloth, const std::vector<SelfContact>& pairs);
 
   // Frame start without freeze: every piece awake, no vertex frozen.
   void thaw(Cloth& cloth);

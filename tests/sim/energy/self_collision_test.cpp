@@ -15,20 +15,20 @@ using namespace drape::sim;
 
 namespace {
 
-// The test panel: 0.4 x 0.2 m, 21 x 11 vertices (2 cm edges), flat.
-Cloth test_panel() {
+// The test panel: 0.4 x 0.2 m, nx x ny vertices (21 x 11: 2 cm edges), flat.
+Cloth test_panel(int nx = 21, int ny = 11) {
   PanelSpec p;
   p.width = 0.4;
   p.height = 0.2;
-  p.nx = 21;
-  p.ny = 11;
+  p.nx = nx;
+  p.ny = ny;
   return make_panel(p, FabricParams{});
 }
 
 // The test panel folded in two about u = 0.2: the half u <= 0.2 lies at height y0, the other
 // half mirrored over it at y0 + gap.
-Cloth folded_panel(double y0, double gap) {
-  Cloth c = test_panel();
+Cloth folded_panel(double y0, double gap, int nx = 21, int ny = 11) {
+  Cloth c = test_panel(nx, ny);
   for (int i = 0; i < c.num_vertices(); ++i) {
     const Vec2 m = c.topo.material[i];
     const double u = m.x() - c.topo.material[0].x(), v = m.y() - c.topo.material[0].y();
@@ -46,9 +46,9 @@ Cloth folded_panel(double y0, double gap) {
 }
 
 // Vertex of the other layer directly below / above vertex i (mirror about u = 0.2).
-int mirror(int i) {
-  const int nx = 21, col = i % nx, row = i / nx;
-  return row * nx + (20 - col);
+int mirror(int i, int nx = 21) {
+  const int col = i % nx, row = i / nx;
+  return row * nx + (nx - 1 - col);
 }
 
 }  // namespace
@@ -144,4 +144,67 @@ TEST(SelfCollision, FoldedSheetOnTheFloorKeepsItsLayersApart) {
   // With it every top vertex stays above the one below it by most of the thickness.
   EXPECT_GT(worst_gap[1], 0.8 * 0.002);
   EXPECT_GT(top_mean[1], top_mean[0] + 1e-3);
+}
+
+// The same fold at 81 x 41 vertices (6400 triangles: the solver's element sweep runs the
+// substeps, the pairs projected after it) on one and two threads: the layers stay apart, and the
+// two runs agree bit for bit.
+TEST(SelfCollision, FoldInTheElementSweepKeepsLayersApartOnAnyThreadCount) {
+  const int nx = 81, ny = 41;
+  std::vector<Vec3> end[2];
+  for (int threads = 1; threads <= 2; ++threads) {
+    Cloth c = folded_panel(0.05, 0.01, nx, ny);
+    SceneObjects scene;
+    scene.floor = true;
+    scene.self_collision = true;
+    XpbdOptions o;
+    o.substeps = 10;
+    o.air_drag = 2.0;
+    o.threads = threads;
+    XpbdSolver s(o);
+    for (int f = 0; f < 90; ++f) s.step(c, scene, 1.0 / 90);
+    if (threads == 2) {
+      EXPECT_GT(s.sweeps(), 0) << "the substeps did not run as element sweeps";
+    }
+    double worst = 1;
+    for (int i = 0; i < c.num_vertices(); ++i) {
+      const double u = c.topo.material[i].x() - c.topo.material[0].x();
+      const double v = c.topo.material[i].y() - c.topo.material[0].y();
+      if (u < 0.26 || u > 0.38 || v < 0.03 || v > 0.17) continue;
+      worst = std::min(worst, c.state.x[i].y() - c.state.x[mirror(i, nx)].y());
+    }
+    std::printf("81 x 41 fold, %d thread(s): smallest gap to the layer below %.3f mm, %zu pairs\n",
+                threads, worst * 1e3, s.self_collision().contacts().size());
+    EXPECT_GT(worst, 0.8 * scene.offset);
+    end[threads - 1] = c.state.x;
+  }
+  ASSERT_EQ(end[0].size(), end[1].size());
+  int differ = 0;
+  for (size_t i = 0; i < end[0].size(); ++i) differ += end[0][i] != end[1][i];
+  EXPECT_EQ(differ, 0);
+}
+
+// The region cull: a flat sheet has no region to test; the folded one tests only the regions
+// of the two layers that lie against each other, and finds the same pairs as without the cull.
+TEST(SelfCollision, RegionCullTestsOnlyTheLayersThatTouch) {
+  const double thick = 0.002, margin = 0.005;
+  Cloth flat = test_panel(81, 41);
+  SelfCollision sc;
+  EXPECT_EQ(sc.detect(flat, flat.state.x, thick, margin), 0);
+  std::printf("flat 81 x 41: %d of %d regions tested\n", sc.active_regions(), sc.regions());
+  EXPECT_GT(sc.regions(), 8);
+  EXPECT_EQ(sc.active_regions(), 0);
+  Cloth two = folded_panel(0.1, 0.004, 81, 41);
+  SelfCollision plain;
+  plain.set_region_cull(false);
+  const int a = sc.detect(two, two.state.x, thick, margin);
+  const int b = plain.detect(two, two.state.x, thick, margin);
+  std::printf("folded 81 x 41: %d pairs culled, %d without the cull; %d of %d regions tested\n", a,
+              b, sc.active_regions(), sc.regions());
+  EXPECT_EQ(a, b);
+  EXPECT_GT(a, 0);
+  for (int k = 0; k < std::min(a, b); ++k) {
+    EXPECT_EQ(sc.contacts()[k].vertex, plain.contacts()[k].vertex);
+    EXPECT_EQ(sc.contacts()[k].triangle, plain.contacts()[k].triangle);
+  }
 }
