@@ -23,6 +23,7 @@ namespace {
 constexpr int kTickRateHz = 90;
 constexpr int kSubsteps = 1;
 const char* kSolver = "default";
+constexpr int kSelfCollisionMinRes = 48;  // 10.6 mm edges on the 0.5 m panel
 }  // namespace
 
 sim::JournalHeader journal_header(const XrAppOptions& opt) {
@@ -104,7 +105,11 @@ sim::Result<sim::World> make_session_world(const XrAppOptions& opt, bool finish_
   sim::World w;
   w.cloth = std::move(scene->cloth);
   w.scene = std::move(scene->objects);
-  w.scene.self_collision = opt.self_collision;
+  // Self-collision only on cloths fine enough for its vertex-triangle pairs: on a coarse grid
+  // (edges several times the 7 mm reach) layers pass between the vertices, and pairs found
+  // after a crossing hold the layers on the wrong sides (a pinched 16^2 panel locks into a
+  // crumpled band).
+  w.scene.self_collision = opt.self_collision && opt.cloth_res >= kSelfCollisionMinRes;
   w.solver = std::move(solver.value());
   return w;
 }
