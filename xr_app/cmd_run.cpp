@@ -584,7 +584,7 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
       {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
        {"--no-pattern", &o.pattern, "skip the pattern of the draped cloth (pattern/session-1/)"},
        {"--no-record", &o.record, "live: do not record the session into OUT/sessions/"}});
-  drape::app::add_record_option(cli, o.app.record_dir);
+  drape::app::add_record_option(cli, o.app.record_dir, o.app.checkpoint_every_s);
   o.resume_opt = cli.add_option("--resume", o.resume,
                                 "live: resume the session recorded in DIR (default: the newest "
                                 "under OUT/sessions/): its journal replayed, then live, appending")

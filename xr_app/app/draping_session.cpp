@@ -156,6 +156,7 @@ void DrapingSession::start_sim() {
   }
   profile_ticks(w);
   if (!opt_.record_dir.empty()) open_record();
+  install_checkpoints(w);
   // Lock step: the ticks run on the frame loop's thread inside advance() (no hand-off per frame).
   if (!opt_.sim_lock_step) sim_->start();
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "render/renderer.hpp"
+#include "sim/ops/checkpoint.hpp"
 #include "sim/ops/operation_controller.hpp"
 #include "sim/runtime/journal.hpp"
 #include "sim/runtime/sim_thread.hpp"
@@ -123,6 +124,10 @@ class DrapingSession : public SessionContent {
   // --resume: the World and the operations from the replay of opt_.resume_dir's journal to its
   // last whole record; `first_tick` the ticks it ran.
   sim::Result<sim::World> resume_world(uint64_t& first_tick);
+  // With the journal open: a checkpoint every opt_.checkpoint_every_s of session time, taken by
+  // the sim thread at a tick's start (journal record, copy, fresh solver), written by
+  // checkpoints_'s thread into the record directory.
+  void install_checkpoints(sim::World& w);
   void close_record();
 
   const XrAppOptions opt_;
@@ -178,6 +183,7 @@ class DrapingSession : public SessionContent {
   // commands while it runs, by finish() after it stopped.
   std::shared_ptr<sim::JournalWriter> journal_;
   uint64_t resume_inputs_end_ = 0;                      // a resumed journal: append from this byte
+  std::unique_ptr<sim::CheckpointWriter> checkpoints_;  // the checkpoint files' writer thread
   std::unique_ptr<tracking::TraceRecorder> hands_csv_;  // --record, external hands
 
   // Each hand's interaction profile family: controller triggers are looked up under it.
