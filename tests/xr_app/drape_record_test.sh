@@ -18,7 +18,8 @@
 #   resume lock step: `drape run --resume DIR` (live, the simulated runtime's window under Xvfb,
 #         --frames 40) replays the recording, goes on live and appends to its journal: the
 #         journal then replays to the resumed run's final state at tick 300 + 40; a copy cut off
-#         mid-record resumes with the cut-off message.
+#         mid-record resumes with the cut-off message; a recording with checkpoints resumes from
+#         its newest (30 ticks replayed) and its journal then replays to the resumed run's state.
 # free and lock also check that a journal cut off mid-record replays up to its last whole
 # record with a message naming the byte offset, and that a bad header is an error naming the
 # file and the field. lock records with a checkpoint every 0.5 s: the replay starts from the
@@ -129,6 +130,25 @@ if [ "$mode" = resume ]; then
   [ $rc -eq 0 ] || fail "drape run --resume of a cut-off journal exited with $rc"
   grep -q "$cut/journal.bin: byte [0-9]*: .*cut off" "$work/cut_resume.log" || fail "no cut-off message"
   grep -q "resume: replayed 299 input records, 299 ticks" "$work/cut_resume.log" || fail "the cut journal did not replay to its last whole record"
+  # A recording with checkpoints (every 0.5 s): the resume starts from the newest, replays the
+  # 30 ticks after it, goes on live; the journal then replays to the resumed run's state from
+  # its checkpoint and from the start alike.
+  ckr=$work/checkpointed
+  "$exe" xr --scenario assets/scenarios/record_replay.json --eye-size 64 --cloth-res 16 \
+    --record "$ckr" --checkpoint-every 0.5 >>"$log" 2>&1 || fail "drape xr --checkpoint-every exited with $?"
+  resume_run "$ckr" "$work/ck_resume.log"
+  rc=$?
+  cat "$work/ck_resume.log" >>"$log"
+  [ $rc -eq 0 ] || fail "drape run --resume of the checkpointed recording exited with $rc"
+  grep -q "resume: from checkpoint-270.bin (tick 270)" "$work/ck_resume.log" || fail "the resume did not start from checkpoint-270.bin"
+  grep -q "resume: replayed 30 input records, 300 ticks" "$work/ck_resume.log" || fail "no replay of the 30 ticks after the checkpoint"
+  live=$(sed -n 's/^drape run: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/ck_resume.log")
+  for from in "" --from-start; do
+    "$exe" replay "$ckr" $from --out "$work/ck.json" >"$work/ck.out" 2>&1 || fail "replay $from of the resumed journal exited with $?"
+    again=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/ck.out")
+    [ "$again" = "$live" ] || fail "the resumed journal replays ($from) to '$again', the run ended at '$live'"
+  done
+  echo "resumed from checkpoint-270.bin: $live; its journal replays to it from the checkpoint and from the start"
   echo "PASS"
   exit 0
 fi
