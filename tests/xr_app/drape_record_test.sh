@@ -20,6 +20,10 @@
 #         journal then replays to the resumed run's final state at tick 300 + 40; a copy cut off
 #         mid-record resumes with the cut-off message; a recording with checkpoints resumes from
 #         its newest (30 ticks replayed) and its journal then replays to the resumed run's state.
+#   save  "save session" spoken (espeak-ng, the scenario's audio cue at frame 150) saves the
+#         session whole (saved_session.drape);
+#         `drape open FILE` under Xvfb starts from exactly that state and goes on, recorded (its
+#         journal replays to it; --from-start is refused); a bad file is an error naming the field.
 # free and lock also check that a journal cut off mid-record replays up to its last whole
 # record with a message naming the byte offset, and that a bad header is an error naming the
 # file and the field. lock records with a checkpoint every 0.5 s: the replay starts from the
@@ -31,6 +35,8 @@ exe=$1 mode=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 log=$work/log.txt
 fail() { echo "FAIL: $*"; echo "--- log:"; cat "$log"; exit 1; }
+# "HASH TICK" of a live run's log (drape run / drape open).
+live_line() { sed -n 's/^drape run: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$1"; }
 unset XR_RUNTIME_JSON DRAPE_MOCK_SCENARIO DRAPE_MOCK_END_AFTER_FRAMES DRAPE_MOCK_WRITE_FRAMES
 export HOME=$work/home XDG_CONFIG_HOME=$work/home/.config XDG_CONFIG_DIRS=$work/none
 case $mode in
@@ -71,7 +77,55 @@ PY
     echo "PASS"
     exit 0
     ;;
-  *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill|resume|tee WORKDIR"; exit 2 ;;
+  save)
+    # "save session" spoken (espeak-ng, 16 kHz) in the scripted lock-step session: the app
+    # saves it whole into OUT/saved_session.drape; `drape open FILE` (the simulated runtime's
+    # window under Xvfb) goes on draping from exactly that state, recorded.
+    command -v xvfb-run >/dev/null || fail "xvfb-run is not installed (Debian xvfb)"
+    espeak-ng -s 140 -w "$work/save_22k.wav" "save session" >>"$log" 2>&1 || fail "espeak-ng failed"
+    sox "$work/save_22k.wav" -r 16000 -c 1 -b 16 "$work/save.wav" pad 0.2 1 >>"$log" 2>&1 || fail "sox failed"
+    # The scenario's audio cue: the spoken phrase at frame 150 (decoded by the app's recogniser).
+    python3 - "$work/save.wav" "$work/save_scenario.json" <<'PY' || fail "scenario writer"
+import json, sys
+s = json.load(open("assets/scenarios/record_replay.json"))
+s["audio"] = [{"wav": sys.argv[1], "frame": 150, "text": "save session"}]
+json.dump(s, open(sys.argv[2], "w"))
+PY
+    "$exe" xr --scenario "$work/save_scenario.json" --eye-size 64 --cloth-res 16 \
+      --record "$work/rec" --out "$work/out" >>"$log" 2>&1 || fail "drape xr exited with $?"
+    saved=$work/out/saved_session.drape
+    [ -s "$saved" ] || fail "no $saved"
+    grep -q "voice .*save" "$work/rec/session.txt" || fail "no save trigger heard"
+    n=$(sed -n "s|^save: the session at tick \([0-9]*\) saved to $saved .*|\1|p" "$work/rec/session.txt")
+    [ -n "$n" ] || fail "no save line in session.txt"
+    want=$("$exe" replay "$work/rec" --until-tick "$n" --from-start --out "$work/a.json" 2>>"$log" |
+      sed -n 's/^final state hash \([0-9a-f]*\) at tick.*/\1/p')
+    xvfb-run -a "$exe" open "$saved" --frames 40 --sim-lock-step --no-pattern --voice off \
+      --out "$work/live" >"$work/open.log" 2>&1
+    rc=$?
+    cat "$work/open.log" >>"$log"
+    [ $rc -eq 0 ] || fail "drape open exited with $rc"
+    grep -q "drape open: $saved: the session at tick $n" "$work/open.log" || fail "no open line"
+    live=$(live_line "$work/open.log")
+    read -r lhash ltick <<<"$live"
+    [ "$ltick" = $((n + 40)) ] || fail "the opened session ended at tick '$ltick', not $n + 40"
+    sess=$(ls -d "$work"/live/sessions/*/ | head -1)
+    [ -f "$sess/journal.bin" ] || fail "the opened session was not recorded"
+    got=$("$exe" replay "$sess" --until-tick "$n" --out "$work/b.json" 2>>"$log" |
+      sed -n 's/^final state hash \([0-9a-f]*\) at tick.*/\1/p')
+    [ -n "$want" ] && [ "$got" = "$want" ] || fail "the opened state $got differs from the saved session's $want at tick $n"
+    again=$("$exe" replay "$sess" --out "$work/c.json" 2>>"$log" | sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p')
+    [ "$again" = "$live" ] || fail "the opened session's journal replays to '$again', it ended at '$live'"
+    "$exe" replay "$sess" --from-start >/dev/null 2>"$work/start.err"
+    [ $? -eq 2 ] && grep -q "header field 'opened'" "$work/start.err" || fail "--from-start of an opened session: $(cat "$work/start.err")"
+    printf 'not a checkpoint' >"$work/bad.drape"
+    xvfb-run -a "$exe" open "$work/bad.drape" --frames 5 >"$work/bad.log" 2>&1
+    [ $? -eq 2 ] && grep -q "$work/bad.drape: byte 0: field 'magic'" "$work/bad.log" || fail "bad file: $(cat "$work/bad.log")"
+    echo "saved at tick $n: $want; opened: the same state, on to $live (its journal replays to it)"
+    echo "PASS"
+    exit 0
+    ;;
+  *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill|resume|tee|save WORKDIR"; exit 2 ;;
 esac
 rec=$work/rec
 start=$(date +%s.%N)
@@ -115,7 +169,7 @@ if [ "$mode" = resume ]; then
   cat "$work/resume.log" >>"$log"
   [ $rc -eq 0 ] || fail "drape run --resume exited with $rc"
   grep -q "resume: replayed 300 input records, 300 ticks" "$work/resume.log" || fail "no replay line"
-  live=$(sed -n 's/^drape run: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/resume.log")
+  live=$(live_line "$work/resume.log")
   read -r lhash ltick <<<"$live"
   [ "$ltick" = 340 ] || fail "the resumed run ended at tick '$ltick', not 300 + 40"
   "$exe" replay "$work/resumed" >"$work/resumed.out" 2>&1 || fail "replay of the resumed journal exited with $?"
@@ -142,7 +196,7 @@ if [ "$mode" = resume ]; then
   [ $rc -eq 0 ] || fail "drape run --resume of the checkpointed recording exited with $rc"
   grep -q "resume: from checkpoint-270.bin (tick 270)" "$work/ck_resume.log" || fail "the resume did not start from checkpoint-270.bin"
   grep -q "resume: replayed 30 input records, 300 ticks" "$work/ck_resume.log" || fail "no replay of the 30 ticks after the checkpoint"
-  live=$(sed -n 's/^drape run: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/ck_resume.log")
+  live=$(live_line "$work/ck_resume.log")
   for from in "" --from-start; do
     "$exe" replay "$ckr" $from --out "$work/ck.json" >"$work/ck.out" 2>&1 || fail "replay $from of the resumed journal exited with $?"
     again=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/ck.out")

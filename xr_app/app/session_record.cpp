@@ -45,6 +45,9 @@ sim::JournalHeader journal_header(const XrAppOptions& opt) {
   f["tick_rate_hz"] = std::to_string(kTickRateHz);
   f["substeps"] = std::to_string(kSubsteps);
   f["lock_step"] = opt.sim_lock_step ? "1" : "0";
+  // A session opened from a saved file (drape open) has no start to replay from: its journal
+  // starts from the file's copy (checkpoint record and file in the session directory).
+  if (!opt.open_file.empty()) f["opened"] = opt.open_file;
   return h;
 }
 
@@ -140,11 +143,13 @@ uint64_t replay_end(const sim::JournalContents& j, uint64_t until_tick, ReplayRe
   return end;
 }
 
-// The header fields a checkpoint must share with its journal (the program's version may differ
-// after a resume by a newer build).
+// The scene fields a checkpoint must share with its journal (the program's version may differ
+// after a resume by a newer build; a saved session opened may run in another sim mode).
 bool same_session(std::map<std::string, std::string> a, std::map<std::string, std::string> b) {
-  a.erase("version");
-  b.erase("version");
+  for (const char* k : {"version", "opened", "lock_step"}) {
+    a.erase(k);
+    b.erase(k);
+  }
   return a == b;
 }
 
@@ -231,6 +236,11 @@ ReplayResult replay_journal(const std::string& dir, uint64_t until_tick,
     sim::restore_checkpoint(*c, w.value(), *ops);
     r.start_tick = c->tick;
     r.checkpoint = sim::checkpoint_file_name(c->tick);
+  } else if (!j.header.field("opened").empty()) {
+    r.error = path + ": header field 'opened': the session was opened from " +
+              j.header.field("opened") + " and has no start to replay from" +
+              (from_start ? "" : ", and no whole checkpoint");
+    return r;
   }
   restart_solver_at_checkpoints(w.value(), j, r.start_tick);
   sim::SimThreadOptions so;
@@ -293,6 +303,19 @@ void DrapingSession::open_record() {
   if (!e.empty()) {
     rep_.note("record: " + e + " (the session goes on unrecorded)");
     return;
+  }
+  if (!opt_.open_file.empty() && resume_inputs_end_ == 0) {
+    // The opened file's copy is the journal's start (replay_journal starts from it).
+    const std::string name = sim::checkpoint_file_name(opened_tick_);
+    std::error_code ec;
+    std::filesystem::copy_file(opt_.open_file, opt_.record_dir + "/" + name,
+                               std::filesystem::copy_options::overwrite_existing, ec);
+    const std::string je = ec ? "" : journal->write(sim::JournalCheckpoint{opened_tick_, name});
+    if (ec || !je.empty()) {
+      rep_.note("record: " + (ec ? opt_.record_dir + "/" + name + ": " + ec.message() : je) +
+                " (the session goes on unrecorded)");
+      return;
+    }
   }
   journal_ = journal;
   if (std::string m = write_meta(opt_.record_dir, opt_, "running", 0, 0); !m.empty())
@@ -375,10 +398,14 @@ void DrapingSession::install_checkpoints(sim::World& w) {
   checkpoints_ = std::make_unique<sim::CheckpointWriter>(opt_.record_dir);
   auto taker = std::make_shared<sim::CheckpointTaker>();
   w.at_tick_start = [every, taker, journal = journal_, ops = ops_, writer = checkpoints_.get(),
-                     header = journal_header(opt_).fields,
-                     in_tick = opt_.sim_lock_step](sim::World& world) {
+                     header = journal_header(opt_).fields, in_tick = opt_.sim_lock_step,
+                     cost = checkpoint_cost_](sim::World& world) {
     if (world.tick == 0 || world.tick % every != 0 || !journal->is_open()) return;
+    const auto t0 = std::chrono::steady_clock::now();
     take_checkpoint(world, *ops, *journal, *taker, *writer, header, in_tick);
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    cost->store(std::max(cost->load(), ms));
   };
 }
 
@@ -388,7 +415,12 @@ void DrapingSession::close_record() {
     const int written = checkpoints_->written();
     for (const std::string& e : checkpoints_->take_errors()) rep_.note("checkpoint: " + e);
     checkpoints_.reset();  // the pending checkpoint is written first
-    rep_.note("record: " + std::to_string(written) + " checkpoints written");
+    char line[128];
+    std::snprintf(line, sizeof line,
+                  "record: %d checkpoints written; taking one cost at most %.2f ms on the sim "
+                  "thread",
+                  written, checkpoint_cost_->load());
+    rep_.note(line);
   }
   if (journal_->is_open()) {
     if (std::string e = journal_->write(sim::JournalEnd{r.final_ticks, r.final_state_hash});

@@ -111,6 +111,9 @@ struct XrAppOptions {
   // When set: the session resumes the one recorded there (its scene options are the journal's):
   // its journal replayed to its last whole record, then the session goes on, appending to it.
   std::string resume_dir;
+  // When set: the session starts from this saved session (a checkpoint file, `drape open`): its
+  // scene options are the file's; "save session" writes out_dir/saved_session.drape.
+  std::string open_file;
 };
 
 struct XrAppResult {
