@@ -85,9 +85,10 @@ PY
     espeak-ng -s 140 -w "$work/save_22k.wav" "save session" >>"$log" 2>&1 || fail "espeak-ng failed"
     sox "$work/save_22k.wav" -r 16000 -c 1 -b 16 "$work/save.wav" pad 0.2 1 >>"$log" 2>&1 || fail "sox failed"
     # The scenario's audio cue: the spoken phrase at frame 150 (decoded by the app's recogniser).
-    python3 - "$work/save.wav" "$work/save_scenario.json" <<'PY' || fail "scenario writer"
+    repo=$(cd "$(dirname "$0")/../.." && pwd)
+    python3 - "$work/save.wav" "$work/save_scenario.json" "$repo/assets/scenarios/record_replay.json" <<'PY' || fail "scenario writer"
 import json, sys
-s = json.load(open("assets/scenarios/record_replay.json"))
+s = json.load(open(sys.argv[3]))
 s["audio"] = [{"wav": sys.argv[1], "frame": 150, "text": "save session"}]
 json.dump(s, open(sys.argv[2], "w"))
 PY
