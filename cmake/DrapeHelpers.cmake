@@ -20,7 +20,7 @@ endif()
 # solver or energy run with more than one thread) gets the label "threads" whatever its name, and
 # joins the target drape_threads_tests: the TSan build builds that target and runs that label.
 set(DRAPE_THREADED_SOURCE_REGEX
-  "std::(j?thread|async)|SimThread|FinishThread|ThreadPool|KinectSource|VoiceInput|threads *= *([2-9]|[a-z_(])")
+  "std::(j?thread|async)|SimThread|FinishThread|ThreadPool|KinectSource|VoiceInput|CheckpointWriter|threads *= *([2-9]|[a-z_(])")
 function(drape_add_test name)
   cmake_parse_arguments(T "" "" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${name} ${T_SOURCES})

@@ -60,6 +60,7 @@ constexpr const char* kDefaults = R"json({
     {"source": "voice", "command": "smooth", "edge": "any", "label": "\"smooth out\"", "phrase": "smooth out", "operation": "smooth", "phase": "toggle"},
     {"source": "voice", "command": "next", "edge": "any", "label": "\"next layer\"", "phrase": "next layer", "operation": "next", "phase": "once"},
     {"source": "voice", "command": "help", "edge": "any", "label": "\"show help\"", "phrase": "show help", "operation": "help", "phase": "toggle"},
+    {"source": "voice", "command": "save", "edge": "any", "label": "\"save session\"", "phrase": "save session", "operation": "save", "phase": "once"},
     {"source": "controller", "command": "button.trigger", "edge": "begin", "profile": "khr/simple", "label": "select (held)", "operation": "pinch", "phase": "begin"},
     {"source": "controller", "command": "button.trigger", "edge": "end", "profile": "khr/simple", "label": "select (held)", "operation": "pinch", "phase": "end"},
     {"source": "controller", "command": "button.trigger", "edge": "begin", "label": "trigger (held)", "operation": "pinch", "phase": "begin"},
@@ -115,7 +116,7 @@ namespace {
 const std::set<std::string> kSources = {"gesture", "voice", "controller", "key", "*"};
 const std::set<std::string> kOperations = {"move", "pinch",  "release", "pin",  "cut",
                                            "map",  "smooth", "next",    "undo", "redo",
-                                           "stop", "help",   "*"};
+                                           "stop", "help",   "save",    "*"};
 const std::set<std::string> kProfiles = {"oculus/touch", "valve/index", "htc/vive",
                                          "microsoft/motion", "khr/simple"};
 

@@ -22,6 +22,7 @@ int cmd_replay(int argc, char** argv) {
 #else
   std::string dir, out;
   uint64_t until = 0;
+  bool from_start = false;
   CLI::App cli(
       "Replays a recorded session (drape run/xr --record DIR) headless in lock step and prints "
       "the final state hash. Exit codes: 0 ok (and the hash equals the recorded one when the "
@@ -29,14 +30,23 @@ int cmd_replay(int argc, char** argv) {
       "drape replay");
   cli.add_option("DIR", dir, "the session directory (holds journal.bin)")->required();
   cli.add_option("--until-tick", until, "stop after this many ticks (0: the journal's end)");
+  cli.add_flag("--from-start", from_start,
+               "replay the whole journal from the session's start (no checkpoint)");
   cli.add_option("--out", out, "write the result as JSON there (default: DIR/replay.json)");
   if (const int rc = drape::app::parse_command_line(cli, argc, argv); rc >= 0) return rc;
-  const drape::app::ReplayResult r = drape::app::replay_journal(dir, until);
+  const drape::app::ReplayResult r =
+      drape::app::replay_journal(dir, until, nullptr, nullptr, nullptr, from_start);
   if (!r.error.empty()) {
     std::fprintf(stderr, "drape replay: %s\n", r.error.c_str());
     return 2;
   }
   if (!r.cut_message.empty()) std::fprintf(stderr, "drape replay: %s\n", r.cut_message.c_str());
+  for (const auto& n : r.notes) std::fprintf(stderr, "drape replay: %s\n", n.c_str());
+  if (r.checkpoint.empty())
+    std::fprintf(stderr, "drape replay: from the session's start\n");
+  else
+    std::fprintf(stderr, "drape replay: from %s (tick %llu)\n", r.checkpoint.c_str(),
+                 static_cast<unsigned long long>(r.start_tick));
   char hash[24], recorded[24];
   std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(r.state_hash));
   std::snprintf(recorded, sizeof recorded, "%016llx",
@@ -53,9 +63,9 @@ int cmd_replay(int argc, char** argv) {
   if (out.empty()) out = dir + "/replay.json";
   std::ofstream o(out);
   o << "{\"final_state_hash\": \"" << hash << "\", \"ticks\": " << r.ticks
-    << ", \"records\": " << r.records << ", \"seconds\": " << r.seconds
-    << ", \"recorded_state_hash\": \"" << (r.has_end ? recorded : "")
-    << "\", \"same\": " << (same ? "true" : "false")
+    << ", \"records\": " << r.records << ", \"start_tick\": " << r.start_tick
+    << ", \"seconds\": " << r.seconds << ", \"recorded_state_hash\": \""
+    << (r.has_end ? recorded : "") << "\", \"same\": " << (same ? "true" : "false")
     << ", \"cut_off\": " << (r.cut_message.empty() ? "false" : "true") << "}\n";
   if (!o) {
     std::fprintf(stderr, "drape replay: --out %s: cannot write\n", out.c_str());

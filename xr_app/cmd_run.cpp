@@ -31,6 +31,7 @@
 #ifdef DRAPE_HAVE_XR_APP
 #include <nlohmann/json.hpp>
 
+#include "sim/ops/checkpoint.hpp"
 #include "xr_app/app/desk_scene.hpp"
 #include "xr_app/app/session_record.hpp"
 #include "xr_app/app/xr_app.hpp"
@@ -237,6 +238,7 @@ struct XrRunOptions {
   bool record = true;        // --no-record: a live session without its default recording
   std::string resume;        // --resume [DIR]
   CLI::Option* resume_opt = nullptr;
+  std::string open;  // --open FILE (drape open FILE)
 };
 
 // A live session's default recording: OUT/sessions/<UTC date and time>, a crash loses nothing
@@ -497,6 +499,31 @@ bool resume_options(XrRunOptions& o) {
   return true;
 }
 
+// --open FILE: the saved session's scene options into o.app (its header, as a journal's).
+bool open_options(XrRunOptions& o) {
+  drape::sim::WorldCheckpoint c;
+  std::string err = drape::sim::load_checkpoint(o.open, c);
+  if (err.empty()) {
+    const bool lock_step = o.app.sim_lock_step;
+    drape::sim::JournalHeader h;
+    h.fields = c.header;
+    err = drape::app::options_from_header(h, o.open, o.app);
+    o.app.sim_lock_step = lock_step;
+  }
+  if (!err.empty()) {
+    std::fprintf(stderr, "drape open: %s\n", err.c_str());
+    return false;
+  }
+  if (!o.resume.empty() || o.resume_opt->count() > 0) {
+    std::fprintf(stderr, "drape open: --resume: a saved session is opened, not resumed\n");
+    return false;
+  }
+  o.app.open_file = o.open;
+  std::printf("drape open: %s: the session at tick %llu\n", o.open.c_str(),
+              static_cast<unsigned long long>(c.tick));
+  return true;
+}
+
 int run_xr(XrRunOptions& o) {
   namespace app = drape::app;
   bool simulated = false;
@@ -517,7 +544,14 @@ int run_xr(XrRunOptions& o) {
     if (o.app.start.empty()) o.app.start = kLiveStart;
     if (!check_scene(o)) return 2;
     if (o.resume_opt->count() > 0 && !resume_options(o)) return 2;
+    if (!o.open.empty() && !open_options(o)) return 2;
     return run_live(o, manifest, simulated);
+  }
+  if (!o.open.empty()) {
+    std::fprintf(stderr,
+                 "drape open: needs a live session (a headset, or a display for the simulated "
+                 "runtime's window) and no --scenario\n");
+    return 2;
   }
   if (o.resume_opt->count() > 0) {
     std::fprintf(stderr,
@@ -586,11 +620,15 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
        {"--no-record", &o.record, "live: do not record the session into OUT/sessions/"},
        {"--no-self-collision", &o.app.self_collision,
         "the cloth does not collide with itself (cheaper; folds may pass through each other)"}});
-  drape::app::add_record_option(cli, o.app.record_dir);
+  drape::app::add_record_option(cli, o.app.record_dir, o.app.checkpoint_every_s);
   o.resume_opt = cli.add_option("--resume", o.resume,
                                 "live: resume the session recorded in DIR (default: the newest "
                                 "under OUT/sessions/): its journal replayed, then live, appending")
                      ->expected(0, 1);
+  cli.add_option("--open", o.open,
+                 "live: open the saved session FILE (\"save session\" writes "
+                 "OUT/saved_session.drape) and go on draping from it (drape open FILE)")
+      ->check(CLI::ExistingFile);
   cli.add_option("--json", o.json,
                  "live: write the session's frame rate, sim step and pose-to-photon probes "
                  "(frames) as JSON to this file");
@@ -618,7 +656,8 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
   for (const char* name :
        {"--frames", "--eye-size", "--cloth-res", "--verbose", "--scenario", "--no-voice",
         "--no-pattern", "--every", "--form", "--mesh", "--start", "--json", "--sim-lock-step",
-        "--state-hashes", "--voice", "--record", "--no-record", "--resume", "--no-self-collision"})
+        "--state-hashes", "--voice", "--record", "--no-record", "--resume", "--open",
+        "--no-self-collision"})
     cli.get_option(name)->excludes(headless);
 }
 #endif
@@ -755,3 +794,27 @@ int run(int argc, char** argv) {
 
 DRAPE_COMMAND(run, "main job: the XR app on the default draping scenario (--headless: sim only)",
               run);
+
+namespace {
+// drape open FILE [drape run's options]: drape run --open FILE.
+int open_command(int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') {
+    if (argc >= 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+      std::printf(
+          "usage: drape open FILE [drape run's options]: opens the saved session FILE "
+          "(\"save session\" writes OUT/saved_session.drape) live and goes on draping "
+          "from it\n");
+      return 0;
+    }
+    std::fprintf(stderr, "drape open: FILE is required (drape open FILE)\n");
+    return 2;
+  }
+  std::vector<std::string> args = {"run", "--open", argv[1]};
+  for (int i = 2; i < argc; ++i) args.emplace_back(argv[i]);
+  std::vector<char*> av;
+  for (auto& a : args) av.push_back(a.data());
+  return run(static_cast<int>(av.size()), av.data());
+}
+}  // namespace
+
+DRAPE_COMMAND(open, "open a saved session live and go on draping (drape open FILE)", open_command);

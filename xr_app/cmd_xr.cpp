@@ -158,7 +158,7 @@ int cmd_xr(int argc, char** argv) {
                  "the command map: triggers -> operations (default: assets/commands.json)");
   cli.add_option("--out", opt.out_dir,
                  "write session_log.json, drape_cloth.gltf and xr_session.txt there");
-  app::add_record_option(cli, opt.record_dir);
+  app::add_record_option(cli, opt.record_dir, opt.checkpoint_every_s);
   cli.add_option("--json", json_path,
                  "write frame-time percentiles, pose-to-photon frames, sim tick jitter and the "
                  "per-stage profile there");

@@ -316,11 +316,16 @@ std::string commands_file(const std::string& given) {
   return fs::exists(bundled, ec) ? bundled.string() : "";
 }
 
-void add_record_option(CLI::App& cli, std::string& dir) {
+void add_record_option(CLI::App& cli, std::string& dir, double& checkpoint_every) {
   cli.add_option("--record", dir,
                  "record the session into DIR: journal.bin (the sim's inputs, for drape replay "
-                 "and --resume), meta.json, session.txt, audio.wav (live voice), hands.csv "
-                 "(external hands)");
+                 "and --resume), checkpoints, meta.json, session.txt, audio.wav (live voice), "
+                 "hands.csv (external hands)");
+  cli.add_option("--checkpoint-every", checkpoint_every,
+                 "with --record: a checkpoint of the World every this many seconds of session "
+                 "time (0: none), from which drape replay and --resume start")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
 }
 
 bool prepare_record_dir(const char* command, const std::string& dir) {

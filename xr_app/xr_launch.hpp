@@ -96,7 +96,7 @@ bool resolve_hands(const char* command, const std::vector<std::string>& hands,
 std::string commands_file(const std::string& given);
 
 // --record DIR (both commands): record the session there (docs/sessions.md).
-void add_record_option(CLI::App& cli, std::string& dir);
+void add_record_option(CLI::App& cli, std::string& dir, double& checkpoint_every);
 // After parsing: creates `dir` (when set) and checks that a file can be written there; else
 // prints "<command>: --record DIR: ..." and returns false.
 bool prepare_record_dir(const char* command, const std::string& dir);

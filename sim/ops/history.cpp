@@ -1,6 +1,7 @@
 // Snapshot-based undo/redo (see history.hpp).
 #include "sim/ops/history.hpp"
 
+#include <atomic>
 #include <utility>
 
 namespace drape::sim {
@@ -52,8 +53,23 @@ Cloth History::take_copy(const Cloth& cloth) {
   return out;
 }
 
+namespace {
+uint64_t next_serial() {
+  static std::atomic<uint64_t> serial{0};
+  return ++serial;
+}
+}  // namespace
+
+void History::restore_entries(std::deque<HistoryEntry> undo, std::deque<HistoryEntry> redo) {
+  for (auto* stack : {&undo, &redo})
+    for (HistoryEntry& e : *stack) e.serial = next_serial();
+  undo_ = std::move(undo);
+  redo_ = std::move(redo);
+}
+
 HistoryEntry History::make(std::string label, Cloth&& cloth, const OperationsState& ops) {
   HistoryEntry e;
+  e.serial = next_serial();
   e.label = std::move(label);
   e.cloth = std::move(cloth);
   e.cut_strokes = ops.cut_strokes;

@@ -16,6 +16,9 @@
 namespace drape::sim {
 
 struct HistoryEntry {
+  // Unique in the process, given when the entry is made: an entry does not change while it is
+  // stacked, so a checkpoint copies each serial once (checkpoint.hpp).
+  uint64_t serial = 0;
   std::string label;  // the operation that followed this state ("pinch", "cut", ...)
   Cloth cloth;
   std::vector<CutStroke> cut_strokes;
@@ -55,6 +58,10 @@ class History {
   void drop_redo() { redo_.clear(); }
   size_t undo_size() const { return undo_.size(); }
   size_t redo_size() const { return redo_.size(); }
+  const std::deque<HistoryEntry>& undo_entries() const { return undo_; }
+  const std::deque<HistoryEntry>& redo_entries() const { return redo_; }
+  // Replaces both stacks (a checkpoint's; each entry gets a fresh serial).
+  void restore_entries(std::deque<HistoryEntry> undo, std::deque<HistoryEntry> redo);
   const HistoryEntry* last() const { return undo_.empty() ? nullptr : &undo_.back(); }
 
  private:

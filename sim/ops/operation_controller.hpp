@@ -50,6 +50,9 @@ class OperationController {
   const OperationsState& state() const { return state_; }
   OperationsState& state() { return state_; }
   const History& history() const { return history_; }
+  History& history() { return history_; }
+  // A checkpoint's step count (restore_checkpoint).
+  void set_step(uint64_t step) { step_ = step; }
   OperationParams& params() { return params_; }
 
   // The hooks (public so a caller can chain them with its own).

@@ -7,6 +7,8 @@
 #include <fstream>
 #include <iterator>
 
+#include "sim/runtime/byte_io.hpp"
+
 namespace drape::sim {
 
 namespace {
@@ -14,109 +16,16 @@ namespace {
 constexpr char kMagic[8] = {'D', 'R', 'A', 'P', 'E', 'J', 'N', 'L'};
 constexpr size_t kPreamble = 12;            // magic + format
 constexpr uint32_t kMaxRecord = 16u << 20;  // a larger length is a corrupt record
-enum Kind : uint8_t { kHeader = 1, kTick = 2, kEnd = 3 };
+enum Kind : uint8_t { kHeader = 1, kTick = 2, kEnd = 3, kCheckpoint = 4 };
 constexpr auto kFlushEvery = std::chrono::milliseconds(100);
 
-// Little-endian encoding of the record payloads.
-struct Out {
-  std::vector<unsigned char> b;
-  void u8(uint8_t v) { b.push_back(v); }
-  void u32(uint32_t v) {
-    for (int i = 0; i < 4; ++i) b.push_back(static_cast<unsigned char>(v >> (8 * i)));
-  }
-  void u64(uint64_t v) {
-    for (int i = 0; i < 8; ++i) b.push_back(static_cast<unsigned char>(v >> (8 * i)));
-  }
-  void f64(double d) {
-    uint64_t v;
-    std::memcpy(&v, &d, 8);
-    u64(v);
-  }
-  void str(const std::string& s) {
-    u32(static_cast<uint32_t>(s.size()));
-    b.insert(b.end(), s.begin(), s.end());
-  }
-};
-
-// Decoding: every read checks the bounds; `ok` turns false on the first short read.
-struct In {
-  const unsigned char* p;
-  size_t n, i = 0;
-  bool ok = true;
-  bool need(size_t k) {
-    if (!ok || n - i < k) ok = false;
-    return ok;
-  }
-  uint8_t u8() { return need(1) ? p[i++] : 0; }
-  uint32_t u32() {
-    if (!need(4)) return 0;
-    uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) v |= static_cast<uint32_t>(p[i++]) << (8 * k);
-    return v;
-  }
-  uint64_t u64() {
-    if (!need(8)) return 0;
-    uint64_t v = 0;
-    for (int k = 0; k < 8; ++k) v |= static_cast<uint64_t>(p[i++]) << (8 * k);
-    return v;
-  }
-  double f64() {
-    const uint64_t v = u64();
-    double d;
-    std::memcpy(&d, &v, 8);
-    return d;
-  }
-  std::string str() {
-    const uint32_t len = u32();
-    if (!need(len)) return {};
-    std::string s(reinterpret_cast<const char*>(p + i), len);
-    i += len;
-    return s;
-  }
-};
-
-void put_vec(Out& o, const Vec3& v) {
-  for (int k = 0; k < 3; ++k) o.f64(v[k]);
-}
-Vec3 get_vec(In& in) {
-  Vec3 v;
-  for (int k = 0; k < 3; ++k) v[k] = in.f64();
-  return v;
-}
-
-void put_hand(Out& o, const HandProxy& h) {
-  o.u32(static_cast<uint32_t>(h.id));
-  o.u8(static_cast<uint8_t>((h.tracked ? 1 : 0) | (h.collides ? 2 : 0)));
-  put_vec(o, h.position);
-  o.f64(h.orientation.w());
-  o.f64(h.orientation.x());
-  o.f64(h.orientation.y());
-  o.f64(h.orientation.z());
-  put_vec(o, h.tip);
-  o.f64(h.radius);
-}
-HandProxy get_hand(In& in) {
-  HandProxy h;
-  h.id = static_cast<int>(in.u32());
-  const uint8_t flags = in.u8();
-  h.tracked = flags & 1;
-  h.collides = (flags & 2) != 0;
-  h.position = get_vec(in);
-  const double w = in.f64(), x = in.f64(), y = in.f64(), z = in.f64();
-  h.orientation = Eigen::Quaterniond(w, x, y, z);
-  h.tip = get_vec(in);
-  h.radius = in.f64();
-  return h;
-}
+using Out = ByteWriter;
+using In = ByteReader;
 
 std::vector<unsigned char> encode_header(const JournalHeader& h) {
   Out o;
   o.u8(kHeader);
-  o.u32(static_cast<uint32_t>(h.fields.size()));
-  for (const auto& [k, v] : h.fields) {
-    o.str(k);
-    o.str(v);
-  }
+  o.fields(h.fields);
   return o.b;
 }
 
@@ -151,9 +60,9 @@ std::string load_journal(const std::string& path, JournalContents& out) {
   if (d.size() < kPreamble || std::memcmp(d.data(), kMagic, 8) != 0)
     return path + ": header field 'magic': not a drape journal (no \"DRAPEJNL\" at its start)";
   In pre{d.data() + 8, 4};
-  if (const uint32_t fmt = pre.u32(); fmt != kJournalFormat)
+  if (const uint32_t fmt = pre.u32(); fmt < 1 || fmt > kJournalFormat)
     return path + ": header field 'format': version " + std::to_string(fmt) +
-           " (this program reads " + std::to_string(kJournalFormat) + ")";
+           " (this program reads 1 to " + std::to_string(kJournalFormat) + ")";
   size_t pos = kPreamble;
   size_t records = 0;
   while (pos < d.size()) {
@@ -202,7 +111,7 @@ std::string load_journal(const std::string& path, JournalContents& out) {
     } else if (kind == kTick) {
       JournalTick t;
       t.tick = in.u64();
-      for (auto& h : t.hands) h = get_hand(in);
+      for (auto& h : t.hands) h = in.hand();
       const uint32_t nops = in.u32();
       for (uint32_t i = 0; i < nops && in.ok; ++i) {
         JournalOp op;
@@ -228,6 +137,15 @@ std::string load_journal(const std::string& path, JournalContents& out) {
       }
       out.end = e;
       out.inputs_end = start;
+    } else if (kind == kCheckpoint) {
+      JournalCheckpoint c;
+      c.tick = in.u64();
+      c.file = in.str();
+      if (!in.ok || in.i != in.n) {
+        cut("a checkpoint record is malformed");
+        break;
+      }
+      out.checkpoints.push_back(std::move(c));
     } else {
       cut("a record of unknown kind " + std::to_string(kind));
       break;
@@ -275,7 +193,7 @@ std::string JournalWriter::write(const JournalTick& t) {
   Out o;
   o.u8(kTick);
   o.u64(t.tick);
-  for (const auto& h : t.hands) put_hand(o, h);
+  for (const auto& h : t.hands) o.hand(h);
   o.u32(static_cast<uint32_t>(t.ops.size()));
   for (const auto& op : t.ops) {
     o.str(op.name);
@@ -292,6 +210,14 @@ std::string JournalWriter::write(const JournalEnd& e) {
   o.u8(kEnd);
   o.u64(e.ticks);
   o.u64(e.state_hash);
+  return put(o.b, true);
+}
+
+std::string JournalWriter::write(const JournalCheckpoint& c) {
+  Out o;
+  o.u8(kCheckpoint);
+  o.u64(c.tick);
+  o.str(c.file);
   return put(o.b, true);
 }
 

@@ -5,8 +5,9 @@
 // a u32 payload length, a u32 CRC32 of the payload and the payload; the payload's first byte is
 // its kind: the header (once, first: key = value fields naming everything needed to rebuild the
 // starting World), a tick's input (the tick index, both hands' proxies, the operations applied,
-// the voice phrases heard) or the end (the ticks run and the final state hash). Integers are
-// little-endian, doubles their IEEE-754 bits, strings a u32 length and the bytes.
+// the voice phrases heard), a checkpoint's tick and file, or the end (the ticks run and the final
+// state hash). Integers are little-endian, doubles their IEEE-754 bits, strings a u32 length and
+// the bytes.
 #pragma once
 
 #include <array>
@@ -22,7 +23,8 @@
 
 namespace drape::sim {
 
-inline constexpr uint32_t kJournalFormat = 1;
+// 2 adds the checkpoint record; journals of format 1 (without it) are read as well.
+inline constexpr uint32_t kJournalFormat = 2;
 
 struct JournalOp {
   std::string name;   // the operation ("pinch", "cut", "undo", ...)
@@ -46,6 +48,15 @@ struct JournalEnd {
   uint64_t state_hash = 0;  // sim::state_hash of the cloth after them
 };
 
+// A checkpoint of the World taken at the start of tick `tick` (before that tick's inputs), whose
+// file `file` (in the journal's directory) is written on another thread after the record: the
+// record says that the sim restarted its solver there (sim/ops/checkpoint.hpp), the file may be
+// missing when the process ended before it was renamed into place.
+struct JournalCheckpoint {
+  uint64_t tick = 0;
+  std::string file;
+};
+
 // The header: named fields (text values). `field` returns "" for a missing one.
 struct JournalHeader {
   std::map<std::string, std::string> fields;
@@ -59,7 +70,8 @@ struct JournalContents {
   JournalHeader header;
   std::vector<JournalTick> ticks;
   std::optional<JournalEnd> end;
-  uint64_t whole_bytes = 0;  // bytes up to the end of the last whole record
+  std::vector<JournalCheckpoint> checkpoints;  // in file order (ascending ticks)
+  uint64_t whole_bytes = 0;                    // bytes up to the end of the last whole record
   // Where the input records end: the end record's offset when there is one, else whole_bytes
   // (a resumed session appends from here).
   uint64_t inputs_end = 0;
@@ -91,6 +103,7 @@ class JournalWriter {
   std::string append_to(const std::string& path, uint64_t whole_bytes);
   std::string write(const JournalTick& t);
   std::string write(const JournalEnd& e);
+  std::string write(const JournalCheckpoint& c);  // flushed at once
   void close();
   bool is_open() const { return f_ != nullptr; }
   uint64_t bytes() const { return bytes_; }

@@ -146,6 +146,13 @@ void SimThread::tick() {
     running_cmds_.swap(pending_);
   }
   world_.tick = ticks_done_.load();
+  if (world_.at_tick_start) {
+    try {
+      world_.at_tick_start(world_);
+    } catch (const std::exception& e) {
+      world_.report(std::string("tick start failed: ") + e.what());
+    }
+  }
   for (auto& cmd : running_cmds_) {
     try {
       cmd(world_);

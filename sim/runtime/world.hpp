@@ -23,7 +23,10 @@ struct World {
   // the tick index a command's input is journaled under (journal.hpp).
   uint64_t tick = 0;
 
-  // Hooks set by higher-level modules (e.g. operations): run on the sim thread.
+  // Hooks set by higher-level modules (e.g. operations): run on the sim thread. at_tick_start
+  // runs at the start of each tick, after `tick` is set and before the tick's commands (a
+  // session's checkpoints: sim/ops/checkpoint.hpp).
+  std::function<void(World&)> at_tick_start;
   std::function<void(World&, double dt)> before_step;
   std::function<void(World&, double dt)> after_step;
   std::function<void(const World&, SceneSnapshot&)> decorate_snapshot;

@@ -141,13 +141,16 @@ TEST_F(Voice, CorruptAudioAndMissingMicrophoneGiveStatus) {
 }
 
 TEST_F(Voice, PhraseFileAndGrammar) {
-  // The shipped phrase file: twelve distinct two-word phrases mapping to the twelve commands.
+  // The shipped phrase file: thirteen distinct two-word phrases mapping to the thirteen commands
+  // (the sim's operations, "show help" and "save session").
   std::vector<VoicePhrase> ph;
   std::string err;
   ASSERT_TRUE(load_phrases(std::string(DRAPE_SOURCE_DIR) + "/assets/voice/phrases.tsv", ph, &err))
       << err;
-  ASSERT_EQ(ph.size(), 12u);
+  ASSERT_EQ(ph.size(), 13u);
   for (const auto& p : ph) EXPECT_NE(p.phrase.find(' '), std::string::npos) << p.phrase;
+  EXPECT_EQ(ph.back().phrase, "save session");
+  EXPECT_EQ(ph.back().command, "save");
   VoiceRecognizer rec(VoiceConfig{});
   ASSERT_TRUE(rec.ok()) << rec.error();
   EXPECT_NE(rec.grammar().find("pinch cloth | release it"), std::string::npos) << rec.grammar();

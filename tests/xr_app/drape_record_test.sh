@@ -5,30 +5,44 @@
 # at its tick in lock step and must print exactly the final state hash the recorded run printed.
 #   free  the recorded run's sim free-running on its own 90 Hz clock (--sim-free)
 #   lock  the recorded run in lock step (one tick per frame)
-#   kill  lock step: recording runs killed with SIGKILL at 5 random moments; each journal replays
-#         to the state the uninterrupted run's journal replays to at the same tick
-#         (drape replay --until-tick), which is the recorded run's own state (free, lock).
+#   kill  lock step, a checkpoint every 0.5 s of session time: recording runs killed with SIGKILL
+#         at 20 random moments. Each killed session is resumed from its newest whole checkpoint
+#         and its journal (drape replay): its state at the kill's tick is the one the
+#         uninterrupted run's journal replays to from the start at that tick (drape replay
+#         --until-tick --from-start), and, given the uninterrupted run's inputs after that tick
+#         (its journal's records spliced after the killed journal's whole records), it reaches
+#         the uninterrupted run's final state hash. Most resumes start from a checkpoint.
 #   tee   --record with --voice FILE.wav and --hands trace FILE: audio.wav holds the audio as
 #         captured (a prefix of the recording, sample for sample) and hands.csv the external
 #         tracker's frames as received (a prefix of the trace, in its format).
 #   resume lock step: `drape run --resume DIR` (live, the simulated runtime's window under Xvfb,
 #         --frames 40) replays the recording, goes on live and appends to its journal: the
 #         journal then replays to the resumed run's final state at tick 300 + 40; a copy cut off
-#         mid-record resumes with the cut-off message.
+#         mid-record resumes with the cut-off message; a recording with checkpoints resumes from
+#         its newest (30 ticks replayed) and its journal then replays to the resumed run's state.
+#   save  "save session" spoken (espeak-ng, the scenario's audio cue at frame 150) saves the
+#         session whole (saved_session.drape);
+#         `drape open FILE` under Xvfb starts from exactly that state and goes on, recorded (its
+#         journal replays to it; --from-start is refused); a bad file is an error naming the field.
 # free and lock also check that a journal cut off mid-record replays up to its last whole
 # record with a message naming the byte offset, and that a bad header is an error naming the
-# file and the field.
+# file and the field. lock records with a checkpoint every 0.5 s: the replay starts from the
+# newest, equals the replay from the start, and a newest checkpoint cut off mid-record is named
+# (byte offset) and passed over for the one before it, to the same final state.
 # usage: drape_record_test.sh DRAPE_EXE MODE WORKDIR
 set -u
 exe=$1 mode=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 log=$work/log.txt
 fail() { echo "FAIL: $*"; echo "--- log:"; cat "$log"; exit 1; }
+# "HASH TICK" of a live run's log (drape run / drape open).
+live_line() { sed -n 's/^drape run: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$1"; }
 unset XR_RUNTIME_JSON DRAPE_MOCK_SCENARIO DRAPE_MOCK_END_AFTER_FRAMES DRAPE_MOCK_WRITE_FRAMES
 export HOME=$work/home XDG_CONFIG_HOME=$work/home/.config XDG_CONFIG_DIRS=$work/none
 case $mode in
   free) sim=(--sim-free) ;;
-  lock | kill | resume) sim=() ;;
+  lock | kill) sim=(--checkpoint-every 0.5) ;;
+  resume) sim=() ;;
   tee)
     here=$(cd "$(dirname "$0")" && pwd)
     cd "$work" || exit 1
@@ -63,7 +77,56 @@ PY
     echo "PASS"
     exit 0
     ;;
-  *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill|resume|tee WORKDIR"; exit 2 ;;
+  save)
+    # "save session" spoken (espeak-ng, 16 kHz) in the scripted lock-step session: the app
+    # saves it whole into OUT/saved_session.drape; `drape open FILE` (the simulated runtime's
+    # window under Xvfb) goes on draping from exactly that state, recorded.
+    command -v xvfb-run >/dev/null || fail "xvfb-run is not installed (Debian xvfb)"
+    espeak-ng -s 140 -w "$work/save_22k.wav" "save session" >>"$log" 2>&1 || fail "espeak-ng failed"
+    sox "$work/save_22k.wav" -r 16000 -c 1 -b 16 "$work/save.wav" pad 0.2 1 >>"$log" 2>&1 || fail "sox failed"
+    # The scenario's audio cue: the spoken phrase at frame 150 (decoded by the app's recogniser).
+    repo=$(cd "$(dirname "$0")/../.." && pwd)
+    python3 - "$work/save.wav" "$work/save_scenario.json" "$repo/assets/scenarios/record_replay.json" <<'PY' || fail "scenario writer"
+import json, sys
+s = json.load(open(sys.argv[3]))
+s["audio"] = [{"wav": sys.argv[1], "frame": 150, "text": "save session"}]
+json.dump(s, open(sys.argv[2], "w"))
+PY
+    "$exe" xr --scenario "$work/save_scenario.json" --eye-size 64 --cloth-res 16 \
+      --record "$work/rec" --out "$work/out" >>"$log" 2>&1 || fail "drape xr exited with $?"
+    saved=$work/out/saved_session.drape
+    [ -s "$saved" ] || fail "no $saved"
+    grep -q "voice .*save" "$work/rec/session.txt" || fail "no save trigger heard"
+    n=$(sed -n "s|^save: the session at tick \([0-9]*\) saved to $saved .*|\1|p" "$work/rec/session.txt")
+    [ -n "$n" ] || fail "no save line in session.txt"
+    want=$("$exe" replay "$work/rec" --until-tick "$n" --from-start --out "$work/a.json" 2>>"$log" |
+      sed -n 's/^final state hash \([0-9a-f]*\) at tick.*/\1/p')
+    xvfb-run -a "$exe" open "$saved" --frames 40 --sim-lock-step --no-pattern --voice off \
+      --out "$work/live" >"$work/open.log" 2>&1
+    rc=$?
+    cat "$work/open.log" >>"$log"
+    [ $rc -eq 0 ] || fail "drape open exited with $rc"
+    grep -q "drape open: $saved: the session at tick $n" "$work/open.log" || fail "no open line"
+    live=$(live_line "$work/open.log")
+    read -r lhash ltick <<<"$live"
+    [ "$ltick" = $((n + 40)) ] || fail "the opened session ended at tick '$ltick', not $n + 40"
+    sess=$(ls -d "$work"/live/sessions/*/ | head -1)
+    [ -f "$sess/journal.bin" ] || fail "the opened session was not recorded"
+    got=$("$exe" replay "$sess" --until-tick "$n" --out "$work/b.json" 2>>"$log" |
+      sed -n 's/^final state hash \([0-9a-f]*\) at tick.*/\1/p')
+    [ -n "$want" ] && [ "$got" = "$want" ] || fail "the opened state $got differs from the saved session's $want at tick $n"
+    again=$("$exe" replay "$sess" --out "$work/c.json" 2>>"$log" | sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p')
+    [ "$again" = "$live" ] || fail "the opened session's journal replays to '$again', it ended at '$live'"
+    "$exe" replay "$sess" --from-start >/dev/null 2>"$work/start.err"
+    [ $? -eq 2 ] && grep -q "header field 'opened'" "$work/start.err" || fail "--from-start of an opened session: $(cat "$work/start.err")"
+    printf 'not a checkpoint' >"$work/bad.drape"
+    xvfb-run -a "$exe" open "$work/bad.drape" --frames 5 >"$work/bad.log" 2>&1
+    [ $? -eq 2 ] && grep -q "$work/bad.drape: byte 0: field 'magic'" "$work/bad.log" || fail "bad file: $(cat "$work/bad.log")"
+    echo "saved at tick $n: $want; opened: the same state, on to $live (its journal replays to it)"
+    echo "PASS"
+    exit 0
+    ;;
+  *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill|resume|tee|save WORKDIR"; exit 2 ;;
 esac
 rec=$work/rec
 start=$(date +%s.%N)
@@ -107,7 +170,7 @@ if [ "$mode" = resume ]; then
   cat "$work/resume.log" >>"$log"
   [ $rc -eq 0 ] || fail "drape run --resume exited with $rc"
   grep -q "resume: replayed 300 input records, 300 ticks" "$work/resume.log" || fail "no replay line"
-  live=$(sed -n 's/^drape run: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/resume.log")
+  live=$(live_line "$work/resume.log")
   read -r lhash ltick <<<"$live"
   [ "$ltick" = 340 ] || fail "the resumed run ended at tick '$ltick', not 300 + 40"
   "$exe" replay "$work/resumed" >"$work/resumed.out" 2>&1 || fail "replay of the resumed journal exited with $?"
@@ -122,42 +185,103 @@ if [ "$mode" = resume ]; then
   [ $rc -eq 0 ] || fail "drape run --resume of a cut-off journal exited with $rc"
   grep -q "$cut/journal.bin: byte [0-9]*: .*cut off" "$work/cut_resume.log" || fail "no cut-off message"
   grep -q "resume: replayed 299 input records, 299 ticks" "$work/cut_resume.log" || fail "the cut journal did not replay to its last whole record"
+  # A recording with checkpoints (every 0.5 s): the resume starts from the newest, replays the
+  # 30 ticks after it, goes on live; the journal then replays to the resumed run's state from
+  # its checkpoint and from the start alike.
+  ckr=$work/checkpointed
+  "$exe" xr --scenario assets/scenarios/record_replay.json --eye-size 64 --cloth-res 16 \
+    --record "$ckr" --checkpoint-every 0.5 >>"$log" 2>&1 || fail "drape xr --checkpoint-every exited with $?"
+  resume_run "$ckr" "$work/ck_resume.log"
+  rc=$?
+  cat "$work/ck_resume.log" >>"$log"
+  [ $rc -eq 0 ] || fail "drape run --resume of the checkpointed recording exited with $rc"
+  grep -q "resume: from checkpoint-270.bin (tick 270)" "$work/ck_resume.log" || fail "the resume did not start from checkpoint-270.bin"
+  grep -q "resume: replayed 30 input records, 300 ticks" "$work/ck_resume.log" || fail "no replay of the 30 ticks after the checkpoint"
+  live=$(live_line "$work/ck_resume.log")
+  for from in "" --from-start; do
+    "$exe" replay "$ckr" $from --out "$work/ck.json" >"$work/ck.out" 2>&1 || fail "replay $from of the resumed journal exited with $?"
+    again=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/ck.out")
+    [ "$again" = "$live" ] || fail "the resumed journal replays ($from) to '$again', the run ended at '$live'"
+  done
+  echo "resumed from checkpoint-270.bin: $live; its journal replays to it from the checkpoint and from the start"
   echo "PASS"
   exit 0
 fi
 
 if [ "$mode" = kill ]; then
-  # Kill recording runs at random moments within the uninterrupted run's duration.
-  killed=0 tries=0
-  while [ $killed -lt 5 ] && [ $tries -lt 12 ]; do
-    tries=$((tries + 1))
-    k=$work/kill$tries
-    delay=$(awk -v t="$run_secs" -v r="$RANDOM" 'BEGIN { printf "%.2f", t * (0.15 + 0.7 * r / 32768) }')
+  here=$(cd "$(dirname "$0")" && pwd)
+  # One killed run: SIGKILL after $2 s, its session resumed (replayed from its newest whole
+  # checkpoint and its journal) and compared with the uninterrupted run; 1 when the run ended
+  # before the kill or had recorded no input yet (nothing to compare).
+  kill_once() {  # kill_once N DELAY
+    local k=$work/kill$1 l=$work/kill$1
     "$exe" xr --scenario assets/scenarios/record_replay.json --eye-size 64 --cloth-res 16 \
-      --record "$k" >"$work/kill$tries.log" 2>&1 &
-    pid=$!
-    sleep "$delay"
+      --record "$k" "${sim[@]}" >"$l.log" 2>&1 &
+    local pid=$!
+    sleep "$2"
     kill -KILL $pid 2>/dev/null
     wait $pid 2>/dev/null
-    grep -q "^drape xr: final state hash" "$work/kill$tries.log" && continue  # ended first
-    [ -f "$k/journal.bin" ] || continue  # killed before the journal was opened
-    "$exe" replay "$k" >"$work/kill$tries.out" 2>"$work/kill$tries.err"
-    rc=$?
-    [ $rc -eq 0 ] || fail "replay of the journal killed after $delay s exited with $rc: $(cat "$work/kill$tries.err")"
-    got=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/kill$tries.out")
+    grep -q "^drape xr: final state hash" "$l.log" && return 1  # ended first
+    [ -f "$k/journal.bin" ] || return 1  # killed before the journal was opened
+    "$exe" replay "$k" >"$l.out" 2>"$l.err" ||
+      fail "replay of the journal killed after $2 s exited with $?: $(cat "$l.err")"
+    local got khash ktick want
+    got=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$l.out")
     read -r khash ktick <<<"$got"
     [ -n "$ktick" ] || fail "no hash from the killed journal's replay"
-    [ "$ktick" -gt 0 ] || continue  # killed before its first input record: nothing to compare
-    "$exe" replay "$rec" --until-tick "$ktick" --out "$work/until$tries.json" >"$work/until$tries.out" 2>&1 ||
+    [ "$ktick" -gt 0 ] || return 1  # killed before its first input record
+    "$exe" replay "$rec" --until-tick "$ktick" --from-start --out "$l.until.json" >"$l.until" 2>&1 ||
       fail "replay --until-tick $ktick exited with $?"
-    want=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/until$tries.out")
-    echo "killed after $delay s: journal to tick $ktick: $khash; uninterrupted at that tick: $want"
+    want=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$l.until")
     [ "$want" = "$khash $ktick" ] || fail "killed journal's state $khash at $ktick != uninterrupted $want"
-    killed=$((killed + 1))
+    # The resumed session goes on with the uninterrupted run's inputs from the kill's tick on.
+    python3 "$here/journal_splice.py" "$k/journal.bin" "$rec/journal.bin" "$ktick" \
+      "$k/journal.bin" || fail "journal splice"
+    "$exe" replay "$k" >"$l.cont.out" 2>"$l.cont.err" ||
+      fail "the resumed session after the kill at tick $ktick: $(cat "$l.cont.err")"
+    local final from
+    final=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$l.cont.out")
+    [ "$final" = "$rhash $rtick" ] || fail "resumed after the kill at $ktick: '$final', uninterrupted '$rhash $rtick'"
+    from=$(sed -n 's/^drape replay: from \(checkpoint-[0-9]*.bin\).*/\1/p' "$l.err")
+    echo "killed after $2 s at tick $ktick: $khash (uninterrupted: the same); resumed from ${from:-the start}: final $final"
+    [ -n "$from" ] && from_checkpoint=$((from_checkpoint + 1))
+    return 0
+  }
+  killed=0 tries=0 from_checkpoint=0
+  while [ $killed -lt 20 ] && [ $tries -lt 40 ]; do
+    tries=$((tries + 1))
+    delay=$(awk -v t="$run_secs" -v r="$RANDOM" 'BEGIN { printf "%.2f", t * (0.15 + 0.7 * r / 32768) }')
+    kill_once $tries "$delay" && killed=$((killed + 1))
   done
-  [ $killed -ge 5 ] || fail "only $killed of $tries runs were killed mid-session"
+  [ $killed -ge 20 ] || fail "only $killed of $tries runs were killed mid-session"
+  echo "$killed kills, $from_checkpoint resumed from a checkpoint"
+  [ $from_checkpoint -ge 10 ] || fail "only $from_checkpoint of $killed resumes started from a checkpoint"
   echo "PASS"
   exit 0
+fi
+
+if [ "$mode" = lock ]; then
+  # Checkpoints every 0.5 s (45 ticks): the replay starts from the newest and equals the replay
+  # from the start; the newest cut off mid-record is named and passed over for the one before.
+  newest=$(ls "$rec" | sed -n 's/^checkpoint-\([0-9]*\)\.bin$/\1/p' | sort -n | tail -1)
+  [ -n "$newest" ] || fail "no checkpoint file in $rec"
+  grep -q "^drape replay: from checkpoint-$newest.bin (tick $newest)" "$work/replay.err" ||
+    fail "the replay did not start from checkpoint-$newest.bin"
+  "$exe" replay "$rec" --from-start --out "$work/start.json" >"$work/start.out" 2>&1 ||
+    fail "drape replay --from-start exited with $?"
+  grep -q "^final state hash $rhash at tick $rtick$" "$work/start.out" || fail "--from-start: $(cat "$work/start.out")"
+  ck=$work/cut_checkpoint
+  cp -r "$rec" "$ck"
+  size=$(stat -c %s "$rec/checkpoint-$newest.bin")
+  head -c $((size / 2)) "$rec/checkpoint-$newest.bin" >"$ck/checkpoint-$newest.bin"
+  "$exe" replay "$ck" >"$work/ck.out" 2>"$work/ck.err" || fail "replay with a cut-off checkpoint exited with $?: $(cat "$work/ck.err")"
+  cat "$work/ck.err" >>"$log"
+  grep -q "$ck/checkpoint-$newest.bin: byte [0-9]*: .*the checkpoint is cut off there" "$work/ck.err" ||
+    fail "no cut-off message for the checkpoint: $(cat "$work/ck.err")"
+  grep -q "^drape replay: from checkpoint-$((newest - 45)).bin" "$work/ck.err" ||
+    fail "the replay did not fall back to checkpoint-$((newest - 45)).bin: $(cat "$work/ck.err")"
+  grep -q "^final state hash $rhash at tick $rtick$" "$work/ck.out" || fail "cut checkpoint: $(cat "$work/ck.out")"
+  echo "checkpoints: from checkpoint-$newest.bin, from the start, and past a cut-off one: $rhash"
 fi
 
 # A journal cut off mid-record: the replay loads its whole records and says where it stops.

@@ -20,6 +20,12 @@
 #   disk_full_pattern  `drape pattern --out DIR` over an earlier pattern with the disk full (from
 #                the first byte, and after 100000 bytes): exit 1, a message naming the file and
 #                saying the earlier files are kept; they are, byte for byte.
+#   journal_full the recording's folder full (--record DIR): without checkpoints, the journal's
+#                write fails after 12000 bytes: a message says the recording stopped, the session
+#                goes on to the same cloth as an unrecorded run, the journal's whole records replay;
+#                with a checkpoint every 0.5 s, the first checkpoint's file cannot be written: a
+#                message names it, no partial file is left, the journal's whole records replay to
+#                the state of a recording without the fault at the same tick.
 # usage: faults_test.sh DRAPE_EXE FAULT_INJECT_SO MODE WORKDIR [PORT]
 set -u
 exe=$1 inject=$2 mode=$3 work=$4 port=${5:-0}
@@ -193,6 +199,41 @@ EOF
     cmp -s "$work/kept/xr_session.txt" "$work/before/xr_session.txt" && fail "the run with room did not replace the outputs"
     grep -q "^frames 140 " "$work/before/xr_session.txt" || fail "the run with room: not its outputs"
     echo "with room again, the outputs are replaced"
+    ;;
+  journal_full)
+    scenario 140 true
+    run reference
+    check_complete reference
+    replay_hash() {  # replay_hash DIR [ARGS]: "HASH TICK" of drape replay
+      local d=$1; shift
+      "$exe" replay "$d" "$@" --out "$work/r.json" 2>>"$log" |
+        sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p'
+    }
+    DRAPE_FAULT_ENOSPC_MATCH="$work/rec/" DRAPE_FAULT_ENOSPC_AFTER=12000 LD_PRELOAD=$inject \
+      run full --record "$work/rec" --checkpoint-every 0
+    check_complete full
+    grep -q "fault_inject: ENOSPC" "$work/full.txt" || fail "the disk was never full"
+    grep -q "journal: .*cannot .* the journal.*(recording stopped)" "$work/full/xr_session.txt" ||
+      fail "no message that the recording stopped"
+    grep "journal: " "$work/full/xr_session.txt" | head -1
+    same_cloth full reference
+    got=$(replay_hash "$work/rec")
+    [ -n "$got" ] || fail "the journal's whole records do not replay"
+    echo "the journal's whole records replay: $got"
+    # With checkpoints: the first checkpoint's file does not fit.
+    run recorded --record "$work/rec_ok" --checkpoint-every 0.5
+    check_complete recorded
+    DRAPE_FAULT_ENOSPC_MATCH="$work/rec_ck/" DRAPE_FAULT_ENOSPC_AFTER=20000 LD_PRELOAD=$inject \
+      run full_ck --record "$work/rec_ck" --checkpoint-every 0.5
+    check_complete full_ck
+    grep -q "checkpoint: $work/rec_ck/checkpoint-45.bin: cannot write the checkpoint" "$work/full_ck/xr_session.txt" ||
+      fail "no message naming the checkpoint that could not be written"
+    ls "$work/rec_ck" | grep -q "checkpoint-" && fail "a checkpoint file or its partial file was left"
+    got=$(replay_hash "$work/rec_ck")
+    read -r _ tick <<<"$got"
+    want=$(replay_hash "$work/rec_ok" --until-tick "$tick" --from-start)
+    [ -n "$got" ] && [ "$got" = "$want" ] || fail "the journal kept replays to '$got', the recording without the fault to '$want'"
+    echo "checkpoint not written, named; the journal's records replay to $got as without the fault"
     ;;
   disk_full_pattern)
     pattern() { "$exe" pattern --design tight-skirt --form 9AR --out "$work/pattern" "$@"; }

@@ -125,8 +125,9 @@ bool DrapingSession::create(const VulkanDevice& device) {
   sim::SimThreadOptions so;
   so.lock_step = opt_.sim_lock_step;
   // A resumed session (--resume) starts from its journal's replay (session_record.cpp).
-  auto w = opt_.resume_dir.empty() ? make_session_world(opt_, opt_.sim_lock_step)
-                                   : resume_world(so.first_tick);
+  auto w = !opt_.resume_dir.empty()  ? resume_world(so.first_tick)
+           : !opt_.open_file.empty() ? open_world(so.first_tick)
+                                     : make_session_world(opt_, opt_.sim_lock_step);
   if (!w) {
     rep_.r.error = w.error();
     return false;
@@ -156,6 +157,7 @@ void DrapingSession::start_sim() {
   }
   profile_ticks(w);
   if (!opt_.record_dir.empty()) open_record();
+  install_checkpoints(w);
   // Lock step: the ticks run on the frame loop's thread inside advance() (no hand-off per frame).
   if (!opt_.sim_lock_step) sim_->start();
 }
@@ -414,6 +416,7 @@ void DrapingSession::finish() {
   if (!sim_) return;
   rep_.r.thread_cpu_s = threads_.seconds();  // before the sim's threads end
   sim_->stop();
+  poll_saves(-1, true);
   if (ops_ && !opt_.sim_lock_step) drain_free_outcomes();
   sim::World& w = sim_->world();
   rep_.r.pinned_added = count_pinned(w.cloth) - pinned_at_start_;

@@ -8,12 +8,14 @@
 
 #include <array>
 #include <atomic>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "render/renderer.hpp"
+#include "sim/ops/checkpoint.hpp"
 #include "sim/ops/operation_controller.hpp"
 #include "sim/runtime/journal.hpp"
 #include "sim/runtime/sim_thread.hpp"
@@ -123,6 +125,17 @@ class DrapingSession : public SessionContent {
   // --resume: the World and the operations from the replay of opt_.resume_dir's journal to its
   // last whole record; `first_tick` the ticks it ran.
   sim::Result<sim::World> resume_world(uint64_t& first_tick);
+  // With the journal open: a checkpoint every opt_.checkpoint_every_s of session time, taken by
+  // the sim thread at a tick's start (journal record, copy, fresh solver), written by
+  // checkpoints_'s thread into the record directory.
+  void install_checkpoints(sim::World& w);
+  // "save session": the sim copies the session at its next tick; a thread writes it whole into
+  // out_dir/saved_session.drape (session_save.cpp). poll_saves reports the ended saves (all of
+  // them, waiting, when `wait`).
+  void save_session(int64_t frame);
+  void poll_saves(int64_t frame, bool wait);
+  // drape open FILE: the World and the operations from the saved session opt_.open_file.
+  sim::Result<sim::World> open_world(uint64_t& first_tick);
   void close_record();
 
   const XrAppOptions opt_;
@@ -178,6 +191,11 @@ class DrapingSession : public SessionContent {
   // commands while it runs, by finish() after it stopped.
   std::shared_ptr<sim::JournalWriter> journal_;
   uint64_t resume_inputs_end_ = 0;                      // a resumed journal: append from this byte
+  std::unique_ptr<sim::CheckpointWriter> checkpoints_;  // the checkpoint files' writer thread
+  // The longest a checkpoint took on the sim thread (ms: journal record, copy, fresh solver).
+  std::shared_ptr<std::atomic<double>> checkpoint_cost_ = std::make_shared<std::atomic<double>>(0);
+  std::vector<std::future<std::string>> saves_;         // "save session": each save's message
+  uint64_t opened_tick_ = 0;                            // drape open: the saved session's tick
   std::unique_ptr<tracking::TraceRecorder> hands_csv_;  // --record, external hands
 
   // Each hand's interaction profile family: controller triggers are looked up under it.

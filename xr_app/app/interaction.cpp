@@ -85,7 +85,8 @@ void DrapingSession::interact(int64_t frame, const HandInput& in) {
   } else if (ops_) {
     drain_free_outcomes();
   }
-  if (ops_) drain_said(frame);  // refusals and the hands' operations into the feedback panel
+  if (ops_) drain_said(frame);
+  poll_saves(frame, false);  // refusals and the hands' operations into the feedback panel
   if (!ext_)
     feedback_.set_status("hands", hands[0].tracked || hands[1].tracked ? "" : "no hand tracked");
 }
@@ -275,6 +276,11 @@ std::vector<DrapingSession::Op> DrapingSession::map_triggers(
         feedback_.toggle_help();
       else
         feedback_.show_help(act->phase != tracking::Phase::End);
+      continue;
+    }
+    // Saving is the app's too: the sim copies the session, another thread writes the file.
+    if (op.name == "save") {
+      if (act->phase != tracking::Phase::End) save_session(frame);
       continue;
     }
     use.push_back(op);

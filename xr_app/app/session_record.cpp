@@ -6,7 +6,10 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
 
+#include "sim/ops/checkpoint.hpp"
 #include "sim/runtime/sim_thread.hpp"
 #include "sim/solvers/solver_factory.hpp"
 #include "sim/testbeds/testbed.hpp"
@@ -44,6 +47,9 @@ sim::JournalHeader journal_header(const XrAppOptions& opt) {
   f["substeps"] = std::to_string(kSubsteps);
   f["lock_step"] = opt.sim_lock_step ? "1" : "0";
   f["self_collision"] = opt.self_collision ? "1" : "0";
+  // A session opened from a saved file (drape open) has no start to replay from: its journal
+  // starts from the file's copy (checkpoint record and file in the session directory).
+  if (!opt.open_file.empty()) f["opened"] = opt.open_file;
   return h;
 }
 
@@ -91,16 +97,25 @@ std::string options_from_header(const sim::JournalHeader& h, const std::string& 
   return "";
 }
 
-sim::Result<sim::World> make_session_world(const XrAppOptions& opt, bool finish_in_tick) {
-  auto scene = opt.start.empty() ? sim::Result<sim::Testbed>(sim::make_form_drape(opt.cloth_res))
-                                 : make_desk_scene(opt);
-  if (!scene) return sim::Error{"scene: " + scene.error()};
+sim::Result<std::unique_ptr<sim::Solver>> make_session_solver(bool finish_in_tick) {
   sim::SolverConfig solver_cfg;
   solver_cfg.freeze = true;  // pieces at rest sleep until a hand, pin or cut disturbs them
   // A lock-step run replays bit for bit: the static finish of a sleeping piece then runs one
   // cycle per tick instead of landing whenever its thread ends.
   solver_cfg.finish_thread = !finish_in_tick;
-  auto solver = sim::make_solver(kSolver, solver_cfg);
+  return sim::make_solver(kSolver, solver_cfg);
+}
+
+uint64_t checkpoint_ticks(double seconds) {
+  if (seconds <= 0) return 0;
+  return std::max<uint64_t>(1, static_cast<uint64_t>(std::llround(seconds * kTickRateHz)));
+}
+
+sim::Result<sim::World> make_session_world(const XrAppOptions& opt, bool finish_in_tick) {
+  auto scene = opt.start.empty() ? sim::Result<sim::Testbed>(sim::make_form_drape(opt.cloth_res))
+                                 : make_desk_scene(opt);
+  if (!scene) return sim::Error{"scene: " + scene.error()};
+  auto solver = make_session_solver(finish_in_tick);
   if (!solver) return sim::Error{"solver: " + solver.error()};
   sim::World w;
   w.cloth = std::move(scene->cloth);
@@ -123,10 +138,88 @@ void apply_input(sim::World& w, sim::OperationController& ops,
     ops.trigger(w, op.name, static_cast<sim::TriggerPhase>(op.phase), op.hand);
 }
 
+namespace {
+
+// The journal's replay ends: its end record's tick when it has one, else the tick after its last
+// whole record, or `until_tick` when earlier.
+uint64_t replay_end(const sim::JournalContents& j, uint64_t until_tick, ReplayResult& r) {
+  uint64_t end = j.ticks.empty() ? 0 : j.ticks.back().tick + 1;
+  if (j.end) {
+    r.has_end = true;
+    r.recorded_hash = j.end->state_hash;
+    r.recorded_ticks = j.end->ticks;
+    end = std::max(end, j.end->ticks);
+  }
+  if (until_tick > 0 && until_tick < end) end = until_tick;
+  return end;
+}
+
+// The scene fields a checkpoint must share with its journal (the program's version may differ
+// after a resume by a newer build; a saved session opened may run in another sim mode).
+bool same_session(std::map<std::string, std::string> a, std::map<std::string, std::string> b) {
+  for (const char* k : {"version", "opened", "lock_step"}) {
+    a.erase(k);
+    b.erase(k);
+  }
+  return a == b;
+}
+
+bool plain_checkpoint_name(const std::string& f) {
+  return f.rfind("checkpoint-", 0) == 0 && f.find('/') == std::string::npos && f.size() > 15 &&
+         f.compare(f.size() - 4, 4, ".bin") == 0;
+}
+
+// The newest checkpoint the journal names at or before `end` whose file loads whole and belongs
+// to the journal's session; why a newer one was passed over goes to `notes`.
+std::optional<sim::WorldCheckpoint> newest_checkpoint(const std::string& dir,
+                                                      const sim::JournalContents& j, uint64_t end,
+                                                      std::vector<std::string>& notes) {
+  bool first = true;
+  for (auto it = j.checkpoints.rbegin(); it != j.checkpoints.rend(); ++it) {
+    if (it->tick > end || it->tick == 0) continue;
+    const std::string p = dir + "/" + it->file;
+    std::error_code ec;
+    if (!plain_checkpoint_name(it->file) || !std::filesystem::exists(p, ec)) {
+      if (first) notes.push_back(p + ": not there (the session ended before it was written)");
+      first = false;
+      continue;
+    }
+    first = false;
+    sim::WorldCheckpoint c;
+    if (std::string e = sim::load_checkpoint(p, c); !e.empty()) {
+      notes.push_back(e);
+      continue;
+    }
+    if (c.tick != it->tick || !same_session(c.header, j.header.fields)) {
+      notes.push_back(p + ": field 'header': another session's checkpoint: not used");
+      continue;
+    }
+    return c;
+  }
+  return std::nullopt;
+}
+
+// The sim restarts its solver at each checkpoint the journal records after `after`, as the
+// recorded session did when it took them.
+void restart_solver_at_checkpoints(sim::World& w, const sim::JournalContents& j, uint64_t after) {
+  std::set<uint64_t> ticks;
+  for (const auto& c : j.checkpoints)
+    if (c.tick > after) ticks.insert(c.tick);
+  w.at_tick_start = nullptr;
+  if (ticks.empty()) return;
+  w.at_tick_start = [ticks](sim::World& wd) {
+    if (!ticks.count(wd.tick)) return;
+    auto s = make_session_solver(true);
+    if (s) wd.solver = std::move(s.value());
+  };
+}
+
+}  // namespace
+
 ReplayResult replay_journal(const std::string& dir, uint64_t until_tick,
                             std::unique_ptr<sim::World>* world_out,
                             std::shared_ptr<sim::OperationController>* ops_out,
-                            uint64_t* inputs_end) {
+                            uint64_t* inputs_end, bool from_start) {
   ReplayResult r;
   const auto t0 = std::chrono::steady_clock::now();
   const std::string path = dir + "/journal.bin";
@@ -149,20 +242,26 @@ ReplayResult replay_journal(const std::string& dir, uint64_t until_tick,
   }
   auto ops = std::make_shared<sim::OperationController>();
   ops->install(w.value());
+  const uint64_t end = replay_end(j, until_tick, r);
+  if (auto c = from_start ? std::nullopt : newest_checkpoint(dir, j, end, r.notes)) {
+    sim::restore_checkpoint(*c, w.value(), *ops);
+    r.start_tick = c->tick;
+    r.checkpoint = sim::checkpoint_file_name(c->tick);
+  } else if (!j.header.field("opened").empty()) {
+    r.error = path + ": header field 'opened': the session was opened from " +
+              j.header.field("opened") + " and has no start to replay from" +
+              (from_start ? "" : ", and no whole checkpoint");
+    return r;
+  }
+  restart_solver_at_checkpoints(w.value(), j, r.start_tick);
   sim::SimThreadOptions so;
   so.lock_step = true;
   so.tick_rate_hz = kTickRateHz;
   so.substeps = kSubsteps;
+  so.first_tick = r.start_tick;
   sim::SimThread sim(std::move(w.value()), so);  // not started: advance() ticks on this thread
-  uint64_t end = j.ticks.empty() ? 0 : j.ticks.back().tick + 1;
-  if (j.end) {
-    r.has_end = true;
-    r.recorded_hash = j.end->state_hash;
-    r.recorded_ticks = j.end->ticks;
-    end = std::max(end, j.end->ticks);
-  }
-  if (until_tick > 0 && until_tick < end) end = until_tick;
   for (const auto& t : j.ticks) {
+    if (t.tick < r.start_tick) continue;
     if (t.tick >= end) break;
     if (t.tick > sim.ticks()) sim.advance(static_cast<int>(t.tick - sim.ticks()));
     sim.post(
@@ -216,6 +315,19 @@ void DrapingSession::open_record() {
     rep_.note("record: " + e + " (the session goes on unrecorded)");
     return;
   }
+  if (!opt_.open_file.empty() && resume_inputs_end_ == 0) {
+    // The opened file's copy is the journal's start (replay_journal starts from it).
+    const std::string name = sim::checkpoint_file_name(opened_tick_);
+    std::error_code ec;
+    std::filesystem::copy_file(opt_.open_file, opt_.record_dir + "/" + name,
+                               std::filesystem::copy_options::overwrite_existing, ec);
+    const std::string je = ec ? "" : journal->write(sim::JournalCheckpoint{opened_tick_, name});
+    if (ec || !je.empty()) {
+      rep_.note("record: " + (ec ? opt_.record_dir + "/" + name + ": " + ec.message() : je) +
+                " (the session goes on unrecorded)");
+      return;
+    }
+  }
   journal_ = journal;
   if (std::string m = write_meta(opt_.record_dir, opt_, "running", 0, 0); !m.empty())
     rep_.note("record: " + m);
@@ -248,6 +360,10 @@ sim::Result<sim::World> DrapingSession::resume_world(uint64_t& first_tick) {
                 r.records, static_cast<unsigned long long>(r.ticks), r.seconds,
                 static_cast<unsigned long long>(r.state_hash));
   rep_.note(line);
+  for (const auto& n : r.notes) rep_.note("resume: " + n);
+  rep_.note(r.checkpoint.empty()
+                ? "resume: from the session's start"
+                : "resume: from " + r.checkpoint + " (tick " + std::to_string(r.start_tick) + ")");
   first_tick = r.ticks;
   if (!opt_.sim_lock_step) {
     // The replay ran the static finish in the tick; live, it lands from its own thread again.
@@ -261,8 +377,62 @@ sim::Result<sim::World> DrapingSession::resume_world(uint64_t& first_tick) {
   return std::move(*w);
 }
 
+namespace {
+
+// On the sim thread at the start of a checkpoint's tick: the journal's record first (a replay
+// restarts its solver there), then the copy, the fresh solver and the copy handed to the writer
+// (the old solver with it, to end off the sim thread).
+void take_checkpoint(sim::World& w, sim::OperationController& ops, sim::JournalWriter& journal,
+                     sim::CheckpointTaker& taker, sim::CheckpointWriter& writer,
+                     const std::map<std::string, std::string>& header, bool finish_in_tick) {
+  for (const std::string& e : writer.take_errors()) w.report("checkpoint: " + e);
+  const std::string file = sim::checkpoint_file_name(w.tick);
+  if (std::string e = journal.write(sim::JournalCheckpoint{w.tick, file}); !e.empty()) {
+    w.report("checkpoint: " + e + " (recording stopped)");
+    journal.close();
+    return;
+  }
+  auto solver = make_session_solver(finish_in_tick);
+  if (!solver) throw std::runtime_error("checkpoint: solver: " + solver.error());
+  auto c = taker.take(w, ops, header);
+  std::shared_ptr<sim::Solver> old = std::move(w.solver);
+  w.solver = std::move(solver.value());
+  writer.submit(std::move(c), file, std::move(old));
+}
+
+}  // namespace
+
+void DrapingSession::install_checkpoints(sim::World& w) {
+  w.at_tick_start = nullptr;  // a resumed World keeps its replay's hook otherwise
+  const uint64_t every = checkpoint_ticks(opt_.checkpoint_every_s);
+  if (!journal_ || !ops_ || every == 0) return;
+  checkpoints_ = std::make_unique<sim::CheckpointWriter>(opt_.record_dir);
+  auto taker = std::make_shared<sim::CheckpointTaker>();
+  w.at_tick_start = [every, taker, journal = journal_, ops = ops_, writer = checkpoints_.get(),
+                     header = journal_header(opt_).fields, in_tick = opt_.sim_lock_step,
+                     cost = checkpoint_cost_](sim::World& world) {
+    if (world.tick == 0 || world.tick % every != 0 || !journal->is_open()) return;
+    const auto t0 = std::chrono::steady_clock::now();
+    take_checkpoint(world, *ops, *journal, *taker, *writer, header, in_tick);
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    cost->store(std::max(cost->load(), ms));
+  };
+}
+
 void DrapingSession::close_record() {
   XrAppResult& r = rep_.r;
+  if (checkpoints_) {
+    const int written = checkpoints_->written();
+    for (const std::string& e : checkpoints_->take_errors()) rep_.note("checkpoint: " + e);
+    checkpoints_.reset();  // the pending checkpoint is written first
+    char line[128];
+    std::snprintf(line, sizeof line,
+                  "record: %d checkpoints written; taking one cost at most %.2f ms on the sim "
+                  "thread",
+                  written, checkpoint_cost_->load());
+    rep_.note(line);
+  }
   if (journal_->is_open()) {
     if (std::string e = journal_->write(sim::JournalEnd{r.final_ticks, r.final_state_hash});
         !e.empty())

@@ -29,6 +29,10 @@ std::string options_from_header(const sim::JournalHeader& h, const std::string& 
 // The session's starting World: the scene of `opt` with the default solver (pieces at rest
 // sleep; a free-running sim lands the static finish from its own thread unless `finish_in_tick`).
 sim::Result<sim::World> make_session_world(const XrAppOptions& opt, bool finish_in_tick);
+// The session's solver (make_session_world's); a checkpoint restarts the sim with a fresh one.
+sim::Result<std::unique_ptr<sim::Solver>> make_session_solver(bool finish_in_tick);
+// Ticks between checkpoints for `seconds` of session time (0: none).
+uint64_t checkpoint_ticks(double seconds);
 
 // On the sim thread: one journaled input (hands, then the operations in order), as
 // DrapingSession's posted command applies it.
@@ -45,16 +49,23 @@ struct ReplayResult {
   bool has_end = false;     // the journal has its end record ...
   uint64_t recorded_hash = 0, recorded_ticks = 0;  // ... with these
   double seconds = 0;                              // wall time of the replay
+  uint64_t start_tick = 0;  // the checkpoint's tick it started from (0: the journal's start)
+  std::string checkpoint;   // that checkpoint's file name ("" when none)
+  // Newer checkpoints passed over and why (not written, cut off, corrupt, another session's).
+  std::vector<std::string> notes;
 };
 
 // Replays the journal `dir`/journal.bin in lock step on the calling thread: to its end record's
 // tick when it has one, else to the tick after its last whole record (or `until_tick` when > 0
-// and earlier). For a resume: the World and its operations stay in `world` / `ops`, and
-// `inputs_end` gets where the journal's input records end (sim::JournalContents::inputs_end).
+// and earlier). It starts from the newest checkpoint the journal names up to there whose file is
+// whole (unless `from_start`), feeding only the inputs from its tick on, and restarts the solver
+// at the later checkpoints' ticks as the recorded session did. For a resume: the World and its
+// operations stay in `world` / `ops`, and `inputs_end` gets where the journal's input records end
+// (sim::JournalContents::inputs_end).
 ReplayResult replay_journal(const std::string& dir, uint64_t until_tick,
                             std::unique_ptr<sim::World>* world = nullptr,
                             std::shared_ptr<sim::OperationController>* ops = nullptr,
-                            uint64_t* inputs_end = nullptr);
+                            uint64_t* inputs_end = nullptr, bool from_start = false);
 
 // The session directory's meta.json: the options, the version and, at the end, the ticks and
 // the final state hash.

@@ -108,9 +108,15 @@ struct XrAppOptions {
   // When set: the session is recorded there (docs/sessions.md): journal.bin (the sim's inputs,
   // written from the sim thread), meta.json and, at the end, session.txt.
   std::string record_dir;
+  // With record_dir: a World checkpoint every this many seconds of session time (0: none), at
+  // which the sim restarts its solver (sim/ops/checkpoint.hpp).
+  double checkpoint_every_s = 10;
   // When set: the session resumes the one recorded there (its scene options are the journal's):
   // its journal replayed to its last whole record, then the session goes on, appending to it.
   std::string resume_dir;
+  // When set: the session starts from this saved session (a checkpoint file, `drape open`): its
+  // scene options are the file's; "save session" writes out_dir/saved_session.drape.
+  std::string open_file;
 };
 
 struct XrAppResult {
