@@ -42,6 +42,10 @@ void add_tester_options(CLI::App& c, DrapeTestOptions& o) {
   c.add_option("--resolution", o.resolution, "rings of vertices from the centre to the rim")
       ->check(CLI::Range(4, 200))
       ->capture_default_str();
+  c.add_option("--rim-spacing", o.rim_spacing,
+               "radial ring spacing at the disc's rim, a fraction of the nominal edge")
+      ->check(CLI::Range(0.1, 1.0))
+      ->capture_default_str();
   c.add_option("--seed", o.seed, "first seed of the start's perturbation")->capture_default_str();
 }
 

@@ -16,8 +16,9 @@ namespace drape::sim {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
-int ring_count(int k) {
-  return k == 0 ? 1 : std::max(6, static_cast<int>(std::lround(2 * kPi * k)));
+// Vertices of a ring of radius r on a mesh of nominal edge h (6 on the first ring).
+int ring_count(double r, double h) {
+  return std::max(6, static_cast<int>(std::lround(2 * kPi * r / h)));
 }
 
 // Joins ring `in` (first vertex `a`, na vertices) to ring `out` (first `b`, nb), walking both
@@ -39,31 +40,48 @@ void join_rings(int a, int na, double off_a, int b, int nb, double off_b,
   }
 }
 
-// The ring's first vertex's angle: every other ring turned by half a step, so that no seam of
-// aligned edges runs out from the centre.
-double ring_offset(int k) {
-  return k % 2 ? kPi / ring_count(k) : 0.0;
+// Ring radii from the centre to `radius`: steps of h = radius / rings, shrunk to
+// h * rim_spacing at rim_radius and back to h over 3 h on either side.
+std::vector<double> ring_radii(double radius, int rings, double rim_radius, double rim_spacing) {
+  const double h = radius / rings;
+  std::vector<double> r{0.0};
+  for (;;) {
+    const double g =
+        rim_spacing + (1 - rim_spacing) * std::min(1.0, std::abs(r.back() - rim_radius) / (3 * h));
+    const double next = r.back() + h * g;
+    if (next > radius - 0.5 * h * g) break;
+    r.push_back(next);
+  }
+  r.push_back(radius);
+  return r;
 }
 }  // namespace
 
-Cloth make_circular_specimen(double radius, int rings, const FabricParams& fabric) {
+Cloth make_circular_specimen(double radius, int rings, const FabricParams& fabric,
+                             double rim_radius, double rim_spacing) {
   Cloth c;
   c.fabric = fabric;
-  c.topo.spacing = radius / rings;
-  std::vector<int> first;
-  for (int k = 0; k <= rings; ++k) {
+  const double h = radius / rings;
+  c.topo.spacing = h;
+  const std::vector<double> radii = ring_radii(radius, rings, rim_radius, rim_spacing);
+  std::vector<int> first, count;
+  std::vector<double> offset;
+  for (size_t k = 0; k < radii.size(); ++k) {
     first.push_back(c.topo.num_vertices());
-    const int n = ring_count(k);
+    const int n = k == 0 ? 1 : ring_count(radii[k], h);
+    count.push_back(n);
+    // Every other ring turned by half a step: no seam of aligned edges runs from the centre.
+    offset.push_back(k % 2 ? kPi / n : 0.0);
     for (int q = 0; q < n; ++q) {
-      const double a = ring_offset(k) + 2 * kPi * q / n, r = radius * k / rings;
-      c.topo.material.emplace_back(r * std::cos(a), r * std::sin(a));
+      const double a = offset[k] + 2 * kPi * q / n;
+      c.topo.material.emplace_back(radii[k] * std::cos(a), radii[k] * std::sin(a));
     }
   }
-  for (int q = 0; q < ring_count(1); ++q)
-    c.topo.triangles.push_back({0, first[1] + q, first[1] + (q + 1) % ring_count(1)});
-  for (int k = 1; k < rings; ++k)
-    join_rings(first[k], ring_count(k), ring_offset(k), first[k + 1], ring_count(k + 1),
-               ring_offset(k + 1), c.topo.triangles);
+  for (int q = 0; q < count[1]; ++q)
+    c.topo.triangles.push_back({0, first[1] + q, first[1] + (q + 1) % count[1]});
+  for (size_t k = 1; k + 1 < radii.size(); ++k)
+    join_rings(first[k], count[k], offset[k], first[k + 1], count[k + 1], offset[k + 1],
+               c.topo.triangles);
   const int n = c.topo.num_vertices();
   c.topo.vertex_zone.assign(n, 0);
   c.topo.triangle_zone.assign(c.topo.triangles.size(), 0);
@@ -83,6 +101,7 @@ std::string check_options(const DrapeTestOptions& o) {
   if (!(o.disc_diameter > 0) || !(o.disc_diameter < o.specimen_diameter))
     return "disc diameter must be positive and smaller than the specimen's";
   if (o.resolution < 4 || o.resolution > 200) return "resolution must be 4 to 200 rings";
+  if (!(o.rim_spacing >= 0.1 && o.rim_spacing <= 1)) return "rim spacing must be in [0.1, 1]";
   if (!(o.perturbation >= 0) || !(o.friction >= 0) || !(o.offset > 0))
     return "perturbation and friction must be >= 0, offset > 0";
   if (!(o.edge_radius > 0) || !(o.disc_thickness >= 2 * o.edge_radius))
@@ -152,7 +171,7 @@ Result<DrapeTestResult> run_drape_test(const FabricParams& fabric, const DrapeTe
   const auto t0 = std::chrono::steady_clock::now();
   DrapeTestResult res;
   const double R = 0.5 * o.specimen_diameter, rd = 0.5 * o.disc_diameter;
-  res.cloth = make_circular_specimen(R, o.resolution, fabric);
+  res.cloth = make_circular_specimen(R, o.resolution, fabric, rd, o.rim_spacing);
   lay_specimen(res.cloth, o, rd - o.edge_radius);
   SceneObjects scene;
   scene.floor = false;

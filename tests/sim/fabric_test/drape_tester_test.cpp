@@ -20,6 +20,8 @@ DrapeTestOptions small() {
   return o;
 }
 
+void check_specimen(const Cloth& c);
+
 FabricParams with_bending(double b) {
   FabricParams f;
   f.bending_warp = f.bending_weft = b;
@@ -27,7 +29,16 @@ FabricParams with_bending(double b) {
 }
 
 TEST(DrapeTester, SpecimenIsTheCircleWithConsistentTriangles) {
-  const Cloth c = make_circular_specimen(0.15, 10, FabricParams{});
+  for (double rim_spacing : {1.0, 0.4}) {
+    SCOPED_TRACE(rim_spacing);
+    const Cloth c = make_circular_specimen(0.15, 10, FabricParams{}, 0.09, rim_spacing);
+    check_specimen(c);
+    // Rings closer at the rim: more vertices than the uniform 10 rings' 347.
+    EXPECT_GE(c.num_vertices(), rim_spacing < 1 ? 348 : 347);
+  }
+}
+
+void check_specimen(const Cloth& c) {
   EXPECT_EQ(c.validate(), "");
   double area = 0, rim = 0;
   for (const auto& t : c.topo.triangles) {
