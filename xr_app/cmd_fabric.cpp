@@ -6,6 +6,7 @@
 #include <string>
 
 #include "sim/fabric_test/calibrate.hpp"
+#include "sim/fabric_test/drape_photo.hpp"
 #include "xr_app/command.hpp"
 #include "xr_app/paths.hpp"
 
@@ -125,10 +126,43 @@ int run_test(const std::string& spec, DrapeTestOptions o, int seeds, int threads
 struct CalibrateArgs {
   double density = 0, dc = 0;
   int nodes = -1;
-  std::string name = "calibrated", out;
+  std::string name = "calibrated", out, photo;
 };
 
-int run_calibrate(const CalibrateArgs& a, const drape::sim::CalibrationOptions& opt) {
+// --photo: the measured figures from a top-view photo of a drape test. Returns false on error.
+bool figures_from_photo(CalibrateArgs& a, const DrapeTestOptions& t) {
+  drape::sim::DrapeMeasureOptions mo;
+  mo.specimen_diameter = t.specimen_diameter;
+  mo.disc_diameter = t.disc_diameter;
+  auto ph = drape::sim::shadow_from_photo(a.photo, mo);
+  if (!ph) {
+    std::fprintf(stderr, "drape fabric calibrate: %s\n", ph.error().c_str());
+    return false;
+  }
+  for (const auto& w : ph->warnings)
+    std::fprintf(stderr, "drape fabric calibrate: warning: %s: %s\n", a.photo.c_str(), w.c_str());
+  const auto& m = ph->measures;
+  std::printf("photo %s: %.3f mm per pixel, DC %.4f, nodes %d, R_min %.1f mm, R_max %.1f mm\n",
+              a.photo.c_str(), ph->metres_per_pixel * 1e3, m.dc, m.nodes, m.r_min * 1e3,
+              m.r_max * 1e3);
+  a.dc = m.dc;
+  if (a.nodes < 0) a.nodes = m.nodes;
+  if (!(a.dc > 0 && a.dc < 1)) {
+    std::fprintf(stderr, "drape fabric calibrate: %s: DC %.4f cannot be fitted (needs (0, 1))\n",
+                 a.photo.c_str(), a.dc);
+    return false;
+  }
+  return true;
+}
+
+int run_calibrate(CalibrateArgs a, const drape::sim::CalibrationOptions& opt) {
+  if ((a.dc > 0) == !a.photo.empty()) {
+    std::fprintf(stderr,
+                 "drape fabric calibrate: give the measured DC (--dc) or a photo "
+                 "(--photo), one of them\n");
+    return 2;
+  }
+  if (!a.photo.empty() && !figures_from_photo(a, opt.test)) return 1;
   auto cal = drape::sim::calibrate_bending(a.density, a.dc, opt);
   if (!cal) {
     std::fprintf(stderr, "drape fabric calibrate: %s\n", cal.error().c_str());
@@ -181,8 +215,11 @@ int run(int argc, char** argv) {
       ->required()
       ->check(drape::app::positive_up_to(5000));
   cal->add_option("--dc", ca.dc, "measured drape coefficient")
-      ->required()
       ->check(drape::app::positive_up_to(0.999));
+  cal->add_option("--photo", ca.photo,
+                  "top-view photo of a drape test (dark drape on a light ground, the specimen's "
+                  "circle printed around it): DC and nodes from it")
+      ->type_name("FILE.png|.jpg");
   cal->add_option("--nodes", ca.nodes, "measured node count (reported beside the prediction)")
       ->check(CLI::Range(1, 60));
   cal->add_option("--name", ca.name, "preset name")->capture_default_str();

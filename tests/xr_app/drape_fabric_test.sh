@@ -36,7 +36,10 @@ expect 1 "notjson.json" "invalid JSON" -- fabric test --fabric notjson.json
 expect 2 "--density" -- fabric calibrate --density -5 --dc 0.5
 expect 2 "--density" -- fabric calibrate --density abc --dc 0.5
 expect 2 "--dc" -- fabric calibrate --density 120 --dc 1.5
-expect 2 "--dc" -- fabric calibrate --density 120
+expect 2 "--dc" "--photo" -- fabric calibrate --density 120
+expect 2 "--dc" "--photo" -- fabric calibrate --density 120 --dc 0.5 --photo x.png
+printf 'not a picture' > junk.png
+expect 1 "junk.png: cannot read it as an image" -- fabric calibrate --density 120 --photo junk.png
 expect 2 "--resolution" -- fabric test --fabric muslin --resolution 2
 expect 1 "disc diameter" -- fabric test --fabric muslin --disc 0.4
 # A coarse drape: figures printed, files written.
@@ -52,6 +55,16 @@ expect 0 "fitted in" "residual" "predicted: nodes" "wrote preset 'mine'" -- \
   fabric calibrate --density 120 --dc 0.5 --nodes 8 --resolution 6 --seeds 1 --name mine --out my.json
 expect 0 "fabric mine: 120 g/m^2" -- fabric test --fabric my.json:mine --resolution 6 --out res2
 expect 0 "fabric mine" -- fabric test --fabric my.json --resolution 6 --out res3
+# The tester's own shadow image as a photo: the drape dark on white, the specimen's circle
+# printed around it. Its DC is the drape's (printed by the test above) within 0.01.
+expect 0 "photo res/seed1_shadow.png" "fitted in" -- \
+  fabric calibrate --photo res/seed1_shadow.png --density 130 --resolution 6 --seeds 1
+photo_dc=$(sed -n 's/^photo .*, DC \([0-9.]*\),.*/\1/p' out.txt)
+"$exe" fabric test --fabric muslin --resolution 6 --out res4 > test.txt 2>&1
+drape_dc=$(sed -n 's/^seed 1 *DC \([0-9.]*\) .*/\1/p' test.txt)
+awk -v a="$photo_dc" -v b="$drape_dc" 'BEGIN { d = a - b; exit !(a != "" && b != "" && d < 0.01 && d > -0.01) }' ||
+  fail "photo DC '$photo_dc' is not the drape's DC '$drape_dc'"
+echo "ok: photo DC $photo_dc, drape DC $drape_dc"
 # A broken file is not overwritten by --out.
 cp notjson.json keep.json
 expect 1 "keep.json: invalid JSON, not overwritten" -- \
