@@ -84,6 +84,7 @@ TEST(DrapeTester, ClampedPartStaysOnTheDiscAndTheRestHangsBelowIt) {
   EXPECT_LT(lowest, -0.02);
 }
 
+// Two drapes at once, on two std::thread workers of run_drape_series (so the TSan build runs it).
 TEST(DrapeTester, SeriesOfSeedsGivesASpread) {
   auto s = run_drape_series(with_bending(5e-6), small(), 2, 2);
   ASSERT_TRUE(s) << s.error();
