@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -29,6 +31,46 @@ struct Sphere {
   Vec3 centre{0, 1, 0};
   double radius = 0.2;
 };
+
+// Horizontal disc with a rounded rim (a drape tester's support disc): top face at top.y(),
+// centred on top, `thickness` thick; the rim is a half-torus of radius edge_radius (at most
+// thickness / 2), so the cloth folding over it meets a smooth edge.
+struct Disc {
+  Vec3 top{0, 0, 0};
+  double radius = 0.09;
+  double thickness = 0.004;
+  double edge_radius = 0.002;
+};
+
+// Signed distance from p to the disc's surface (< 0 inside) and the outward unit normal
+// there: the distance to a solid cylinder of radius radius - edge_radius and height
+// thickness - 2 edge_radius, less edge_radius (the rounded cylinder is that core grown by it).
+inline double disc_distance(const Vec3& p, const Disc& d, Vec3* normal) {
+  const double re = std::min(d.edge_radius, 0.5 * d.thickness);
+  const double a = d.radius - re;
+  const double yt = d.top.y() - re, yb = d.top.y() - d.thickness + re;
+  const Vec3 q = p - d.top;
+  const double rho = std::hypot(q.x(), q.z());
+  const Vec3 radial = rho > 1e-12 ? Vec3(q.x() / rho, 0, q.z() / rho) : Vec3::UnitX();
+  const double dr = rho - a;
+  const double mid = 0.5 * (yt + yb);
+  const double dy = std::abs(p.y() - mid) - 0.5 * (yt - yb);
+  const Vec3 up(0, p.y() >= mid ? 1.0 : -1.0, 0);
+  double core = 0;
+  Vec3 n;
+  if (dr > 0 && dy > 0) {
+    core = std::hypot(dr, dy);
+    n = (dr * radial + dy * up) / core;
+  } else if (dr > dy) {
+    core = dr;
+    n = radial;
+  } else {
+    core = dy;
+    n = up;
+  }
+  if (normal) *normal = n;
+  return core - re;
+}
 
 // A hand as the simulation sees it: no device, only a pose and a size. `id` is 0 (left) or
 // 1 (right); a capsule from palm to fingertip when `tip` differs from `position`.
@@ -67,6 +109,7 @@ struct SceneObjects {
   std::vector<Plate> plates;
   std::vector<Box> boxes;
   std::vector<Sphere> spheres;
+  std::vector<Disc> discs;  // not kept in session logs (only the drape tester sets them)
   std::vector<HandProxy> hands;
   bool floor = true;      // the stage floor y = 0
   double offset = 0.002;  // cloth thickness / collision offset (m): kept-out distance

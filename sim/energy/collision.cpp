@@ -68,6 +68,14 @@ double collide_plate(Vec3& p, const Plate& plate, double offset) {
   return collide_box(p, c, Vec3(plate.half_x, 0.5 * plate.thickness, plate.half_z), offset);
 }
 
+double collide_disc(Vec3& p, const Disc& disc, double offset) {
+  Vec3 n;
+  const double d = disc_distance(p, disc, &n);
+  if (d >= offset) return 0;
+  p += (offset - d) * n;
+  return offset - d;
+}
+
 void Collider::prepare(const ClothState& state, const SceneObjects& scene) {
   cloth_box_ = Aabb{};
   for (const Vec3& p : state.x) cloth_box_.grow(p);
@@ -96,6 +104,12 @@ void Collider::prepare(const ClothState& state, const SceneObjects& scene) {
     const Sphere& s = scene.spheres[i];
     if (cb.overlaps({s.centre.array() - s.radius, s.centre.array() + s.radius}))
       active_.push_back({Kind::kSphere, static_cast<int>(i)});
+  }
+  for (size_t i = 0; i < scene.discs.size(); ++i) {
+    const Disc& d = scene.discs[i];
+    const Vec3 half(d.radius, d.thickness, d.radius);
+    if (cb.overlaps({d.top - half, d.top + Vec3(d.radius, 0, d.radius)}))
+      active_.push_back({Kind::kDisc, static_cast<int>(i)});
   }
   for (size_t i = 0; i < scene.hands.size(); ++i) {
     const HandProxy& h = scene.hands[i];
@@ -128,6 +142,9 @@ double Collider::push_out(Vec3& p, const SceneObjects& scene) const {
         break;
       case Kind::kSphere:
         d = collide_sphere(p, scene.spheres[a.index].centre, scene.spheres[a.index].radius, off);
+        break;
+      case Kind::kDisc:
+        d = collide_disc(p, scene.discs[a.index], off);
         break;
       case Kind::kHand: {
         const HandProxy& h = scene.hands[a.index];

@@ -1,7 +1,7 @@
 // Cloth collision against the scene: the dress form by O(1) section lookup (method 2.2,
-// DressForm::push_outside), plates, boxes and spheres analytically, hand spheres/capsules, and
-// the floor. Every object keeps the cloth `offset` (thickness) away from its surface.
-// Objects whose bounding box does not touch the cloth's (grown by the offset) are skipped.
+// DressForm::push_outside), plates, boxes, spheres and discs analytically, hand spheres/capsules,
+// and the floor. Every object keeps the cloth `offset` (thickness) away from its surface. Objects
+// whose bounding box does not touch the cloth's (grown by the offset) are skipped.
 #pragma once
 
 #include <cstdint>
@@ -34,6 +34,7 @@ double collide_sphere(Vec3& p, const Vec3& centre, double radius, double offset)
 double collide_capsule(Vec3& p, const Vec3& a, const Vec3& b, double radius, double offset);
 double collide_box(Vec3& p, const Vec3& centre, const Vec3& half, double offset);
 double collide_plate(Vec3& p, const Plate& plate, double offset);
+double collide_disc(Vec3& p, const Disc& disc, double offset);
 
 struct CollisionStats {
   double max_penetration = 0;  // deepest (offset - distance) found before the response (m)
@@ -62,7 +63,7 @@ class Collider {
   const Aabb& cloth_bounds() const { return cloth_box_; }
 
  private:
-  enum class Kind : uint8_t { kFloor, kForm, kPlate, kBox, kSphere, kHand };
+  enum class Kind : uint8_t { kFloor, kForm, kPlate, kBox, kSphere, kDisc, kHand };
   struct Active {
     Kind kind;
     int index;

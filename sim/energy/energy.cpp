@@ -1042,6 +1042,12 @@ double ClothEnergy::test_vertex(const Cloth& cloth, const SceneObjects& scene, i
     const Vec3 nrm = d / dn;
     consider(dn - s.radius, nrm, s.centre + s.radius * nrm);
   }
+  for (const auto& dsc : scene.discs) {
+    Vec3 nrm;
+    const double sd = disc_distance(p, dsc, &nrm);  // |gradient| = 1: a distance
+    clear = std::min(clear, sd - reach);
+    if (sd < reach) consider(sd, nrm, p - sd * nrm);
+  }
   for (const auto& h : scene.hands) {
     if (!h.tracked || !h.collides) continue;
     const Vec3 ab = h.tip - h.position;

@@ -12,7 +12,7 @@ static const std::string kAssets = std::string(DRAPE_SOURCE_DIR) + "/assets/fabr
 TEST(Fabric, LoadsAssetPresets) {
   auto all = load_fabric_presets(kAssets);
   ASSERT_TRUE(all) << all.error();
-  EXPECT_EQ(all->size(), 4u);
+  EXPECT_EQ(all->size(), 9u);  // four literature mid-points, five calibrated (docs/fabrics.md)
   auto m = load_fabric(kAssets, "muslin");
   ASSERT_TRUE(m) << m.error();
   EXPECT_EQ(m->name, "muslin");
@@ -25,6 +25,10 @@ TEST(Fabric, LoadsAssetPresets) {
   auto d = load_fabric(kAssets, "denim");
   ASSERT_TRUE(d);
   EXPECT_DOUBLE_EQ(d->areal_density, 0.40);
+  auto w = load_fabric(kAssets, "wool_red");  // a preset calibrated by `./drape bench fabrics`
+  ASSERT_TRUE(w) << w.error();
+  EXPECT_DOUBLE_EQ(w->areal_density, 0.274);
+  EXPECT_GT(w->bending_warp, w->bending_weft);
 }
 
 static std::string preset(const std::string& shear) {

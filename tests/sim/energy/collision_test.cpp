@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "sim/form/dress_form.hpp"
 
 using namespace drape::sim;
@@ -111,4 +113,25 @@ TEST(Collision, DressFormSectionLookup) {
   far.flags = {0};
   auto cf = col.project(far, scene);
   EXPECT_EQ(cf.objects_tested, 0);
+}
+
+TEST(Collision, DiscWithRoundedRim) {
+  const Disc d{Vec3(0, 0, 0), 0.09, 0.004, 0.002};  // top at y = 0, rim a 2 mm half-torus
+  Vec3 n;
+  EXPECT_NEAR(disc_distance(Vec3(0.03, 0.01, 0), d, &n), 0.01, 1e-12);  // above the top
+  EXPECT_NEAR(n.y(), 1, 1e-12);
+  EXPECT_NEAR(disc_distance(Vec3(0.1, -0.002, 0), d, &n), 0.01, 1e-12);  // beside the rim
+  EXPECT_NEAR(n.x(), 1, 1e-12);
+  // Off the rounded corner: distance from the rim's circle of centres (r 0.088, y -0.002).
+  const Vec3 corner(0.088 + 0.01 * std::cos(0.7), -0.002 + 0.01 * std::sin(0.7), 0);
+  EXPECT_NEAR(disc_distance(corner, d, &n), 0.008, 1e-12);
+  EXPECT_NEAR(n.dot(Vec3(std::cos(0.7), std::sin(0.7), 0)), 1, 1e-12);
+  EXPECT_LT(disc_distance(Vec3(0.05, -0.001, 0), d, nullptr), 0);  // inside
+  // A point inside is pushed out to the offset, along the nearest face (the top here).
+  Vec3 p(0.05, -0.0005, 0.01);
+  EXPECT_NEAR(collide_disc(p, d, 0.001), 0.0015, 1e-12);
+  EXPECT_NEAR(p.y(), 0.001, 1e-12);
+  Vec3 q(0.2, 0.0, 0);  // far: untouched
+  EXPECT_EQ(collide_disc(q, d, 0.001), 0);
+  EXPECT_EQ(q, Vec3(0.2, 0.0, 0));
 }

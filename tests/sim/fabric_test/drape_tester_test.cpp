@@ -1,0 +1,141 @@
+// The virtual drape tester on a coarse specimen: a finite drape with DC in (0, 1), a stiffer
+// fabric drapes less (higher DC), the specimen mesh is the circle, the series reports a spread,
+// and bad options are refused with a message.
+#include "sim/fabric_test/drape_tester.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sim/fabric_test/calibrate.hpp"
+
+namespace drape::sim {
+namespace {
+
+DrapeTestOptions small() {
+  DrapeTestOptions o;
+  o.resolution = 10;
+  o.max_time = 3;
+  o.finish_cycles = 10;
+  return o;
+}
+
+void check_specimen(const Cloth& c);
+
+FabricParams with_bending(double b) {
+  FabricParams f;
+  f.bending_warp = f.bending_weft = b;
+  return f;
+}
+
+TEST(DrapeTester, SpecimenIsTheCircleWithConsistentTriangles) {
+  for (double rim_spacing : {1.0, 0.4}) {
+    SCOPED_TRACE(rim_spacing);
+    const Cloth c = make_circular_specimen(0.15, 10, FabricParams{}, 0.09, rim_spacing);
+    check_specimen(c);
+    // Rings closer at the rim: more vertices than the uniform 10 rings' 347.
+    EXPECT_GE(c.num_vertices(), rim_spacing < 1 ? 348 : 347);
+  }
+}
+
+void check_specimen(const Cloth& c) {
+  EXPECT_EQ(c.validate(), "");
+  double area = 0, rim = 0;
+  for (const auto& t : c.topo.triangles) {
+    const Vec2 a = c.topo.material[t[0]], b = c.topo.material[t[1]], d = c.topo.material[t[2]];
+    const double s = 0.5 * ((b - a).x() * (d - a).y() - (b - a).y() * (d - a).x());
+    EXPECT_GT(s, 0);  // counter-clockwise, none degenerate
+    area += s;
+  }
+  for (const Vec2& m : c.topo.material) rim = std::max(rim, m.norm());
+  EXPECT_NEAR(rim, 0.15, 1e-12);
+  EXPECT_NEAR(area, 3.14159265358979 * 0.15 * 0.15, 0.01 * 0.0707);  // polygon vs circle
+}
+
+TEST(DrapeTester, DrapeIsFiniteAndStifferFabricDrapesLess) {
+  auto soft = run_drape_test(with_bending(2e-6), small());
+  auto stiff = run_drape_test(with_bending(5e-5), small());
+  ASSERT_TRUE(soft) << soft.error();
+  ASSERT_TRUE(stiff) << stiff.error();
+  for (const auto* r : {&*soft, &*stiff}) {
+    EXPECT_GT(r->measures.dc, 0);
+    EXPECT_LT(r->measures.dc, 1);
+    EXPECT_GT(r->measures.r_min, 0.09 - 0.002);  // never inside the disc
+    EXPECT_LE(r->measures.r_max, 0.15 + 0.001);  // never beyond the flat specimen
+    for (const Vec3& p : r->cloth.state.x) EXPECT_TRUE(p.allFinite());
+  }
+  EXPECT_GT(stiff->measures.dc, soft->measures.dc + 0.1);
+}
+
+TEST(DrapeTester, ClampedPartStaysOnTheDiscAndTheRestHangsBelowIt) {
+  auto r = run_drape_test(with_bending(5e-6), small());
+  ASSERT_TRUE(r) << r.error();
+  double lowest = 0;
+  for (int i = 0; i < r->cloth.num_vertices(); ++i) {
+    const Vec3& p = r->cloth.state.x[i];
+    if (!r->cloth.is_free(i)) {
+      EXPECT_NEAR(p.y(), 0.001, 1e-9);
+    }
+    lowest = std::min(lowest, p.y());
+    // Outside the disc's rim, nothing is inside the disc.
+    Vec3 n;
+    EXPECT_GT(disc_distance(p, Disc{}, &n), 0.0005);
+  }
+  EXPECT_LT(lowest, -0.02);
+}
+
+// Two drapes at once, on two std::thread workers of run_drape_series (so the TSan build runs it).
+TEST(DrapeTester, SeriesOfSeedsGivesASpread) {
+  auto s = run_drape_series(with_bending(5e-6), small(), 2, 2);
+  ASSERT_TRUE(s) << s.error();
+  ASSERT_EQ(s->runs.size(), 2u);
+  EXPECT_NE(s->runs[0].measures.dc, s->runs[1].measures.dc);  // different perturbations
+  EXPECT_GT(s->dc_sd, 0);
+  EXPECT_LT(s->dc_sd, 0.1);
+}
+
+TEST(DrapeTester, BadOptionsAreRefused) {
+  DrapeTestOptions o = small();
+  o.disc_diameter = 0.4;
+  auto r = run_drape_test(FabricParams{}, o);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().find("disc diameter"), std::string::npos);
+  o = small();
+  o.resolution = 2;
+  EXPECT_FALSE(run_drape_test(FabricParams{}, o));
+}
+
+TEST(DrapeCalibration, BadTargetsAreRefused) {
+  CalibrationOptions o;
+  auto r = calibrate_bending(-10, 0.5, o);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().find("density"), std::string::npos);
+  auto r2 = calibrate_bending(100, 1.2, o);
+  ASSERT_FALSE(r2);
+  EXPECT_NE(r2.error().find("DC"), std::string::npos);
+}
+
+TEST(DrapeCalibration, RecoversTheBendingOfASimulatedDrape) {
+  // The DC of a known bending, measured by the tester, fitted back from DC alone. On this
+  // coarse specimen DC(B) is flat to within +-0.01 over about +-30 % of B where the folds
+  // change their pattern, so the bending comes back within a factor 1.5.
+  CalibrationOptions o;
+  o.test = small();
+  o.seeds = 1;
+  o.warp_weft_ratio = 1;
+  o.dc_tolerance = 0.003;
+  const double b_true = 6e-6;
+  auto ref = run_drape_test(with_bending(b_true), o.test);
+  ASSERT_TRUE(ref) << ref.error();
+  auto cal = calibrate_bending(130, ref->measures.dc, o);
+  ASSERT_TRUE(cal) << cal.error();
+  std::string trace;
+  for (const auto& st : cal->steps)
+    trace += " (" + std::to_string(st.bending * 1e6) + "e-6, " + std::to_string(st.dc) + ")";
+  EXPECT_LT(std::abs(cal->residual), 0.01) << trace;
+  EXPECT_NEAR(std::log(cal->fabric.bending_warp / b_true), 0, std::log(1.5))
+      << "target DC " << ref->measures.dc << ":" << trace;
+}
+
+}  // namespace
+}  // namespace drape::sim
