@@ -68,7 +68,7 @@ struct Edge {
 };
 // The diagonals (shear) give way to the rows and columns (weft and warp, whose lengths the widths
 // and seams carry): over a curved form the cloth shears rather than stretches.
-constexpr double kShearStiffness = 0.15;
+constexpr double kShearStiffness = 0.4;
 
 // The cell edges: along rows, along columns and both diagonals (shear).
 std::vector<Edge> zone_edges(const Zone& z) {
@@ -764,6 +764,22 @@ DressReport dress_report(const BodiceResult& bodice, const PipelineResult& skirt
     r.checks.push_back(check(b.name + " waist seam vs " + s.name + " waist seam", "mm",
                              b.waist_width_mm, s.waist_seam_mm, 2.0, false));
   }
+  // The skirt's own bounds, as `drape pattern --design` of the skirt reports them.
+  const PipelineReport& k = skirt.report;
+  const double hip = k.form_hip_girth_mm + k.ease_mm, waist = k.form_waist_girth_mm + k.ease_mm;
+  r.checks.push_back(check("skirt hip widths", "mm", k.hip_width_sum_mm, hip, 2.0, false));
+  r.checks.push_back(check("skirt waist widths - intakes", "mm", k.waist_width_minus_intakes_sum_mm,
+                           waist, 2.0, false));
+  for (const PieceReport& p : k.pieces)
+    r.checks.push_back(check("Skirt " + p.name + " area vs draped", "%", p.area_piece_cm2,
+                             p.area_draped_cm2, 1.0, true));
+  if (k.flare == "none")
+    r.checks.push_back(check("sewn skirt hip girth", "%", k.garment_hip_girth_mm, hip, 1.0, true));
+  else  // a flared skirt stands away from the hip: its sewn hip line against the pattern's
+    r.checks.push_back(check("sewn skirt hip line vs pattern", "%", k.garment_hip_line_mm,
+                             k.pattern_hip_girth_mm, 1.0, true));
+  r.checks.push_back(
+      check("sewn skirt waist girth", "%", k.garment_waist_girth_mm, waist, 1.0, true));
   return r;
 }
 
