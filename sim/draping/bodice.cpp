@@ -31,17 +31,34 @@ struct PieceGeom {
   double waist_y = 0, neck_y = 0, neck_centre_y = 0;  // neck point on the centre line
   double apex_y = 0, apex_phi = 0, dart_top_y = 0;     // shoulder dart's end on the shoulder
   double armpit_y = 0, shoulder_y = 0, inset = 0;
+  double apex_x = 0, dart_top_x = 0, neck_x = 0;  // distances from the centre plane
+  const MappingSurface* surf = nullptr;
   double theta(double phi) const { return theta_c + dir * phi; }
-  // The dart line: straight up from the waist to the apex, then to the shoulder seam.
+  // The angle whose surface point at height y lies `x` from the centre plane (x grows with phi
+  // from the centre line to the side line on a convex section).
+  double phi_at_x(double y, double x) const {
+    const double cx = surf->centre(y).x();
+    double lo = 0, hi = span;
+    for (int it = 0; it < 50; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (std::abs(surf->point(y, theta(mid)).x() - cx) < x ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+  // The dart line: straight up from the waist to the apex, then running out from the centre
+  // plane evenly with height to its end on the shoulder seam (over the chest or the blade, then
+  // over the top of the shoulder).
   double dart_phi(double y) const {
     if (y <= apex_y) return apex_phi;
-    return apex_phi + (span - apex_phi) * std::min(1.0, (y - apex_y) / (dart_top_y - apex_y));
+    const double t = std::min(1.0, (y - apex_y) / (dart_top_y - apex_y));
+    return t >= 1 ? span : phi_at_x(y, apex_x + (dart_top_x - apex_x) * t);
   }
-  // The neckline: level at the centre line and at the neck point, rising between them.
+  // The neckline: level at the centre line, rising ever more steeply to the neck point (a
+  // quarter ellipse in height and distance from the centre plane).
   double neck_phi(double y) const {
     if (y <= neck_centre_y) return 0;
     const double t = std::min(1.0, (y - neck_centre_y) / (neck_y - neck_centre_y));
-    return span / kPi * std::acos(1 - 2 * t);
+    return t >= 1 ? span : phi_at_x(y, neck_x * std::sqrt(1 - (1 - t) * (1 - t)));
   }
   // The armhole's arc in from the side line: half an ellipse between armpit and shoulder point.
   double armhole_inset(double y) const {
@@ -246,6 +263,13 @@ PieceGeom piece_geometry(const BodicePieceDesign& pd, const DressForm& form,
   int k = 0;
   while (k < 200 && len[k] < pd.shoulder_dart_at * len.back()) ++k;
   g.dart_top_y = ys[k];
+  g.surf = &surf;
+  const auto off_centre = [&](double y, double th) {
+    return std::abs(surf.point(y, th).x() - surf.centre(y).x());
+  };
+  g.apex_x = off_centre(g.apex_y, g.theta(g.apex_phi));
+  g.dart_top_x = off_centre(g.dart_top_y, th_s);
+  g.neck_x = off_centre(g.neck_y, th_s);
   return g;
 }
 
