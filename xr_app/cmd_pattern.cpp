@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include "sim/core/fabric.hpp"
@@ -82,8 +82,8 @@ int run_upper_body(const std::string& type, const std::string& design_path,
     files.clear();
     std::vector<std::string> names = {"pattern.svg", "pattern.dxf", "pattern_a4.pdf",
                                       "pattern_letter.pdf", "report.json"};
-    const std::string json = dr ? ds::dress_report_json(*dr, names)
-                                : ds::bodice_report_json(bodice->report, names);
+    const std::string json =
+        dr ? ds::dress_report_json(*dr, names) : ds::bodice_report_json(bodice->report, names);
     return ds::write_pattern_files(dir, pieces, dress->name, dress->bodice.seam_allowance, json,
                                    &files);
   });
@@ -95,8 +95,8 @@ int run_upper_body(const std::string& type, const std::string& design_path,
   print_bodice(bodice->report);
   if (dr) {
     std::printf("dress %s: skirt %s; sewn skirt hip girth %+.3f %%, waist %+.3f %%\n",
-                dress->name.c_str(), dr->skirt.design.c_str(), dr->skirt.garment_hip_girth_error_pct,
-                dr->skirt.garment_waist_girth_error_pct);
+                dress->name.c_str(), dr->skirt.design.c_str(),
+                dr->skirt.garment_hip_girth_error_pct, dr->skirt.garment_waist_girth_error_pct);
     for (const auto& [k, v] : dr->waist_mismatch_mm)
       std::printf("  waist seam mismatch %s: %+.2f mm\n", k.c_str(), v);
     print_checks(dr->checks);

@@ -29,7 +29,7 @@ struct PieceGeom {
   double theta_c = 0, span = kPi / 2;
   int dir = -1;
   double waist_y = 0, neck_y = 0, neck_centre_y = 0;  // neck point on the centre line
-  double apex_y = 0, apex_phi = 0, dart_top_y = 0;     // shoulder dart's end on the shoulder
+  double apex_y = 0, apex_phi = 0, dart_top_y = 0;    // shoulder dart's end on the shoulder
   double armpit_y = 0, shoulder_y = 0, inset = 0;
   double apex_x = 0, dart_top_x = 0, neck_x = 0;  // distances from the centre plane
   const MappingSurface* surf = nullptr;
@@ -146,9 +146,9 @@ Zone mesh_zone(const MappingSurface& surf, const PieceGeom& g, const std::vector
       const double a = lr[r].first + (lr[r].second - lr[r].first) * c / (z.cols - 1);
       z.x3[z.at(r, c)] = surf.point(z.row_y[r], T[r].theta_at(a));
       // Weft: the arc from the centre line; warp: the length up the cloth from the waist.
-      const double up = r == 0 ? 0.0
-                               : z.start[z.at(r - 1, c)].y() +
-                                     (z.x3[z.at(r, c)] - z.x3[z.at(r - 1, c)]).norm();
+      const double up =
+          r == 0 ? 0.0
+                 : z.start[z.at(r - 1, c)].y() + (z.x3[z.at(r, c)] - z.x3[z.at(r - 1, c)]).norm();
       z.start[z.at(r, c)] = Vec2(a, up);
     }
   z.flat = z.start;
@@ -300,7 +300,8 @@ DrapedPiece drape_piece(const BodiceDesign& d, const PieceGeom& g, const Mapping
 // the waist dart (up the centre zone's dart edge to the apex, down the side zone's), waist (side
 // zone), side seam, armhole, shoulder (outer part), the shoulder dart (down the side zone's dart
 // edge to the apex, up the centre zone's), shoulder (inner part), neckline, centre line.
-PatternPiece outline_of(const DrapedPiece& p, const BodicePieceDesign& pd, const std::string& size) {
+PatternPiece outline_of(const DrapedPiece& p, const BodicePieceDesign& pd,
+                        const std::string& size) {
   PatternPiece pc;
   pc.name = pd.name;
   pc.size = size;
@@ -395,8 +396,7 @@ BodicePieceReport measure_piece(const DrapedPiece& p, const PatternPiece& pc,
   r.waist_dart_legs_mm[1] = column_length(p.side, 0, 0, p.apex_row_side) * 1000;
   r.shoulder_dart_legs_mm[0] =
       column_length(p.centre, cc, p.apex_row_centre, p.dart_top_row) * 1000;
-  r.shoulder_dart_legs_mm[1] =
-      column_length(p.side, 0, p.apex_row_side, p.side.rows - 1) * 1000;
+  r.shoulder_dart_legs_mm[1] = column_length(p.side, 0, p.apex_row_side, p.side.rows - 1) * 1000;
   r.shoulder_mm = pc.seam_length("shoulder") * 1000;
   r.side_mm = pc.seam_length("side") * 1000;
   r.armhole_mm = pc.seam_length("armhole") * 1000;
@@ -413,7 +413,8 @@ BodicePieceReport measure_piece(const DrapedPiece& p, const PatternPiece& pc,
   strain_of(p.centre, &r.max_strain_pct, &sum, &n);
   strain_of(p.side, &r.max_strain_pct, &sum, &n);
   r.rms_strain_pct = n ? std::sqrt(sum / n) : 0;
-  for (const std::string& l : pc.labels) r.fairness_deg_per_mm.emplace_back(l, seam_fairness(pc, l));
+  for (const std::string& l : pc.labels)
+    r.fairness_deg_per_mm.emplace_back(l, seam_fairness(pc, l));
   return r;
 }
 
@@ -442,8 +443,7 @@ Garment sew_bodice(const std::vector<DrapedPiece>& pieces, const MappingSurface&
           v[i] = vertex(q);
         }
         for (const Edge& e : zone_edges(*z))
-          edges.push_back(
-              {v[e.a], v[e.b], (z->flat[e.b] - z->flat[e.a]).norm(), e.stiffness});
+          edges.push_back({v[e.a], v[e.b], (z->flat[e.b] - z->flat[e.a]).norm(), e.stiffness});
         for (int r = 0; r + 1 < z->rows; ++r)
           for (int c = 0; c + 1 < z->cols; ++c) {
             const int a = v[z->at(r, c)], b = v[z->at(r, c + 1)], s = v[z->at(r + 1, c + 1)],
@@ -512,16 +512,17 @@ std::string parse_piece(const json& pj, const std::string& w, BodicePieceDesign*
   if (p->centre_line != "centre_front" && p->centre_line != "centre_back")
     return w + ".centre_line: '" + p->centre_line + "' (known: centre_front, centre_back)";
   double apex_deg = p->apex_angle * 180 / kPi, q = p->quantity;
-  for (std::string e : {get_num(pj, "neck_depth", w, &p->neck_depth),
-                        get_num(pj, "armhole_inset", w, &p->armhole_inset),
-                        get_num(pj, "apex_angle_deg", w, &apex_deg),
-                        get_num(pj, "apex_above_bust", w, &p->apex_above_bust),
-                        get_num(pj, "shoulder_dart_at", w, &p->shoulder_dart_at),
-                        get_num(pj, "quantity", w, &q)})
+  for (std::string e :
+       {get_num(pj, "neck_depth", w, &p->neck_depth),
+        get_num(pj, "armhole_inset", w, &p->armhole_inset),
+        get_num(pj, "apex_angle_deg", w, &apex_deg),
+        get_num(pj, "apex_above_bust", w, &p->apex_above_bust),
+        get_num(pj, "shoulder_dart_at", w, &p->shoulder_dart_at), get_num(pj, "quantity", w, &q)})
     if (!e.empty()) return e;
   p->apex_angle = apex_deg * kPi / 180;
   p->quantity = static_cast<int>(q);
-  if (!(p->neck_depth > 0.005 && p->neck_depth < 0.2)) return w + ".neck_depth: not in (0.005, 0.2) m";
+  if (!(p->neck_depth > 0.005 && p->neck_depth < 0.2))
+    return w + ".neck_depth: not in (0.005, 0.2) m";
   if (!(p->armhole_inset >= 0 && p->armhole_inset < 0.1))
     return w + ".armhole_inset: not in [0, 0.1) m";
   if (!(apex_deg > 5 && apex_deg < 80)) return w + ".apex_angle_deg: not in (5, 80) degrees";
@@ -566,13 +567,14 @@ json bodice_json(const BodiceReport& r) {
                {"bust_arc_mm", p.bust_arc_mm},
                {"waist_width_mm", p.waist_width_mm},
                {"waist_arc_mm", p.waist_arc_mm},
-               {"waist_dart", {{"intake_mm", p.waist_dart_mm},
-                               {"legs_mm", {p.waist_dart_legs_mm[0], p.waist_dart_legs_mm[1]}},
-                               {"fold", "toward the centre line"}}},
-               {"shoulder_dart", {{"intake_mm", p.shoulder_dart_mm},
-                                  {"legs_mm",
-                                   {p.shoulder_dart_legs_mm[0], p.shoulder_dart_legs_mm[1]}},
-                                  {"fold", "toward the neck"}}},
+               {"waist_dart",
+                {{"intake_mm", p.waist_dart_mm},
+                 {"legs_mm", {p.waist_dart_legs_mm[0], p.waist_dart_legs_mm[1]}},
+                 {"fold", "toward the centre line"}}},
+               {"shoulder_dart",
+                {{"intake_mm", p.shoulder_dart_mm},
+                 {"legs_mm", {p.shoulder_dart_legs_mm[0], p.shoulder_dart_legs_mm[1]}},
+                 {"fold", "toward the neck"}}},
                {"shoulder_mm", p.shoulder_mm},
                {"side_mm", p.side_mm},
                {"armhole_mm", p.armhole_mm},
@@ -597,8 +599,8 @@ void add_checks(BodiceReport& rep, double bust_target, double waist_target) {
         check(p.name + " bust width", "mm", p.bust_width_mm, p.bust_arc_mm, 2.0, false));
     rep.checks.push_back(
         check(p.name + " waist width", "mm", p.waist_width_mm, p.waist_arc_mm, 2.0, false));
-    rep.checks.push_back(check(p.name + " area vs draped", "%", p.area_piece_cm2,
-                               p.area_draped_cm2, 1.0, true));
+    rep.checks.push_back(
+        check(p.name + " area vs draped", "%", p.area_piece_cm2, p.area_draped_cm2, 1.0, true));
   }
   rep.checks.push_back(
       check("sewn bust girth", "%", rep.sewn_bust_girth_mm, bust_target, 1.0, true));
@@ -620,22 +622,22 @@ Result<BodiceDesign> parse_bodice_design(const std::string& text, const std::str
   BodiceDesign d;
   const std::string w = source;
   for (const char* key : {"name", "form", "fabric"})
-    if (j->contains(key) && !(*j)[key].is_string()) return Error{w + "." + key + ": must be a string"};
+    if (j->contains(key) && !(*j)[key].is_string())
+      return Error{w + "." + key + ": must be a string"};
   d.name = j->value("name", d.name);
   d.form = j->value("form", d.form);
   d.fabric = j->value("fabric", d.fabric);
   double ease_mm = 0, sa_mm = d.seam_allowance * 1000, ri = d.relax_iterations,
          si = d.sew_iterations;
-  for (std::string e : {get_num(*j, "ease_mm", w, &ease_mm),
-                        get_num(*j, "seam_allowance_mm", w, &sa_mm),
-                        get_num(*j, "row_step", w, &d.row_step),
-                        get_num(*j, "column_step", w, &d.column_step),
-                        get_num(*j, "relax_iterations", w, &ri),
-                        get_num(*j, "sew_iterations", w, &si)})
+  for (std::string e :
+       {get_num(*j, "ease_mm", w, &ease_mm), get_num(*j, "seam_allowance_mm", w, &sa_mm),
+        get_num(*j, "row_step", w, &d.row_step), get_num(*j, "column_step", w, &d.column_step),
+        get_num(*j, "relax_iterations", w, &ri), get_num(*j, "sew_iterations", w, &si)})
     if (!e.empty()) return Error{e};
   if (!(ease_mm >= 0 && ease_mm <= 300)) return Error{w + ".ease_mm: not in [0, 300]"};
   if (!(sa_mm >= 0 && sa_mm <= 50)) return Error{w + ".seam_allowance_mm: not in [0, 50]"};
-  if (!(d.row_step >= 0.001 && d.row_step <= 0.02)) return Error{w + ".row_step: not in [0.001, 0.02] m"};
+  if (!(d.row_step >= 0.001 && d.row_step <= 0.02))
+    return Error{w + ".row_step: not in [0.001, 0.02] m"};
   if (!(d.column_step >= 0.002 && d.column_step <= 0.03))
     return Error{w + ".column_step: not in [0.002, 0.03] m"};
   if (!(ri >= 0 && ri <= 1e6) || !(si >= 0 && si <= 1e6))
@@ -648,7 +650,8 @@ Result<BodiceDesign> parse_bodice_design(const std::string& text, const std::str
     return Error{w + ".pieces: missing or empty (a front and a back)"};
   for (size_t i = 0; i < (*j)["pieces"].size(); ++i) {
     BodicePieceDesign p;
-    if (std::string e = parse_piece((*j)["pieces"][i], w + ".pieces[" + std::to_string(i) + "]", &p);
+    if (std::string e =
+            parse_piece((*j)["pieces"][i], w + ".pieces[" + std::to_string(i) + "]", &p);
         !e.empty())
       return Error{e};
     d.pieces.push_back(p);

@@ -30,7 +30,7 @@ class MappingSurface;
 struct BodicePieceDesign {
   std::string name = "Bodice front";
   std::string centre_line = "centre_front";  // centre_front | centre_back
-  double neck_depth = 0.07;       // centre-line neck point below the form's neck height
+  double neck_depth = 0.07;                  // centre-line neck point below the form's neck height
   double armhole_inset = 0.04;    // arc from the side line to the armhole at its middle height
   double apex_angle = 0.65;       // apex angle from the centre line (rad)
   double apex_above_bust = 0.0;   // apex height above the bust line
@@ -42,7 +42,7 @@ struct BodiceDesign {
   std::string name = "bodice";
   std::string form = "9AR";
   std::string fabric = "muslin";
-  double ease = 0.0;            // m of girth ease (the surface offset, as for the skirts)
+  double ease = 0.0;             // m of girth ease (the surface offset, as for the skirts)
   double seam_allowance = 0.01;  // m
   double row_step = 0.004;       // m between mesh rows
   double column_step = 0.006;    // m between mesh columns (at most)
