@@ -344,9 +344,9 @@ PatternPiece outline_of(const DrapedPiece& p, const BodicePieceDesign& pd,
   // Darts as folded: the waist dart pressed toward the centre line, the shoulder dart toward
   // the neck (both onto their leg 1 side); notches at the leg tops and mid-armhole.
   pc.darts.push_back({waist_tip, waist_leg1, waist_leg2,
-                      (pc.outline[waist_leg1] - pc.outline[waist_leg2]).norm()});
+                      (pc.outline[waist_leg1] - pc.outline[waist_leg2]).norm(), 2});
   pc.darts.push_back(
-      {sh_tip, sh_leg1, sh_leg2, (pc.outline[sh_leg1] - pc.outline[sh_leg2]).norm()});
+      {sh_tip, sh_leg1, sh_leg2, (pc.outline[sh_leg1] - pc.outline[sh_leg2]).norm(), 1});
   pc.notches = {waist_leg1, waist_leg2, sh_leg1, sh_leg2};
   const std::vector<int> arm = pc.seam_points("armhole");
   if (!arm.empty()) pc.notches.push_back(arm[arm.size() / 2]);

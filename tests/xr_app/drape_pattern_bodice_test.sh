@@ -36,6 +36,8 @@ PY
     pdfinfo "$design/$pdf" >pdf.txt 2>&1 || { cat pdf.txt; fail "$design/$pdf: pdfinfo"; }
     grep -q "^Pages:" pdf.txt || fail "$design/$pdf: no pages"
   done
+  # The bodice's four darts (two per piece) carry a fold arrow.
+  [ "$(grep -c 'class="fold"' "$design/pattern.svg")" = 4 ] || fail "$design: not 4 fold arrows"
   rsvg-convert -o "$design/pattern.png" "$design/pattern.svg" || fail "$design/pattern.svg: rsvg-convert"
   [ -s "$design/pattern.png" ] || fail "$design/pattern.svg: nothing rendered"
   echo "ok: $design"

@@ -164,3 +164,28 @@ TEST(Bodice, DesignErrorsNameTheField) {
   ASSERT_FALSE(json.ok());
   EXPECT_NE(json.error().find("b.json"), std::string::npos);
 }
+
+TEST(Dress, WaistSeamsOfBodiceAndSkirtMatchWithinTwoMillimetres) {
+  const Draped& b = bodice_on_9ar();
+  for (const char* skirt_name : {"tight-skirt", "flared-skirt"}) {
+    auto skirt = load_design(kDesigns + skirt_name + ".json");
+    ASSERT_TRUE(skirt.ok()) << skirt.error();
+    auto s = run_pattern_pipeline(*skirt, b.form, FabricParams{});
+    ASSERT_TRUE(s.ok()) << s.error();
+    const DressReport r = dress_report(b.result, *s);
+    ASSERT_EQ(r.waist_mismatch_mm.size(), 2u);
+    for (const auto& [pair, mm] : r.waist_mismatch_mm) {
+      std::printf("%s: waist seams %s differ by %+.2f mm\n", skirt_name, pair.c_str(), mm);
+      EXPECT_LT(std::abs(mm), 2.0) << skirt_name << " " << pair;
+    }
+    for (const FitCheck& c : r.checks) EXPECT_TRUE(c.pass) << skirt_name << " " << c.name;
+  }
+  auto dress = parse_dress_design(read_file(kDesigns + "dress.json"), "dress.json", kDesigns);
+  ASSERT_TRUE(dress.ok()) << dress.error();
+  EXPECT_EQ(dress->skirt.name, "tight-skirt");
+  EXPECT_EQ(dress->bodice.pieces.size(), 2u);
+  auto missing = parse_dress_design(R"({"name": "d", "bodice": "bodice", "skirt": "nope"})",
+                                    "d.json", kDesigns);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().find("d.json.skirt"), std::string::npos) << missing.error();
+}
