@@ -47,7 +47,8 @@ void print_bodice(const drape::sim::BodiceReport& r) {
 // The bodice and the dress (design files of "type" bodice or dress): drape, check, export.
 int run_upper_body(const std::string& type, const std::string& design_path,
                    const drape::sim::DressForm& form, const std::string& form_name,
-                   const drape::sim::FabricParams& fabric, const std::string& out) {
+                   const drape::sim::FabricParams& fabric, const std::string& out,
+                   const drape::sim::PipelineOptions& opt) {
   namespace ds = drape::sim;
   std::ifstream f(design_path);
   std::stringstream ss;
@@ -63,13 +64,21 @@ int run_upper_body(const std::string& type, const std::string& design_path,
     dress = ds::DressDesign{d->name, *d, {}};
   }
   dress->bodice.form = form_name;
+  // --ease, --seam-allowance and --relax-iterations apply to the bodice as to the skirt (opt
+  // passes them on); --spacing and the solver flags concern the skirt's panels only.
+  if (opt.ease >= 0) dress->bodice.ease = opt.ease;
+  if (opt.seam_allowance >= 0) dress->bodice.seam_allowance = opt.seam_allowance;
+  if (opt.relax_iterations >= 0) dress->bodice.relax_iterations = opt.relax_iterations;
   auto bodice = ds::drape_bodice(dress->bodice, form);
   if (!bodice) return std::fprintf(stderr, "drape pattern: %s\n", bodice.error().c_str()), 1;
   std::vector<ds::PatternPiece> pieces = bodice->pieces;
   std::optional<ds::DressReport> dr;
   if (type == "dress") {
     dress->skirt.form = form_name;
-    auto skirt = ds::run_pattern_pipeline(dress->skirt, form, fabric, {});
+    ds::PipelineOptions skirt_opt = opt;
+    skirt_opt.out_dir.clear();  // the dress writes its own files
+    skirt_opt.seam_allowance = dress->bodice.seam_allowance;
+    auto skirt = ds::run_pattern_pipeline(dress->skirt, form, fabric, skirt_opt);
     if (!skirt) return std::fprintf(stderr, "drape pattern: %s\n", skirt.error().c_str()), 1;
     dr = ds::dress_report(*bodice, *skirt);
     for (ds::PatternPiece pc : skirt->pieces) {
@@ -210,7 +219,7 @@ int run_pattern(int argc, char** argv) {
     fabric = *f;
   else
     std::fprintf(stderr, "drape pattern: note: %s; using the default muslin\n", f.error().c_str());
-  if (*type != "skirt") return run_upper_body(*type, design_path, *form, d->form, fabric, out);
+  if (*type != "skirt") return run_upper_body(*type, design_path, *form, d->form, fabric, out, opt);
   // The pattern's files replace those of an earlier run only when every one was written: a full
   // disk leaves the earlier pattern whole (output_files.hpp).
   std::optional<drape::sim::Result<drape::sim::PipelineResult>> r;

@@ -72,6 +72,17 @@ for path in sys.argv[2:]:
     assert d['all_pass']
     print(path, 'waist seams', d['waist_mismatch_mm'])
 PY
+# With ease: the bodice's widths and girths follow the eased form (--ease reaches the bodice).
+"$exe" pattern --design dress --ease 40 --out eased >out.txt 2>&1 || fail "drape pattern --design dress --ease 40"
+grep -q "FAIL" out.txt && fail "dress with 40 mm ease: a bound failed"
+/usr/bin/python3 - eased/report.json <<'PY' || fail "dress with ease: report"
+import json, sys
+d = json.load(open(sys.argv[1]))
+b = d['bodice']
+assert b['ease_mm'] == 40 and d['all_pass']
+assert abs(b['sewn_bust_girth_mm'] - (b['form_bust_girth_mm'] + 40)) <= 0.01 * b['form_bust_girth_mm']
+print('eased dress: sewn bust %.1f mm' % b['sewn_bust_girth_mm'])
+PY
 # A bad bodice design: the file and field named, nothing written.
 cat >bad.json <<'JSON'
 {"name": "bad", "type": "bodice",
