@@ -2,10 +2,13 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include "sim/core/fabric.hpp"
+#include "sim/draping/bodice.hpp"
 #include "sim/draping/pattern_pipeline.hpp"
 #include "sim/form/dress_form.hpp"
 #include "sim/form/vit_measurements.hpp"
@@ -15,6 +18,103 @@
 #include "xr_app/paths.hpp"
 
 namespace {
+
+void print_checks(const std::vector<drape::sim::FitCheck>& checks) {
+  for (const auto& c : checks)
+    std::printf("  %-4s %-44s %10.2f vs %10.2f: error %+8.3f %s (bound +-%.0f %s)\n",
+                c.pass ? "pass" : "FAIL", c.name.c_str(), c.value, c.target, c.error,
+                c.unit.c_str(), c.bound, c.unit.c_str());
+}
+
+void print_bodice(const drape::sim::BodiceReport& r) {
+  std::printf("bodice %s on form %s (ease %.1f mm)\n", r.design.c_str(), r.form.c_str(), r.ease_mm);
+  for (const auto& p : r.pieces) {
+    std::printf(
+        "  %-13s waist dart %.1f mm (legs %.1f/%.1f), shoulder dart %.1f mm (legs %.1f/%.1f); "
+        "side %.1f, shoulder %.1f, armhole %.1f, neckline %.1f mm; strain rms %.2f %%\n",
+        p.name.c_str(), p.waist_dart_mm, p.waist_dart_legs_mm[0], p.waist_dart_legs_mm[1],
+        p.shoulder_dart_mm, p.shoulder_dart_legs_mm[0], p.shoulder_dart_legs_mm[1], p.side_mm,
+        p.shoulder_mm, p.armhole_mm, p.neckline_mm, p.rms_strain_pct);
+    std::printf("  %-13s fairness (largest turn per mm):", p.name.c_str());
+    for (const auto& [label, f] : p.fairness_deg_per_mm) std::printf(" %s %.2f", label.c_str(), f);
+    std::printf(" deg/mm\n");
+  }
+  std::printf("  seams front - back: side %+.2f mm, shoulder %+.2f mm\n", r.side_seam_mismatch_mm,
+              r.shoulder_seam_mismatch_mm);
+  print_checks(r.checks);
+}
+
+// The bodice and the dress (design files of "type" bodice or dress): drape, check, export.
+int run_upper_body(const std::string& type, const std::string& design_path,
+                   const drape::sim::DressForm& form, const std::string& form_name,
+                   const drape::sim::FabricParams& fabric, const std::string& out,
+                   const drape::sim::PipelineOptions& opt) {
+  namespace ds = drape::sim;
+  std::ifstream f(design_path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  std::optional<ds::DressDesign> dress;
+  if (type == "dress") {
+    auto d = ds::parse_dress_design(ss.str(), design_path, drape::app::asset("designs").string());
+    if (!d) return std::fprintf(stderr, "drape pattern: %s\n", d.error().c_str()), 1;
+    dress = *d;
+  } else {
+    auto d = ds::parse_bodice_design(ss.str(), design_path);
+    if (!d) return std::fprintf(stderr, "drape pattern: %s\n", d.error().c_str()), 1;
+    dress = ds::DressDesign{d->name, *d, {}};
+  }
+  dress->bodice.form = form_name;
+  // --ease, --seam-allowance and --relax-iterations apply to the bodice as to the skirt (opt
+  // passes them on); --spacing and the solver flags concern the skirt's panels only.
+  if (opt.ease >= 0) dress->bodice.ease = opt.ease;
+  if (opt.seam_allowance >= 0) dress->bodice.seam_allowance = opt.seam_allowance;
+  if (opt.relax_iterations >= 0) dress->bodice.relax_iterations = opt.relax_iterations;
+  auto bodice = ds::drape_bodice(dress->bodice, form);
+  if (!bodice) return std::fprintf(stderr, "drape pattern: %s\n", bodice.error().c_str()), 1;
+  std::vector<ds::PatternPiece> pieces = bodice->pieces;
+  std::optional<ds::DressReport> dr;
+  if (type == "dress") {
+    dress->skirt.form = form_name;
+    ds::PipelineOptions skirt_opt = opt;
+    skirt_opt.out_dir.clear();  // the dress writes its own files
+    skirt_opt.seam_allowance = dress->bodice.seam_allowance;
+    auto skirt = ds::run_pattern_pipeline(dress->skirt, form, fabric, skirt_opt);
+    if (!skirt) return std::fprintf(stderr, "drape pattern: %s\n", skirt.error().c_str()), 1;
+    dr = ds::dress_report(*bodice, *skirt);
+    for (ds::PatternPiece pc : skirt->pieces) {
+      pc.name = "Skirt " + pc.name;
+      pieces.push_back(pc);
+    }
+  }
+  std::vector<std::string> files;
+  const std::string failed = drape::app::write_whole(out, [&](const std::string& dir) {
+    files.clear();
+    std::vector<std::string> names = {"pattern.svg", "pattern.dxf", "pattern_a4.pdf",
+                                      "pattern_letter.pdf", "report.json"};
+    const std::string json =
+        dr ? ds::dress_report_json(*dr, names) : ds::bodice_report_json(bodice->report, names);
+    return ds::write_pattern_files(dir, pieces, dress->name, dress->bodice.seam_allowance, json,
+                                   &files);
+  });
+  if (!failed.empty()) {
+    std::fprintf(stderr, "drape pattern: %s (the pattern files already in %s are kept)\n",
+                 failed.c_str(), out.c_str());
+    return 1;
+  }
+  print_bodice(bodice->report);
+  if (dr) {
+    std::printf("dress %s: skirt %s; sewn skirt hip girth %+.3f %%, waist %+.3f %%\n",
+                dress->name.c_str(), dr->skirt.design.c_str(),
+                dr->skirt.garment_hip_girth_error_pct, dr->skirt.garment_waist_girth_error_pct);
+    for (const auto& [k, v] : dr->waist_mismatch_mm)
+      std::printf("  waist seam mismatch %s: %+.2f mm\n", k.c_str(), v);
+    print_checks(dr->checks);
+  }
+  std::printf("  wrote %s/{", out.c_str());
+  for (size_t i = 0; i < files.size(); ++i) std::printf("%s%s", i ? "," : "", files[i].c_str());
+  std::printf("}\n");
+  return 0;
+}
 
 int run_pattern(int argc, char** argv) {
   std::string design = "tight-skirt", form_name = "9AR", out = "out/pattern", mesh, vit;
@@ -71,7 +171,13 @@ int run_pattern(int argc, char** argv) {
   std::string design_path = design;
   if (design_path.find('/') == std::string::npos && design_path.find(".json") == std::string::npos)
     design_path = drape::app::asset("designs/" + design + ".json").string();
-  auto d = drape::sim::load_design(design_path);
+  auto type = drape::sim::design_type(design_path);
+  if (!type) {
+    std::fprintf(stderr, "drape pattern: %s\n", type.error().c_str());
+    return 1;
+  }
+  auto d = *type == "skirt" ? drape::sim::load_design(design_path)
+                            : drape::sim::Result<drape::sim::Design>(drape::sim::Design{});
   if (!d) {
     std::fprintf(stderr, "drape pattern: %s\n", d.error().c_str());
     return 1;
@@ -113,6 +219,7 @@ int run_pattern(int argc, char** argv) {
     fabric = *f;
   else
     std::fprintf(stderr, "drape pattern: note: %s; using the default muslin\n", f.error().c_str());
+  if (*type != "skirt") return run_upper_body(*type, design_path, *form, d->form, fabric, out, opt);
   // The pattern's files replace those of an earlier run only when every one was written: a full
   // disk leaves the earlier pattern whole (output_files.hpp).
   std::optional<drape::sim::Result<drape::sim::PipelineResult>> r;

@@ -96,6 +96,15 @@ std::vector<Notch> notches(const Layout& L, const Placed& p, double sa) {
   return out;
 }
 
+// The fold arrow of a dart: from the middle of the dart, two thirds of the way from the tip to
+// the leg tops, across to the leg it is pressed onto (in the points' own units).
+std::pair<Vec2, Vec2> fold_arrow(const std::vector<Vec2>& seam, const PatternPiece::Dart& d) {
+  const Vec2 tip = seam[d.tip], onto = seam[d.fold_leg == 1 ? d.leg1_top : d.leg2_top];
+  const Vec2 mid = 0.5 * (seam[d.leg1_top] + seam[d.leg2_top]);
+  const Vec2 a = tip + (2.0 / 3.0) * (mid - tip), b = tip + (2.0 / 3.0) * (onto - tip);
+  return {a, a + 1.6 * (b - a)};
+}
+
 std::string fmt(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3f", v);
@@ -157,6 +166,13 @@ std::string write_svg(const std::string& path, const std::vector<PatternPiece>& 
           << "\" y1=\"" << fmt(L.height - p.seam[d.tip].y()) << "\" x2=\"" << fmt(p.seam[top].x())
           << "\" y2=\"" << fmt(L.height - p.seam[top].y())
           << "\" stroke=\"blue\" stroke-width=\"0.3\"/>\n";
+    for (const auto& d : pc.darts) {
+      if (d.fold_leg == 0) continue;
+      const auto [a, b] = fold_arrow(p.seam, d);
+      f << "<line class=\"fold\" x1=\"" << fmt(a.x()) << "\" y1=\"" << fmt(L.height - a.y())
+        << "\" x2=\"" << fmt(b.x()) << "\" y2=\"" << fmt(L.height - b.y())
+        << "\" stroke=\"blue\" stroke-width=\"0.3\" marker-end=\"url(#arrow)\"/>\n";
+    }
     const Vec2 ga = L.map(p, pc.grain_a), gb = L.map(p, pc.grain_b);
     f << "<line class=\"grain\" x1=\"" << fmt(ga.x()) << "\" y1=\"" << fmt(L.height - ga.y())
       << "\" x2=\"" << fmt(gb.x()) << "\" y2=\"" << fmt(L.height - gb.y())
@@ -278,6 +294,12 @@ std::string write_dxf(const std::string& path, const std::vector<PatternPiece>& 
     for (const auto& d : pc.darts) {  // internal lines: dart legs
       line("8", seam[d.tip], seam[d.leg1_top]);
       line("8", seam[d.tip], seam[d.leg2_top]);
+    }
+    for (const auto& d : pc.darts) {  // annotation: which way each dart is pressed
+      if (d.fold_leg == 0) continue;
+      const auto [a, b] = fold_arrow(seam, d);
+      line("15", a, b);
+      text("15", b, 3, "FOLD");
     }
     const Vec2 t = 0.5 * (pc.grain_a + pc.grain_b) * kMm + Vec2(5, 0);
     text("1", t, 5, "Piece Name: " + pc.name);

@@ -25,6 +25,9 @@ struct PatternPiece {
   struct Dart {
     int tip = -1, leg1_top = -1, leg2_top = -1;  // outline indices
     double intake = 0;                           // flat distance between the leg tops (m)
+    // The leg the folded dart is pressed onto (1 or 2; 0: not given): the exports draw an arrow
+    // across the dart toward it.
+    int fold_leg = 0;
   };
   std::vector<Dart> darts;
   std::vector<Vec2> hip_line;         // flat points along the hip line, centre -> side

@@ -81,11 +81,22 @@ struct FormLandmarks {
   double bottom_y = 0, top_y = 0;             // extent of the section model
   double hip_y = 0, waist_y = 0, bust_y = 0;  // heights of the horizontal reference lines
   double neck_y = 0;
+  // Upper body (the bodice's lines): the armpit, where the side seam ends and the armhole
+  // begins, and the shoulder point's height (the widest section above the bust, where the
+  // shoulder seam down the side line from the neck ends). A parametric form places them from
+  // its heights (form_parametric.cpp); a scanned one in the same proportions between bust and
+  // neck.
+  double armpit_y = 0, shoulder_y = 0;
   double centre_front_theta = 0.0;  // always 0 by construction
   double centre_back_theta = 3.14159265358979323846;
   double left_side_theta = 3.14159265358979323846 / 2;       // side lines (may differ from pi/2
   double right_side_theta = 3 * 3.14159265358979323846 / 2;  // on an asymmetric scan)
 };
+
+// The armpit and shoulder heights as fractions of the bust-to-neck height (FormLandmarks): the
+// armpit this far above the bust, the shoulder point this far below the neck.
+inline constexpr double kArmpitAboveBust = 0.15;
+inline constexpr double kShoulderBelowNeck = 0.29;
 
 class DressForm {
  public:

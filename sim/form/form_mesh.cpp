@@ -447,6 +447,8 @@ Result<DressForm> DressForm::from_triangles(const TriMesh& mesh, const MeshImpor
   lm.hip_y = arg_ext(lm.bottom_y + 0.05 * H, lm.waist_y, true);
   lm.bust_y = arg_ext(lm.waist_y + 0.1 * (lm.top_y - lm.waist_y),
                       lm.waist_y + 0.6 * (lm.top_y - lm.waist_y), true);
+  lm.armpit_y = lm.bust_y + kArmpitAboveBust * (lm.neck_y - lm.bust_y);
+  lm.shoulder_y = lm.neck_y - kShoulderBelowNeck * (lm.neck_y - lm.bust_y);
   {  // side lines: the widest points of the waist section
     const int jw = std::clamp(static_cast<int>(std::lround((lm.waist_y - fy0) / dy)), 0,
                               static_cast<int>(c2.size()) - 1);

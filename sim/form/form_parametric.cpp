@@ -269,7 +269,7 @@ Result<DressForm> DressForm::from_measurements(const FormMeasurements& m, double
                yn = m.neck_height;
   const double y_under = yu - 0.39 * (yu - yw);
   const double y_arm = yu + 0.34 * (yn - yu);
-  const double y_sh = yn - 0.29 * (yn - yu);
+  const double y_sh = yn - kShoulderBelowNeck * (yn - yu);
   const std::vector<double> ky = {yb, yh, yw, y_under, yu, y_arm, y_sh, yn};
   const double B = m.bust_girth, W = m.waist_girth, H = m.hip_girth;
   const double s = B / 0.83;  // size scale for the offsets designed on the 9AR
@@ -315,6 +315,8 @@ Result<DressForm> DressForm::from_measurements(const FormMeasurements& m, double
   lm.bottom_y = yb;
   lm.top_y = yb + spacing * (ns - 1);
   lm.hip_y = yh, lm.waist_y = yw, lm.bust_y = yu, lm.neck_y = yn;
+  lm.shoulder_y = y_sh;
+  lm.armpit_y = yu + kArmpitAboveBust * (yn - yu);
 
   // Exact girths at the three measured heights: when a landmark falls between two sections,
   // scale that pair so the interpolated polygon has the requested perimeter (a correction of

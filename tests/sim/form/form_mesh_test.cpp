@@ -299,6 +299,11 @@ TEST(FormMesh, ParametricFormRoundTripDetectsFrontAndUp) {
               lm.waist_y, lm.bust_y);
   EXPECT_NEAR(f->landmarks().waist_y, lm.waist_y, 0.03);
   EXPECT_NEAR(f->landmarks().bust_y, lm.bust_y, 0.04);
+  // The bodice's armpit and shoulder heights, in the parametric form's proportions between the
+  // detected bust and the top (the neck).
+  EXPECT_NEAR(f->landmarks().armpit_y, lm.armpit_y, 0.04);
+  EXPECT_NEAR(f->landmarks().shoulder_y, lm.shoulder_y, 0.03);
+  EXPECT_GT(f->landmarks().shoulder_y, f->landmarks().armpit_y);
   // Above the floor in the file (z from 60 cm): height kept.
   EXPECT_NEAR(info.lift, 0.0, 1e-12);
   EXPECT_NEAR(f->min_y(), src->min_y() + 0.0025, 1e-4);
