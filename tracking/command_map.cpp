@@ -60,6 +60,8 @@ constexpr const char* kDefaults = R"json({
     {"source": "voice", "command": "smooth", "edge": "any", "label": "\"smooth out\"", "phrase": "smooth out", "operation": "smooth", "phase": "toggle"},
     {"source": "voice", "command": "next", "edge": "any", "label": "\"next layer\"", "phrase": "next layer", "operation": "next", "phase": "once"},
     {"source": "voice", "command": "help", "edge": "any", "label": "\"show help\"", "phrase": "show help", "operation": "help", "phase": "toggle"},
+    {"source": "voice", "command": "pattern", "edge": "any", "label": "\"make pattern\"", "phrase": "make pattern", "operation": "pattern", "phase": "once"},
+    {"source": "voice", "command": "colours", "edge": "any", "label": "\"strain map\"", "phrase": "strain map", "operation": "colours", "phase": "once"},
     {"source": "controller", "command": "button.trigger", "edge": "begin", "profile": "khr/simple", "label": "select (held)", "operation": "pinch", "phase": "begin"},
     {"source": "controller", "command": "button.trigger", "edge": "end", "profile": "khr/simple", "label": "select (held)", "operation": "pinch", "phase": "end"},
     {"source": "controller", "command": "button.trigger", "edge": "begin", "label": "trigger (held)", "operation": "pinch", "phase": "begin"},
@@ -113,9 +115,9 @@ std::optional<CommandMap> CommandMap::load(const std::string& path, std::string*
 
 namespace {
 const std::set<std::string> kSources = {"gesture", "voice", "controller", "key", "*"};
-const std::set<std::string> kOperations = {"move", "pinch",  "release", "pin",  "cut",
-                                           "map",  "smooth", "next",    "undo", "redo",
-                                           "stop", "help",   "*"};
+const std::set<std::string> kOperations = {"move", "pinch",  "release", "pin",     "cut",
+                                           "map",  "smooth", "next",    "undo",    "redo",
+                                           "stop", "help",   "pattern", "colours", "*"};
 const std::set<std::string> kProfiles = {"oculus/touch", "valve/index", "htc/vive",
                                          "microsoft/motion", "khr/simple"};
 
