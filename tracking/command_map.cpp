@@ -43,6 +43,8 @@ constexpr const char* kDefaults = R"json({
     {"source": "gesture", "command": "palm_up", "edge": "begin", "hand": "left", "label": "palm up (held)", "operation": "help", "phase": "begin"},
     {"source": "gesture", "command": "palm_up", "edge": "end", "hand": "left", "label": "palm up (held)", "operation": "help", "phase": "end"},
     {"source": "gesture", "command": "push", "edge": "begin", "label": "push: open palm thrust forward", "operation": "stop", "phase": "once"},
+    {"source": "gesture", "command": "point", "edge": "begin", "hand": "right", "label": "point: index finger out, the others curled", "operation": "pattern", "phase": "once"},
+    {"source": "gesture", "command": "point", "edge": "begin", "hand": "left", "label": "point: index finger out, the others curled", "operation": "colours", "phase": "once"},
     {"source": "gesture", "command": "palm_push", "edge": "begin", "label": "palm push (palm-only trackers: Kinect, UDP)", "operation": "pinch", "phase": "toggle"},
     {"source": "gesture", "command": "dwell", "edge": "begin", "label": "hand still for 1 s (palm-only trackers)", "operation": "release", "phase": "once"},
     {"source": "gesture", "command": "both_push", "edge": "begin", "label": "both palms pushed at once (palm-only trackers)", "operation": "cut", "phase": "toggle"},

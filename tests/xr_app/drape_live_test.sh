@@ -31,9 +31,9 @@ GOLDEN="$(cd "$(dirname "$0")" && pwd)/golden"
 REGION="300 380 520 600"  # the form and the cloth in the view: the image checks look there
 case "$MODE" in
   free) ARGS=(--resolution 12 --eye-size 256) ;;
-  # The cloth's image without the feedback panel (the panel has its own tests).
+  # The cloth's image without the feedback panel and the pattern board (each has its own tests).
   golden | pin) ARGS=(--resolution 16 --eye-size 256 --sim-lock-step --state-hashes
-    --no-feedback-panel) ;;
+    --no-feedback-panel --no-board) ;;
   scene) ;;
   *) echo "usage: drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin|scene] [--update-golden]"; exit 2 ;;
 esac

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -169,6 +170,7 @@ class DrapingSession : public SessionContent {
   // The live pattern board and the mid-session exports (pattern_board.hpp), off the sim thread.
   std::unique_ptr<PatternWorker> patterns_;
   uint64_t board_drawn_serial_ = 0;
+  std::chrono::steady_clock::time_point board_drawn_at_{};  // when the last new board was drawn
   render::ColourMap colour_map_ = render::ColourMap::kNone;
 
   // The external hand source (opt_.hands != "xr") and what the session keeps of it.

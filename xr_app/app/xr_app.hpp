@@ -182,7 +182,8 @@ struct XrAppResult {
   // the session's journal reproduces them.
   uint64_t final_ticks = 0, final_state_hash = 0;
   // The mid-session patterns written ("make pattern") and the pieces on the last board drawn
-  // (profile_ms "board.latency": ms from the snapshot's tick to the board drawn; "board.build").
+  // (profile_ms "board.latency": ms from the snapshot's tick to the board drawn; "board.build":
+  // its extraction on the worker; "board.interval": ms between new boards drawn).
   int patterns_written = 0;
   int board_pieces = 0;
   bool has_final_state = false;
