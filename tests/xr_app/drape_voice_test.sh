@@ -113,18 +113,19 @@ check_failure() {
   echo "cloth identical to the run with --voice off"
 }
 
-# The phrases one after the other (2 s of silence before each, 1.5 s after the last) into
+# The phrases one after the other (1.2 s of silence before each, 1 s after the last: all heard
+# within the scenario's 10 s) into
 # $work/phrases.wav.
 make_phrases() {
   local parts=() i=0
   for p in "$@"; do
     espeak-ng -s 140 -w "$work/p$i.wav" "$p" >>"$log" 2>&1 || fail "espeak-ng failed"
-    sox "$work/p$i.wav" -r 16000 -c 1 -b 16 "$work/q$i.wav" pad 2 0 >>"$log" 2>&1 ||
+    sox "$work/p$i.wav" -r 16000 -c 1 -b 16 "$work/q$i.wav" pad 1.2 0 >>"$log" 2>&1 ||
       fail "sox failed"
     parts+=("$work/q$i.wav")
     i=$((i + 1))
   done
-  sox "${parts[@]}" "$work/phrases.wav" pad 0 1.5 >>"$log" 2>&1 || fail "sox concat failed"
+  sox "${parts[@]}" "$work/phrases.wav" pad 0 1 >>"$log" 2>&1 || fail "sox concat failed"
 }
 
 # The pattern mode's checks on $out.
