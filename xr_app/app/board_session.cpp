@@ -70,10 +70,12 @@ void DrapingSession::drain_exports() {
 void DrapingSession::note_board_drawn(const BoardBuild& b) {
   if (b.serial == board_drawn_serial_) return;
   board_drawn_serial_ = b.serial;
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - b.snapshot_at)
-          .count();
-  rep_.r.profile_ms["board.latency"].push_back(ms);
+  const auto now = std::chrono::steady_clock::now();
+  const auto ms = [](auto d) { return std::chrono::duration<double, std::milli>(d).count(); };
+  rep_.r.profile_ms["board.latency"].push_back(ms(now - b.snapshot_at));
+  if (board_drawn_at_ != std::chrono::steady_clock::time_point{})
+    rep_.r.profile_ms["board.interval"].push_back(ms(now - board_drawn_at_));
+  board_drawn_at_ = now;
   rep_.r.profile_ms["board.build"].push_back(b.build_ms);
   rep_.r.board_pieces = static_cast<int>(b.board->pieces.size());
 }
