@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -141,12 +142,17 @@ TEST_F(Voice, CorruptAudioAndMissingMicrophoneGiveStatus) {
 }
 
 TEST_F(Voice, PhraseFileAndGrammar) {
-  // The shipped phrase file: twelve distinct two-word phrases mapping to the twelve commands.
+  // The shipped phrase file: fourteen distinct two-word phrases mapping to the fourteen commands
+  // (the sim's operations, the help, the pattern and the colour map).
   std::vector<VoicePhrase> ph;
   std::string err;
   ASSERT_TRUE(load_phrases(std::string(DRAPE_SOURCE_DIR) + "/assets/voice/phrases.tsv", ph, &err))
       << err;
-  ASSERT_EQ(ph.size(), 12u);
+  ASSERT_EQ(ph.size(), 14u);
+  std::set<std::string> phrases, commands;
+  for (const auto& p : ph) phrases.insert(p.phrase), commands.insert(p.command);
+  EXPECT_EQ(phrases.size(), 14u);
+  EXPECT_EQ(commands.size(), 14u);
   for (const auto& p : ph) EXPECT_NE(p.phrase.find(' '), std::string::npos) << p.phrase;
   VoiceRecognizer rec(VoiceConfig{});
   ASSERT_TRUE(rec.ok()) << rec.error();
