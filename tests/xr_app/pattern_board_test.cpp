@@ -185,3 +185,21 @@ TEST(PatternBoard, WorkerBuildsBoardsAndNumbersExports) {
   EXPECT_LE(done[0].tick, 3u);
   EXPECT_EQ(done[1].tick, 8u);
 }
+
+// A worker with no snapshot reader (every reader of the sim taken) writes nothing and says so
+// for each export asked for.
+TEST(PatternBoard, WorkerWithoutReaderSaysWhyNothingWasWritten) {
+  app::PatternWorkerOptions po;
+  po.out_dir = (fs::path(DRAPE_BINARY_DIR) / "xr_test_out" / "pattern_no_reader").string();
+  fs::remove_all(po.out_dir);
+  app::PatternWorker w(sim::SnapshotReader{}, po);
+  EXPECT_EQ(w.request_export(), 1);
+  w.stop();
+  const auto done = w.take_exports();
+  ASSERT_EQ(done.size(), 1u);
+  EXPECT_NE(done[0].error.find("no snapshot reader"), std::string::npos) << done[0].error;
+  EXPECT_NE(done[0].error.find("session-1 not written"), std::string::npos) << done[0].error;
+  EXPECT_TRUE(done[0].files.empty());
+  EXPECT_FALSE(fs::exists(po.out_dir));
+  EXPECT_FALSE(w.latest_board().board);
+}

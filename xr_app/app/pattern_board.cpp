@@ -145,7 +145,15 @@ void PatternWorker::loop() {
       todo.swap(pending_);
       stopping = stop_;
     }
-    if (!reader_.valid()) {
+    if (!reader_.valid()) {  // every reader of the sim taken: said for each export asked for
+      for (int n : todo) {
+        SessionPatternExport e;
+        e.error = "no snapshot reader left for the pattern worker (session-" + std::to_string(n) +
+                  " not written)";
+        e.summary = "pattern: " + e.error;
+        std::lock_guard lock(m_);
+        done_.push_back(std::move(e));
+      }
       if (stopping) return;
       continue;
     }
