@@ -580,10 +580,11 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
                  "the draping scenario the simulated runtime plays (given: the scripted run even "
                  "with a display)");
   drape::app::add_off_switches(
-      cli,
-      {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
-       {"--no-pattern", &o.pattern, "skip the pattern of the draped cloth (pattern/session-1/)"},
-       {"--no-record", &o.record, "live: do not record the session into OUT/sessions/"}});
+      cli, {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
+            {"--no-pattern", &o.pattern,
+             "skip the pattern of the draped cloth at the session's end (pattern/session-N/; "
+             "\"make pattern\" still writes one)"},
+            {"--no-record", &o.record, "live: do not record the session into OUT/sessions/"}});
   drape::app::add_record_option(cli, o.app.record_dir);
   o.resume_opt = cli.add_option("--resume", o.resume,
                                 "live: resume the session recorded in DIR (default: the newest "
