@@ -278,6 +278,123 @@ void append_cloth(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& 
   }
 }
 
+namespace {
+// The floating square panel of DrawOptions (centre, yaw, size): its axes and the map from flat
+// pattern coordinates (m) onto it, the given extent fitted into 85 % of it.
+struct PanelFrame {
+  V3 right, up, normal, centre;
+  float half = 0, scale = 0;
+  Eigen::Vector2f mid = Eigen::Vector2f::Zero();
+  V3 at(const Eigen::Vector2f& q, float lift = 0.002f) const {
+    const Eigen::Vector2f s = (q - mid) * scale;
+    return centre + s.x() * right + s.y() * up + lift * normal;
+  }
+};
+
+PanelFrame panel_frame(const DrawOptions& opt, const Eigen::Vector2f& lo,
+                       const Eigen::Vector2f& hi) {
+  PanelFrame f;
+  f.right = V3(std::cos(opt.panel_yaw), 0, -std::sin(opt.panel_yaw));
+  f.up = V3::UnitY();
+  f.normal = f.right.cross(f.up);
+  f.centre = opt.panel_centre;
+  f.half = 0.5f * opt.panel_size;
+  const float ext = std::max(hi.x() - lo.x(), hi.y() - lo.y());
+  f.scale = ext > 1e-9f ? 0.85f * opt.panel_size / ext : 0.0f;
+  f.mid = 0.5f * (lo + hi);
+  return f;
+}
+
+void add_panel_background(const PanelFrame& f, Mesh& out) {
+  const V3 c = f.centre, r = f.half * f.right, u = f.half * f.up;
+  add_quad(out, c - r - u, c + r - u, c + r + u, c - r + u, f.normal, {0.93f, 0.93f, 0.90f},
+           ShadeMode::kUnlit);
+}
+
+// A flat line of half width w from a to b on the panel (already mapped).
+void add_panel_line(const PanelFrame& f, const V3& a, const V3& b, float w,
+                    const std::array<float, 3>& rgb, Mesh& out) {
+  if ((b - a).norm() < 1e-7f) return;
+  const V3 side = (b - a).normalized().cross(f.normal) * w;
+  add_quad(out, a - side, b - side, b + side, a + side, f.normal, rgb, ShadeMode::kUnlit);
+}
+
+void add_panel_loop(const PanelFrame& f, const std::vector<Eigen::Vector2f>& loop, float w,
+                    const std::array<float, 3>& rgb, Mesh& out) {
+  for (size_t i = 0; i < loop.size(); ++i)
+    add_panel_line(f, f.at(loop[i]), f.at(loop[(i + 1) % loop.size()]), w, rgb, out);
+}
+
+void extend_bounds(const std::vector<Eigen::Vector2f>& pts, Eigen::Vector2f& lo,
+                   Eigen::Vector2f& hi) {
+  for (const auto& q : pts) {
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+}
+
+void append_outline_panel(const std::vector<std::vector<Eigen::Vector2f>>& outlines,
+                          const DrawOptions& opt, Mesh& out) {
+  Eigen::Vector2f lo(1e30f, 1e30f), hi(-1e30f, -1e30f);
+  for (const auto& o : outlines) extend_bounds(o, lo, hi);
+  const PanelFrame f = panel_frame(opt, lo, hi);
+  add_panel_background(f, out);
+  if (f.scale <= 0) return;
+  for (const auto& o : outlines) add_panel_loop(f, o, 0.0022f, {0.1f, 0.15f, 0.45f}, out);
+}
+
+// The grain line with an arrow head at each end (a pattern's "place on grain" mark).
+void add_grain_arrow(const PanelFrame& f, const BoardPiece& p, Mesh& out) {
+  const V3 a = f.at(p.grain_a, 0.003f), b = f.at(p.grain_b, 0.003f);
+  if ((b - a).norm() < 1e-5f) return;
+  const std::array<float, 3> red{0.75f, 0.1f, 0.1f};
+  add_panel_line(f, a, b, 0.0015f, red, out);
+  const V3 d = (b - a).normalized(), side = d.cross(f.normal);
+  const float len = std::min(0.015f, 0.3f * (b - a).norm());
+  for (const auto& [tip, dir] : {std::pair{b, d}, std::pair{a, V3(-d)}}) {
+    add_panel_line(f, tip, tip - len * dir + 0.5f * len * side, 0.0015f, red, out);
+    add_panel_line(f, tip, tip - len * dir - 0.5f * len * side, 0.0015f, red, out);
+  }
+}
+
+// A notch: a short stroke across the outline, pointing into the piece (towards its centroid).
+void add_notches(const PanelFrame& f, const BoardPiece& p, Mesh& out) {
+  if (p.outline.empty()) return;
+  Eigen::Vector2f c = Eigen::Vector2f::Zero();
+  for (const auto& q : p.outline) c += q;
+  c /= static_cast<float>(p.outline.size());
+  for (const auto& n : p.notches) {
+    const V3 a = f.at(n, 0.003f), inward = f.at(c, 0.003f) - a;
+    if (inward.norm() < 1e-6f) continue;
+    const V3 d = inward.normalized();
+    add_panel_line(f, a - 0.008f * d, a + 0.016f * d, 0.003f, {0.05f, 0.5f, 0.1f}, out);
+  }
+}
+
+// 10 cm of the pattern at the panel's lower left corner, with end ticks.
+void add_scale_bar(const PanelFrame& f, Mesh& out) {
+  const V3 a = f.centre - 0.9f * f.half * f.right - 0.93f * f.half * f.up + 0.002f * f.normal;
+  const V3 b = a + 0.1f * f.scale * f.right;
+  const std::array<float, 3> ink{0.1f, 0.1f, 0.1f};
+  add_panel_line(f, a, b, 0.0012f, ink, out);
+  for (const V3& e : {a, b}) add_panel_line(f, e, e + 0.01f * f.up, 0.0012f, ink, out);
+}
+
+void append_board(const PatternBoard& board, const DrawOptions& opt, Mesh& out) {
+  Eigen::Vector2f lo(1e30f, 1e30f), hi(-1e30f, -1e30f);
+  for (const auto& p : board.pieces) extend_bounds(p.outline, lo, hi);
+  const PanelFrame f = panel_frame(opt, lo, hi);
+  add_panel_background(f, out);
+  if (f.scale <= 0) return;
+  for (const auto& p : board.pieces) {
+    add_panel_loop(f, p.outline, 0.0022f, {0.1f, 0.15f, 0.45f}, out);
+    add_grain_arrow(f, p, out);
+    add_notches(f, p, out);
+  }
+  add_scale_bar(f, out);
+}
+}  // namespace
+
 void append_decorations(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& out) {
   const auto f = [](const sim::Vec3& v) { return V3(v.cast<float>()); };
   for (const auto& p : snap.plates) {
@@ -321,40 +438,11 @@ void append_decorations(const sim::SceneSnapshot& snap, const DrawOptions& opt, 
       append_tube(out, stroke[i], stroke[i + 1], 0.002f, {0.95f, 0.1f, 0.1f}, ShadeMode::kUnlit, 6);
       append_sphere(out, stroke[i + 1], 0.002f, {0.95f, 0.1f, 0.1f}, ShadeMode::kUnlit, 6, 4);
     }
-  if (opt.pattern_panel && !snap.pattern_outlines.empty()) {
-    // A floating square: right axis, up axis and normal from the yaw; outlines fitted inside.
-    const V3 right(std::cos(opt.panel_yaw), 0, -std::sin(opt.panel_yaw)), up = V3::UnitY();
-    const V3 normal = right.cross(up);
-    const V3 c = opt.panel_centre;
-    const float hs = 0.5f * opt.panel_size;
-    add_quad(out, c - hs * right - hs * up, c + hs * right - hs * up, c + hs * right + hs * up,
-             c - hs * right + hs * up, normal, {0.93f, 0.93f, 0.90f}, ShadeMode::kUnlit);
-    Eigen::Vector2f lo(1e30f, 1e30f), hi(-1e30f, -1e30f);
-    for (const auto& o : snap.pattern_outlines)
-      for (const auto& q : o) {
-        lo = lo.cwiseMin(q);
-        hi = hi.cwiseMax(q);
-      }
-    const float ext = std::max(hi.x() - lo.x(), hi.y() - lo.y());
-    if (ext > 1e-9f) {
-      const float scale = 0.85f * opt.panel_size / ext;
-      const Eigen::Vector2f mid = 0.5f * (lo + hi);
-      const V3 lift = 0.002f * normal;
-      const float w = 0.0022f;
-      const auto at = [&](const Eigen::Vector2f& q) {
-        const Eigen::Vector2f s = (q - mid) * scale;
-        return V3(c + s.x() * right + s.y() * up + lift);
-      };
-      for (const auto& o : snap.pattern_outlines)
-        for (size_t i = 0; i < o.size(); ++i) {
-          const V3 a = at(o[i]), b = at(o[(i + 1) % o.size()]);
-          if ((b - a).norm() < 1e-7f) continue;
-          const V3 side = (b - a).normalized().cross(normal) * w;
-          add_quad(out, a - side, b - side, b + side, a + side, normal, {0.1f, 0.15f, 0.45f},
-                   ShadeMode::kUnlit);
-        }
-    }
-  }
+  if (!opt.pattern_panel) return;
+  if (opt.board)
+    append_board(*opt.board, opt, out);
+  else if (!snap.pattern_outlines.empty())
+    append_outline_panel(snap.pattern_outlines, opt, out);
 }
 
 void append_hand_overlays(const sim::SceneSnapshot& snap, const DrawOptions& opt, Mesh& out) {

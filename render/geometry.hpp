@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "sim/core/snapshot.hpp"
@@ -48,6 +49,17 @@ struct HandOverlay {
   bool active = false;  // an operation is held (pinch closed, cutting)
 };
 
+// The live pattern board's content (the app's, xr_app/app/pattern_board.hpp): each piece of the
+// draped cloth flat, in material coordinates (m; u weft, v warp).
+struct BoardPiece {
+  std::vector<Eigen::Vector2f> outline;  // closed, the last point not repeated
+  Eigen::Vector2f grain_a = Eigen::Vector2f::Zero(), grain_b = Eigen::Vector2f::Zero();
+  std::vector<Eigen::Vector2f> notches;  // points on the outline (reference lines crossing it)
+};
+struct PatternBoard {
+  std::vector<BoardPiece> pieces;
+};
+
 // What to draw and how; everything has a sensible default.
 struct DrawOptions {
   ColourMap colour_map = ColourMap::kNone;
@@ -58,9 +70,12 @@ struct DrawOptions {
   bool floor_grid = true;
   bool pattern_panel = true;
   Eigen::Vector3f panel_centre{0.72f, 1.25f, 0.15f};  // floating pattern panel (stage space)
-  float panel_yaw = -0.45f;         // rotation about +y; 0 faces +z (like the form's front)
-  float panel_size = 0.5f;          // edge length of the square panel (m)
-  float line_half_width = 0.0025f;  // reference lines on the form (m)
+  float panel_yaw = -0.45f;  // rotation about +y; 0 faces +z (like the form's front)
+  float panel_size = 0.5f;   // edge length of the square panel (m)
+  // When set, the panel shows this board (outlines, grain lines with arrow heads, notches and a
+  // 10 cm scale bar) instead of the snapshot's pattern_outlines.
+  std::shared_ptr<const PatternBoard> board;
+  float line_half_width = 0.0025f;                             // reference lines on the form (m)
   std::array<float, 4> background{0.55f, 0.60f, 0.68f, 1.0f};  // linear RGB
   std::array<float, 3> cloth_colour{0.92f, 0.89f, 0.80f};      // unbleached muslin
   std::array<float, 3> form_colour{0.62f, 0.52f, 0.40f};       // linen-covered form

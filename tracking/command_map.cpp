@@ -43,6 +43,8 @@ constexpr const char* kDefaults = R"json({
     {"source": "gesture", "command": "palm_up", "edge": "begin", "hand": "left", "label": "palm up (held)", "operation": "help", "phase": "begin"},
     {"source": "gesture", "command": "palm_up", "edge": "end", "hand": "left", "label": "palm up (held)", "operation": "help", "phase": "end"},
     {"source": "gesture", "command": "push", "edge": "begin", "label": "push: open palm thrust forward", "operation": "stop", "phase": "once"},
+    {"source": "gesture", "command": "point", "edge": "begin", "hand": "right", "label": "point: index finger out, the others curled", "operation": "pattern", "phase": "once"},
+    {"source": "gesture", "command": "point", "edge": "begin", "hand": "left", "label": "point: index finger out, the others curled", "operation": "colours", "phase": "once"},
     {"source": "gesture", "command": "palm_push", "edge": "begin", "label": "palm push (palm-only trackers: Kinect, UDP)", "operation": "pinch", "phase": "toggle"},
     {"source": "gesture", "command": "dwell", "edge": "begin", "label": "hand still for 1 s (palm-only trackers)", "operation": "release", "phase": "once"},
     {"source": "gesture", "command": "both_push", "edge": "begin", "label": "both palms pushed at once (palm-only trackers)", "operation": "cut", "phase": "toggle"},
@@ -60,6 +62,8 @@ constexpr const char* kDefaults = R"json({
     {"source": "voice", "command": "smooth", "edge": "any", "label": "\"smooth out\"", "phrase": "smooth out", "operation": "smooth", "phase": "toggle"},
     {"source": "voice", "command": "next", "edge": "any", "label": "\"next layer\"", "phrase": "next layer", "operation": "next", "phase": "once"},
     {"source": "voice", "command": "help", "edge": "any", "label": "\"show help\"", "phrase": "show help", "operation": "help", "phase": "toggle"},
+    {"source": "voice", "command": "pattern", "edge": "any", "label": "\"make pattern\"", "phrase": "make pattern", "operation": "pattern", "phase": "once"},
+    {"source": "voice", "command": "colours", "edge": "any", "label": "\"strain map\"", "phrase": "strain map", "operation": "colours", "phase": "once"},
     {"source": "voice", "command": "save", "edge": "any", "label": "\"save session\"", "phrase": "save session", "operation": "save", "phase": "once"},
     {"source": "controller", "command": "button.trigger", "edge": "begin", "profile": "khr/simple", "label": "select (held)", "operation": "pinch", "phase": "begin"},
     {"source": "controller", "command": "button.trigger", "edge": "end", "profile": "khr/simple", "label": "select (held)", "operation": "pinch", "phase": "end"},
@@ -114,9 +118,9 @@ std::optional<CommandMap> CommandMap::load(const std::string& path, std::string*
 
 namespace {
 const std::set<std::string> kSources = {"gesture", "voice", "controller", "key", "*"};
-const std::set<std::string> kOperations = {"move", "pinch",  "release", "pin",  "cut",
-                                           "map",  "smooth", "next",    "undo", "redo",
-                                           "stop", "help",   "save",    "*"};
+const std::set<std::string> kOperations = {"move",    "pinch",   "release", "pin",  "cut",  "map",
+                                           "smooth",  "next",    "undo",    "redo", "stop", "help",
+                                           "pattern", "colours", "save",    "*"};
 const std::set<std::string> kProfiles = {"oculus/touch", "valve/index", "htc/vive",
                                          "microsoft/motion", "khr/simple"};
 

@@ -34,7 +34,12 @@ HandShape hand_shape(const HandFrame& f) {
   const Vec3 palm = J(Joint::Palm);
   for (int k = 0; k < 4; ++k) {
     s.tip_distance[k] = (J(Joint::ThumbTip) - J(kTips[k])).norm();
-    s.curl += (J(kTips[k]) - palm).norm() / 4.0;
+    const double reach = (J(kTips[k]) - palm).norm();
+    s.curl += reach / 4.0;
+    if (k == 0)
+      s.index_reach = reach;
+    else
+      s.others_curl += reach / 3.0;
   }
   // XR_EXT_hand_tracking: a joint's +y points out of the back of the hand, +x across it.
   s.normal = f.palm.orientation * Vec3(0, -1, 0);
@@ -62,6 +67,7 @@ void GestureRecognizer::lose(const HandFrame& f, State& s, std::vector<Trigger>&
   }
   for (int k = 0; k < 4; ++k) emit(s.pinch[k].update(false, f.time, 0.0), kPinchNames[k], f, out);
   emit(s.grab.update(false, f.time, 0.0), "grab", f, out);
+  emit(s.point.update(false, f.time, 0.0), "point", f, out);
   emit(s.flat.update(false, f.time, 0.0), "flat", f, out);
   emit(s.palm_up.update(false, f.time, 0.0), "palm_up", f, out);
   s.pinch_finger = -1;
@@ -117,11 +123,15 @@ void GestureRecognizer::update_joints(const HandFrame& f, State& s, std::vector<
     emit(s.pinch[k].update(s.pinch_finger == k, f.time, p_.min_duration), kPinchNames[k], f, out);
   const bool no_pinch =
       s.pinch_finger < 0 && *std::min_element(h.tip_distance, h.tip_distance + 4) > p_.pinch_leave;
-  const bool fist = h.curl < p_.grab_curl && s.pinch_finger < 0;
+  // Pointing: the index finger out, the other three curled, no pinch (its mean curl can be a
+  // fist's: pointing is no fist).
+  const bool point = no_pinch && h.index_reach > p_.extend_curl && h.others_curl < p_.grab_curl;
+  const bool fist = h.curl < p_.grab_curl && s.pinch_finger < 0 && !point;
   const bool open = h.curl > p_.extend_curl && no_pinch;
   const bool flat = open && h.spread < p_.together && h.normal.dot(-p_.up) > p_.facing_cos;
   const bool up = open && h.normal.dot(p_.up) > p_.facing_cos;
   emit(s.grab.update(fist, f.time, p_.min_duration), "grab", f, out);
+  emit(s.point.update(point, f.time, p_.min_duration), "point", f, out);
   emit(s.flat.update(flat, f.time, p_.min_duration), "flat", f, out);
   emit(s.palm_up.update(up, f.time, p_.min_duration), "palm_up", f, out);
   if (open && joint_push(f, h, s)) out.push_back(Trigger{"push", "gesture", f.time, f.hand, true});

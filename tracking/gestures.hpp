@@ -1,6 +1,7 @@
 // Gestures -> triggers. From XR_EXT_hand_tracking joints: the thumb's pinches with each finger
 // ("pinch" = index, "pinch_middle", "pinch_ring", "pinch_little"; tip distance with hysteresis,
-// the finger clearly the thumb's nearest), the fist ("grab"), the flat hand with the fingers
+// the finger clearly the thumb's nearest), the fist ("grab"), pointing with the index finger
+// ("point": the other three curled), the flat hand with the fingers
 // together and the palm down ("flat"), the open hand with the palm up ("palm_up") and the open
 // palm thrust forward ("push"); every held one debounced by a minimum duration, and a resting
 // open hand fires nothing. From palm-only sources (Kinect, UDP): "dwell" and "palm_push", and
@@ -61,6 +62,8 @@ class Debounced {
 struct HandShape {
   double tip_distance[4] = {};  // thumb tip to the index, middle, ring, little tips
   double curl = 0;              // mean fingertip-to-palm distance
+  double index_reach = 0;       // the index fingertip's distance from the palm
+  double others_curl = 0;       // mean middle, ring and little fingertip-to-palm distance
   double spread = 1;            // the fingertips' extent across the palm / the knuckles'
   Vec3 normal = Vec3::Zero();   // out of the palm (the palm joint's -y)
 };
@@ -76,7 +79,7 @@ class GestureRecognizer {
  private:
   struct State {
     int pinch_finger = -1;  // the finger the thumb touches (0 index .. 3 little), -1 none
-    Debounced pinch[4], grab, flat, palm_up;
+    Debounced pinch[4], grab, point, flat, palm_up;
     std::deque<std::pair<double, Vec3>> history;  // palm positions for dwell/push
     bool dwell_fired = false;
     double push_block_until = -1;

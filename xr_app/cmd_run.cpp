@@ -614,12 +614,14 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
                  "the draping scenario the simulated runtime plays (given: the scripted run even "
                  "with a display)");
   drape::app::add_off_switches(
-      cli,
-      {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
-       {"--no-pattern", &o.pattern, "skip the pattern of the draped cloth (pattern/session-1/)"},
-       {"--no-record", &o.record, "live: do not record the session into OUT/sessions/"},
-       {"--no-self-collision", &o.app.self_collision,
-        "the cloth does not collide with itself (cheaper; folds may pass through each other)"}});
+      cli, {{"--no-voice", &o.app.voice, "no voice cues (no espeak-ng)"},
+            {"--no-pattern", &o.pattern,
+             "skip the pattern of the draped cloth at the session's end (pattern/session-N/; "
+             "\"make pattern\" still writes one)"},
+            {"--no-record", &o.record, "live: do not record the session into OUT/sessions/"},
+            {"--no-self-collision", &o.app.self_collision,
+             "the cloth does not collide with itself (cheaper; folds may pass through each "
+             "other)"}});
   drape::app::add_record_option(cli, o.app.record_dir, o.app.checkpoint_every_s);
   o.resume_opt = cli.add_option("--resume", o.resume,
                                 "live: resume the session recorded in DIR (default: the newest "
@@ -654,10 +656,10 @@ void add_xr_options(CLI::App& cli, XrRunOptions& o, CLI::Option* headless) {
                  std::string("the cloth's start state: ") + drape::app::desk_start_names() +
                      " (default: pinned-top live; the scenario's scene when scripted)");
   for (const char* name :
-       {"--frames", "--eye-size", "--cloth-res", "--verbose", "--scenario", "--no-voice",
-        "--no-pattern", "--every", "--form", "--mesh", "--start", "--json", "--sim-lock-step",
-        "--state-hashes", "--voice", "--record", "--no-record", "--resume", "--open",
-        "--no-self-collision"})
+       {"--frames",   "--eye-size",   "--cloth-res",     "--verbose",      "--scenario",
+        "--no-voice", "--no-pattern", "--every",         "--form",         "--mesh",
+        "--start",    "--json",       "--sim-lock-step", "--state-hashes", "--voice",
+        "--record",   "--no-record",  "--resume",        "--open",         "--no-self-collision"})
     cli.get_option(name)->excludes(headless);
 }
 #endif

@@ -30,7 +30,7 @@ double max_or_none(const std::vector<double>& v) {
 }
 
 // The run's figures: frame time, pose-to-photon and the per-stage profile (frame stages skip the
-// first 10 frames: pipeline and cache warm-up; sim.* are per tick).
+// first 10 frames: pipeline and cache warm-up; sim.* are per tick, board.* per board drawn).
 struct Summary {
   struct Row {
     std::string stage;
@@ -57,7 +57,8 @@ Summary summarise(const XrAppResult& r) {
   s.clat50 = percentile(s.cloth_latency, 0.5);
   s.clatmax = max_or_none(s.cloth_latency);
   for (const auto& [stage, all] : r.profile_ms) {
-    const size_t skip = stage.rfind("sim.", 0) == 0 ? 0 : std::min<size_t>(10, all.size());
+    const bool whole = stage.rfind("sim.", 0) == 0 || stage.rfind("board.", 0) == 0;
+    const size_t skip = whole ? 0 : std::min<size_t>(10, all.size());
     std::vector<double> v(all.begin() + static_cast<std::ptrdiff_t>(skip), all.end());
     if (v.empty()) continue;
     double sum = 0;

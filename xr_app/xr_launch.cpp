@@ -106,7 +106,9 @@ void add_app_options(CLI::App& cli, XrAppOptions& opt) {
       ->check(CLI::Range(4, 256));
   cli.add_flag("-v,--verbose", opt.verbose, "print the app's log as it happens");
   add_off_switches(cli, {{"--no-feedback-panel", &opt.feedback_panel,
-                          "no feedback panel over the scene (tests of the cloth's image)"}});
+                          "no feedback panel over the scene (tests of the cloth's image)"},
+                         {"--no-board", &opt.pattern_board,
+                          "no live pattern board beside the form (its cost: drape bench board)"}});
   cli.add_option_function<std::string>(
          "--assets", [](const std::string& dir) { set_assets_dir(dir); },
          "the assets directory (default: <exe dir>/../share/drape/assets)")

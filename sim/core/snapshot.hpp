@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -28,6 +29,8 @@ struct SceneSnapshot {
   uint64_t tick = 0;
   double sim_time = 0;
   uint64_t topology_version = 0;
+  // When the sim thread filled it (steady clock): what a consumer's latency is measured from.
+  std::chrono::steady_clock::time_point filled_at{};
 
   // Cloth
   std::vector<Vec3f> positions;
@@ -52,8 +55,10 @@ struct SceneSnapshot {
   // the fixed particle release would free (-1: none). Filled by the operations.
   std::array<std::vector<int32_t>, 2> candidate_alternatives;
   std::array<int32_t, 2> release_candidate{-1, -1};
-  std::vector<Vec3f> pins;                           // pinned particle positions
-  std::vector<std::vector<Vec3f>> cut_strokes;       // smoothed strokes (display)
+  std::vector<Vec3f> pins;                      // pinned particle positions
+  std::vector<std::vector<Vec3f>> cut_strokes;  // smoothed strokes (display)
+  // The finished cuts' smoothed strokes on the flat cloth (u, v; m): a pattern's cut edges.
+  std::vector<std::vector<Vec2f>> cut_strokes_material;
   std::vector<std::vector<Vec2f>> pattern_outlines;  // flattened pattern pieces (m)
 
   // Status

@@ -682,11 +682,16 @@ void ops_decorate(const World& w, const OperationsState& s, SceneSnapshot& snap)
     snap.release_candidate[h] = hc.release_vertex;
   }
   snap.cut_strokes.clear();
+  snap.cut_strokes_material.clear();
   for (const CutStroke& cs : s.cut_strokes) {
     std::vector<Vec3f> pts;
     pts.reserve(cs.smooth.size());
     for (const Vec3& q : cs.smooth) pts.push_back(q.cast<float>());
     snap.cut_strokes.push_back(std::move(pts));
+    std::vector<Vec2f> uv;
+    uv.reserve(cs.material.size());
+    for (const Vec2& q : cs.material) uv.push_back(q.cast<float>());
+    snap.cut_strokes_material.push_back(std::move(uv));
   }
   for (int h = 0; h < 2; ++h) {
     if (!s.cutting[h] || s.stroke[h].size() < 2) continue;

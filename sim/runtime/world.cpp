@@ -8,6 +8,7 @@ void fill_snapshot(const World& world, SceneSnapshot& snap) {
   const auto& st = c.state;
   const size_t n = c.num_vertices();
   snap.sim_time = st.time;
+  snap.filled_at = std::chrono::steady_clock::now();
   snap.topology_version = c.topology_version;
 
   snap.positions.resize(n);
@@ -49,6 +50,7 @@ void fill_snapshot(const World& world, SceneSnapshot& snap) {
   snap.candidate_point = {Vec3f::Zero(), Vec3f::Zero()};
   snap.candidate_is_form = {false, false};
   snap.cut_strokes.clear();
+  snap.cut_strokes_material.clear();
   snap.pattern_outlines.clear();
 
   snap.solver = world.solver ? world.solver->name() : std::string("none");

@@ -45,7 +45,7 @@ const double kHand[kJointCount][3] = {
 constexpr int kTip[4] = {int(Joint::IndexTip), int(Joint::MiddleTip), int(Joint::RingTip),
                          int(Joint::LittleTip)};
 
-enum class Shape { Relaxed, Pinch, Fist, Together, ThumbBetween };
+enum class Shape { Relaxed, Pinch, Fist, Together, ThumbBetween, Point };
 
 // Palm orientations: down (identity: the palm's normal -y), up, sideways, forward (-z).
 const Quat kDown = Quat::Identity();
@@ -66,7 +66,7 @@ HandFrame hand(Shape shape, const Quat& q, double t, Hand side = Hand::Right, in
   if (shape == Shape::ThumbBetween) p[thumb] = 0.5 * (p[kTip[0]] + p[kTip[1]]) + Vec3(0, -0.01, 0);
   for (int k = 0; k < 4; ++k) {
     Vec3& tip = p[kTip[k]];
-    if (shape == Shape::Fist) tip = Vec3(tip.x(), -0.03, -0.02);
+    if (shape == Shape::Fist || (shape == Shape::Point && k > 0)) tip = Vec3(tip.x(), -0.03, -0.02);
     if (shape == Shape::Together) tip.x() *= 0.55;
   }
   HandFrame f;
@@ -188,6 +188,26 @@ TEST(Gestures, FistIsGrabAndNoPinch) {
   feed(
       g, t, 20, [&](double tt) { return hand(Shape::Relaxed, kSideways, tt); }, out);
   EXPECT_EQ(names(out), "grab+ grab- ");
+}
+
+// The index finger out and the other three curled: "point", not a fist (the four tips' mean
+// distance is a fist's), with either hand; a fist is still a grab, not a point.
+TEST(Gestures, PointingIsPointAndNoGrab) {
+  for (Hand side : {Hand::Right, Hand::Left}) {
+    GestureRecognizer g;
+    std::vector<Trigger> out;
+    double t = 0;
+    const HandFrame probe = hand(Shape::Point, kDown, 0, side);
+    EXPECT_LT(hand_shape(probe).curl, GestureParams{}.grab_curl) << "a fist's mean curl";
+    feed(
+        g, t, 20, [&](double tt) { return hand(Shape::Point, kDown, tt, side); }, out);
+    feed(
+        g, t, 20, [&](double tt) { return hand(Shape::Relaxed, kDown, tt, side); }, out);
+    feed(
+        g, t, 20, [&](double tt) { return hand(Shape::Fist, kDown, tt, side); }, out);
+    EXPECT_EQ(names(out), "point+ point- grab+ ");
+    for (const auto& tr : out) EXPECT_EQ(tr.hand, side);
+  }
 }
 
 TEST(Gestures, FlatHandPalmDownIsFlatAndItsNeighboursAreNot) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -141,13 +142,17 @@ TEST_F(Voice, CorruptAudioAndMissingMicrophoneGiveStatus) {
 }
 
 TEST_F(Voice, PhraseFileAndGrammar) {
-  // The shipped phrase file: thirteen distinct two-word phrases mapping to the thirteen commands
-  // (the sim's operations, "show help" and "save session").
+  // The shipped phrase file: fifteen distinct two-word phrases mapping to the fifteen commands
+  // (the sim's operations, the help, the pattern, the colour map and "save session").
   std::vector<VoicePhrase> ph;
   std::string err;
   ASSERT_TRUE(load_phrases(std::string(DRAPE_SOURCE_DIR) + "/assets/voice/phrases.tsv", ph, &err))
       << err;
-  ASSERT_EQ(ph.size(), 13u);
+  ASSERT_EQ(ph.size(), 15u);
+  std::set<std::string> phrases, commands;
+  for (const auto& p : ph) phrases.insert(p.phrase), commands.insert(p.command);
+  EXPECT_EQ(phrases.size(), 15u);
+  EXPECT_EQ(commands.size(), 15u);
   for (const auto& p : ph) EXPECT_NE(p.phrase.find(' '), std::string::npos) << p.phrase;
   EXPECT_EQ(ph.back().phrase, "save session");
   EXPECT_EQ(ph.back().command, "save");

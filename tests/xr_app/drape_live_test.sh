@@ -19,7 +19,9 @@
 # pin: hand tracking (the window's start profile when the app enables hand tracking), lock step:
 #   with the hanging cloth at rest, Z (the thumb-middle pinch: the right hand's pin) pins the cloth
 #   under the hand; checked in xr_session.txt (pinned vertices added), session_log.json (a pin
-#   trigger) and the golden image live_pin.png; then the left button pinches.
+#   trigger) and the golden image live_pin.png; then the left button pinches, and P (the right
+#   hand pointing) writes the pattern mid-session into out/pattern/session-1/ (the log line with
+#   its tick; with --no-pattern no session-2 at the end).
 # scene: the scene's options (--fabric, --form, --mesh, --start, --resolution): bad values exit 2
 #   naming the option and file before a window opens; good ones run 20 live frames; a fakenect
 #   recording as the hands (--hands kinect --kinect-record) runs live to its last frame.
@@ -31,9 +33,9 @@ GOLDEN="$(cd "$(dirname "$0")" && pwd)/golden"
 REGION="300 380 520 600"  # the form and the cloth in the view: the image checks look there
 case "$MODE" in
   free) ARGS=(--resolution 12 --eye-size 256) ;;
-  # The cloth's image without the feedback panel (the panel has its own tests).
+  # The cloth's image without the feedback panel and the pattern board (each has its own tests).
   golden | pin) ARGS=(--resolution 16 --eye-size 256 --sim-lock-step --state-hashes
-    --no-feedback-panel) ;;
+    --no-feedback-panel --no-board) ;;
   scene) ;;
   *) echo "usage: drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin|scene] [--update-golden]"; exit 2 ;;
 esac
@@ -244,6 +246,14 @@ case "$MODE" in
     expect "the left button pinches the right hand" "v('pinch', 2) == 1"
     frames 10
     xdotool mouseup 1
+    # P: the right hand points (held like a gesture): the pattern of the cloth as it is now,
+    # written off the sim thread into out/pattern/session-1/ while the session goes on.
+    frames 20
+    xdotool keydown p
+    expect "P makes the right hand point" "f('gesture') == 'open,point'"
+    frames 20
+    xdotool keyup p
+    frames 60
     ;;
 esac
 
@@ -318,6 +328,15 @@ print("triggers:", triggers)
 assert "pin" in [n for n, _ in triggers], "no pin trigger"
 m = re.search(r"pinned_added (-?\d+)", session)
 assert m and int(m.group(1)) >= 1, "no vertex pinned"'
+    session_check "P asked for the pattern mid-session; it was written into session-1 only" '
+assert re.search(r"gesture point begin hand right -> pattern once", session), "no point -> pattern"
+m = re.search(r"^pattern: (\d+) piece\(s\), .* -> .*/pattern/session-1 \(tick (\d+)\)$", session, re.M)
+assert m and int(m.group(1)) >= 1, "no mid-session pattern line"
+print("mid-session pattern:", m.group(0))
+import os
+d = os.path.dirname(sys.argv[1]) + "/pattern/"
+assert os.path.getsize(d + "session-1/report.json") > 0 and os.path.getsize(d + "session-1/pattern.dxf") > 0
+assert not os.path.exists(d + "session-2"), "--no-pattern: no pattern at the end"'
     compare_golden live_pin
     ;;
 esac

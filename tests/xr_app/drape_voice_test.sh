@@ -15,6 +15,10 @@
 #            manifest) is a scripted run: live voice off, the scenario's audio cue read; a
 #            configured runtime (an active_runtime.json, here a copy of the simulated runtime's
 #            manifest standing in for a headset) is live: the microphone, no audio cue.
+#   pattern  "make pattern", "map pattern" and "strain map" in one recording: each heard as its own
+#            command (make/map differ in one vowel: the recogniser must not confuse them); the
+#            mid-session pattern written from a snapshot into pattern/session-1/ while the
+#            session runs, the end's into session-2/; the colour map turned to strain.
 #   args     --voice on a file that does not exist exits 2 naming the option (both commands);
 #            `drape run --headless --voice off` exits 2; --help of both lists --voice.
 # usage: drape_voice_test.sh DRAPE_EXE MODE WORKDIR
@@ -109,7 +113,44 @@ check_failure() {
   echo "cloth identical to the run with --voice off"
 }
 
+# The phrases one after the other (1.2 s of silence before each, 1 s after the last: all heard
+# within the scenario's 10 s) into
+# $work/phrases.wav.
+make_phrases() {
+  local parts=() i=0
+  for p in "$@"; do
+    espeak-ng -s 140 -w "$work/p$i.wav" "$p" >>"$log" 2>&1 || fail "espeak-ng failed"
+    sox "$work/p$i.wav" -r 16000 -c 1 -b 16 "$work/q$i.wav" pad 1.2 0 >>"$log" 2>&1 ||
+      fail "sox failed"
+    parts+=("$work/q$i.wav")
+    i=$((i + 1))
+  done
+  sox "${parts[@]}" "$work/phrases.wav" pad 0 1 >>"$log" 2>&1 || fail "sox concat failed"
+}
+
+# The pattern mode's checks on $out.
+check_pattern() {
+  [ $rc -eq 0 ] || fail "exit code $rc"
+  local s=$out/xr_session.txt
+  grep "heard 'make pattern' -> pattern" "$s" || fail "'make pattern' not heard as pattern"
+  grep "heard 'map pattern' -> map" "$s" || fail "'map pattern' not heard as map"
+  grep "heard 'strain map' -> colours" "$s" || fail "'strain map' not heard as colours"
+  grep -c "heard '" "$s" | grep -qx 3 || fail "not exactly three phrases heard"
+  grep -q "^colour map: strain" "$s" || fail "the colour map did not turn to strain"
+  grep "^pattern: [0-9]* piece(s), .* -> $out/pattern/session-1 (tick [0-9]*)" "$s" ||
+    fail "no mid-session pattern in session-1"
+  for f in pattern.svg pattern.dxf pattern_a4.pdf report.json; do
+    [ -s "$out/pattern/session-1/$f" ] || fail "session-1/$f missing"
+  done
+  grep -q "^pattern: .* -> $out/pattern/session-2\$" "$s" || fail "the end's pattern is not session-2"
+}
+
 case $mode in
+  pattern)
+    make_phrases "make pattern" "map pattern" "strain map"
+    run pattern --voice "$work/phrases.wav"
+    check_pattern
+    ;;
   wav)
     make_speech
     run wav --voice "$work/pin.wav"

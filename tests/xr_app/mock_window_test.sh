@@ -56,14 +56,15 @@ PY
 
 if [ "$MODE" = depth ]; then
   # --- the client enables XR_EXT_hand_tracking and no scenario names a profile: the window
-  # starts with the hands alone, and Z X C G U T make the gestures of the hand under the mouse:
+  # starts with the hands alone, and Z X C G U T P make the gestures of the hand under the mouse:
   # the thumb tip 5 mm from the middle, ring, little tip; the fingers together palm down; the
-  # palm up; the open palm facing forward, thrust 20 cm forward.
+  # palm up; the open palm facing forward, thrust 20 cm forward; pointing (the middle, ring and
+  # little fingers curled: the thumb far from their tips, the index's gap open).
   expect "the window starts in hand tracking" "f('profile') == 'hand_tracking'"
   xdotool mousemove 400 300
   client_expect "the client reads the open hand" "v('gaps', 1) > 0.02 and v('spread') > 0.065 and v('palm_normal', 2) < -0.9"
   pz=$(tail -1 "$OUT/stdout" | tr ' ' '\n' | sed -n 's/^palm=//p' | cut -d, -f3)
-  for k in z x c g u t; do
+  for k in z x c g u t p; do
     case $k in
       z) want=pinch_middle; reads="v('gaps', 1) < 0.007 and v('gaps', 2) > 0.015 and v('pinch_gap') > 0.02" ;;
       x) want=pinch_ring; reads="v('gaps', 2) < 0.007 and v('gaps', 1) > 0.015 and v('gaps', 3) > 0.015" ;;
@@ -71,6 +72,7 @@ if [ "$MODE" = depth ]; then
       g) want=flat; reads="v('spread') < 0.055 and v('palm_normal', 2) < -0.9" ;;
       u) want=palm_up; reads="v('palm_normal', 2) > 0.9 and v('spread') > 0.065" ;;
       t) want=push; reads="v('palm_normal', 3) < -0.9 and v('palm', 3) < $pz - 0.15" ;;
+      p) want=point; reads="v('pinch_gap') > 0.02 and v('palm_normal', 2) < -0.9" ;;
     esac
     xdotool keydown $k
     expect "key $k makes the right hand's $want" "f('gesture') == 'open,$want'"

@@ -190,6 +190,7 @@ TEST(XrApp, DefaultScenarioPinchesPinsAndCutsTheCloth) {
   o.cloth_res = 12;
   o.out_dir = dir.string();
   o.feedback_panel = false;  // the golden images are of the scene
+  o.pattern_board = false;   // (the board: XrApp.PointGestureWritesThePatternMidSession)
   auto r = run_with_screenshots(o, dir, "30");
   for (const auto& t : r.triggers) std::printf("trigger %s\n", t.c_str());
   for (const auto& l : r.log)
@@ -639,6 +640,8 @@ TEST(XrApp, EachGestureBindingReachesItsOperation) {
       {1, "\"shape\": \"open\"", up, "palm_up", "next once", ""},
       {0, "\"shape\": \"open\"", up, "palm_up", "help begin", "help end"},
       {1, "\"shape\": \"open\"", forward, "push", "stop once", "", true},
+      {1, "\"shape\": \"point\"", down, "point", "pattern once", ""},
+      {0, "\"shape\": \"point\"", down, "point", "colours once", ""},
   };
   int frame = 6;
   for (auto& x : g) {
@@ -726,6 +729,59 @@ TEST(XrApp, EachGestureBindingReachesItsOperation) {
   };
   EXPECT_TRUE(said("undo: pinch"));
   EXPECT_TRUE(said("redo: pinch"));
+}
+
+// The mid-session pattern by the key P's gesture (the simulated runtime's window makes it from
+// P; here the scenario makes the same joints): the right hand points at frame 40, the pattern
+// worker writes pattern/session-1/ from the snapshot then, the session's end writes
+// session-2/; the live board was drawn with the cloth's one piece on it.
+TEST(XrApp, PointGestureWritesThePatternMidSession) {
+  base_env();
+  auto o = small();
+  o.eye_size = 64;
+  o.voice = false;
+  const fs::path dir = fresh_out_dir("app_point_pattern");
+  o.out_dir = (dir / "out").string();
+  // The right hand held still, pointing from frame 40 to 55.
+  std::string keys;
+  for (int f : {0, 39, 40, 55, 56, 90})
+    keys += std::string(keys.empty() ? "" : ",\n") + "{\"frame\": " + std::to_string(f) +
+            ", \"palm\": {\"position\": [0.3, 1.0, 0.5]}" +
+            (f == 40 || f == 55 ? ", \"shape\": \"point\"}" : "}");
+  const std::string sc = (dir / "scenario.json").string();
+  std::ofstream(sc) << "{\"name\": \"point_pattern\", \"end_after_frames\": 90, \"fast\": true,\n"
+                       "\"head\": [{\"frame\": 0, \"position\": [0.0, 1.3, 1.2]}],\n"
+                       "\"hands\": {\"right\": [\n"
+                    << keys << "]}}\n";
+  play_scenario(o, sc);
+  auto r = drape::app::run_xr_app(o);
+  print(r);
+  ASSERT_EQ(r.exit_code, 0) << r.error;
+  const auto mapped = std::find_if(r.triggers.begin(), r.triggers.end(), [](const std::string& t) {
+    return t.find("gesture point begin hand right -> pattern once") != std::string::npos;
+  });
+  ASSERT_NE(mapped, r.triggers.end());
+  EXPECT_EQ(r.patterns_written, 1);
+  const fs::path s1 = dir / "out" / "pattern" / "session-1",
+                 s2 = dir / "out" / "pattern" / "session-2";
+  for (const char* f : {"pattern.svg", "pattern.dxf", "pattern_a4.pdf", "report.json"})
+    EXPECT_TRUE(fs::exists(s1 / f)) << (s1 / f);
+  EXPECT_TRUE(fs::exists(s2 / "report.json")) << "the end's pattern is the next number";
+  // Written from a snapshot of the session's middle, not its end.
+  bool mid = false;
+  for (const auto& l : r.log) {
+    unsigned long long tick = 0;
+    const auto at = l.find(s1.string() + " (tick ");
+    if (l.rfind("pattern: 1 piece(s)", 0) == 0 && at != std::string::npos &&
+        std::sscanf(l.c_str() + at + s1.string().size(), " (tick %llu)", &tick) == 1) {
+      std::printf("%s\n", l.c_str());
+      mid = tick >= 40 && tick < r.final_ticks;
+    }
+  }
+  EXPECT_TRUE(mid) << "no mid-session pattern line with its tick";
+  EXPECT_EQ(r.board_pieces, 1);
+  ASSERT_TRUE(r.profile_ms.count("board.latency"));
+  EXPECT_FALSE(r.profile_ms.at("board.latency").empty());
 }
 
 namespace {

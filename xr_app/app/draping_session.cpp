@@ -104,6 +104,7 @@ std::unique_ptr<SessionContent> make_draping_session(const VulkanDevice& device,
 }
 
 DrapingSession::~DrapingSession() {
+  patterns_.reset();  // its snapshot reader goes before the sim thread
   reader_ = sim::SnapshotReader();
   sim_.reset();
   renderer_.reset();
@@ -135,6 +136,12 @@ bool DrapingSession::create(const VulkanDevice& device) {
   sim_ = std::make_unique<sim::SimThread>(std::move(w.value()), so);
   reader_ = sim_->make_reader();
   start_sim();
+  if (ops_) {
+    PatternWorkerOptions po;
+    po.board = opt_.pattern_board;
+    po.out_dir = opt_.out_dir;
+    patterns_ = std::make_unique<PatternWorker>(sim_->make_reader(), po);
+  }
   return rep_.r.error.empty();
 }
 
@@ -294,6 +301,14 @@ void DrapingSession::draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& 
   render::DrawOptions dopt;
   dopt.hands = overlays_;
   dopt.markers = markers_;
+  dopt.colour_map = colour_map_;
+  const BoardBuild board = patterns_ ? patterns_->latest_board() : BoardBuild{};
+  dopt.board = board.board;
+  // The board stands beside the form, to its left seen from the front (the user's right),
+  // turned towards where the user stands, within the default view.
+  dopt.panel_centre = {0.5f, 1.2f, 0.2f};
+  dopt.panel_yaw = -0.4f;
+  dopt.panel_size = 0.38f;
   // The form's level of detail from the eyes' pixel size (lavapipe is vertex-bound).
   const XrFovf& f0 = eyes[0].view.fov;
   const float rad_per_px = (f0.angleRight - f0.angleLeft) / static_cast<float>(eyes[0].width);
@@ -314,6 +329,7 @@ void DrapingSession::draw(int64_t frame, const EyeTarget (&eyes)[2], FrameLaps& 
                    ? "; the cloth is no longer drawn, the session goes on and saves its work"
                    : ""));
   laps.lap("render");
+  if (st && board.board) note_board_drawn(board);
   const render::FrameStats& rs = renderer_->last_frame();
   laps.add("render.build", rs.build_ms);
   laps.add("render.upload", rs.upload_ms);
@@ -415,6 +431,10 @@ void DrapingSession::session_lost() {
 void DrapingSession::finish() {
   if (!sim_) return;
   rep_.r.thread_cpu_s = threads_.seconds();  // before the sim's threads end
+  if (patterns_) {                           // the exports asked for are written before the end
+    patterns_->stop();
+    drain_exports();
+  }
   sim_->stop();
   poll_saves(-1, true);
   if (ops_ && !opt_.sim_lock_step) drain_free_outcomes();
@@ -467,7 +487,8 @@ void DrapingSession::write_outputs(sim::World& w) {
   else
     not_saved(rep_, "glTF", e);
   if (opt_.export_pattern) {
-    const SessionPatternExport pe = export_session_pattern(w, ops_->state(), opt_.out_dir, 1);
+    const int n = patterns_ ? patterns_->next_number() : 1;
+    const SessionPatternExport pe = export_session_pattern(w, ops_->state(), opt_.out_dir, n);
     r.log.push_back(pe.summary);
     for (const auto& f : pe.files) r.written.push_back(f);
   }

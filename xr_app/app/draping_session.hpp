@@ -8,6 +8,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <future>
 #include <memory>
 #include <mutex>
@@ -29,6 +30,7 @@
 #include "tracking/voice.hpp"
 #include "xr_app/app/calibration_mode.hpp"
 #include "xr_app/app/feedback.hpp"
+#include "xr_app/app/pattern_board.hpp"
 #include "xr_app/app/session_content.hpp"
 #include "xr_app/app/voice_input.hpp"
 
@@ -113,6 +115,16 @@ class DrapingSession : public SessionContent {
   static void apply_triggers(sim::World& w, const std::vector<Op>& use,
                              sim::OperationController& ops, Said& out);
   void drain_said(int64_t frame);
+  // The app's own operations (not sent to the sim): "help", "pattern" (an export of the newest
+  // snapshot by the pattern worker) and "colours" (the cloth's colour map: none, strain, ease).
+  // Returns false for a sim operation.
+  bool app_operation(const tracking::Action& act, const Op& op);
+  void ask_pattern();
+  void next_colour_map();
+  // The pattern worker's finished exports into the log, the written files and the panel.
+  void drain_exports();
+  // The board drawn with this frame: its latency (snapshot filled -> drawn) when it is new.
+  void note_board_drawn(const BoardBuild& b);
   void prepare_panel(int64_t frame, const EyeTarget (&eyes)[2]);
   void record_pointer_probe(int64_t frame, const render::ViewTarget& left_eye);
   void write_outputs(sim::World& w);
@@ -168,6 +180,11 @@ class DrapingSession : public SessionContent {
   bool panel_set_ = false, text_error_noted_ = false;
   TickProfile ticks_;
   ThreadGroups threads_;
+  // The live pattern board and the mid-session exports (pattern_board.hpp), off the sim thread.
+  std::unique_ptr<PatternWorker> patterns_;
+  uint64_t board_drawn_serial_ = 0;
+  std::chrono::steady_clock::time_point board_drawn_at_{};  // when the last new board was drawn
+  render::ColourMap colour_map_ = render::ColourMap::kNone;
 
   // The external hand source (opt_.hands != "xr") and what the session keeps of it.
   struct ExternalHands {

@@ -85,8 +85,9 @@ std::string help_label(const tracking::Binding& b) {
 // The end of a held input is its begin's ("(held)" in the label); per-profile variants and the
 // palm-only trackers' gestures are in commands.json and `drape run --help`.
 std::vector<std::string> help_lines(const tracking::CommandMap& map) {
-  static const char* kOps[] = {"pinch", "move", "pin",  "release", "cut",  "map", "smooth",
-                               "next",  "undo", "redo", "stop",    "help", "save"};
+  static const char* kOps[] = {"pinch", "move",    "pin",     "release", "cut",
+                               "map",   "smooth",  "next",    "undo",    "redo",
+                               "stop",  "pattern", "colours", "save",    "help"};
   std::vector<std::string> out{"help: each operation's gesture | buttons | phrase"};
   for (const char* op : kOps) {
     std::string by[3];  // gesture, controller, voice

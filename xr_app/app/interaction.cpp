@@ -87,6 +87,7 @@ void DrapingSession::interact(int64_t frame, const HandInput& in) {
   }
   if (ops_) drain_said(frame);
   poll_saves(frame, false);  // refusals and the hands' operations into the feedback panel
+  drain_exports();           // mid-session patterns written by the pattern worker
   if (!ext_)
     feedback_.set_status("hands", hands[0].tracked || hands[1].tracked ? "" : "no hand tracked");
 }
@@ -269,20 +270,12 @@ std::vector<DrapingSession::Op> DrapingSession::map_triggers(
     line += " -> " + op.name + " " + tracking::phase_name(act->phase);
     rep_.r.triggers.push_back(line);
     if (opt_.verbose) rep_.note("trigger " + line);
-    // The help is the app's, not sent to the sim: shown while its gesture or button is held;
-    // the spoken "show help" turns it on or off.
-    if (op.name == "help") {
-      if (act->phase == tracking::Phase::Toggle)
-        feedback_.toggle_help();
-      else
-        feedback_.show_help(act->phase != tracking::Phase::End);
-      continue;
-    }
-    // Saving is the app's too: the sim copies the session, another thread writes the file.
+    // Saving is the app's: the sim copies the session, another thread writes the file.
     if (op.name == "save") {
       if (act->phase != tracking::Phase::End) save_session(frame);
       continue;
     }
+    if (app_operation(*act, op)) continue;
     use.push_back(op);
   }
   return use;

@@ -59,6 +59,9 @@ struct XrAppOptions {
   std::string out_dir;        // when set: session_log.json and drape_cloth.gltf written there
   // At the session's end, the pattern of the cloth as draped into out_dir/pattern/session-1/.
   bool export_pattern = true;
+  // The live pattern board beside the form (app/pattern_board.hpp): the draped cloth's pattern
+  // rebuilt off the sim thread from its snapshots; false: no board (the renderer's panel empty).
+  bool pattern_board = true;
   // The scenario file the simulated runtime plays ("" = none): its audio cues are the voice
   // input (docs/xr.md).
   std::string scenario_path;
@@ -187,6 +190,11 @@ struct XrAppResult {
   // The sim's ticks and the cloth's state hash at the end (sessions with a sim), as a replay of
   // the session's journal reproduces them.
   uint64_t final_ticks = 0, final_state_hash = 0;
+  // The mid-session patterns written ("make pattern") and the pieces on the last board drawn
+  // (profile_ms "board.latency": ms from the snapshot's tick to the board drawn; "board.build":
+  // its extraction on the worker; "board.interval": ms between new boards drawn).
+  int patterns_written = 0;
+  int board_pieces = 0;
   bool has_final_state = false;
 };
 

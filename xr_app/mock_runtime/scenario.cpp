@@ -122,8 +122,8 @@ float len(XrVector3f a) {
 }
 
 bool hand_shape_from_name(const std::string& name, HandShape* shape) {
-  const char* names[] = {"open", "pinch_middle", "pinch_ring", "pinch_little", "together"};
-  for (int i = 0; i < 5; ++i)
+  const char* names[] = {"open", "pinch_middle", "pinch_ring", "pinch_little", "together", "point"};
+  for (int i = 0; i < 6; ++i)
     if (name == names[i]) return *shape = static_cast<HandShape>(i), true;
   return false;
 }
@@ -142,6 +142,13 @@ void shape_hand(HandShape shape, XrVector3f* p) {
     p[XR_HAND_JOINT_THUMB_DISTAL_EXT] = add(p[XR_HAND_JOINT_THUMB_DISTAL_EXT], mul(d, 0.6f));
     p[XR_HAND_JOINT_THUMB_PROXIMAL_EXT] = add(p[XR_HAND_JOINT_THUMB_PROXIMAL_EXT], mul(d, 0.25f));
   }
+  if (shape == kShapePoint)  // as a fist's curl, index finger left out
+    for (int f0 : {XR_HAND_JOINT_MIDDLE_INTERMEDIATE_EXT, XR_HAND_JOINT_RING_INTERMEDIATE_EXT,
+                   XR_HAND_JOINT_LITTLE_INTERMEDIATE_EXT}) {
+      const XrVector3f curl{p[f0].x, -0.03f, -0.01f};
+      const float amount[] = {0.4f, 0.75f, 0.9f};
+      for (int k = 0; k < 3; ++k) p[f0 + k] = add(p[f0 + k], mul(sub(curl, p[f0 + k]), amount[k]));
+    }
   if (shape == kShapeTogether) {
     for (int f0 : {XR_HAND_JOINT_INDEX_INTERMEDIATE_EXT, XR_HAND_JOINT_RING_INTERMEDIATE_EXT,
                    XR_HAND_JOINT_LITTLE_INTERMEDIATE_EXT})
@@ -378,7 +385,7 @@ void parse_hand_shape(const json& kj, const std::string& f, HandKey* k) {
       (!kj["shape"].is_string() || !hand_shape_from_name(kj["shape"], &k->shape)))
     throw FieldError(f +
                      ".shape: expected one of open, pinch_middle, pinch_ring, pinch_little, "
-                     "together");
+                     "together, point");
 }
 
 double frame_of(const json& j, const std::string& field, double prev) {

@@ -36,13 +36,15 @@ struct HandSample {
 };
 
 // A generated hand's shape: the thumb tip 5 mm under the middle, ring or little fingertip (the
-// thumb's pinch with that finger), or the fingers together (a flat hand); open: as generated.
+// thumb's pinch with that finger), the fingers together (a flat hand), or pointing (the index
+// finger out, the middle, ring and little fingers curled into the palm); open: as generated.
 enum HandShape {
   kShapeOpen,
   kShapePinchMiddle,
   kShapePinchRing,
   kShapePinchLittle,
-  kShapeTogether
+  kShapeTogether,
+  kShapePoint
 };
 
 struct HandKey {

@@ -32,7 +32,7 @@ constexpr float kSelfHit = 0.01f;        // depth hits within a joint's radius p
 constexpr float kPushDistance = 0.2f;  // m: T thrusts the open palm this far forward ...
 constexpr float kPushSpeed = 1.5f;     // m/s: ... at this speed
 
-// The keys held down (besides the one-shot ones: Tab, R, V, Escape). Z X C G U T: gestures;
+// The keys held down (besides the one-shot ones: Tab, R, V, Escape). Z X C G U T P: gestures;
 // the arrows and Enter: the thumbstick (trackpad) and its click.
 enum Key {
   kW,
@@ -55,6 +55,7 @@ enum Key {
   kG,
   kU,
   kT,
+  kP,
   kUp,
   kDown,
   kLeft,
@@ -63,11 +64,12 @@ enum Key {
   kKeys
 };
 constexpr int kGlfwKeys[kKeys] = {
-    GLFW_KEY_W,  GLFW_KEY_A,    GLFW_KEY_S,          GLFW_KEY_D,           GLFW_KEY_Q,
-    GLFW_KEY_E,  GLFW_KEY_F,    GLFW_KEY_1,          GLFW_KEY_2,           GLFW_KEY_3,
-    GLFW_KEY_4,  GLFW_KEY_M,    GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT, GLFW_KEY_Z,
-    GLFW_KEY_X,  GLFW_KEY_C,    GLFW_KEY_G,          GLFW_KEY_U,           GLFW_KEY_T,
-    GLFW_KEY_UP, GLFW_KEY_DOWN, GLFW_KEY_LEFT,       GLFW_KEY_RIGHT,       GLFW_KEY_ENTER};
+    GLFW_KEY_W,    GLFW_KEY_A,  GLFW_KEY_S,          GLFW_KEY_D,           GLFW_KEY_Q,
+    GLFW_KEY_E,    GLFW_KEY_F,  GLFW_KEY_1,          GLFW_KEY_2,           GLFW_KEY_3,
+    GLFW_KEY_4,    GLFW_KEY_M,  GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT, GLFW_KEY_Z,
+    GLFW_KEY_X,    GLFW_KEY_C,  GLFW_KEY_G,          GLFW_KEY_U,           GLFW_KEY_T,
+    GLFW_KEY_P,    GLFW_KEY_UP, GLFW_KEY_DOWN,       GLFW_KEY_LEFT,        GLFW_KEY_RIGHT,
+    GLFW_KEY_ENTER};
 
 double seconds_now() {
   return static_cast<double>(now_ns()) * 1e-9;
@@ -149,12 +151,13 @@ struct Window {
     float z = kDefaultDistance;  // view depth of the surface it sits on
     float wheel = 0;             // nearer (<0) / farther (>0) than that surface
     float pinch = 0, fist = 0;
-    HandShape shape = kShapeOpen;  // Z X C: the thumb's pinch with middle, ring, little; G: flat
-    bool palm_up = false;          // U
-    float push = -1;               // T: how far the palm has thrust forward (-1: not pushing)
-    XrVector2f stick{0, 0};        // the arrows
-    bool stick_click = false;      // Enter
-    HandSample published;          // the joints as last published (stage)
+    HandShape shape =
+        kShapeOpen;        // Z X C: the thumb's pinch with middle, ring, little; G: flat; P: point
+    bool palm_up = false;  // U
+    float push = -1;       // T: how far the palm has thrust forward (-1: not pushing)
+    XrVector2f stick{0, 0};    // the arrows
+    bool stick_click = false;  // Enter
+    HandSample published;      // the joints as last published (stage)
   } hands[2];
   bool both = false;  // both eyes side by side
   int eye_w = 0, eye_h = 0;
@@ -474,7 +477,7 @@ float depth_to_distance(float d, float min_depth, float max_depth, float near_z,
 }
 
 namespace {
-// Z X C G U T and the arrows / Enter for the hand under the mouse; the other hand's gestures and
+// Z X C G U T P and the arrows / Enter for the hand under the mouse; the other hand's gestures and
 // stick are let go. T thrusts the palm forward at kPushSpeed (held_t: T's time held since the
 // last frame) up to kPushDistance.
 template <class On>
@@ -483,6 +486,7 @@ void take_gesture_keys(Window::Hand& hd, Window::Hand& other, On on, float held_
              : on(kX) ? kShapePinchRing
              : on(kC) ? kShapePinchLittle
              : on(kG) ? kShapeTogether
+             : on(kP) ? kShapePoint
                       : kShapeOpen;
   hd.palm_up = on(kU);
   hd.push = on(kT) ? std::min(kPushDistance, std::max(0.f, hd.push) + kPushSpeed * held_t) : -1;
@@ -499,7 +503,7 @@ void take_gesture_keys(Window::Hand& hd, Window::Hand& other, On on, float held_
 const char* gesture_name(const Window::Hand& k) {
   if (k.push >= 0) return "push";
   if (k.palm_up) return "palm_up";
-  const char* names[] = {"open", "pinch_middle", "pinch_ring", "pinch_little", "flat"};
+  const char* names[] = {"open", "pinch_middle", "pinch_ring", "pinch_little", "flat", "point"};
   return names[k.shape];
 }
 
