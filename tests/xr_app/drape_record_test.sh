@@ -6,7 +6,7 @@
 #   free  the recorded run's sim free-running on its own 90 Hz clock (--sim-free)
 #   lock  the recorded run in lock step (one tick per frame)
 #   kill  lock step, a checkpoint every 0.5 s of session time: recording runs killed with SIGKILL
-#         at 20 random moments. Each killed session is resumed from its newest whole checkpoint
+#         at 20 random points (when its journal reaches a random size). Each killed session is resumed from its newest whole checkpoint
 #         and its journal (drape replay): its state at the kill's tick is the one the
 #         uninterrupted run's journal replays to from the start at that tick (drape replay
 #         --until-tick --from-start), and, given the uninterrupted run's inputs after that tick
@@ -129,12 +129,11 @@ PY
   *) echo "usage: drape_record_test.sh DRAPE_EXE free|lock|kill|resume|tee|save WORKDIR"; exit 2 ;;
 esac
 rec=$work/rec
-start=$(date +%s.%N)
 "$exe" xr --scenario assets/scenarios/record_replay.json --eye-size 64 --cloth-res 16 \
   --record "$rec" "${sim[@]}" >"$log" 2>&1
 rc=$?
 [ $rc -eq 0 ] || fail "drape xr exited with $rc"
-run_secs=$(echo "$(date +%s.%N) - $start" | bc)
+journal_bytes=$(stat -c %s "$rec/journal.bin")
 for f in journal.bin meta.json session.txt; do
   [ -s "$rec/$f" ] || fail "missing $rec/$f"
 done
@@ -210,21 +209,25 @@ fi
 
 if [ "$mode" = kill ]; then
   here=$(cd "$(dirname "$0")" && pwd)
-  # One killed run: SIGKILL after $2 s, its session resumed (replayed from its newest whole
+  # One killed run: SIGKILL once its journal has grown to $2 bytes (a point of the session that
+  # does not depend on the machine's load), its session resumed (replayed from its newest whole
   # checkpoint and its journal) and compared with the uninterrupted run; 1 when the run ended
   # before the kill or had recorded no input yet (nothing to compare).
-  kill_once() {  # kill_once N DELAY
+  kill_once() {  # kill_once N BYTES
     local k=$work/kill$1 l=$work/kill$1
     "$exe" xr --scenario assets/scenarios/record_replay.json --eye-size 64 --cloth-res 16 \
       --record "$k" "${sim[@]}" >"$l.log" 2>&1 &
     local pid=$!
-    sleep "$2"
+    while kill -0 $pid 2>/dev/null &&
+      [ "$(stat -c %s "$k/journal.bin" 2>/dev/null || echo 0)" -lt "$2" ]; do
+      sleep 0.01
+    done
     kill -KILL $pid 2>/dev/null
     wait $pid 2>/dev/null
     grep -q "^drape xr: final state hash" "$l.log" && return 1  # ended first
     [ -f "$k/journal.bin" ] || return 1  # killed before the journal was opened
     "$exe" replay "$k" >"$l.out" 2>"$l.err" ||
-      fail "replay of the journal killed after $2 s exited with $?: $(cat "$l.err")"
+      fail "replay of the journal killed at $2 bytes exited with $?: $(cat "$l.err")"
     local got khash ktick want
     got=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$l.out")
     read -r khash ktick <<<"$got"
@@ -243,15 +246,15 @@ if [ "$mode" = kill ]; then
     final=$(sed -n 's/^final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$l.cont.out")
     [ "$final" = "$rhash $rtick" ] || fail "resumed after the kill at $ktick: '$final', uninterrupted '$rhash $rtick'"
     from=$(sed -n 's/^drape replay: from \(checkpoint-[0-9]*.bin\).*/\1/p' "$l.err")
-    echo "killed after $2 s at tick $ktick: $khash (uninterrupted: the same); resumed from ${from:-the start}: final $final"
+    echo "killed at $2 journal bytes, tick $ktick: $khash (uninterrupted: the same); resumed from ${from:-the start}: final $final"
     [ -n "$from" ] && from_checkpoint=$((from_checkpoint + 1))
     return 0
   }
   killed=0 tries=0 from_checkpoint=0
   while [ $killed -lt 20 ] && [ $tries -lt 40 ]; do
     tries=$((tries + 1))
-    delay=$(awk -v t="$run_secs" -v r="$RANDOM" 'BEGIN { printf "%.2f", t * (0.15 + 0.7 * r / 32768) }')
-    kill_once $tries "$delay" && killed=$((killed + 1))
+    at=$(awk -v t="$journal_bytes" -v r="$RANDOM" 'BEGIN { printf "%d", t * (0.15 + 0.7 * r / 32768) }')
+    kill_once $tries "$at" && killed=$((killed + 1))
   done
   [ $killed -ge 20 ] || fail "only $killed of $tries runs were killed mid-session"
   echo "$killed kills, $from_checkpoint resumed from a checkpoint"
