@@ -143,6 +143,7 @@ void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double 
     double cone;  // half-angle of the normals about the axis (pi: not flat)
   };
   std::vector<Box> box(R);
+  region_n_.resize(region_tri_.size());
   for (int r = 0; r < R; ++r) {
     Box& b = box[r];
     b.lo = Vec3::Constant(std::numeric_limits<double>::infinity());
@@ -154,7 +155,8 @@ void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double 
         b.lo = b.lo.cwiseMin(x[v]);
         b.hi = b.hi.cwiseMax(x[v]);
       }
-      sum += (x[T[1]] - x[T[0]]).cross(x[T[2]] - x[T[0]]);
+      region_n_[k] = (x[T[1]] - x[T[0]]).cross(x[T[2]] - x[T[0]]);
+      sum += region_n_[k];
     }
     b.lo.array() -= reach;
     b.hi.array() += reach;
@@ -164,8 +166,7 @@ void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double 
     b.axis = sum / len;
     double cmin = 1;
     for (int k = region_lo_[r]; k < region_lo_[r + 1]; ++k) {
-      const auto& T = tris[region_tri_[k]];
-      const Vec3 N = (x[T[1]] - x[T[0]]).cross(x[T[2]] - x[T[0]]);
+      const Vec3& N = region_n_[k];
       const double nn = N.norm();
       cmin = std::min(cmin, nn > 0 ? N.dot(b.axis) / nn : -1.0);
     }

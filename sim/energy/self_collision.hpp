@@ -81,6 +81,7 @@ class SelfCollision {
   std::vector<int32_t> region_tri_;        // triangles grouped by region
   std::vector<uint64_t> region_adjacent_;  // (a << 32 | b), a < b: regions sharing a vertex
   std::vector<char> tri_active_, vertex_active_;
+  std::vector<Vec3> region_n_;  // per entry of region_tri_: its triangle's area normal (cull)
   int active_regions_ = 0, active_tris_ = 0;
   void build_regions(const Cloth& cloth);
   void cull(const Cloth& cloth, const std::vector<Vec3>& x, double reach);

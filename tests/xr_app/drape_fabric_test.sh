@@ -6,22 +6,8 @@
 # usage: drape_fabric_test.sh DRAPE_EXE
 set -u
 exe=$1
-work=$(mktemp -d "${TMPDIR:-/tmp}/drape_fabric_test.XXXXXX") || exit 1
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-fail() { echo "FAIL: $*"; cat out.txt; exit 1; }
-# expect RC [TEXT...] -- ARGS...: drape ARGS exits RC and its output contains each TEXT.
-expect() {
-  local rc=$1 texts=()
-  shift
-  while [ "$1" != -- ]; do texts+=("$1"); shift; done
-  shift
-  "$exe" "$@" >out.txt 2>&1
-  local got=$?
-  [ $got -eq "$rc" ] || fail "drape $*: exit $got, expected $rc"
-  for t in "${texts[@]}"; do grep -qF -- "$t" out.txt || fail "drape $*: no '$t' in the output"; done
-  echo "ok: drape $* (exit $got)"
-}
+. "$(cd "$(dirname "$0")" && pwd)/cli_test_lib.sh"
+cli_test_setup drape_fabric_test
 expect 0 test calibrate -- fabric --help
 expect 0 --fabric --specimen --disc --resolution --seed --seeds --out -- fabric test --help
 expect 0 --density --dc --nodes --out -- fabric calibrate --help

@@ -5,22 +5,8 @@
 # usage: drape_options_test.sh DRAPE_EXE
 set -u
 exe=$1
-work=$(mktemp -d "${TMPDIR:-/tmp}/drape_options_test.XXXXXX") || exit 1
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-fail() { echo "FAIL: $*"; cat out.txt; exit 1; }
-# expect RC [TEXT...] -- ARGS...: drape ARGS exits RC and its output contains each TEXT.
-expect() {
-  local rc=$1 texts=()
-  shift
-  while [ "$1" != -- ]; do texts+=("$1"); shift; done
-  shift
-  "$exe" "$@" >out.txt 2>&1
-  local got=$?
-  [ $got -eq "$rc" ] || fail "drape $*: exit $got, expected $rc"
-  for t in "${texts[@]}"; do grep -qF -- "$t" out.txt || fail "drape $*: no '$t' in the output"; done
-  echo "ok: drape $* (exit $got)"
-}
+. "$(cd "$(dirname "$0")" && pwd)/cli_test_lib.sh"
+cli_test_setup drape_options_test
 expect 0 --assets --simd form pattern render run -- --help
 expect 2 -- 
 expect 2 "unknown command 'nosuch'" -- nosuch

@@ -7,10 +7,8 @@
 # usage: drape_pattern_bodice_test.sh DRAPE_EXE
 set -u
 exe=$1
-work=$(mktemp -d "${TMPDIR:-/tmp}/drape_pattern_bodice_test.XXXXXX") || exit 1
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-fail() { echo "FAIL: $*"; cat out.txt; exit 1; }
+. "$(cd "$(dirname "$0")" && pwd)/cli_test_lib.sh"
+cli_test_setup drape_pattern_bodice_test
 # run DESIGN PIECES LEGS...: drape the design, then read its files back; LEGS lists the dart-leg
 # lines (DXF layer 8) of each piece's block in order.
 run() {

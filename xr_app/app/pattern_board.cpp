@@ -136,17 +136,17 @@ void PatternWorker::stop() {
 // then the board when the snapshot is of a newer tick than the board's.
 void PatternWorker::loop() {
   for (;;) {
-    std::vector<int> todo;
+    std::vector<int> requested;
     bool stopping = false;
     {
       std::unique_lock lock(m_);
       cv_.wait_for(lock, std::chrono::milliseconds(opt_.period_ms),
                    [this] { return stop_ || !pending_.empty(); });
-      todo.swap(pending_);
+      requested.swap(pending_);
       stopping = stop_;
     }
     if (!reader_.valid()) {  // every reader of the sim taken: said for each export asked for
-      for (int n : todo) {
+      for (int n : requested) {
         SessionPatternExport e;
         e.error = "no snapshot reader left for the pattern worker (session-" + std::to_string(n) +
                   " not written)";
@@ -158,7 +158,7 @@ void PatternWorker::loop() {
       continue;
     }
     const sim::SceneSnapshot& snap = reader_.latest();
-    for (int n : todo) run_export(snap, n);
+    for (int n : requested) run_export(snap, n);
     if (stopping) return;
     if (opt_.board && snap.tick != built_tick_) build_board(snap);
   }
