@@ -13,25 +13,12 @@
 
 #include "sim/fabric_test/calibrate.hpp"
 #include "sim/fabric_test/drape_tester.hpp"
+#include "tests/sim/fabric_test/small_drape.hpp"
 
 namespace drape::sim {
 namespace {
 
 const std::string kDir = std::string(DRAPE_BINARY_DIR) + "/test_out/drape_photo";
-
-DrapeTestOptions small() {
-  DrapeTestOptions o;
-  o.resolution = 10;
-  o.max_time = 3;
-  o.finish_cycles = 10;
-  return o;
-}
-
-FabricParams with_bending(double b) {
-  FabricParams f;
-  f.bending_warp = f.bending_weft = b;
-  return f;
-}
 
 std::string path(const std::string& name) {
   std::filesystem::create_directories(kDir);

@@ -8,25 +8,12 @@
 #include <cmath>
 
 #include "sim/fabric_test/calibrate.hpp"
+#include "tests/sim/fabric_test/small_drape.hpp"
 
 namespace drape::sim {
 namespace {
 
-DrapeTestOptions small() {
-  DrapeTestOptions o;
-  o.resolution = 10;
-  o.max_time = 3;
-  o.finish_cycles = 10;
-  return o;
-}
-
 void check_specimen(const Cloth& c);
-
-FabricParams with_bending(double b) {
-  FabricParams f;
-  f.bending_warp = f.bending_weft = b;
-  return f;
-}
 
 TEST(DrapeTester, SpecimenIsTheCircleWithConsistentTriangles) {
   for (double rim_spacing : {1.0, 0.4}) {
