@@ -3,17 +3,20 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
 
 #include "sim/core/fabric.hpp"
 #include "sim/draping/bodice.hpp"
+#include "sim/draping/garment_sim.hpp"
 #include "sim/draping/pattern_pipeline.hpp"
 #include "sim/form/dress_form.hpp"
 #include "sim/form/vit_measurements.hpp"
 #include "sim/io/mesh_io.hpp"
 #include "xr_app/command.hpp"
+#include "xr_app/garment_view.hpp"
 #include "xr_app/output_files.hpp"
 #include "xr_app/paths.hpp"
 
@@ -116,6 +119,67 @@ int run_upper_body(const std::string& type, const std::string& design_path,
   return 0;
 }
 
+// What --simulate needs besides the pipeline's result: the form (shared with the solver's scene),
+// how a scene file names it, the fabric and the solver's limits.
+struct SimulateRequest {
+  std::shared_ptr<const drape::sim::DressForm> form;
+  nlohmann::json scene_form;  // null: no scene file (a form the scene files cannot name)
+  drape::sim::FabricParams fabric;
+  std::string fabric_name;
+  drape::sim::GarmentSimOptions options;
+};
+
+// The sewn garment simulated on the form (--simulate): garment_sim.gltf, fit_map.png,
+// garment_sim.json and garment_scene.json into dir; "" or an error naming the file.
+std::string simulate_and_write(const std::string& dir, const drape::sim::PipelineResult& pr,
+                               const SimulateRequest& rq,
+                               std::optional<drape::sim::GarmentSimResult>* out) {
+  namespace ds = drape::sim;
+  const ds::MappingSurface surf(*rq.form, pr.design.ease, true);
+  auto sim = ds::simulate_garment(pr.garment, rq.form, surf, rq.fabric, rq.options);
+  if (!sim) return sim.error();
+  const std::string o = dir + "/";
+  ds::TriMesh mesh = ds::garment_to_mesh(pr.garment, pr.design.name + " (simulated)");
+  mesh.vertices = sim->cloth.state.x;
+  if (std::string e = ds::write_meshes(o + "garment_sim.gltf", {mesh}); !e.empty()) return e;
+  if (std::string e = drape::app::write_fit_map(o + "fit_map.png", sim->cloth, rq.form);
+      !e.empty())
+    return e;
+  nlohmann::json j = nlohmann::json::parse(sim->to_json());
+  j["design"] = pr.design.name;
+  j["fabric"] = rq.fabric_name;
+  std::ofstream f(o + "garment_sim.json");
+  f << j.dump(2) << "\n";
+  if (!f) return o + "garment_sim.json: write failed";
+  if (!rq.scene_form.is_null())
+    if (std::string e = drape::app::write_garment_scene(o + "garment_scene.json",
+                                                        "garment_sim.gltf", rq.scene_form,
+                                                        *rq.form);
+        !e.empty())
+      return e;
+  *out = std::move(*sim);
+  return "";
+}
+
+void print_simulation(const drape::sim::GarmentSimResult& s, const std::string& fabric) {
+  std::printf(
+      "simulated garment (xpbd, %s): %d vertices, %zu seam ties; %d frames (%s), %.1f ms, "
+      "%.2f ms/frame\n",
+      fabric.c_str(), s.cloth.num_vertices(), s.ties.size(), s.frames,
+      s.at_rest ? "at rest" : "NOT at rest", s.wall_ms, s.ms_per_frame);
+  std::printf("  seam gap max %.3f mm (start %.3f mm); deepest into the form %.3f mm\n",
+              s.seam_gap_max_mm, s.seam_gap_start_mm, s.penetration_max_mm);
+  std::printf("  strain max %.2f %%, rms %.2f %%\n", s.strain_max_pct, s.strain_rms_pct);
+  for (const auto* b : {&s.waist, &s.hip})
+    std::printf(
+        "  %-5s ease max %.2f mm, mean %.2f mm; girth %.2f mm (geometric %.2f mm: %+.3f %%)\n",
+        b == &s.waist ? "waist" : "hip", b->ease_max_mm, b->ease_mean_mm, b->girth_mm,
+        b->girth_geometric_mm,
+        b->girth_geometric_mm > 0
+            ? (b->girth_mm - b->girth_geometric_mm) / b->girth_geometric_mm * 100
+            : 0.0);
+}
+
 int run_pattern(int argc, char** argv) {
   std::string design = "tight-skirt", form_name = "9AR", out = "out/pattern", mesh, vit;
   drape::sim::PipelineOptions opt;
@@ -163,7 +227,25 @@ int run_pattern(int argc, char** argv) {
                "relax with the static Newton solver instead of Gauss-Seidel");
   bool no_grain = false;
   cli.add_flag("--no-grain-control", no_grain, "do not keep the grain lines straight");
+  bool simulate = false;
+  std::string sim_fabric;
+  SimulateRequest rq;
+  cli.add_flag("--simulate", simulate,
+               "also drape the sewn garment on the form with the solver (XPBD) and write "
+               "garment_sim.gltf, fit_map.png, garment_sim.json, garment_scene.json");
+  auto* o_fabric = cli.add_option("--fabric", sim_fabric,
+                                  "with --simulate: the fabric preset (default: the design's)")
+                       ->default_str("")
+                       ->type_name("NAME");
+  cli.add_option("--sim-frames", rq.options.max_frames,
+                 "with --simulate: frames (1/90 s) at most before rest")
+      ->type_name("N")
+      ->check(CLI::Range(1, 100000));
   if (int rc = drape::app::parse_command_line(cli, argc, argv); rc >= 0) return rc;
+  if (o_fabric->count() && !simulate) {
+    std::fprintf(stderr, "drape pattern: --fabric: needs --simulate\n");
+    return 1;
+  }
   if (o_ease->count()) opt.ease = ease_mm / 1000.0;
   if (o_seam->count()) opt.seam_allowance = seam_mm / 1000.0;
   if (o_spacing->count()) opt.spacing = spacing_mm / 1000.0;
@@ -219,14 +301,45 @@ int run_pattern(int argc, char** argv) {
     fabric = *f;
   else
     std::fprintf(stderr, "drape pattern: note: %s; using the default muslin\n", f.error().c_str());
+  if (*type != "skirt" && simulate) {
+    std::fprintf(stderr,
+                 "drape pattern: --simulate: %s is a %s design; the simulation takes the sewn "
+                 "skirts only (the bodice's sewn garment has no flat pattern to rest on)\n",
+                 design.c_str(), type->c_str());
+    return 1;
+  }
   if (*type != "skirt") return run_upper_body(*type, design_path, *form, d->form, fabric, out, opt);
+  if (simulate) {
+    rq.fabric = fabric;
+    rq.fabric_name = d->fabric;
+    if (o_fabric->count()) {
+      auto f = drape::sim::load_fabric(drape::app::asset("fabrics.json").string(), sim_fabric);
+      if (!f) {
+        std::fprintf(stderr, "drape pattern: --fabric %s: %s\n", sim_fabric.c_str(),
+                     f.error().c_str());
+        return 1;
+      }
+      rq.fabric = *f;
+      rq.fabric_name = sim_fabric;
+    }
+    rq.form = std::make_shared<const drape::sim::DressForm>(*form);
+    namespace fs = std::filesystem;
+    if (!mesh.empty())
+      rq.scene_form = {{"mesh", fs::absolute(mesh).string()}};
+    else if (vit.empty())
+      rq.scene_form = form_name.find(".json") != std::string::npos
+                          ? nlohmann::json{{"measurements", fs::absolute(form_name).string()}}
+                          : nlohmann::json{{"size", form_name}};
+  }
+  std::optional<drape::sim::GarmentSimResult> sim;
   // The pattern's files replace those of an earlier run only when every one was written: a full
   // disk leaves the earlier pattern whole (output_files.hpp).
   std::optional<drape::sim::Result<drape::sim::PipelineResult>> r;
   const std::string failed = drape::app::write_whole(out, [&](const std::string& dir) {
     opt.out_dir = dir;
     r = drape::sim::run_pattern_pipeline(*d, *form, fabric, opt);
-    return *r ? std::string() : r->error();
+    if (!*r) return r->error();
+    return simulate ? simulate_and_write(dir, **r, rq, &sim) : std::string();
   });
   if (!failed.empty()) {
     std::fprintf(stderr, "drape pattern: %s (the pattern files already in %s are kept)\n",
@@ -278,7 +391,12 @@ int run_pattern(int argc, char** argv) {
   std::printf("  wrote %s/{", out.c_str());
   for (size_t i = 0; i < rep.files.size(); ++i)
     std::printf("%s%s", i ? "," : "", rep.files[i].c_str());
+  if (sim) {
+    std::printf(",garment_sim.gltf,fit_map.png,garment_sim.json%s",
+                rq.scene_form.is_null() ? "" : ",garment_scene.json");
+  }
   std::printf("}\n");
+  if (sim) print_simulation(*sim, rq.fabric_name);
   return 0;
 }
 

@@ -567,10 +567,12 @@ void XpbdSolver::substep(Step& c) {
     ++c.st.iterations;
   }
   if (c.fused && c.scene.self_collision) project_self_after_sweep(c);
+  if (c.fused) project_ties_after_sweep(c);
   collect_retests(c);
   for (int it = 0; it < opt_.iterations && !c.fused; ++it) {
     project_triangles(c);
     project_bending_springs(c);
+    for (int p = 0; p < tie_passes_; ++p) xpbd::project_ties(ties_, c.x, c.w, nullptr);
     ++c.st.iterations;
   }
   if (!c.fused) pool_->parallel_for(c.n, [&](int b, int e, int wk) { velocities(c, b, e, wk); });
@@ -936,6 +938,17 @@ void XpbdSolver::project_self_after_sweep(Step& c) {
     if (c.w[i] > 0)
       c.S.v[i] = ((c.scale[c.piece_of[i]] > 1.0 ? c.damp_settle : c.damp) / c.h) *
                  (c.x[i] - c.S.x_prev[i]);
+}
+
+// Ties in a substep run as one element sweep: projected after it, then the velocities of the
+// vertices they moved computed again from their corrected positions, as velocities() does.
+void XpbdSolver::project_ties_after_sweep(Step& c) {
+  if (ties_.empty()) return;
+  tie_moved_.clear();
+  for (int p = 0; p < tie_passes_; ++p) xpbd::project_ties(ties_, c.x, c.w, &tie_moved_);
+  for (const int i : tie_moved_)
+    c.S.v[i] =
+        ((c.scale[c.piece_of[i]] > 1.0 ? c.damp_settle : c.damp) / c.h) * (c.x[i] - c.S.x_prev[i]);
 }
 
 void XpbdSolver::project_hinges(const Step& c, int b, int e) {

@@ -28,6 +28,7 @@
 #include "sim/solvers/xpbd/xpbd_options.hpp"
 #include "sim/solvers/xpbd/xpbd_rest.hpp"
 #include "sim/solvers/xpbd/xpbd_sweep.hpp"
+#include "sim/solvers/xpbd/xpbd_ties.hpp"
 
 namespace drape::sim {
 
@@ -40,6 +41,14 @@ class XpbdSolver : public Solver {
   ThreadPool* pool() override { return pool_.get(); }
   XpbdOptions& options() { return opt_; }
   int frozen_count() const { return rest_.frozen_count(); }
+  // Ties (xpbd_ties.hpp: a sewn garment's seams), projected tie_passes times after the elements
+  // in every substep; the velocities of the vertices they move follow their corrected positions.
+  // Indices refer to the cloth the solver steps; kept until set again.
+  void set_ties(std::vector<xpbd::Tie> ties, int passes = 2) {
+    ties_ = std::move(ties);
+    tie_passes_ = passes;
+  }
+  const std::vector<xpbd::Tie>& ties() const { return ties_; }
   int contact_detections() const { return detections_; }
   // Single precision: how many times the anchors were renewed (XpbdOptions::single_precision).
   long anchor_renewals() const { return anchor_renewals_; }
@@ -130,6 +139,7 @@ class XpbdSolver : public Solver {
   void project_triangles(const Step& c);  // and the bending blocks (packed alike)
   void project_bending_springs(Step& c);  // hinges, springs, contacts, self-collision
   void project_self_after_sweep(Step& c);
+  void project_ties_after_sweep(Step& c);
   void velocities(const Step& c, int b, int e, int wk);
   void update_pieces(Step& c);  // the pieces' motion sums
   void schedule_rest(Step& c);  // settling and sleep
@@ -264,6 +274,9 @@ class XpbdSolver : public Solver {
   std::vector<Vec3> x_det_;      // each vertex's position at its last contact test
   SelfCollision self_;
   std::vector<int> self_moved_;  // vertices the last self-collision projection moved
+  std::vector<xpbd::Tie> ties_;
+  int tie_passes_ = 2;
+  std::vector<int> tie_moved_;  // vertices the last tie projection moved
   CookStats last_cook_;
   int detections_ = 0;  // contact detections so far (for tests and the bench)
   double fresh_penetration_ = 0;
