@@ -142,8 +142,7 @@ std::string simulate_and_write(const std::string& dir, const drape::sim::Pipelin
   ds::TriMesh mesh = ds::garment_to_mesh(pr.garment, pr.design.name + " (simulated)");
   mesh.vertices = sim->cloth.state.x;
   if (std::string e = ds::write_meshes(o + "garment_sim.gltf", {mesh}); !e.empty()) return e;
-  if (std::string e = drape::app::write_fit_map(o + "fit_map.png", sim->cloth, rq.form);
-      !e.empty())
+  if (std::string e = drape::app::write_fit_map(o + "fit_map.png", sim->cloth, rq.form); !e.empty())
     return e;
   nlohmann::json j = nlohmann::json::parse(sim->to_json());
   j["design"] = pr.design.name;
@@ -152,9 +151,8 @@ std::string simulate_and_write(const std::string& dir, const drape::sim::Pipelin
   f << j.dump(2) << "\n";
   if (!f) return o + "garment_sim.json: write failed";
   if (!rq.scene_form.is_null())
-    if (std::string e = drape::app::write_garment_scene(o + "garment_scene.json",
-                                                        "garment_sim.gltf", rq.scene_form,
-                                                        *rq.form);
+    if (std::string e = drape::app::write_garment_scene(
+            o + "garment_scene.json", "garment_sim.gltf", rq.scene_form, *rq.form);
         !e.empty())
       return e;
   *out = std::move(*sim);

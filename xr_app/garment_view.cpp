@@ -91,13 +91,10 @@ std::string write_garment_scene(const std::string& path, const std::string& gltf
   nlohmann::json j;
   j["form"] = form;
   j["cloth"] = {{"mesh", gltf_name}};
-  j["camera"] = {{"eye", {c.x(), y + 0.1, c.y() + 2.2}},
-                 {"target", {c.x(), y, c.y()}},
-                 {"fov_y_deg", 40}};
-  j["options"] = {{"colour_map", "ease"},
-                  {"ease_range", 0.02},
-                  {"pattern_panel", false},
-                  {"grain", false}};
+  j["camera"] = {
+      {"eye", {c.x(), y + 0.1, c.y() + 2.2}}, {"target", {c.x(), y, c.y()}}, {"fov_y_deg", 40}};
+  j["options"] = {
+      {"colour_map", "ease"}, {"ease_range", 0.02}, {"pattern_panel", false}, {"grain", false}};
   std::ofstream f(path);
   f << j.dump(2) << "\n";
   return f ? std::string() : path + ": write failed";

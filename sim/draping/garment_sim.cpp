@@ -157,7 +157,10 @@ Result<GarmentSimResult> simulate_garment(const Garment& garment,
   r.seam_gap_max_mm = xpbd::max_tie_gap(r.ties, r.cloth.state.x) * 1000;
   measure_fit(r, *form);
   const FormLandmarks& lm = form->landmarks();
-  r.waist = fit_band(r, garment, surf, lm.waist_y, opt.band);
+  // The waist band a band's height below the waist line: the sewn waist seam rests a few mm
+  // below it (the contact offset lifts the cloth off the form and the tie-held top edge settles),
+  // so a slice at the line itself may miss the cloth.
+  r.waist = fit_band(r, garment, surf, lm.waist_y - opt.band, opt.band);
   r.hip = fit_band(r, garment, surf, lm.hip_y, opt.band);
   return r;
 }
