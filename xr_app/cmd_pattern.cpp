@@ -131,7 +131,7 @@ struct SimulateRequest {
 
 // The sewn garment simulated on the form (--simulate): garment_sim.gltf, fit_map.png,
 // garment_sim.json and garment_scene.json into dir; "" or an error naming the file.
-std::string simulate_and_write(const std::string& dir, const drape::sim::PipelineResult& pr,
+std::string simulate_and_write(const std::string& dir, drape::sim::PipelineResult& pr,
                                const SimulateRequest& rq,
                                std::optional<drape::sim::GarmentSimResult>* out) {
   namespace ds = drape::sim;
@@ -155,8 +155,20 @@ std::string simulate_and_write(const std::string& dir, const drape::sim::Pipelin
             o + "garment_scene.json", "garment_sim.gltf", rq.scene_form, *rq.form);
         !e.empty())
       return e;
+  for (const char* f : {"garment_sim.gltf", "fit_map.png", "garment_sim.json"})
+    pr.report.files.push_back(f);
+  if (!rq.scene_form.is_null()) pr.report.files.push_back("garment_scene.json");
   *out = std::move(*sim);
   return "";
+}
+
+// --simulate with a bodice or dress design: refused (their sewn garment has no flat pattern).
+int simulate_refused(const std::string& design, const std::string& type) {
+  std::fprintf(stderr,
+               "drape pattern: --simulate: %s is a %s design; the simulation takes the sewn "
+               "skirts only (the bodice's sewn garment has no flat pattern to rest on)\n",
+               design.c_str(), type.c_str());
+  return 1;
 }
 
 void print_simulation(const drape::sim::GarmentSimResult& s, const std::string& fabric) {
@@ -167,15 +179,63 @@ void print_simulation(const drape::sim::GarmentSimResult& s, const std::string& 
       s.at_rest ? "at rest" : "NOT at rest", s.wall_ms, s.ms_per_frame);
   std::printf("  seam gap max %.3f mm (start %.3f mm); deepest into the form %.3f mm\n",
               s.seam_gap_max_mm, s.seam_gap_start_mm, s.penetration_max_mm);
-  std::printf("  strain max %.2f %%, rms %.2f %%\n", s.strain_max_pct, s.strain_rms_pct);
+  std::printf("  strain max %.2f %%, rms %.2f %%, median %.2f %%, 95th percentile %.2f %%\n",
+              s.strain_max_pct, s.strain_rms_pct, s.strain_median_pct, s.strain_p95_pct);
+  std::printf("  waist seam %.1f mm below its geometric place\n", s.waist_seam_drop_mm);
   for (const auto* b : {&s.waist, &s.hip})
     std::printf(
-        "  %-5s ease max %.2f mm, mean %.2f mm; girth %.2f mm (geometric %.2f mm: %+.3f %%)\n",
-        b == &s.waist ? "waist" : "hip", b->ease_max_mm, b->ease_mean_mm, b->girth_mm,
-        b->girth_geometric_mm,
-        b->girth_geometric_mm > 0
-            ? (b->girth_mm - b->girth_geometric_mm) / b->girth_geometric_mm * 100
-            : 0.0);
+        "  %-5s (y %.3f m) ease max %.2f mm, mean %.2f mm; girth %.2f mm vs geometric %.2f mm + "
+        "2 pi offset = %.2f mm: %+.3f %%\n",
+        b == &s.waist ? "waist" : "hip", b->y, b->ease_max_mm, b->ease_mean_mm, b->girth_mm,
+        b->girth_geometric_mm, b->girth_expected_mm, b->girth_error_pct);
+}
+
+// The options of --simulate; returns --fabric's option (counted: given or not).
+CLI::Option* add_simulate_options(CLI::App& cli, bool& simulate, std::string& fabric,
+                                  SimulateRequest& rq) {
+  cli.add_flag("--simulate", simulate,
+               "also drape the sewn garment on the form with the solver (XPBD) and write "
+               "garment_sim.gltf, fit_map.png, garment_sim.json, garment_scene.json");
+  auto* o_fabric = cli.add_option("--fabric", fabric,
+                                  "with --simulate: the fabric preset (default: the design's)")
+                       ->default_str("")
+                       ->type_name("NAME");
+  cli.add_option("--sim-frames", rq.options.max_frames,
+                 "with --simulate: frames (1/90 s) at most before rest")
+      ->type_name("N")
+      ->check(CLI::Range(1, 100000));
+  return o_fabric;
+}
+
+// Fills what --simulate needs: the fabric (`fabric_name` when given, else the design's), the
+// form shared with the solver and how a scene file names it. false (and a message) on a bad
+// fabric.
+bool prepare_simulate(SimulateRequest& rq, const drape::sim::DressForm& form,
+                      const drape::sim::FabricParams& design_fabric,
+                      const std::string& design_fabric_name, const std::string& fabric_name,
+                      const std::string& mesh, const std::string& vit,
+                      const std::string& form_name) {
+  rq.fabric = design_fabric;
+  rq.fabric_name = design_fabric_name;
+  if (!fabric_name.empty()) {
+    auto f = drape::sim::load_fabric(drape::app::asset("fabrics.json").string(), fabric_name);
+    if (!f) {
+      std::fprintf(stderr, "drape pattern: --fabric %s: %s\n", fabric_name.c_str(),
+                   f.error().c_str());
+      return false;
+    }
+    rq.fabric = *f;
+    rq.fabric_name = fabric_name;
+  }
+  rq.form = std::make_shared<const drape::sim::DressForm>(form);
+  namespace fs = std::filesystem;
+  if (!mesh.empty())
+    rq.scene_form = {{"mesh", fs::absolute(mesh).string()}};
+  else if (vit.empty())  // a .vit form has no scene file form: no scene file then
+    rq.scene_form = form_name.find(".json") != std::string::npos
+                        ? nlohmann::json{{"measurements", fs::absolute(form_name).string()}}
+                        : nlohmann::json{{"size", form_name}};
+  return true;
 }
 
 int run_pattern(int argc, char** argv) {
@@ -228,17 +288,7 @@ int run_pattern(int argc, char** argv) {
   bool simulate = false;
   std::string sim_fabric;
   SimulateRequest rq;
-  cli.add_flag("--simulate", simulate,
-               "also drape the sewn garment on the form with the solver (XPBD) and write "
-               "garment_sim.gltf, fit_map.png, garment_sim.json, garment_scene.json");
-  auto* o_fabric = cli.add_option("--fabric", sim_fabric,
-                                  "with --simulate: the fabric preset (default: the design's)")
-                       ->default_str("")
-                       ->type_name("NAME");
-  cli.add_option("--sim-frames", rq.options.max_frames,
-                 "with --simulate: frames (1/90 s) at most before rest")
-      ->type_name("N")
-      ->check(CLI::Range(1, 100000));
+  auto* o_fabric = add_simulate_options(cli, simulate, sim_fabric, rq);
   if (int rc = drape::app::parse_command_line(cli, argc, argv); rc >= 0) return rc;
   if (o_fabric->count() && !simulate) {
     std::fprintf(stderr, "drape pattern: --fabric: needs --simulate\n");
@@ -299,36 +349,11 @@ int run_pattern(int argc, char** argv) {
     fabric = *f;
   else
     std::fprintf(stderr, "drape pattern: note: %s; using the default muslin\n", f.error().c_str());
-  if (*type != "skirt" && simulate) {
-    std::fprintf(stderr,
-                 "drape pattern: --simulate: %s is a %s design; the simulation takes the sewn "
-                 "skirts only (the bodice's sewn garment has no flat pattern to rest on)\n",
-                 design.c_str(), type->c_str());
-    return 1;
-  }
+  if (*type != "skirt" && simulate) return simulate_refused(design, *type);
   if (*type != "skirt") return run_upper_body(*type, design_path, *form, d->form, fabric, out, opt);
-  if (simulate) {
-    rq.fabric = fabric;
-    rq.fabric_name = d->fabric;
-    if (o_fabric->count()) {
-      auto f = drape::sim::load_fabric(drape::app::asset("fabrics.json").string(), sim_fabric);
-      if (!f) {
-        std::fprintf(stderr, "drape pattern: --fabric %s: %s\n", sim_fabric.c_str(),
-                     f.error().c_str());
-        return 1;
-      }
-      rq.fabric = *f;
-      rq.fabric_name = sim_fabric;
-    }
-    rq.form = std::make_shared<const drape::sim::DressForm>(*form);
-    namespace fs = std::filesystem;
-    if (!mesh.empty())
-      rq.scene_form = {{"mesh", fs::absolute(mesh).string()}};
-    else if (vit.empty())
-      rq.scene_form = form_name.find(".json") != std::string::npos
-                          ? nlohmann::json{{"measurements", fs::absolute(form_name).string()}}
-                          : nlohmann::json{{"size", form_name}};
-  }
+  if (simulate && !prepare_simulate(rq, *form, fabric, d->fabric,
+                                    o_fabric->count() ? sim_fabric : "", mesh, vit, form_name))
+    return 1;
   std::optional<drape::sim::GarmentSimResult> sim;
   // The pattern's files replace those of an earlier run only when every one was written: a full
   // disk leaves the earlier pattern whole (output_files.hpp).
@@ -389,10 +414,6 @@ int run_pattern(int argc, char** argv) {
   std::printf("  wrote %s/{", out.c_str());
   for (size_t i = 0; i < rep.files.size(); ++i)
     std::printf("%s%s", i ? "," : "", rep.files[i].c_str());
-  if (sim) {
-    std::printf(",garment_sim.gltf,fit_map.png,garment_sim.json%s",
-                rq.scene_form.is_null() ? "" : ",garment_scene.json");
-  }
   std::printf("}\n");
   if (sim) print_simulation(*sim, rq.fabric_name);
   return 0;

@@ -16,9 +16,9 @@
 namespace drape::sim {
 namespace {
 
-// The ease and girths of one band of heights around y.
+// The ease and girths of one band of heights around y (the cloth kept `offset` off the form).
 FitBand fit_band(const GarmentSimResult& r, const Garment& geometric, const MappingSurface& surf,
-                 double y, double band) {
+                 double y, double offset, double band) {
   FitBand b;
   b.y = y;
   double sum = 0;
@@ -33,6 +33,8 @@ FitBand fit_band(const GarmentSimResult& r, const Garment& geometric, const Mapp
   sim.x = r.cloth.state.x;
   b.girth_mm = garment_girth(sim, surf, y) * 1000;
   b.girth_geometric_mm = garment_girth(geometric, surf, y) * 1000;
+  b.girth_expected_mm = b.girth_geometric_mm + 2 * 3.14159265358979 * offset * 1000;
+  b.girth_error_pct = (b.girth_mm - b.girth_expected_mm) / b.girth_expected_mm * 100;
   return b;
 }
 
@@ -55,6 +57,14 @@ void measure_fit(GarmentSimResult& r, const DressForm& form) {
     sq += r.strain[t] * r.strain[t];
   }
   r.strain_rms_pct = nt ? std::sqrt(sq / nt) * 100 : 0;
+  std::vector<double> a(nt);
+  for (int t = 0; t < nt; ++t) a[t] = std::abs(r.strain[t]);
+  if (nt) {
+    std::nth_element(a.begin(), a.begin() + nt / 2, a.end());
+    r.strain_median_pct = a[nt / 2] * 100;
+    std::nth_element(a.begin(), a.begin() + nt * 95 / 100, a.end());
+    r.strain_p95_pct = a[nt * 95 / 100] * 100;
+  }
 }
 
 // Steps the solver until the garment rests (or max_frames); false when it diverged.
@@ -141,6 +151,7 @@ Result<GarmentSimResult> simulate_garment(const Garment& garment,
   SceneObjects scene;
   scene.form = form;
   scene.friction = opt.friction;
+  scene.offset = opt.contact_offset;
   XpbdOptions xo;
   xo.substeps = opt.substeps;
   xo.threads = opt.threads;
@@ -157,11 +168,19 @@ Result<GarmentSimResult> simulate_garment(const Garment& garment,
   r.seam_gap_max_mm = xpbd::max_tie_gap(r.ties, r.cloth.state.x) * 1000;
   measure_fit(r, *form);
   const FormLandmarks& lm = form->landmarks();
-  // The waist band a band's height below the waist line: the sewn waist seam rests a few mm
-  // below it (the contact offset lifts the cloth off the form and the tie-held top edge settles),
-  // so a slice at the line itself may miss the cloth.
-  r.waist = fit_band(r, garment, surf, lm.waist_y - opt.band, opt.band);
-  r.hip = fit_band(r, garment, surf, lm.hip_y, opt.band);
+  // The waist band a band's height below the simulated waist seam (its mean height), both
+  // garments sliced there: the seam settles a few mm to cm below the form's waist line (a flared
+  // skirt further: only the cone between waist and hip holds it), so a slice at the line itself
+  // may miss the cloth. The hip band at the form's hip line.
+  const auto seam_y = [&](const std::vector<Vec3>& x) {
+    double y = 0;
+    for (int v : garment.waist_vertices) y += x[v].y();
+    return garment.waist_vertices.empty() ? lm.waist_y : y / garment.waist_vertices.size();
+  };
+  r.waist_seam_drop_mm = (seam_y(garment.x) - seam_y(r.cloth.state.x)) * 1000;
+  const double waist_band_y = seam_y(r.cloth.state.x) - opt.band;
+  r.waist = fit_band(r, garment, surf, waist_band_y, opt.contact_offset, opt.band);
+  r.hip = fit_band(r, garment, surf, lm.hip_y, opt.contact_offset, opt.band);
   return r;
 }
 
@@ -173,6 +192,8 @@ std::string GarmentSimResult::to_json() const {
                 {"ease_mean_mm", b.ease_mean_mm},
                 {"girth_mm", b.girth_mm},
                 {"girth_geometric_mm", b.girth_geometric_mm},
+                {"girth_expected_mm", b.girth_expected_mm},
+                {"girth_error_pct", b.girth_error_pct},
                 {"vertices", b.vertices}};
   };
   json j;
@@ -190,6 +211,9 @@ std::string GarmentSimResult::to_json() const {
   j["penetration_max_mm"] = penetration_max_mm;
   j["strain_max_pct"] = strain_max_pct;
   j["strain_rms_pct"] = strain_rms_pct;
+  j["strain_median_pct"] = strain_median_pct;
+  j["strain_p95_pct"] = strain_p95_pct;
+  j["waist_seam_drop_mm"] = waist_seam_drop_mm;
   j["waist"] = band(waist);
   j["hip"] = band(hip);
   return j.dump(2);

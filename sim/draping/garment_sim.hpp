@@ -35,6 +35,7 @@ struct GarmentSimOptions {
   double rest_speed = 0.01;
   int rest_frames = 30;
   double friction = kFormFriction;  // the cloth on the form's cover (as the app)
+  double contact_offset = 0.002;    // m the cloth is kept off the form (SceneObjects::offset)
   int tie_passes = 2;               // tie projections per substep
   double band = 0.006;              // m: half height of the waist and hip bands of the fit
 };
@@ -45,6 +46,10 @@ struct FitBand {
   double ease_max_mm = 0, ease_mean_mm = 0;
   double girth_mm = 0;            // tape girth of the cloth at y (garment_girth)
   double girth_geometric_mm = 0;  // the same of the geometrically relaxed garment
+  // The geometric garment lies on the form's surface (with the design's ease), the simulated
+  // cloth contact_offset off it: its girth is that of the geometric garment plus 2 pi offset.
+  double girth_expected_mm = 0;
+  double girth_error_pct = 0;  // girth_mm against girth_expected_mm
   int vertices = 0;
 };
 
@@ -61,7 +66,10 @@ struct GarmentSimResult {
   double penetration_max_mm = 0;
   std::vector<double> ease;    // per vertex: signed distance from the form (m; NaN outside it)
   std::vector<double> strain;  // per triangle: the principal stretch furthest from 1, minus 1
-  double strain_max_pct = 0, strain_rms_pct = 0;
+  double strain_max_pct = 0, strain_rms_pct = 0;  // |strain| over the triangles
+  double strain_median_pct = 0, strain_p95_pct = 0;
+  // How far the sewn waist seam (its mean height) came down from the geometric placement (mm).
+  double waist_seam_drop_mm = 0;
   FitBand waist, hip;
   std::string to_json() const;
 };
