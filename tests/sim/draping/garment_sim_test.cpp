@@ -1,6 +1,6 @@
 // The sewn tight skirt simulated on the 9AR form by XPBD (sim/draping/garment_sim.hpp): it
 // comes to rest, its seams stay closed, it does not go into the form, and its girths at the
-// waist and hip agree with the pattern's; the seam ties alone hold two cloths together.
+// waist and hip agree with the geometric garment's (the pattern sewn); its waist stays up.
 #include "sim/draping/garment_sim.hpp"
 
 #include <gtest/gtest.h>
