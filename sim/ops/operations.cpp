@@ -457,6 +457,25 @@ bool ops_smooth_end(World& w, OperationsState& s, int hand) {
   return true;
 }
 
+// The map's boundary conditions: the top edge, the centre line (the warp thread u = uc) and the
+// rows at the heights of the form's reference lines (material v in `rows`: the waist and the
+// hip) are fixed where the map put them, as the geometric draping's relaxation holds the hip and
+// waist lines; everything else is freed. Without the two lines the strained, mapped cloth
+// relaxes at once (the along-grain mapping stretches the warp where the sections change girth)
+// and slides by up to a centimetre at the side lines before a hand can pin or cut there.
+void pin_map_lines(Cloth& c, double uc, double vmax, const std::array<double, 2>& rows) {
+  const double tol = 0.5 * c.topo.spacing + 1e-9;
+  for (int32_t i = 0; i < c.num_vertices(); ++i) {
+    const Vec2 m = c.topo.material[i];
+    bool fixed = m.y() > vmax - 1e-9 || std::abs(m.x() - uc) <= tol;
+    for (double r : rows) fixed = fixed || std::abs(m.y() - r) < tol;
+    const uint8_t set = fixed ? kFlagPinned : 0;
+    set_vertex_flags(c, i, set,
+                     static_cast<uint8_t>(kFlagPinned | kFlagKinematic | kFlagPinched) &
+                         static_cast<uint8_t>(~set));
+  }
+}
+
 // The centre line the map puts the grain on: centre back when the hand asking for the map is
 // tracked behind the form's centre at the waist (the user stands at the back), else centre front.
 double map_centre_theta(const World& w, const OperationsState& s, int hand) {
@@ -523,20 +542,12 @@ bool ops_map(World& w, OperationsState& s, int hand) {
   }
   st.x_prev = st.x;
   for (auto& v : st.v) v.setZero();
-  // The map's boundary conditions: top edge and centre line fixed.
-  const double tol = 0.5 * c.topo.spacing + 1e-9;
-  for (int32_t i = 0; i < c.num_vertices(); ++i) {
-    const Vec2 m = c.topo.material[i];
-    uint8_t set = 0;
-    if (m.y() > vmax - 1e-9 || std::abs(m.x() - uc) <= tol) set = kFlagPinned;
-    set_vertex_flags(c, i, set,
-                     static_cast<uint8_t>(kFlagPinned | kFlagKinematic | kFlagPinched) &
-                         static_cast<uint8_t>(~set));
-  }
+  pin_map_lines(c, uc, vmax,
+                {vmax - (left.y_top - waist), vmax - (left.y_top - form.landmarks().hip_y)});
   s.settling.clear();
   w.report(std::string("map: cloth mapped onto the form, grain on centre ") +
            (tc == form.landmarks().centre_front_theta ? "front" : "back") +
-           "; top edge and centre line fixed");
+           "; top edge, centre line, waist and hip lines fixed");
   return true;
 }
 

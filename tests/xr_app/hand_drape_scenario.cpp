@@ -2,7 +2,7 @@
 // xr_drape_hand_drape: assets/scenarios/hand_drape_{front,back}.json), the way a pattern maker
 // drapes one: the left hand maps the muslin onto the form along the grain from the centre line
 // (thumb-ring pinch; in front of the form: centre front, behind it: centre back), the right hand
-// pins it along the waist line and at the hip 3 cm inside each side line (thumb-middle pinch),
+// pins it 1 cm below the waist and at the hip, 3 cm inside each side line (thumb-middle pinch),
 // cuts down both side lines, trims above the waist line and cuts down the centre line
 // (thumb-ring pinch toggles each cut). The hands' pinch points follow the form's lines, computed
 // from the form; the scenario holds the palm poses the simulated runtime plays.
@@ -151,12 +151,10 @@ json scenario(const DressForm& form, bool back) {
   // Pins, then the cuts.
   R.key(0, Vec3(-0.35, 1.0, 0.6 * zs), d.tc, "open");
   R.frame = 60;
-  for (double side : {right_side, left_side}) {
-    for (double part : {0.3, 0.65, 1.0}) pin(R, d, d.waist, side, 0.03, part);
-    pin(R, d, d.hip, side, 0.03, 1.0);
-  }
   for (double side : {right_side, left_side})
-    cut(R, vertical(d, side, d.top() + 0.03, d.bottom() - 0.03));
+    for (double y : {d.waist - 0.01, d.hip}) pin(R, d, y, side, 0.03, 1.0);
+  for (double side : {right_side, left_side})
+    cut(R, vertical(d, side, d.top() + 0.03, d.bottom() - 0.08));
   std::vector<std::pair<Vec3, double>> trim;  // 1 cm above the waist, side to side
   const double reach = kPi / 2 - 0.1;
   for (int i = 0; i <= 30; ++i) {
@@ -164,7 +162,7 @@ json scenario(const DressForm& form, bool back) {
     trim.push_back({d.on_cloth(d.waist + 0.01, th), th});
   }
   cut(R, trim);
-  cut(R, vertical(d, d.tc, d.waist + 0.005, d.bottom() - 0.03));
+  cut(R, vertical(d, d.tc, d.waist + 0.005, d.bottom() - 0.08));
   R.frame += 20;
   R.key(R.frame, Vec3(-0.35, 1.0, 0.6 * zs), d.tc, "open");
   const int end = R.frame + 60;
@@ -177,8 +175,8 @@ json scenario(const DressForm& form, bool back) {
       " draped by hand on the 9AR form (drape run --cloth-res 51): the left hand's thumb-ring "
       "pinch maps the 0.5 m muslin onto the form along the grain from the centre " +
       (back ? "back (the hand behind the form)" : "front") +
-      "; the right hand pins it along the waist line (three pins a side, the last 3 cm "
-      "inside the side line) and at the hip 3 cm inside each side line (thumb-middle pinch), cuts "
+      "; the right hand pins it 1 cm below the waist line and at the hip line, 3 cm inside "
+      "each side line (thumb-middle pinch), cuts "
       "down the right and the left side line, trims 1 cm above the "
       "waist line from side to side and cuts down the centre line (a thumb-ring pinch starts and "
       "ends each cut). tests/xr_app/drape_hand_drape_test.sh compares the two half pieces' hip "
