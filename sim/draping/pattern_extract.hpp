@@ -31,6 +31,7 @@ struct PatternPiece {
   };
   std::vector<Dart> darts;
   std::vector<Vec2> hip_line;         // flat points along the hip line, centre -> side
+  std::vector<Vec2> waist_line;       // the same along the waist (session pieces only)
   Vec2 grain_a{0, 0}, grain_b{0, 0};  // grain line (parallel to the warp)
   int loops_removed = 0;              // self-crossing loops cut out of the extracted outline
 

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "sim/draping/pattern_export.hpp"
+#include "sim/draping/session_lines.hpp"
 
 namespace drape::sim {
 namespace {
@@ -220,6 +221,12 @@ Result<std::vector<PatternPiece>> extract_session_pieces(
     if (pc.area() < 0) continue;  // a stroke folded the outline over itself: not a piece
     add_notches(pc, opt.waist_y);
     add_notches(pc, opt.hip_y);
+    // The widths along the hip and waist lines (the line from edge to edge on the flat piece,
+    // its ends on the smoothed cut edges: continued by up to three cut tolerances).
+    if (opt.hip_y >= 0)
+      pc.hip_line = session_reference_line(cloth, tris_of[c], pc.outline, opt.hip_y, 3 * tol);
+    if (opt.waist_y >= 0)
+      pc.waist_line = session_reference_line(cloth, tris_of[c], pc.outline, opt.waist_y, 3 * tol);
     Vec2 lo = pc.outline[0], hi = pc.outline[0];
     for (const Vec2& m : pc.outline) {
       lo = lo.cwiseMin(m);
@@ -246,6 +253,9 @@ std::string SessionPatternReport::to_json(const std::vector<PatternPiece>& piece
     pj["outline_points"] = pc.outline.size();
     pj["notches"] = pc.notches.size();
     pj["loops_removed"] = pc.loops_removed;
+    // Widths along the reference lines, flat, edge to edge (absent: the piece does not cross).
+    if (!pc.hip_line.empty()) pj["hip_width_mm"] = pc.hip_width() * 1000;
+    if (!pc.waist_line.empty()) pj["waist_width_mm"] = polyline_length(pc.waist_line) * 1000;
     for (size_t l = 0; l < pc.labels.size(); ++l) {
       pj["seam_length_mm"][pc.labels[l]] = pc.seam_length(pc.labels[l]) * 1000;
       pj["fairness_deg_per_mm"][pc.labels[l]] = seam_fairness(pc, pc.labels[l]);

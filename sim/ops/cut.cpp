@@ -128,6 +128,18 @@ bool boundary_vertex(const Cloth& c, const ClothIncidence& I, int32_t v) {
   return false;
 }
 
+// A cut that has reached the cloth's edge ends there: anchors that go on along the edge after
+// it (the edge anchor of an end extension next to a hit that already lies on the boundary, where
+// the side line nearly meets the panel's edge) are dropped from both ends. A leg along boundary
+// edges separates nothing and leaves the cut's end a slit tip.
+void trim_boundary_runs(const Cloth& c, const ClothIncidence& I, std::vector<int32_t>& anchors) {
+  const auto on_edge = [&](int32_t v) { return boundary_vertex(c, I, v); };
+  while (anchors.size() > 2 && on_edge(anchors.back()) && on_edge(anchors[anchors.size() - 2]))
+    anchors.pop_back();
+  while (anchors.size() > 2 && on_edge(anchors[0]) && on_edge(anchors[1]))
+    anchors.erase(anchors.begin());
+}
+
 // ---------------------------------------------------------------- surface queries --------
 
 // Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5);
@@ -827,6 +839,7 @@ CutResult cut_along(Cloth& cloth, const std::vector<Vec3>& stroke_points,
     r.smooth_stroke_uv.push_back(exits[1].material);
   }
   anchors.erase(std::unique(anchors.begin(), anchors.end()), anchors.end());
+  trim_boundary_runs(cloth, I, anchors);
   if (anchors.size() < 2) {
     r.reason = "cut: stroke covers a single particle";
     return r;

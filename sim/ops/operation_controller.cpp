@@ -151,7 +151,7 @@ void OperationController::apply_trigger(World& w, const std::string& name, Trigg
   } else if (name == "move") {
     done = begin ? ops_move_begin(w, state_) : ops_move_end(w, state_);
   } else if (name == "map") {
-    if (begin) done = ops_map(w, state_);
+    if (begin) done = ops_map(w, state_, hand);
   } else if (name == "smooth") {
     done = begin ? ops_smooth_begin(w, state_, hand) : ops_smooth_end(w, state_, hand);
     if (!begin) done = false;  // the state before smoothing began is the undo point

@@ -457,7 +457,36 @@ bool ops_smooth_end(World& w, OperationsState& s, int hand) {
   return true;
 }
 
-bool ops_map(World& w, OperationsState& s) {
+// The map's boundary conditions: the top edge, the centre line (the warp thread u = uc) and the
+// rows at the heights of the form's reference lines (material v in `rows`: the waist and the
+// hip) are fixed where the map put them, as the geometric draping's relaxation holds the hip and
+// waist lines; everything else is freed. Without the two lines the strained, mapped cloth
+// relaxes at once (the along-grain mapping stretches the warp where the sections change girth)
+// and slides by up to a centimetre at the side lines before a hand can pin or cut there.
+void pin_map_lines(Cloth& c, double uc, double vmax, const std::array<double, 2>& rows) {
+  const double tol = 0.5 * c.topo.spacing + 1e-9;
+  for (int32_t i = 0; i < c.num_vertices(); ++i) {
+    const Vec2 m = c.topo.material[i];
+    bool fixed = m.y() > vmax - 1e-9 || std::abs(m.x() - uc) <= tol;
+    for (double r : rows) fixed = fixed || std::abs(m.y() - r) < tol;
+    const uint8_t set = fixed ? kFlagPinned : 0;
+    set_vertex_flags(c, i, set,
+                     static_cast<uint8_t>(kFlagPinned | kFlagKinematic | kFlagPinched) &
+                         static_cast<uint8_t>(~set));
+  }
+}
+
+// The centre line the map puts the grain on: centre back when the hand asking for the map is
+// tracked behind the form's centre at the waist (the user stands at the back), else centre front.
+double map_centre_theta(const World& w, const OperationsState& s, int hand) {
+  const DressForm& form = *w.scene.form;
+  if (!valid_index(hand) || !s.hands[hand].tracked) return form.landmarks().centre_front_theta;
+  const Vec2 c = form.centre_at(form.landmarks().waist_y);
+  return s.hands[hand].position.z() < c.y() ? form.landmarks().centre_back_theta
+                                            : form.landmarks().centre_front_theta;
+}
+
+bool ops_map(World& w, OperationsState& s, int hand) {
   if (!w.scene.form || w.scene.form->num_sections() < 2)
     return w.report("map: no dress form in the scene: ignored"), false;
   if (s.pinched[0] >= 0 || s.pinched[1] >= 0 || s.moving)
@@ -472,10 +501,13 @@ bool ops_map(World& w, OperationsState& s) {
     vmin = std::min(vmin, c.topo.material[i].y()), vmax = std::max(vmax, c.topo.material[i].y());
   }
   if (!(umax > umin && vmax > vmin)) return w.report("map: the cloth is empty: ignored"), false;
-  // Chapter 2 mapping (sim/draping/mapping.hpp) with the grain (warp, v) on centre front: the
-  // panel's middle warp line u = uc on theta = 0, each half wrapped toward its side line along the
-  // sections, the top edge 3 cm above the waist (eq. 2-1).
+  // Chapter 2 mapping (sim/draping/mapping.hpp) with the grain (warp, v) on the centre line: the
+  // panel's middle warp line u = uc on theta = tc (centre front, or centre back when the hand is
+  // behind the form), each half wrapped toward its side line along the sections (u > uc toward
+  // increasing theta: the user's right whichever side the user stands), the top edge 3 cm above
+  // the waist (eq. 2-1).
   const DressForm& form = *w.scene.form;
+  const double tc = map_centre_theta(w, s, hand);
   const MappingSurface surf(form, 0.0, false);  // the form itself (no tight-skirt hip shape)
   Panel shape;
   shape.design.width = umax - umin;
@@ -483,8 +515,10 @@ bool ops_map(World& w, OperationsState& s) {
   shape.design.top_above_waist = 0.03;
   const double waist = form.landmarks().waist_y;
   const double pi = 3.14159265358979323846;
-  const PieceMapping left = make_piece_mapping(shape, surf, 0.0, +1, pi / 2, waist);
-  const PieceMapping right = make_piece_mapping(shape, surf, 0.0, -1, 3 * pi / 2, waist);
+  const PieceMapping left =
+      make_piece_mapping(shape, surf, tc, +1, std::fmod(tc + pi / 2, 2 * pi), waist);
+  const PieceMapping right =
+      make_piece_mapping(shape, surf, tc, -1, std::fmod(tc + 3 * pi / 2, 2 * pi), waist);
   const double uc = 0.5 * (umin + umax);
   std::vector<std::pair<double, std::array<ArcTable, 2>>> tables;  // per distinct height
   auto& st = c.state;
@@ -495,7 +529,7 @@ bool ops_map(World& w, OperationsState& s) {
     for (const auto& [ty, t] : tables)
       if (std::abs(ty - y) < 1e-12) T = &t;
     if (!T) {
-      tables.push_back({y, {ArcTable::build(surf, y, 0.0, +1), ArcTable::build(surf, y, 0.0, -1)}});
+      tables.push_back({y, {ArcTable::build(surf, y, tc, +1), ArcTable::build(surf, y, tc, -1)}});
       T = &tables.back().second;
     }
     const double l = m.x() - uc;
@@ -508,19 +542,12 @@ bool ops_map(World& w, OperationsState& s) {
   }
   st.x_prev = st.x;
   for (auto& v : st.v) v.setZero();
-  // The map's boundary conditions: top edge and centre line fixed.
-  const double tol = 0.5 * c.topo.spacing + 1e-9;
-  for (int32_t i = 0; i < c.num_vertices(); ++i) {
-    const Vec2 m = c.topo.material[i];
-    uint8_t set = 0;
-    if (m.y() > vmax - 1e-9 || std::abs(m.x() - uc) <= tol) set = kFlagPinned;
-    set_vertex_flags(c, i, set,
-                     static_cast<uint8_t>(kFlagPinned | kFlagKinematic | kFlagPinched) &
-                         static_cast<uint8_t>(~set));
-  }
+  pin_map_lines(c, uc, vmax,
+                {vmax - (left.y_top - waist), vmax - (left.y_top - form.landmarks().hip_y)});
   s.settling.clear();
-  w.report(
-      "map: cloth mapped onto the form, grain on centre front; top edge and centre line fixed");
+  w.report(std::string("map: cloth mapped onto the form, grain on centre ") +
+           (tc == form.landmarks().centre_front_theta ? "front" : "back") +
+           "; top edge, centre line, waist and hip lines fixed");
   return true;
 }
 

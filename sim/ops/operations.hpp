@@ -119,7 +119,7 @@ bool ops_cut_stroke(World& w, OperationsState& s, const OperationParams& p,
                     const std::vector<Vec3>& stroke);
 bool ops_smooth_begin(World& w, OperationsState& s, int hand);
 bool ops_smooth_end(World& w, OperationsState& s, int hand);
-bool ops_map(World& w, OperationsState& s);
+bool ops_map(World& w, OperationsState& s, int hand = -1);
 // Ends every operation in progress (an unfinished cut stroke is discarded).
 void ops_stop(World& w, OperationsState& s);
 

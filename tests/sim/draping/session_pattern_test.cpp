@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "sim/draping/session_lines.hpp"
 #include "sim/ops/cut.hpp"
 
 using namespace drape::sim;
@@ -155,4 +156,34 @@ TEST(SessionPattern, BadClothIsAnError) {
   auto w = write_session_pattern("/proc/no/such/dir", *p, 0.01, "s");
   ASSERT_FALSE(w.ok());
   EXPECT_NE(w.error().find("/proc/no/such/dir"), std::string::npos);
+}
+
+// The widths along the reference lines: a panel cut top to bottom along a slanted stroke that
+// runs between the grid's columns; the left piece's width at height y is the stroke's u there
+// (the panel's edge is at u = 0), read to the smoothed stroke, not to the zigzag of split edges.
+TEST(SessionPattern, ReferenceLineWidthsEndOnTheSmoothedCut) {
+  Cloth c = flat_panel();
+  std::vector<Vec2> stroke;
+  const auto u_at = [](double v) { return 0.2537 + 0.05 * (v - 0.2); };
+  for (int k = 0; k <= 80; ++k) stroke.emplace_back(u_at(0.4 * k / 80.0), 0.4 * k / 80.0);
+  const CutResult cut = cut_along_material(c, stroke);
+  ASSERT_TRUE(cut.ok) << cut.reason;
+  SessionPatternOptions opt;
+  opt.hip_y = 0.1234;
+  opt.waist_y = 0.3117;
+  auto pieces = extract_session_pieces(c, {cut.smooth_stroke_uv}, opt);
+  ASSERT_TRUE(pieces.ok()) << pieces.error();
+  ASSERT_EQ(pieces->size(), 2u);
+  const PatternPiece& left =
+      pieces->at(0).area() < pieces->at(1).area() ? pieces->at(1) : pieces->at(0);
+  const double hip = left.hip_width(), waist = polyline_length(left.waist_line);
+  std::printf("left piece: hip width %.3f mm (stroke %.3f), waist width %.3f mm (stroke %.3f)\n",
+              hip * 1e3, u_at(opt.hip_y) * 1e3, waist * 1e3, u_at(opt.waist_y) * 1e3);
+  EXPECT_NEAR(hip, u_at(opt.hip_y), 2e-4);
+  EXPECT_NEAR(waist, u_at(opt.waist_y), 2e-4);
+  // A line the piece does not cross: no width.
+  opt.hip_y = 0.5;
+  auto off = extract_session_pieces(c, {cut.smooth_stroke_uv}, opt);
+  ASSERT_TRUE(off.ok()) << off.error();
+  for (const PatternPiece& pc : *off) EXPECT_TRUE(pc.hip_line.empty());
 }

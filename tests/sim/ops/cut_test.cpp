@@ -321,6 +321,34 @@ TEST(Cut, StrokeFromBeyondTheEdgesSplitsASpreadCloth) {
   expect_incidence_consistent(c);
 }
 
+// Strokes down the cloth within two grid spacings of its left edge and off the bottom edge: the
+// last hits lie on the boundary row, and the edge anchor of the end's extension is the next
+// boundary node. The cut ends where it reaches the edge instead of going on along it: a leg along
+// boundary edges separates nothing and left the strip attached by a slit tip (80 of these 1280
+// strokes before).
+TEST(Cut, StrokeNearlyAlongTheEdgeSeparatesTheStrip) {
+  int attached = 0, total = 0;
+  for (int a = 0; a < 40; ++a)
+    for (int b = 0; b < 8; ++b)
+      for (int e = 0; e < 4; ++e) {
+        Cloth c = flat(41);  // 10 mm grid
+        const double u0 = 0.005 + 0.0005 * a, slope = 0.05 * b, y_end = -0.01 - 0.02 * e;
+        std::vector<Vec3> stroke;
+        for (int i = 0; i <= 100; ++i) {
+          const double y = 0.43 - (0.43 - y_end) * i / 100.0;
+          stroke.emplace_back(u0 + slope * std::max(0.0, y - 0.2), y, 0.002);
+        }
+        const CutResult r = cut_along(c, stroke);
+        ++total;
+        if (!r.ok || r.components_after != 2 || count_components(c) != 2) {
+          ++attached;
+          ADD_FAILURE() << "u0 " << u0 << " slope " << slope << " end " << y_end << ": "
+                        << (r.ok ? "components " + std::to_string(r.components_after) : r.reason);
+        }
+      }
+  std::printf("strokes near the edge: %d of %d left the strip attached\n", attached, total);
+}
+
 TEST(Cut, StrokeFromBeyondTheEdgesSplitsARolledCloth) {
   Cloth c = flat(17);
   place_rolled(c, Vec3(0, 1.0, 0), Vec3::UnitX(), Vec3::UnitY(), 0.02);

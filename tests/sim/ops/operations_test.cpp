@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <random>
 
+#include "sim/draping/mapping.hpp"
 #include "sim/form/dress_form.hpp"
 #include "sim/ops/cut.hpp"
 #include "sim/testbeds/testbed.hpp"
@@ -631,6 +632,50 @@ TEST_P(Ops, MapOntoTheFormAlongCentreFront) {
   std::printf("map then 40 ticks of dynamics: deepest particle %.2f mm inside the form\n",
               inside * 1e3);
   EXPECT_LT(inside, 0.006);  // the solver's contact penalty, not the mapping (0 mm above)
+}
+
+// Asked for by a hand behind the form, the map puts the grain on centre back; the cloth's
+// u > uc half wraps toward the right side line (the user's right, seen from behind) with each
+// node at its weft distance along the section; the rows nearest the waist and the hip are fixed
+// with the top edge and the centre line (the lines the design pipeline's relaxation holds).
+TEST_P(Ops, MapFromBehindTheFormPutsTheGrainOnCentreBack) {
+  SetUpWorld(2);
+  auto m = measurements_for_size("9AR");
+  ASSERT_TRUE(m.ok()) << m.error();
+  auto form = DressForm::from_measurements(*m);
+  ASSERT_TRUE(form.ok()) << form.error();
+  w.scene.form = std::make_shared<const DressForm>(std::move(*form));
+  const DressForm& f = *w.scene.form;
+  set(1, Vec3(0.1, 1.0, -0.5));  // behind the form
+  trig("map", TriggerPhase::kBegin, 1);
+  ASSERT_TRUE(has_message(w, "grain on centre back")) << w.messages.back();
+  const double pi = 3.14159265358979323846, waist = f.landmarks().waist_y;
+  const double hip = f.landmarks().hip_y, sp = 0.05;  // the test panel: 0.4 m, 9 x 9 nodes
+  const MappingSurface surf(f, 0.0, false);
+  double worst_arc = 0;
+  for (int v = 0; v < w.cloth.num_vertices(); ++v) {
+    const Vec2 mu = w.cloth.topo.material[v];
+    const Vec2 c = f.centre_at(X(v).y());
+    const double theta = std::atan2(X(v).x() - c.x(), X(v).z() - c.y());
+    const double l = mu.x() - 0.2;
+    const ArcTable T = ArcTable::build(surf, X(v).y(), pi, l >= 0 ? +1 : -1);
+    worst_arc =
+        std::max(worst_arc, std::abs(T.arc_at(std::fmod(theta + 2 * pi, 2 * pi)) - std::abs(l)));
+    if (std::abs(l) < 1e-9) {
+      EXPECT_LT(X(v).z(), c.y());  // on the back
+    }
+    if (l > 0.05) {
+      EXPECT_LT(X(v).x(), c.x());  // toward the right side line (-x)
+    }
+    const double below_top = waist + 0.03 - X(v).y();
+    const bool line_row = std::abs(below_top - 0.03) < 0.5 * sp ||
+                          std::abs(below_top - (waist + 0.03 - hip)) < 0.5 * sp;
+    const bool fixed = below_top < 1e-9 || std::abs(l) < 1e-9 || line_row;
+    EXPECT_EQ((w.cloth.state.flags[v] & kFlagPinned) != 0, fixed) << "vertex " << v;
+  }
+  std::printf("map from behind: worst weft distance error along the sections %.4f mm\n",
+              worst_arc * 1e3);
+  EXPECT_LT(worst_arc, 1e-4);
 }
 
 // --- smooth (weak pressure onto the form under the hand) ----------------------------------
