@@ -562,9 +562,16 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   auto q = [](const Vec2& p) {
     return Eigen::Vector3d(p.x() * p.x(), p.y() * p.y(), 2 * p.x() * p.y());
   };
+  // update(): only the hinges of the triangles whose local estimates the rows made again read
+  // (need_local_) are needed; the others' L, Nn, len and Km rows are left empty (unread).
+  if (reuse_rows_) widen_reach();
+  auto used = [&](int h) {
+    return !reuse_rows_ || need_local_[hinge_t_[h][0]] || need_local_[hinge_t_[h][1]];
+  };
   std::vector<Eigen::Vector3d> L(nh), Nn(nh);
   std::vector<double> len(nh);
   for (int h = 0; h < nh; ++h) {
+    if (!used(h)) continue;
     const auto& v = hinge_v_[h];
     const auto& K = hinge_k_[h];
     const Vec2 o = M[v[0]];
@@ -590,7 +597,6 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
       tn[t][tri_nh_[t]] = rigid[o] ? -1 : o;
       th[t][tri_nh_[t]++] = h;
     }
-  if (reuse_rows_) widen_reach();
   // Raw per-triangle estimates S_t = G_t theta (rows 3t..3t+2 over hinge columns).
   // Local: S = D^-1 L^T (L D^-1 L^T)^-1 theta over the triangle's k hinges (= L^-1 theta with
   // three hinges: exact for any constant S; with fewer, the least-energy S compatible with the
@@ -634,7 +640,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   }
   for (int t = 0; t < nt; ++t) {
     const int k = tri_nh_[t];
-    if (k > 0) {
+    if (k > 0 && (!reuse_rows_ || need_local_[t])) {
       const Eigen::Matrix3d& Mloc = mloc[t];
       for (int c = 0; c < 3; ++c) {
         for (int a = 0; a < k; ++a) {
@@ -655,7 +661,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   Csr Km;
   Km.reset(nh);
   for (int h = 0; h < nh; ++h) {
-    for (int k = 0; k < 4; ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
+    for (int k = 0; k < 4 && used(h); ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
     Km.end_row();
   }
   Csr Gs, Gk, GkT, P;
@@ -678,7 +684,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
     W.val.reserve(12 * static_cast<size_t>(nt));
     for (int t = 0; t < nt; ++t)
       for (int c = 0; c < 3; ++c) {
-        if (tri_nh_[t] > 0) {
+        if (tri_nh_[t] > 0 && (!reuse_rows_ || need_rows_[t])) {
           int nn = 0;
           for (int a = 0; a < 3; ++a)
             if (tn[t][a] >= 0 && tri_nh_[tn[t][a]] > 0) {
