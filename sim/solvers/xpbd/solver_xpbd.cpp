@@ -290,12 +290,10 @@ void XpbdSolver::cook_bending(int n, bool incremental) {
   row_ik_.reserve(bik.size());
   row_off_.reserve(boff.size());
   for (int bk : order_b) {
-    for (int e = boff[bk]; e < boff[bk + 1]; ++e) {
-      row_colv_.push_back(bcol[e]);
-      for (int a = 0; a < 3; ++a) row_val_.push_back(bval[3 * e + a]);
-    }
+    row_colv_.insert(row_colv_.end(), bcol.begin() + boff[bk], bcol.begin() + boff[bk + 1]);
+    row_val_.insert(row_val_.end(), bval.begin() + 3 * boff[bk], bval.begin() + 3 * boff[bk + 1]);
     row_off_.push_back(static_cast<int>(row_colv_.size()));
-    for (int a = 0; a < 3; ++a) row_ik_.push_back(bik[3 * bk + a]);
+    row_ik_.insert(row_ik_.end(), bik.begin() + 3 * bk, bik.begin() + 3 * bk + 3);
   }
   lambda_row_.assign(row_ik_.size(), Vec3::Zero());
   row_packs_.clear();
