@@ -284,6 +284,36 @@ CutTicks bench_cut_ticks(int res, int threads, bool incremental) {
   return r;
 }
 
+// One cut's re-cook alone, for an instruction count (valgrind --tool=callgrind; docs/solvers.md,
+// section 3): the form drape at res^2 on one thread, two frames, the cut across of
+// bench_cut_ticks, one frame (the cook); prints the cook's parts. Every cook is a full one with
+// `full`.
+void cook_probe(int res, bool full) {
+  Testbed sc = make_scene("form", res);
+  XpbdOptions o;
+  o.air_drag = sc.air_drag;
+  o.threads = 1;
+  o.freeze = true;
+  o.incremental_cook = !full;
+  XpbdSolver s(o);
+  for (int f = 0; f < 2; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  double umin = 1e9, umax = -1e9, vmin = 1e9, vmax = -1e9;
+  for (const Vec2& m : sc.cloth.topo.material) {
+    umin = std::min(umin, m.x()), umax = std::max(umax, m.x());
+    vmin = std::min(vmin, m.y()), vmax = std::max(vmax, m.y());
+  }
+  const double v = 0.5 * (vmin + vmax) + 0.25 * (vmax - vmin) / res;
+  if (!cut_along_material(sc.cloth, {Vec2(umin - 0.01, v), Vec2(umax + 0.01, v)}).ok)
+    std::fprintf(stderr, "the cut across %d^2 failed\n", res);
+  s.step(sc.cloth, sc.objects, 1.0 / 90);
+  const auto& k = s.last_cook();
+  std::printf(
+      "%d^2, the cut's cook (%s): %.2f ms (energy %.2f, triangles %.2f, bending %.2f, sweep "
+      "plan %.2f, other %.2f; rows of %d triangles made)\n",
+      res, k.incremental ? "incremental" : "full", k.total_ms, k.energy_ms, k.triangles_ms,
+      k.bending_ms, k.sweep_ms, k.other_ms, k.rebuilt_triangles);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -299,7 +329,17 @@ int main(int argc, char** argv) {
   app.add_option("--tick-threads", tick_threads, "the solver's threads in the ticks around a cut")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
+  int probe_res = 0;
+  bool full_cook = false;
+  app.add_option("--cook-probe", probe_res,
+                 "only one cut's re-cook at this form resolution, on one thread (for callgrind)")
+      ->check(CLI::Range(4, 1024));
+  app.add_flag("--full-cook", full_cook, "with --cook-probe: a full cook instead");
   CLI11_PARSE(app, argc, argv);
+  if (probe_res > 0) {
+    cook_probe(probe_res, full_cook);
+    return 0;
+  }
   if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
     char buf[64] = {};
     if (std::fgets(buf, sizeof buf, f)) std::printf("load average: %s", buf);
