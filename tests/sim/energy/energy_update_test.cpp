@@ -1,7 +1,7 @@
 // ClothEnergy::update: after a topology change the tensor bending rows of the triangles the
 // change did not reach are kept, the others made again; the rows must be those of a full build
-// bit for bit (after a cut across, a slit, and pins that make triangles rigid), and the cases
-// update() does not serve must fall back to a full build.
+// bit for bit (after a cut across, its undo, the cut again, a slit, and pins that make triangles
+// rigid), and the cases update() does not serve must fall back to a full build.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -61,9 +61,17 @@ TEST(EnergyUpdate, RowsAfterACutASlitAndPinsEqualAFullBuild) {
   e.build(c, row_options());
   EXPECT_EQ(count(e.rebuilt_triangles()), e.num_triangles());
   const double dv = 0.4 / (n - 1);
-  ASSERT_TRUE(
-      cut_along_material(c, {Vec2(-0.01, 0.2 + 0.25 * dv), Vec2(0.41, 0.2 + 0.25 * dv)}).ok);
+  const std::vector<Vec2> across{Vec2(-0.01, 0.2 + 0.25 * dv), Vec2(0.41, 0.2 + 0.25 * dv)};
+  const Cloth uncut = c;
+  ASSERT_TRUE(cut_along_material(c, across).ok);
   expect_rows_equal(e, c, "cut across");
+  // An undo puts the uncut cloth back (fewer vertices, the cut triangles' old indices).
+  const uint64_t version = c.topology_version;
+  c = uncut;
+  c.topology_version = version + 1;
+  expect_rows_equal(e, c, "undo of the cut");
+  ASSERT_TRUE(cut_along_material(c, across).ok);
+  expect_rows_equal(e, c, "cut across again");
   ASSERT_TRUE(cut_along_material(c, {Vec2(0.2 + 0.25 * dv, 0.41), Vec2(0.2 + 0.25 * dv, 0.3)}).ok);
   expect_rows_equal(e, c, "slit from the top");
   // Pins on the bottom two rows of a third of the width: triangles there become rigid (no topology
