@@ -201,10 +201,14 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt, ThreadPool
   contacts_.clear();
   contacts_.reserve(num_vertices_);
   build_vertex_lists();
-  // What update() compares the next topology with, and the triangles whose rows were made.
-  built_material_ = M;
-  built_fabric_ = fab;
-  built_all_triangles_ = tri_v_.size() == topo.triangles.size();
+  note_built(cloth);
+}
+
+// What update() compares the next topology with, and the triangles whose rows were made.
+void ClothEnergy::note_built(const Cloth& cloth) {
+  built_material_ = cloth.topo.material;
+  built_fabric_ = cloth.fabric;
+  built_all_triangles_ = tri_v_.size() == cloth.topo.triangles.size();
   if (reuse_rows_ && tensor_)
     rebuilt_.swap(need_rows_);
   else
@@ -534,6 +538,44 @@ void transpose(const Csr& A, int ncols, Csr& T) {
 // angles are replaced by the linear hinge vectors s_e = sum_k K_ek x_k (|s_e| ~ theta_e), so
 // E = 1/2 sum_t sum_ij C_t,ij s_i . s_j = 1/2 x^T (P (x) I3) x, P = sum_t K_t^T C_t K_t.
 
+// update(): a hinge of a triangle whose local estimate the rows made again read (need_local_);
+// every hinge in a full build.
+bool ClothEnergy::hinge_needed(int h) const {
+  return !reuse_rows_ || need_local_[hinge_t_[h][0]] || need_local_[hinge_t_[h][1]];
+}
+
+// L_e = 1/2 sum_k K_ek q(p_k), q(p) = (u^2, v^2, 2uv), p relative to the edge's first vertex:
+// theta_e for the height field z = 1/2 p^T S p (K annihilates affine fields, so the origin
+// does not matter). Next to a rigid (clamped) triangle the rigid side does not curve: its
+// opposite vertex takes the chord value along the edge (foot parameter s: s q(p_1)), so the
+// hinge angle is that of the free side alone (theta = S_nn h_free / 2). Per needed hinge: L,
+// Nn (the edge's in-plane normal n as n n^T: uu, vv, uv) and len.
+void ClothEnergy::hinge_vectors(const std::vector<Vec2>& M, const std::vector<char>& rigid,
+                                std::vector<Eigen::Vector3d>& L, std::vector<Eigen::Vector3d>& Nn,
+                                std::vector<double>& len) const {
+  auto q = [](const Vec2& p) {
+    return Eigen::Vector3d(p.x() * p.x(), p.y() * p.y(), 2 * p.x() * p.y());
+  };
+  for (int h = 0; h < num_hinges(); ++h) {
+    if (!hinge_needed(h)) continue;
+    const auto& v = hinge_v_[h];
+    const auto& K = hinge_k_[h];
+    const Vec2 o = M[v[0]];
+    const Vec2 e = M[v[1]] - o;
+    const bool r1 = rigid[hinge_t_[h][0]], r2 = rigid[hinge_t_[h][1]];
+    Eigen::Vector3d acc = K[1] * q(e);
+    for (int k = 2; k < 4; ++k) {
+      const Vec2 p = M[v[k]] - o;
+      const bool chord = (k == 2 ? r1 : r2) && !(r1 && r2);
+      acc += K[k] * (chord ? Eigen::Vector3d(p.dot(e) / e.squaredNorm() * q(e)) : q(p));
+    }
+    L[h] = 0.5 * acc;
+    len[h] = e.norm();
+    const double nu = -e.y() / len[h], nv = e.x() / len[h];
+    Nn[h] = Eigen::Vector3d(nu * nu, nv * nv, nu * nv);  // n n^T as (uu, vv, uv)
+  }
+}
+
 void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   const auto& M = cloth.topo.material;
   const FabricParams& fab = cloth.fabric;
@@ -554,40 +596,12 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
                !cloth.is_free(tv[2]);
   }
   built_rigid_ = rigid;
-  // L_e = 1/2 sum_k K_ek q(p_k), q(p) = (u^2, v^2, 2uv), p relative to the edge's first vertex:
-  // theta_e for the height field z = 1/2 p^T S p (K annihilates affine fields, so the origin
-  // does not matter). Next to a rigid (clamped) triangle the rigid side does not curve: its
-  // opposite vertex takes the chord value along the edge (foot parameter s: s q(p_1)), so the
-  // hinge angle is that of the free side alone (theta = S_nn h_free / 2).
-  auto q = [](const Vec2& p) {
-    return Eigen::Vector3d(p.x() * p.x(), p.y() * p.y(), 2 * p.x() * p.y());
-  };
   // update(): only the hinges of the triangles whose local estimates the rows made again read
   // (need_local_) are needed; the others' L, Nn, len and Km rows are left empty (unread).
   if (reuse_rows_) widen_reach();
-  auto used = [&](int h) {
-    return !reuse_rows_ || need_local_[hinge_t_[h][0]] || need_local_[hinge_t_[h][1]];
-  };
   std::vector<Eigen::Vector3d> L(nh), Nn(nh);
   std::vector<double> len(nh);
-  for (int h = 0; h < nh; ++h) {
-    if (!used(h)) continue;
-    const auto& v = hinge_v_[h];
-    const auto& K = hinge_k_[h];
-    const Vec2 o = M[v[0]];
-    const Vec2 e = M[v[1]] - o;
-    const bool r1 = rigid[hinge_t_[h][0]], r2 = rigid[hinge_t_[h][1]];
-    Eigen::Vector3d acc = K[1] * q(e);
-    for (int k = 2; k < 4; ++k) {
-      const Vec2 p = M[v[k]] - o;
-      const bool chord = (k == 2 ? r1 : r2) && !(r1 && r2);
-      acc += K[k] * (chord ? Eigen::Vector3d(p.dot(e) / e.squaredNorm() * q(e)) : q(p));
-    }
-    L[h] = 0.5 * acc;
-    len[h] = e.norm();
-    const double nu = -e.y() / len[h], nv = e.x() / len[h];
-    Nn[h] = Eigen::Vector3d(nu * nu, nv * nv, nu * nv);  // n n^T as (uu, vv, uv)
-  }
+  hinge_vectors(M, rigid, L, Nn, len);
   // Hinges and deformable edge-neighbours per triangle.
   std::vector<std::array<int, 3>> th(nt, {-1, -1, -1}), tn(nt, {-1, -1, -1});
   for (int h = 0; h < nh; ++h)
@@ -661,7 +675,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   Csr Km;
   Km.reset(nh);
   for (int h = 0; h < nh; ++h) {
-    for (int k = 0; k < 4 && used(h); ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
+    for (int k = 0; k < 4 && hinge_needed(h); ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
     Km.end_row();
   }
   Csr Gs, Gk, GkT, P;

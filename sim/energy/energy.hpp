@@ -340,6 +340,11 @@ class ClothEnergy {
   bool built_all_triangles_ = false;  // no triangle left out as degenerate
   bool mark_changed(const Cloth& cloth, const EnergyOptions& opt);
   void widen_reach();
+  void note_built(const Cloth& cloth);
+  bool hinge_needed(int h) const;
+  void hinge_vectors(const std::vector<Vec2>& M, const std::vector<char>& rigid,
+                     std::vector<Eigen::Vector3d>& L, std::vector<Eigen::Vector3d>& Nn,
+                     std::vector<double>& len) const;
   void build_tensor_bending(const Cloth& cloth, ThreadPool* pool);
   void stress(int t, const std::vector<Vec3>& x, Eigen::Matrix<double, 3, 2>& F,
               Eigen::Matrix2d& S) const;
