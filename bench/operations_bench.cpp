@@ -231,24 +231,30 @@ void bench_latency(int n, std::vector<Row>& rows) {
   sim.stop();
 }
 
-// The ticks around a cut: the form drape (XPBD, the default solver, `threads` threads) falls for
-// 60 frames, then 15 ticks, a cut across the cloth at half its height (material space, the cut
-// inside the tick that follows it), 14 more: each tick's wall ms (the cut's tick includes the cut
-// and the solver's cook of the new topology). p50, p99 and max over the 30 ticks, the cut's tick
+// The ticks around a cut: the form drape (XPBD, the default solver, `threads` threads, its re-cook
+// incremental or full: XpbdOptions::incremental_cook) falls for 60 frames, then 15 ticks, a cut
+// across the cloth at half its height (material space, the cut inside the tick that follows it),
+// 14 more: each tick's wall ms (the cut's tick includes the cut and the solver's cook of the new
+// topology). p50, p99 and max over the 30 ticks, the cut's tick
 // on its own. Wall time: it is what the 90 Hz loop sees (11.1 ms per tick).
 struct CutTicks {
   int res = 0, threads = 0;
+  bool incremental = true;  // XpbdOptions::incremental_cook
   double p50 = 0, p99 = 0, max = 0, cut_tick = 0, before_p50 = 0;
   int max_at = 0;              // the slowest tick, counted from the cut's (0)
   XpbdSolver::CookStats cook;  // the solver's re-cook in the cut's tick
 };
-CutTicks bench_cut_ticks(int res, int threads) {
+CutTicks bench_cut_ticks(int res, int threads, bool incremental) {
   Testbed sc = make_scene("form", res);
   SolverConfig cfg;
   cfg.threads = threads;
   cfg.air_drag = sc.air_drag;
   auto solver = make_solver("default", cfg);
   Solver& s = **solver;
+  Solver* inner = &s;
+  if (auto* wd = dynamic_cast<WatchdogSolver*>(inner)) inner = &wd->inner();
+  auto* xp = dynamic_cast<XpbdSolver*>(inner);
+  if (xp) xp->options().incremental_cook = incremental;
   for (int f = 0; f < 60; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
   prepare_for_cuts(sc.cloth);
   double umin = 1e9, umax = -1e9, vmin = 1e9, vmax = -1e9;
@@ -258,7 +264,7 @@ CutTicks bench_cut_ticks(int res, int threads) {
   }
   const double v = 0.5 * (vmin + vmax) + 0.25 * (vmax - vmin) / res;  // between two grid rows
   std::vector<double> ticks;
-  CutTicks r{res, threads};
+  CutTicks r{res, threads, incremental};
   for (int k = 0; k < 30; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
     if (k == 15 && !cut_along_material(sc.cloth, {Vec2(umin - 0.01, v), Vec2(umax + 0.01, v)}).ok)
@@ -268,9 +274,7 @@ CutTicks bench_cut_ticks(int res, int threads) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   r.cut_tick = ticks[15];
-  Solver* inner = &s;
-  if (auto* wd = dynamic_cast<WatchdogSolver*>(inner)) inner = &wd->inner();
-  if (auto* xp = dynamic_cast<XpbdSolver*>(inner)) r.cook = xp->last_cook();
+  if (xp) r.cook = xp->last_cook();
   r.max_at = static_cast<int>(std::max_element(ticks.begin(), ticks.end()) - ticks.begin()) - 15;
   r.before_p50 = median(std::vector<double>(ticks.begin(), ticks.begin() + 15));
   std::sort(ticks.begin(), ticks.end());
@@ -278,6 +282,36 @@ CutTicks bench_cut_ticks(int res, int threads) {
   r.p99 = ticks[std::min(ticks.size() - 1, static_cast<size_t>(0.99 * ticks.size()))];
   r.max = ticks.back();
   return r;
+}
+
+// One cut's re-cook alone, for an instruction count (valgrind --tool=callgrind; docs/solvers.md,
+// section 3): the form drape at res^2 on one thread, two frames, the cut across of
+// bench_cut_ticks, one frame (the cook); prints the cook's parts. Every cook is a full one with
+// `full`.
+void cook_probe(int res, bool full) {
+  Testbed sc = make_scene("form", res);
+  XpbdOptions o;
+  o.air_drag = sc.air_drag;
+  o.threads = 1;
+  o.freeze = true;
+  o.incremental_cook = !full;
+  XpbdSolver s(o);
+  for (int f = 0; f < 2; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  double umin = 1e9, umax = -1e9, vmin = 1e9, vmax = -1e9;
+  for (const Vec2& m : sc.cloth.topo.material) {
+    umin = std::min(umin, m.x()), umax = std::max(umax, m.x());
+    vmin = std::min(vmin, m.y()), vmax = std::max(vmax, m.y());
+  }
+  const double v = 0.5 * (vmin + vmax) + 0.25 * (vmax - vmin) / res;
+  if (!cut_along_material(sc.cloth, {Vec2(umin - 0.01, v), Vec2(umax + 0.01, v)}).ok)
+    std::fprintf(stderr, "the cut across %d^2 failed\n", res);
+  s.step(sc.cloth, sc.objects, 1.0 / 90);
+  const auto& k = s.last_cook();
+  std::printf(
+      "%d^2, the cut's cook (%s): %.2f ms (energy %.2f, triangles %.2f, bending %.2f, sweep "
+      "plan %.2f, other %.2f; rows of %d triangles made)\n",
+      res, k.incremental ? "incremental" : "full", k.total_ms, k.energy_ms, k.triangles_ms,
+      k.bending_ms, k.sweep_ms, k.other_ms, k.rebuilt_triangles);
 }
 
 }  // namespace
@@ -295,7 +329,17 @@ int main(int argc, char** argv) {
   app.add_option("--tick-threads", tick_threads, "the solver's threads in the ticks around a cut")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
+  int probe_res = 0;
+  bool full_cook = false;
+  app.add_option("--cook-probe", probe_res,
+                 "only one cut's re-cook at this form resolution, on one thread (for callgrind)")
+      ->check(CLI::Range(4, 1024));
+  app.add_flag("--full-cook", full_cook, "with --cook-probe: a full cook instead");
   CLI11_PARSE(app, argc, argv);
+  if (probe_res > 0) {
+    cook_probe(probe_res, full_cook);
+    return 0;
+  }
   if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
     char buf[64] = {};
     if (std::fgets(buf, sizeof buf, f)) std::printf("load average: %s", buf);
@@ -323,25 +367,35 @@ int main(int argc, char** argv) {
               ok ? "met" : "NOT met");
   std::printf("wrote out/bench/operations.csv\n");
   std::ofstream tcsv("out/bench/operations_cut_ticks.csv");
-  tcsv << "resolution,threads,ticks,p50_ms,p99_ms,max_ms,max_tick_after_cut,cut_tick_ms,"
+  tcsv << "resolution,threads,cook,ticks,p50_ms,p99_ms,max_ms,max_tick_after_cut,cut_tick_ms,"
           "p50_before_cut_ms,recook_ms,recook_energy_ms,recook_triangles_ms,recook_bending_ms,"
-          "recook_sweep_ms,recook_other_ms\n";
-  std::printf("\nticks around a cut (form drape, XPBD; 30 ticks, the cut in the 16th), wall ms:\n");
-  std::printf("%10s %7s %8s %8s %8s %7s %10s %13s\n", "resolution", "threads", "p50", "p99", "max",
-              "max at", "cut tick", "p50 before");
+          "recook_sweep_ms,recook_other_ms,recook_triangles_made\n";
+  std::printf(
+      "\nticks around a cut (form drape, XPBD; 30 ticks, the cut in the 16th), wall ms;\n"
+      "the re-cook incremental (XpbdOptions::incremental_cook) and full:\n");
+  std::printf("%10s %7s %12s %8s %8s %8s %7s %10s %13s\n", "resolution", "threads", "cook", "p50",
+              "p99", "max", "max at", "cut tick", "p50 before");
   for (int res : tick_res) {
-    const CutTicks t = bench_cut_ticks(res, tick_threads);
-    const auto& k = t.cook;
-    std::printf("%7d^2 %7d %8.2f %8.2f %8.2f %+7d %10.2f %13.2f\n", t.res, t.threads, t.p50, t.p99,
-                t.max, t.max_at, t.cut_tick, t.before_p50);
-    tcsv << t.res << ',' << t.threads << ",30," << t.p50 << ',' << t.p99 << ',' << t.max << ','
-         << t.max_at << ',' << t.cut_tick << ',' << t.before_p50 << ',' << k.total_ms << ','
-         << k.energy_ms << ',' << k.triangles_ms << ',' << k.bending_ms << ',' << k.sweep_ms << ','
-         << k.other_ms << '\n';
-    std::printf(
-        "          the re-cook in the cut's tick: %.2f ms (energy %.2f, triangles %.2f, "
-        "bending %.2f, sweep plan %.2f, other %.2f)\n",
-        k.total_ms, k.energy_ms, k.triangles_ms, k.bending_ms, k.sweep_ms, k.other_ms);
+    double recook[2] = {0, 0};
+    for (bool incremental : {true, false}) {
+      const CutTicks t = bench_cut_ticks(res, tick_threads, incremental);
+      const auto& k = t.cook;
+      const char* cook = t.incremental ? "incremental" : "full";
+      recook[incremental ? 0 : 1] = k.total_ms;
+      std::printf("%7d^2 %7d %12s %8.2f %8.2f %8.2f %+7d %10.2f %13.2f\n", t.res, t.threads, cook,
+                  t.p50, t.p99, t.max, t.max_at, t.cut_tick, t.before_p50);
+      tcsv << t.res << ',' << t.threads << ',' << cook << ",30," << t.p50 << ',' << t.p99 << ','
+           << t.max << ',' << t.max_at << ',' << t.cut_tick << ',' << t.before_p50 << ','
+           << k.total_ms << ',' << k.energy_ms << ',' << k.triangles_ms << ',' << k.bending_ms
+           << ',' << k.sweep_ms << ',' << k.other_ms << ',' << k.rebuilt_triangles << '\n';
+      std::printf(
+          "          the re-cook in the cut's tick: %.2f ms (energy %.2f, triangles %.2f, "
+          "bending %.2f, sweep plan %.2f, other %.2f; rows of %d triangles made)\n",
+          k.total_ms, k.energy_ms, k.triangles_ms, k.bending_ms, k.sweep_ms, k.other_ms,
+          k.rebuilt_triangles);
+    }
+    std::printf("          re-cook full / incremental at %d^2: %.2fx\n", res,
+                recook[0] > 0 ? recook[1] / recook[0] : 0.0);
   }
   std::printf(
       "goal: max <= 11.1 ms at 128^2 (the 90 Hz tick); wrote out/bench/operations_cut_ticks.csv\n");

@@ -201,6 +201,113 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt, ThreadPool
   contacts_.clear();
   contacts_.reserve(num_vertices_);
   build_vertex_lists();
+  note_built(cloth);
+}
+
+// What update() compares the next topology with, and the triangles whose rows were made.
+void ClothEnergy::note_built(const Cloth& cloth) {
+  built_material_ = cloth.topo.material;
+  built_fabric_ = cloth.fabric;
+  built_all_triangles_ = tri_v_.size() == cloth.topo.triangles.size();
+  if (reuse_rows_ && tensor_)
+    rebuilt_.swap(need_rows_);
+  else
+    rebuilt_.assign(tri_v_.size(), 1);
+  if (!tensor_) built_rigid_.clear();
+  reuse_rows_ = false;
+}
+
+namespace {
+
+// The options and fabric values the tensor bending rows are made of (update(): equal, or a full
+// build).
+bool same_bending_cook(const EnergyOptions& a, const EnergyOptions& b) {
+  return a.model == b.model && a.bending == b.bending && a.bending_model == b.bending_model &&
+         a.bending_twist == b.bending_twist && a.curvature_estimator == b.curvature_estimator &&
+         a.curvature_smoothing == b.curvature_smoothing &&
+         a.rigid_boundary_hinges == b.rigid_boundary_hinges && a.bending_matrix == b.bending_matrix;
+}
+bool same_fabric(const FabricParams& a, const FabricParams& b) {
+  return a.stretch_warp == b.stretch_warp && a.stretch_weft == b.stretch_weft &&
+         a.shear == b.shear && a.bending_warp == b.bending_warp && a.bending_weft == b.bending_weft;
+}
+// to[b] |= from[a] and to[a] |= from[b] for each pair (a, b) of triangles sharing a hinge.
+void spread(const std::vector<std::array<int32_t, 2>>& pairs, const std::vector<char>& from,
+            std::vector<char>& to) {
+  for (const auto& p : pairs) {
+    if (from[p[0]]) to[p[1]] = 1;
+    if (from[p[1]]) to[p[0]] = 1;
+  }
+}
+
+}  // namespace
+
+bool ClothEnergy::update(const Cloth& cloth, const EnergyOptions& opt, ThreadPool* pool) {
+  const auto& T = cloth.topo.triangles;
+  const int nt = static_cast<int>(T.size());
+  const bool eligible = built_version_ != 0 && tensor_ && same_bending_cook(opt_, opt) &&
+                        !opt.bending_matrix && opt.model == EnergyOptions::Model::kFem &&
+                        opt.bending && opt.bending_model == EnergyOptions::Bending::kTensor &&
+                        opt.curvature_estimator == EnergyOptions::Curvature::kBlended &&
+                        opt.curvature_smoothing <= 1 && same_fabric(built_fabric_, cloth.fabric) &&
+                        built_all_triangles_ && nt == num_triangles() &&
+                        static_cast<int>(built_rigid_.size()) == nt;
+  if (!eligible || !mark_changed(cloth, opt)) {
+    build(cloth, opt, pool);
+    return false;
+  }
+  old_S_off_.swap(tri_S_off_);
+  old_S_col_.swap(tri_S_col_);
+  old_S_val_.swap(tri_S_val_);
+  reuse_rows_ = true;
+  build(cloth, opt, pool);
+  return true;
+}
+
+// D0 (need_local_ for now): the triangles whose vertices, their material coordinates or their
+// rigidity changed since the last build; need_rows_: D0 and its edge neighbours before the
+// change (widen_reach() adds those after it). False when D0 is too large to gain (an eighth of
+// the triangles) or a triangle is degenerate in material space (build() skips those: the
+// triangle indices would not be the energy's).
+bool ClothEnergy::mark_changed(const Cloth& cloth, const EnergyOptions& opt) {
+  const auto& T = cloth.topo.triangles;
+  const auto& M = cloth.topo.material;
+  const int nt = static_cast<int>(T.size());
+  const int n_old = static_cast<int>(built_material_.size());
+  need_local_.assign(nt, 0);
+  int changed = 0;
+  for (int t = 0; t < nt; ++t) {
+    const auto& tv = T[t];
+    bool c = tv != tri_v_[t];
+    for (int k = 0; k < 3 && !c; ++k) c = tv[k] >= n_old || M[tv[k]] != built_material_[tv[k]];
+    const bool rigid = opt.rigid_boundary_hinges && !cloth.is_free(tv[0]) &&
+                       !cloth.is_free(tv[1]) && !cloth.is_free(tv[2]);
+    c = c || rigid != static_cast<bool>(built_rigid_[t]);
+    if (c) {
+      Eigen::Matrix2d Dm;
+      Dm.col(0) = M[tv[1]] - M[tv[0]];
+      Dm.col(1) = M[tv[2]] - M[tv[0]];
+      if (std::abs(Dm.determinant()) < 1e-16) return false;
+    }
+    need_local_[t] = c;
+    changed += c;
+  }
+  if (changed > nt / 8) return false;
+  need_rows_ = need_local_;
+  spread(hinge_t_, need_local_, need_rows_);
+  return true;
+}
+
+// update(), once the new hinges are known: D1 = need_rows_ plus D0's edge neighbours after the
+// change (every triangle whose own hinges or their data changed); the rows made again are A =
+// D1 and its neighbours (a row reads its triangle's hinges and its neighbours'); need_local_:
+// A and its neighbours (the local estimates those rows read).
+void ClothEnergy::widen_reach() {
+  spread(hinge_t_, need_local_, need_rows_);
+  std::vector<char> d1 = need_rows_;
+  spread(hinge_t_, d1, need_rows_);
+  need_local_ = need_rows_;
+  spread(hinge_t_, need_rows_, need_local_);
 }
 
 namespace {
@@ -315,11 +422,64 @@ void spadd(const Csr& A, const Csr& B, int ncols, Csr& C, ThreadPool* pool = nul
 // Gk = (Gl + W Gd) Km, row by row with the arithmetic (its order included) of spgemm(W, Gd) ->
 // WG, spadd(Gl, WG) -> Gs, spgemm(Gs, Km) -> Gk: the same values without the two intermediate
 // matrices (at 128^2 ~17 MB, whose filling was mostly page faults). Gd, Gl: nh columns; Km: n.
+// One row at a time (row()): blend_rows() makes all of them, ClothEnergy::update() those of the
+// triangles a topology edit reached, with the same arithmetic.
+class RowBlender {
+ public:
+  RowBlender(const Csr& Gl, const Csr& W, const Csr& Gd, const Csr& Km, int nh, int n)
+      : Gl_(Gl),
+        W_(W),
+        Gd_(Gd),
+        Km_(Km),
+        a1_(nh, 0.0),
+        a2_(nh, 0.0),
+        a3_(n, 0.0),
+        m1_(nh, -1),
+        m2_(nh, -1),
+        m3_(n, -1) {}
+  void row(int i, Csr& out) {
+    t1_.clear();
+    t2_.clear();
+    t3_.clear();
+    for (int ka = W_.off[i]; ka < W_.off[i + 1]; ++ka) {
+      const int r = W_.col[ka];
+      const double a = W_.val[ka];
+      for (int kb = Gd_.off[r]; kb < Gd_.off[r + 1]; ++kb)
+        add(a1_, m1_, t1_, i, Gd_.col[kb], a * Gd_.val[kb]);
+    }
+    std::sort(t1_.begin(), t1_.end());
+    for (int k = Gl_.off[i]; k < Gl_.off[i + 1]; ++k) add(a2_, m2_, t2_, i, Gl_.col[k], Gl_.val[k]);
+    for (int j : t1_) add(a2_, m2_, t2_, i, j, a1_[j]);
+    std::sort(t2_.begin(), t2_.end());
+    for (int j : t2_) {
+      const double a = a2_[j];
+      for (int kb = Km_.off[j]; kb < Km_.off[j + 1]; ++kb)
+        add(a3_, m3_, t3_, i, Km_.col[kb], a * Km_.val[kb]);
+    }
+    std::sort(t3_.begin(), t3_.end());
+    for (int j : t3_) out.push(j, a3_[j]);
+    out.end_row();
+  }
+
+ private:
+  static void add(std::vector<double>& acc, std::vector<int>& mark, std::vector<int>& touched,
+                  int row, int j, double v) {
+    if (mark[j] != row) {
+      mark[j] = row;
+      acc[j] = 0.0;
+      touched.push_back(j);
+    }
+    acc[j] += v;
+  }
+  const Csr &Gl_, &W_, &Gd_, &Km_;
+  std::vector<double> a1_, a2_, a3_;
+  std::vector<int> m1_, m2_, m3_, t1_, t2_, t3_;
+};
+
 void blend_rows(const Csr& Gl, const Csr& W, const Csr& Gd, const Csr& Km, int nh, int n, Csr& Gk,
                 ThreadPool* pool) {
   by_row_parts(Gl.rows(), pool, Gk, [&](int lo, int hi, Csr& out) {
-    std::vector<double> a1(nh, 0.0), a2(nh, 0.0), a3(n, 0.0);
-    std::vector<int> m1(nh, -1), m2(nh, -1), m3(n, -1), t1, t2, t3;
+    RowBlender blend(Gl, W, Gd, Km, nh, n);
     size_t bound = 0;  // (an upper bound of the output, as in spgemm)
     for (int k = Gl.off[lo]; k < Gl.off[hi]; ++k)
       bound += static_cast<size_t>(Km.off[Gl.col[k] + 1] - Km.off[Gl.col[k]]);
@@ -327,39 +487,29 @@ void blend_rows(const Csr& Gl, const Csr& W, const Csr& Gd, const Csr& Km, int n
       bound += 4 * static_cast<size_t>(Gd.off[W.col[k] + 1] - Gd.off[W.col[k]]);
     out.col.reserve(bound);
     out.val.reserve(bound);
-    auto add = [](std::vector<double>& acc, std::vector<int>& mark, std::vector<int>& touched,
-                  int row, int j, double v) {
-      if (mark[j] != row) {
-        mark[j] = row;
-        acc[j] = 0.0;
-        touched.push_back(j);
-      }
-      acc[j] += v;
-    };
-    for (int i = lo; i < hi; ++i) {
-      t1.clear();
-      t2.clear();
-      t3.clear();
-      for (int ka = W.off[i]; ka < W.off[i + 1]; ++ka) {
-        const int r = W.col[ka];
-        const double a = W.val[ka];
-        for (int kb = Gd.off[r]; kb < Gd.off[r + 1]; ++kb)
-          add(a1, m1, t1, i, Gd.col[kb], a * Gd.val[kb]);
-      }
-      std::sort(t1.begin(), t1.end());
-      for (int k = Gl.off[i]; k < Gl.off[i + 1]; ++k) add(a2, m2, t2, i, Gl.col[k], Gl.val[k]);
-      for (int j : t1) add(a2, m2, t2, i, j, a1[j]);
-      std::sort(t2.begin(), t2.end());
-      for (int j : t2) {
-        const double a = a2[j];
-        for (int kb = Km.off[j]; kb < Km.off[j + 1]; ++kb)
-          add(a3, m3, t3, i, Km.col[kb], a * Km.val[kb]);
-      }
-      std::sort(t3.begin(), t3.end());
-      for (int j : t3) out.push(j, a3[j]);
-      out.end_row();
-    }
+    for (int i = lo; i < hi; ++i) blend.row(i, out);
   });
+}
+
+// ClothEnergy::update(): the rows of triangle t (3t .. 3t + 2) blended again where need[t], else
+// copied from the last build's rows `old` (the same values: nothing they read changed).
+void splice_rows(RowBlender&& blend, const std::vector<char>& need, const std::vector<int>& old_off,
+                 const std::vector<int>& old_col, const std::vector<double>& old_val, Csr& Gk) {
+  const int nt = static_cast<int>(need.size());
+  Gk.reset(3 * nt);
+  Gk.col.reserve(old_col.size() + 1024);
+  Gk.val.reserve(old_val.size() + 1024);
+  for (int t = 0; t < nt; ++t) {
+    if (need[t]) {
+      for (int c = 0; c < 3; ++c) blend.row(3 * t + c, Gk);
+      continue;
+    }
+    const int b = old_off[3 * t], e = old_off[3 * t + 3];
+    const int base = static_cast<int>(Gk.col.size()) - b;
+    Gk.col.insert(Gk.col.end(), old_col.begin() + b, old_col.begin() + e);
+    Gk.val.insert(Gk.val.end(), old_val.begin() + b, old_val.begin() + e);
+    for (int c = 1; c <= 3; ++c) Gk.off.push_back(base + old_off[3 * t + c]);
+  }
 }
 
 void transpose(const Csr& A, int ncols, Csr& T) {
@@ -388,6 +538,44 @@ void transpose(const Csr& A, int ncols, Csr& T) {
 // angles are replaced by the linear hinge vectors s_e = sum_k K_ek x_k (|s_e| ~ theta_e), so
 // E = 1/2 sum_t sum_ij C_t,ij s_i . s_j = 1/2 x^T (P (x) I3) x, P = sum_t K_t^T C_t K_t.
 
+// update(): a hinge of a triangle whose local estimate the rows made again read (need_local_);
+// every hinge in a full build.
+bool ClothEnergy::hinge_needed(int h) const {
+  return !reuse_rows_ || need_local_[hinge_t_[h][0]] || need_local_[hinge_t_[h][1]];
+}
+
+// L_e = 1/2 sum_k K_ek q(p_k), q(p) = (u^2, v^2, 2uv), p relative to the edge's first vertex:
+// theta_e for the height field z = 1/2 p^T S p (K annihilates affine fields, so the origin
+// does not matter). Next to a rigid (clamped) triangle the rigid side does not curve: its
+// opposite vertex takes the chord value along the edge (foot parameter s: s q(p_1)), so the
+// hinge angle is that of the free side alone (theta = S_nn h_free / 2). Per needed hinge: L,
+// Nn (the edge's in-plane normal n as n n^T: uu, vv, uv) and len.
+void ClothEnergy::hinge_vectors(const std::vector<Vec2>& M, const std::vector<char>& rigid,
+                                std::vector<Eigen::Vector3d>& L, std::vector<Eigen::Vector3d>& Nn,
+                                std::vector<double>& len) const {
+  auto q = [](const Vec2& p) {
+    return Eigen::Vector3d(p.x() * p.x(), p.y() * p.y(), 2 * p.x() * p.y());
+  };
+  for (int h = 0; h < num_hinges(); ++h) {
+    if (!hinge_needed(h)) continue;
+    const auto& v = hinge_v_[h];
+    const auto& K = hinge_k_[h];
+    const Vec2 o = M[v[0]];
+    const Vec2 e = M[v[1]] - o;
+    const bool r1 = rigid[hinge_t_[h][0]], r2 = rigid[hinge_t_[h][1]];
+    Eigen::Vector3d acc = K[1] * q(e);
+    for (int k = 2; k < 4; ++k) {
+      const Vec2 p = M[v[k]] - o;
+      const bool chord = (k == 2 ? r1 : r2) && !(r1 && r2);
+      acc += K[k] * (chord ? Eigen::Vector3d(p.dot(e) / e.squaredNorm() * q(e)) : q(p));
+    }
+    L[h] = 0.5 * acc;
+    len[h] = e.norm();
+    const double nu = -e.y() / len[h], nv = e.x() / len[h];
+    Nn[h] = Eigen::Vector3d(nu * nu, nv * nv, nu * nv);  // n n^T as (uu, vv, uv)
+  }
+}
+
 void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   const auto& M = cloth.topo.material;
   const FabricParams& fab = cloth.fabric;
@@ -407,33 +595,13 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
     rigid[t] = opt_.rigid_boundary_hinges && !cloth.is_free(tv[0]) && !cloth.is_free(tv[1]) &&
                !cloth.is_free(tv[2]);
   }
-  // L_e = 1/2 sum_k K_ek q(p_k), q(p) = (u^2, v^2, 2uv), p relative to the edge's first vertex:
-  // theta_e for the height field z = 1/2 p^T S p (K annihilates affine fields, so the origin
-  // does not matter). Next to a rigid (clamped) triangle the rigid side does not curve: its
-  // opposite vertex takes the chord value along the edge (foot parameter s: s q(p_1)), so the
-  // hinge angle is that of the free side alone (theta = S_nn h_free / 2).
-  auto q = [](const Vec2& p) {
-    return Eigen::Vector3d(p.x() * p.x(), p.y() * p.y(), 2 * p.x() * p.y());
-  };
+  built_rigid_ = rigid;
+  // update(): only the hinges of the triangles whose local estimates the rows made again read
+  // (need_local_) are needed; the others' L, Nn, len and Km rows are left empty (unread).
+  if (reuse_rows_) widen_reach();
   std::vector<Eigen::Vector3d> L(nh), Nn(nh);
   std::vector<double> len(nh);
-  for (int h = 0; h < nh; ++h) {
-    const auto& v = hinge_v_[h];
-    const auto& K = hinge_k_[h];
-    const Vec2 o = M[v[0]];
-    const Vec2 e = M[v[1]] - o;
-    const bool r1 = rigid[hinge_t_[h][0]], r2 = rigid[hinge_t_[h][1]];
-    Eigen::Vector3d acc = K[1] * q(e);
-    for (int k = 2; k < 4; ++k) {
-      const Vec2 p = M[v[k]] - o;
-      const bool chord = (k == 2 ? r1 : r2) && !(r1 && r2);
-      acc += K[k] * (chord ? Eigen::Vector3d(p.dot(e) / e.squaredNorm() * q(e)) : q(p));
-    }
-    L[h] = 0.5 * acc;
-    len[h] = e.norm();
-    const double nu = -e.y() / len[h], nv = e.x() / len[h];
-    Nn[h] = Eigen::Vector3d(nu * nu, nv * nv, nu * nv);  // n n^T as (uu, vv, uv)
-  }
+  hinge_vectors(M, rigid, L, Nn, len);
   // Hinges and deformable edge-neighbours per triangle.
   std::vector<std::array<int, 3>> th(nt, {-1, -1, -1}), tn(nt, {-1, -1, -1});
   for (int h = 0; h < nh; ++h)
@@ -450,11 +618,12 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   // Divergence form: S_t = 1/A_t sum_e beta_e |e| theta_e n_e n_e^T (the distributional Hessian
   // of the piecewise-linear surface, beta = 1/2; 1 next to a rigid triangle).
   // The local estimators first (a 3x3 eigensolve per triangle: ~10 ms at 128^2), on the pool.
-  std::vector<Eigen::Matrix3d> mloc(nt);
+  // (update(): only those the rows made again read; the others are left zero, unread.)
+  std::vector<Eigen::Matrix3d> mloc(nt, Eigen::Matrix3d::Zero());
   auto local = [&](int t0, int t1) {
     for (int t = t0; t < t1; ++t) {
       const int k = tri_nh_[t];
-      if (k == 0) continue;
+      if (k == 0 || (reuse_rows_ && !need_local_[t])) continue;
       Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
       Eigen::Matrix3d Lt = Eigen::Matrix3d::Zero();
       for (int a = 0; a < k; ++a) Lt.row(a) = L[th[t][a]].transpose();
@@ -471,7 +640,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
       mloc[t] = dinv.asDiagonal() * Lt.transpose() * Gi;  // S = Mloc theta
     }
   };
-  if (pool && nt >= 4096) {
+  if (pool && nt >= 4096 && !reuse_rows_) {
     pool->parallel_parts(nt, [&](int b, int e, int) { local(b, e); });
   } else {
     local(0, nt);
@@ -485,7 +654,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   }
   for (int t = 0; t < nt; ++t) {
     const int k = tri_nh_[t];
-    if (k > 0) {
+    if (k > 0 && (!reuse_rows_ || need_local_[t])) {
       const Eigen::Matrix3d& Mloc = mloc[t];
       for (int c = 0; c < 3; ++c) {
         for (int a = 0; a < k; ++a) {
@@ -506,7 +675,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   Csr Km;
   Km.reset(nh);
   for (int h = 0; h < nh; ++h) {
-    for (int k = 0; k < 4; ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
+    for (int k = 0; k < 4 && hinge_needed(h); ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
     Km.end_row();
   }
   Csr Gs, Gk, GkT, P;
@@ -529,7 +698,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
     W.val.reserve(12 * static_cast<size_t>(nt));
     for (int t = 0; t < nt; ++t)
       for (int c = 0; c < 3; ++c) {
-        if (tri_nh_[t] > 0) {
+        if (tri_nh_[t] > 0 && (!reuse_rows_ || need_rows_[t])) {
           int nn = 0;
           for (int a = 0; a < 3; ++a)
             if (tn[t][a] >= 0 && tri_nh_[tn[t][a]] > 0) {
@@ -540,7 +709,11 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
         }
         W.end_row();
       }
-    if (opt_.curvature_smoothing <= 1) {
+    if (reuse_rows_) {
+      splice_rows(RowBlender(Gloc, W, Gdl, Km, nh, n), need_rows_, old_S_off_, old_S_col_,
+                  old_S_val_, Gk);
+      fused = true;
+    } else if (opt_.curvature_smoothing <= 1) {
       blend_rows(Gloc, W, Gdl, Km, nh, n, Gk, pool);
       fused = true;
     } else {

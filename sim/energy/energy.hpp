@@ -97,6 +97,18 @@ class ClothEnergy {
   // Cooks element data for the cloth's current topology and rest state (material coords). With
   // a pool, the tensor bending's sparse products run on it (the same result as without).
   void build(const Cloth& cloth, const EnergyOptions& opt, ThreadPool* pool = nullptr);
+  // The same for a cloth whose topology changed since the last build (a cut, slit or sew), with
+  // the tensor bending rows of every triangle the change did not reach kept from that build:
+  // the rows made again are those of the triangles whose vertices, material coordinates or
+  // rigidity changed, their edge neighbours before and after the change, and those neighbours'
+  // neighbours (a row reads its triangle's hinges and its neighbours'). The result equals
+  // build()'s bit for bit. Falls back to build() (returns false) unless the last build and this
+  // one are of the tensor bending with the blended estimate (one smoothing pass) without the
+  // matrix P, with the same options and fabric and the same triangle count, no triangle
+  // degenerate in material space, and at most an eighth of the triangles changed.
+  bool update(const Cloth& cloth, const EnergyOptions& opt, ThreadPool* pool = nullptr);
+  // Per triangle: 1 when the last build or update made its bending rows, 0 when it kept them.
+  const std::vector<char>& rebuilt_triangles() const { return rebuilt_; }
   bool up_to_date(const Cloth& cloth) const {
     return built_version_ == cloth.topology_version && num_vertices_ == cloth.num_vertices();
   }
@@ -315,6 +327,24 @@ class ClothEnergy {
   // The tangential part of contact c's vertex's motion from its friction anchor.
   Vec3 friction_slip(const Contact& c, const Vec3& xi) const;
   void build_vertex_lists();
+  // update(): the last build's inputs (material coordinates, fabric, each triangle's rigidity),
+  // its rows while the new ones are made, the triangles whose rows are made again (need_rows_),
+  // those whose local estimates they read (need_local_), and per triangle whether the last
+  // build made its rows (rebuilt_).
+  std::vector<Vec2> built_material_;
+  FabricParams built_fabric_;
+  std::vector<char> built_rigid_, need_rows_, need_local_, rebuilt_;
+  std::vector<int> old_S_off_, old_S_col_;
+  std::vector<double> old_S_val_;
+  bool reuse_rows_ = false;
+  bool built_all_triangles_ = false;  // no triangle left out as degenerate
+  bool mark_changed(const Cloth& cloth, const EnergyOptions& opt);
+  void widen_reach();
+  void note_built(const Cloth& cloth);
+  bool hinge_needed(int h) const;
+  void hinge_vectors(const std::vector<Vec2>& M, const std::vector<char>& rigid,
+                     std::vector<Eigen::Vector3d>& L, std::vector<Eigen::Vector3d>& Nn,
+                     std::vector<double>& len) const;
   void build_tensor_bending(const Cloth& cloth, ThreadPool* pool);
   void stress(int t, const std::vector<Vec3>& x, Eigen::Matrix<double, 3, 2>& F,
               Eigen::Matrix2d& S) const;

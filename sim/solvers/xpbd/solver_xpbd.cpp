@@ -60,12 +60,18 @@ void XpbdSolver::cook(const Cloth& cloth) {
   // XPBD projects the bending rows and never evaluates P (EnergyOptions::bending_matrix).
   EnergyOptions eo = opt_.energy;
   eo.bending_matrix = false;
-  energy_.build(cloth, eo, pool_.get());
+  // An incremental cook keeps the bending rows and blocks of the triangles the change did not
+  // reach (ClothEnergy::update); everything else is cooked again as in a full cook.
+  if (opt_.incremental_cook)
+    st.incremental = energy_.update(cloth, eo, pool_.get());
+  else
+    energy_.build(cloth, eo, pool_.get());
+  for (char r : energy_.rebuilt_triangles()) st.rebuilt_triangles += r;
   st.energy_ms = since(t);
   const int n = cloth.num_vertices();
   cook_triangles(cloth);
   st.triangles_ms = since(t);
-  cook_bending(n);
+  cook_bending(n, st.incremental);
   st.bending_ms = since(t);
   cook_hinges_springs(n);
   const int S = scratch_slots_;
@@ -150,82 +156,128 @@ void XpbdSolver::cook_triangles(const Cloth& cloth) {
                               : 64);
 }
 
-// Bending: the energy's own rows when it has them (tensor bending). The three rows of a triangle
-// (uu, vv, uv) share their stencil: they are one block, solved together (3x3 system) with one
-// pass over the stencil.
-void XpbdSolver::cook_bending(int n) {
-  const int S = scratch_slots_;
+// The bending blocks in triangle order (blk_*), one per three energy rows. Incremental (the
+// energy's update() kept the rows of some triangles): the blocks of those triangles are kept
+// from the last cook, the others assembled again; the same blocks as assembling all.
+void XpbdSolver::assemble_blocks(bool incremental) {
+  const int nrows = energy_.num_bending_rows();
+  const int nb = (nrows + 2) / 3;
+  const auto& rebuilt = energy_.rebuilt_triangles();
+  const bool reuse = incremental && static_cast<int>(blk_off_.size()) == nb + 1 &&
+                     static_cast<int>(rebuilt.size()) == nb;
+  std::vector<int> old_off, old_col;
+  std::vector<double> old_val, old_ik;
+  if (reuse) {
+    old_off.swap(blk_off_);
+    old_col.swap(blk_col_);
+    old_val.swap(blk_val_);
+    old_ik.swap(blk_ik_);
+  }
+  // Upper bounds (a block's three rows share most columns): ~1M entries at 128^2, which
+  // growing by push_back copied many times over (a re-cook after every cut).
+  const size_t entries = energy_.bending_row_columns().size();
+  blk_off_.assign(1, 0);
+  blk_col_.clear();
+  blk_val_.clear();
+  blk_ik_.clear();
+  blk_col_.reserve(reuse ? old_col.size() + 4096 : entries);
+  blk_val_.reserve(reuse ? old_val.size() + 3 * 4096 : 3 * entries);
+  blk_off_.reserve(nb + 1);
+  blk_ik_.reserve(3 * nb);
+  for (int bk = 0; bk < nb; ++bk) {
+    if (reuse && !rebuilt[bk]) {
+      blk_col_.insert(blk_col_.end(), old_col.begin() + old_off[bk],
+                      old_col.begin() + old_off[bk + 1]);
+      blk_val_.insert(blk_val_.end(), old_val.begin() + 3 * old_off[bk],
+                      old_val.begin() + 3 * old_off[bk + 1]);
+      blk_off_.push_back(static_cast<int>(blk_col_.size()));
+      blk_ik_.insert(blk_ik_.end(), old_ik.begin() + 3 * bk, old_ik.begin() + 3 * bk + 3);
+      continue;
+    }
+    assemble_block(3 * bk);
+  }
+}
+
+// Appends the block of rows r0 .. r0 + 2 to blk_*.
+void XpbdSolver::assemble_block(int r0) {
   const int nrows = energy_.num_bending_rows();
   const auto& ro = energy_.bending_row_offsets();
   const auto& rc = energy_.bending_row_columns();
   const auto& rv = energy_.bending_row_values();
-  std::vector<int> boff(1, 0), bcol;
-  std::vector<double> bval, bik;
-  std::vector<std::array<double, 4>> ent;  // column, value uu, vv, uv
-  // Upper bounds (a block's three rows share most columns): ~1M entries at 128^2, which
-  // growing by push_back copied many times over (a re-cook after every cut).
-  bcol.reserve(rc.size());
-  bval.reserve(3 * rc.size());
-  boff.reserve(nrows / 3 + 2);
-  bik.reserve(nrows + 3);
-  for (int r0 = 0; r0 < nrows; r0 += 3) {
-    // The energy's three rows of a triangle share one pattern, sorted, exact zeros kept: then
-    // the block is read off directly (the merge below costs ~15 ms at 128^2), with the same
-    // values (the merge adds each to zeros).
-    const int len = ro[r0 + 1] - ro[r0];
-    const auto c0 = rc.begin() + ro[r0];
-    if (r0 + 2 < nrows && ro[r0 + 2] - ro[r0 + 1] == len && ro[r0 + 3] - ro[r0 + 2] == len &&
-        std::equal(c0, c0 + len, rc.begin() + ro[r0 + 1]) &&
-        std::equal(c0, c0 + len, rc.begin() + ro[r0 + 2]) &&
-        std::adjacent_find(c0, c0 + len, std::greater_equal<int>()) == c0 + len) {
-      for (int e = 0; e < len; ++e) {
-        bcol.push_back(c0[e]);
-        for (int a = 0; a < 3; ++a) bval.push_back(rv[ro[r0 + a] + e]);
-      }
-    }
-    ent.clear();
-    for (int a = 0; a < 3 && r0 + a < nrows && static_cast<int>(bcol.size()) == boff.back(); ++a)
-      for (int e = ro[r0 + a]; e < ro[r0 + a + 1]; ++e) {
-        std::array<double, 4> q{double(rc[e]), 0, 0, 0};
-        q[1 + a] = rv[e];
-        ent.push_back(q);
-      }
-    std::sort(ent.begin(), ent.end(), [](const auto& p, const auto& q) { return p[0] < q[0]; });
-    for (size_t i = 0; i < ent.size(); ++i) {
-      if (!bcol.empty() && static_cast<int>(boff.size()) - 1 >= 0 &&
-          static_cast<int>(bcol.size()) > boff.back() && bcol.back() == int(ent[i][0])) {
-        for (int a = 0; a < 3; ++a) bval[bval.size() - 3 + a] += ent[i][1 + a];
-        continue;
-      }
-      bcol.push_back(static_cast<int>(ent[i][0]));
-      for (int a = 0; a < 3; ++a) bval.push_back(ent[i][1 + a]);
-    }
-    // Columns whose three coefficients are round-off of an exact zero (a cancellation: on a
-    // regular grid one in five, ~1e-11 of the block's largest coefficient) are left out; the
-    // block's rows keep their other coefficients bit for bit.
-    {
-      const int b0 = boff.back(), b1 = static_cast<int>(bcol.size());
-      double big = 0;
-      for (int e = 3 * b0; e < 3 * b1; ++e) big = std::max(big, std::abs(bval[e]));
-      int out = b0;
-      for (int e = b0; e < b1; ++e) {
-        if (std::abs(bval[3 * e]) <= kZeroCoefficient * big &&
-            std::abs(bval[3 * e + 1]) <= kZeroCoefficient * big &&
-            std::abs(bval[3 * e + 2]) <= kZeroCoefficient * big)
-          continue;
-        bcol[out] = bcol[e];
-        for (int a = 0; a < 3; ++a) bval[3 * out + a] = bval[3 * e + a];
-        ++out;
-      }
-      bcol.resize(out);
-      bval.resize(3 * out);
-    }
-    boff.push_back(static_cast<int>(bcol.size()));
-    for (int a = 0; a < 3; ++a) {
-      const double k = r0 + a < nrows ? energy_.bending_row_stiffness(r0 + a) : 0.0;
-      bik.push_back(k > 0 ? 1.0 / k : 0.0);
+  std::vector<int>& boff = blk_off_;
+  std::vector<int>& bcol = blk_col_;
+  std::vector<double>& bval = blk_val_;
+  std::vector<double>& bik = blk_ik_;
+  thread_local std::vector<std::array<double, 4>> ent;  // column, value uu, vv, uv
+  // The energy's three rows of a triangle share one pattern, sorted, exact zeros kept: then
+  // the block is read off directly (the merge below costs ~15 ms at 128^2), with the same
+  // values (the merge adds each to zeros).
+  const int len = ro[r0 + 1] - ro[r0];
+  const auto c0 = rc.begin() + ro[r0];
+  if (r0 + 2 < nrows && ro[r0 + 2] - ro[r0 + 1] == len && ro[r0 + 3] - ro[r0 + 2] == len &&
+      std::equal(c0, c0 + len, rc.begin() + ro[r0 + 1]) &&
+      std::equal(c0, c0 + len, rc.begin() + ro[r0 + 2]) &&
+      std::adjacent_find(c0, c0 + len, std::greater_equal<int>()) == c0 + len) {
+    for (int e = 0; e < len; ++e) {
+      bcol.push_back(c0[e]);
+      for (int a = 0; a < 3; ++a) bval.push_back(rv[ro[r0 + a] + e]);
     }
   }
+  ent.clear();
+  for (int a = 0; a < 3 && r0 + a < nrows && static_cast<int>(bcol.size()) == boff.back(); ++a)
+    for (int e = ro[r0 + a]; e < ro[r0 + a + 1]; ++e) {
+      std::array<double, 4> q{double(rc[e]), 0, 0, 0};
+      q[1 + a] = rv[e];
+      ent.push_back(q);
+    }
+  std::sort(ent.begin(), ent.end(), [](const auto& p, const auto& q) { return p[0] < q[0]; });
+  for (size_t i = 0; i < ent.size(); ++i) {
+    if (!bcol.empty() && static_cast<int>(boff.size()) - 1 >= 0 &&
+        static_cast<int>(bcol.size()) > boff.back() && bcol.back() == int(ent[i][0])) {
+      for (int a = 0; a < 3; ++a) bval[bval.size() - 3 + a] += ent[i][1 + a];
+      continue;
+    }
+    bcol.push_back(static_cast<int>(ent[i][0]));
+    for (int a = 0; a < 3; ++a) bval.push_back(ent[i][1 + a]);
+  }
+  // Columns whose three coefficients are round-off of an exact zero (a cancellation: on a
+  // regular grid one in five, ~1e-11 of the block's largest coefficient) are left out; the
+  // block's rows keep their other coefficients bit for bit.
+  {
+    const int b0 = boff.back(), b1 = static_cast<int>(bcol.size());
+    double big = 0;
+    for (int e = 3 * b0; e < 3 * b1; ++e) big = std::max(big, std::abs(bval[e]));
+    int out = b0;
+    for (int e = b0; e < b1; ++e) {
+      if (std::abs(bval[3 * e]) <= kZeroCoefficient * big &&
+          std::abs(bval[3 * e + 1]) <= kZeroCoefficient * big &&
+          std::abs(bval[3 * e + 2]) <= kZeroCoefficient * big)
+        continue;
+      bcol[out] = bcol[e];
+      for (int a = 0; a < 3; ++a) bval[3 * out + a] = bval[3 * e + a];
+      ++out;
+    }
+    bcol.resize(out);
+    bval.resize(3 * out);
+  }
+  boff.push_back(static_cast<int>(bcol.size()));
+  for (int a = 0; a < 3; ++a) {
+    const double k = r0 + a < nrows ? energy_.bending_row_stiffness(r0 + a) : 0.0;
+    bik.push_back(k > 0 ? 1.0 / k : 0.0);
+  }
+}
+
+// Bending: the energy's own rows when it has them (tensor bending). The three rows of a triangle
+// (uu, vv, uv) share their stencil: they are one block, solved together (3x3 system) with one
+// pass over the stencil. The blocks in triangle order (assemble_blocks), then coloured and
+// packed.
+void XpbdSolver::cook_bending(int n, bool incremental) {
+  const int S = scratch_slots_;
+  assemble_blocks(incremental);
+  const std::vector<int>& boff = blk_off_;
+  const std::vector<int>& bcol = blk_col_;
+  const std::vector<double>& bval = blk_val_;
+  const std::vector<double>& bik = blk_ik_;
   std::vector<int> order_b, col;
   colour_elements(n, boff, bcol, order_b, col);
   row_cols_ = col.empty() ? std::vector<int>(1, 0) : col;
@@ -238,12 +290,10 @@ void XpbdSolver::cook_bending(int n) {
   row_ik_.reserve(bik.size());
   row_off_.reserve(boff.size());
   for (int bk : order_b) {
-    for (int e = boff[bk]; e < boff[bk + 1]; ++e) {
-      row_colv_.push_back(bcol[e]);
-      for (int a = 0; a < 3; ++a) row_val_.push_back(bval[3 * e + a]);
-    }
+    row_colv_.insert(row_colv_.end(), bcol.begin() + boff[bk], bcol.begin() + boff[bk + 1]);
+    row_val_.insert(row_val_.end(), bval.begin() + 3 * boff[bk], bval.begin() + 3 * boff[bk + 1]);
     row_off_.push_back(static_cast<int>(row_colv_.size()));
-    for (int a = 0; a < 3; ++a) row_ik_.push_back(bik[3 * bk + a]);
+    row_ik_.insert(row_ik_.end(), bik.begin() + 3 * bk, bik.begin() + 3 * bk + 3);
   }
   lambda_row_.assign(row_ik_.size(), Vec3::Zero());
   row_packs_.clear();
@@ -296,7 +346,9 @@ void XpbdSolver::cook_hinges_springs(int n) {
 }
 
 // The connected pieces (union-find over the elements' vertices) and the sweep blocks of one
-// piece.
+// piece. A bending block's stencil (the vertices of its triangle's hinges and its edge
+// neighbours' hinges) lies in triangles joined edge to edge with its own, so the triangles join
+// every vertex a block joins: the blocks are not walked (a million entries at 128^2).
 void XpbdSolver::cook_pieces(int n) {
   std::vector<int> parent(n);
   for (int i = 0; i < n; ++i) parent[i] = i;
@@ -308,9 +360,6 @@ void XpbdSolver::cook_pieces(int n) {
   for (const Tri& T : tris_) join(T.v[0], T.v[1]), join(T.v[1], T.v[2]);
   for (const Hinge& H : hinges_) join(H.v[0], H.v[2]), join(H.v[0], H.v[3]);
   for (const Spring& Sp : springs_) join(Sp.v[0], Sp.v[1]);
-  for (size_t r = 0; r + 1 < row_off_.size(); ++r)
-    for (int e = row_off_[r] + 1; e < row_off_[r + 1]; ++e)
-      join(row_colv_[row_off_[r]], row_colv_[e]);
   std::vector<int> piece_of(n, -1);
   std::vector<int> id(n, -1);
   int pieces = 0;

@@ -61,10 +61,14 @@ class XpbdSolver : public Solver {
   // The last cook of a topology (the first step, and the step after a cut, slit or sew): wall ms
   // of its parts (the energy's build, the triangles' packs, the bending blocks and their packs,
   // the sweep's plan, the rest) and the cooks so far.
+  // With XpbdOptions::incremental_cook: whether the energy's bending rows and the blocks were
+  // made again only for the triangles the change reached (ClothEnergy::update), and how many.
   struct CookStats {
     double energy_ms = 0, triangles_ms = 0, bending_ms = 0, sweep_ms = 0, other_ms = 0,
            total_ms = 0;
     int cooks = 0;
+    bool incremental = false;
+    int rebuilt_triangles = 0;
   };
   const CookStats& last_cook() const { return last_cook_; }
   // The energy as the solver cooked it (its contacts: those of the last step).
@@ -120,7 +124,9 @@ class XpbdSolver : public Solver {
   // Cooking: the element data of a new topology (cook() and its parts).
   void cook(const Cloth& cloth);
   void cook_triangles(const Cloth& cloth);
-  void cook_bending(int n);
+  void cook_bending(int n, bool incremental);
+  void assemble_blocks(bool incremental);
+  void assemble_block(int r0);
   void cook_hinges_springs(int n);
   void cook_pieces(int n);
   void build_sweep(int n);
@@ -192,6 +198,11 @@ class XpbdSolver : public Solver {
   // colour order: row r is sum_k row_val_[k] x[row_col_[k]], inverse stiffness row_ik_[r].
   std::vector<int> row_off_, row_colv_, row_cols_;
   std::vector<double> row_val_, row_ik_;
+  // The same blocks in triangle order, before the colouring (block t: columns blk_col_[blk_off_[t]
+  // .. blk_off_[t + 1]), three values each, three inverse stiffnesses): an incremental cook
+  // makes again only the blocks of the triangles whose rows the energy made again.
+  std::vector<int> blk_off_, blk_col_;
+  std::vector<double> blk_val_, blk_ik_;
   // The same blocks in packs of four doubles of one colour (xpbd_kernels.hpp), colour offsets in
   // packs (or eight floats: row_packs8_).
   // Per block the packs hold the inverse of its 3x3 system matrix A = sum_j w_j v_j v_j^T +

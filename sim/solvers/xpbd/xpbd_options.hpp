@@ -23,6 +23,10 @@ struct XpbdOptions {
   // too little work to share (on two cores, 32^2 takes 1.49 ms per frame on one thread and 1.83
   // on two).
   int min_parallel_triangles = 4000;
+  // After a topology change (cut, slit, sew) the energy's tensor bending rows and the bending
+  // blocks made of them are made again only for the triangles the change reached
+  // (ClothEnergy::update; bit for bit those of a full cook); false: every cook is a full one.
+  bool incremental_cook = true;
   // Tests only: false keeps the pool's workers from taking their shares of the element sweep
   // (as if they were never scheduled), so that the caller takes them over; sweep_absent_worker
   // >= 1 does so for that one worker only, whose share the others take over (xpbd_sweep.hpp).
