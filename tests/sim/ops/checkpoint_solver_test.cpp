@@ -40,11 +40,8 @@ std::unique_ptr<Solver> session_solver(int threads) {
 struct Session {
   World w;
   OperationController ops;
-  explicit Session(int threads) {
-    Testbed t = make_form_drape(kRes, {}, true);
-    w.cloth = std::move(t.cloth);
-    w.scene = std::move(t.objects);
-    w.solver = session_solver(threads);
+  explicit Session(int threads)
+      : w(testbed_world(make_form_drape(kRes, {}, true), session_solver(threads))) {
     ops.install(w);
   }
   void step_to(uint64_t tick) {
