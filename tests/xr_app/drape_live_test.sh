@@ -357,10 +357,11 @@ assert not os.path.exists(d + "session-2"), "--no-pattern: no pattern at the end
     compare_golden live_pin
     ;;
   save)
-    session_check "F5 held the menu: a save from the controller" '
-print("triggers:", triggers)
-assert re.search(r"controller button\.menu_hold begin hand left -> save once", session), "no menu held -> save"
-assert "save" in [n for n, _ in triggers], "no save trigger"'
+    session_check "F5 held the menu: a save from the controller (its press: stop)" '
+assert re.search(r"controller button\.menu begin hand left -> stop once", session), "no menu press"
+m = re.search(r"frame (\d+): controller button\.menu_hold begin hand left -> save once", session)
+assert m, "no menu held -> save"
+assert re.search(r"^save: frame " + m.group(1) + r": saving the session$", session, re.M), "no save"'
     saved=$OUT/out/saved_session.drape
     tick=$(sed -n "s|^save: the session at tick \([0-9]*\) saved to $saved .*|\1|p" "$SESSION")
     [ -n "$tick" ] || fail "no save line naming $saved in $SESSION"
@@ -368,7 +369,7 @@ assert "save" in [n for n, _ in triggers], "no save trigger"'
     "$EXE" open "$saved" --out "$OUT/opened" --no-record --no-pattern --voice off --frames 20 \
       --sim-lock-step --eye-size 128 >"$OUT/open.out" 2>&1 ||
       fail "drape open $saved exited with $?: $(tail -3 "$OUT/open.out")"
-    grep -q "drape open: $saved: the session at tick $tick " "$OUT/open.out" ||
+    grep -qE "^drape open: $saved: the session at tick $tick( |$)" "$OUT/open.out" ||
       fail "drape open did not start from the saved tick $tick: $(grep open: "$OUT/open.out")"
     echo "ok: F5 saved the session at tick $tick; drape open started from it"
     ;;
