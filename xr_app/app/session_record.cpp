@@ -158,9 +158,10 @@ uint64_t replay_end(const sim::JournalContents& j, uint64_t until_tick, ReplayRe
 }
 
 // The scene fields a checkpoint must share with its journal (the program's version may differ
-// after a resume by a newer build; a saved session opened may run in another sim mode).
+// after a resume by a newer build; a saved session opened may run in another sim mode, and may
+// have been saved before checkpoints held the solver's state).
 bool same_session(std::map<std::string, std::string> a, std::map<std::string, std::string> b) {
-  for (const char* k : {"version", "opened", "lock_step"}) {
+  for (const char* k : {"version", "opened", "lock_step", "solver_state"}) {
     a.erase(k);
     b.erase(k);
   }
