@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <map>
@@ -28,6 +29,13 @@ void copy_little_endian(unsigned char* to, const unsigned char* from, size_t cou
       for (size_t b = 0; b < sizeof(T); ++b)
         to[k * sizeof(T) + b] = from[k * sizeof(T) + sizeof(T) - 1 - b];
   }
+}
+
+// True when the n doubles from p are all finite (a state read back must not bring NaN or inf).
+inline bool all_finite(const double* p, size_t n) {
+  for (size_t k = 0; k < n; ++k)
+    if (!std::isfinite(p[k])) return false;
+  return true;
 }
 
 struct ByteWriter {

@@ -74,10 +74,17 @@ bool RestScheduler::restore(ByteReader& in) {
     if (g < -1 || g >= num_pieces_) return false;
   for (int f : finish_)
     if (f < -1) return false;
+  if (!all_finite(scale_.data(), scale_.size()) ||
+      !all_finite(reinterpret_cast<const double*>(motion_.data()), 4 * motion_.size()))
+    return false;
+  for (double sc : scale_)
+    if (sc < 1) return false;  // an inertia scale: 1 (own mass) or more
   finisher_.reset();
   if (in.u8() != 0) {
     std::vector<Vec3> anchors;
     in.array<double>(anchors, 3);
+    if (!all_finite(reinterpret_cast<const double*>(anchors.data()), 3 * anchors.size()))
+      return false;
     finisher_ = std::make_unique<EquilibriumFinisher>();
     finisher_->set_anchors(std::move(anchors));
   }

@@ -1,5 +1,7 @@
 // XpbdSolver's saved state (Solver::save_state, restore_state): what one step hands to the next
 // beyond the cloth, so that a solver restored from it steps on bit for bit as the saved one.
+#include <cmath>
+
 #include "sim/solvers/xpbd/solver_xpbd.hpp"
 
 namespace drape::sim {
@@ -67,11 +69,13 @@ std::string XpbdSolver::read_state(ByteReader& in, const Cloth& cloth) {
            " threads' scratch slots; the cloth has " + std::to_string(cloth.num_vertices()) +
            " vertices and the solver " + std::to_string(scratch_slots_);
   h_prev_ = in.f64();
+  if (!std::isfinite(h_prev_) || h_prev_ < 0) return "the last substep's length is not a length";
   auto lambdas = [&](auto& v, size_t per) {
     using Item = typename std::decay_t<decltype(v)>::value_type;
     std::vector<Item> got;
     in.array<double>(got, per);
     if (!got.empty() && got.size() != v.size()) return false;
+    if (!all_finite(reinterpret_cast<const double*>(got.data()), got.size() * per)) return false;
     if (!got.empty()) v.swap(got);
     return in.ok;
   };
@@ -80,7 +84,8 @@ std::string XpbdSolver::read_state(ByteReader& in, const Cloth& cloth) {
     return "the warm-start multipliers do not fit the cloth's elements";
   in.array<double>(anchors_);
   const bool anchored = anchors_.size() == static_cast<size_t>(3 * (n + scratch_slots_));
-  if (!in.ok || (!anchors_.empty() && (!anchored || !cooked_f32_)))
+  if (!in.ok || (!anchors_.empty() && (!anchored || !cooked_f32_)) ||
+      !all_finite(anchors_.data(), anchors_.size()))
     return "the anchors do not fit the cloth";
   if (anchored) anchor_terms();
   if (!rest_.restore(in)) return "the pieces' rest state does not fit the cloth";
