@@ -4,9 +4,10 @@
 // checkpoint, the time it takes on the sim thread (the copy of the World with the solver's
 // state: CheckpointTaker::take), its encoding and writing on the writer's thread, the file's
 // size and the solver state's share, the time to load it and restore it into a fresh World (the
-// start of a resume, the solver's cook included; the World's build from the header not) and whether that World, stepped to the end, reaches the live run's state
-// hash; then the sim thread's cost spread over the ticks of the default interval (10 s = 900
-// ticks) against a tick's step. Writes out/bench/checkpoint.csv.
+// start of a resume, the solver's cook included; the World's build from the header not) and
+// whether that World, stepped to the end, reaches the live run's state hash; then the sim
+// thread's cost spread over the ticks of the default interval (10 s = 900 ticks) against a
+// tick's step. Writes out/bench/checkpoint.csv; exits 1 when a restored World ends elsewhere.
 // `./drape bench checkpoint [--res N] [--ticks T] [--every K] [--dir DIR]`.
 #include <CLI/CLI.hpp>
 #include <chrono>
