@@ -2,13 +2,17 @@
 // or an error, no crash; a checkpoint that decodes encodes to bytes that decode to the same
 // encoding again. Half the inputs get their records' CRCs made right first (the first byte's
 // low bit chooses), so mutations of the payloads reach the record decoders instead of stopping
-// at the CRC check.
+// at the CRC check. The solver's state of a checkpoint that decodes goes into the session's
+// solver (XPBD) with the checkpoint's cloth, when the cloth is small (restoring cooks it): its
+// reader (sim/solvers/xpbd/xpbd_state.cpp) must reject what does not fit with an error, and the
+// solver must then step (without the scene's objects: the solver's state is what is fuzzed).
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "sim/ops/checkpoint.hpp"
 #include "sim/runtime/journal.hpp"
+#include "sim/solvers/xpbd/solver_xpbd.hpp"
 
 namespace {
 
@@ -40,5 +44,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!drape::sim::decode_checkpoint(bytes.data(), bytes.size(), "fuzz2", again).empty())
     __builtin_trap();
   if (drape::sim::encode_checkpoint(again) != bytes) __builtin_trap();
+  constexpr int kMaxVertices = 64;  // a cook per input: kept small
+  if (!c.solver_state.empty() && c.cloth.num_vertices() <= kMaxVertices) {
+    drape::sim::XpbdOptions o;
+    o.threads = 1;
+    o.freeze = true;
+    o.finish_thread = false;
+    drape::sim::XpbdSolver solver(o);
+    (void)solver.restore_state(c.solver_state, c.cloth);
+    solver.step(c.cloth, drape::sim::SceneObjects{}, 1.0 / 90);
+  }
   return 0;
 }

@@ -77,6 +77,7 @@ constexpr const char* kDefaults = R"json({
     {"source": "controller", "command": "button.b", "edge": "begin", "label": "B (right) / Y (left)", "operation": "undo", "phase": "once"},
     {"source": "controller", "command": "button.menu", "edge": "begin", "profile": "khr/simple", "label": "menu", "operation": "undo", "phase": "once"},
     {"source": "controller", "command": "button.menu", "edge": "begin", "label": "menu", "operation": "stop", "phase": "once"},
+    {"source": "controller", "command": "button.menu_hold", "edge": "begin", "label": "menu held 1 s", "operation": "save", "phase": "once"},
     {"source": "controller", "command": "stick.up", "edge": "begin", "label": "thumbstick up", "operation": "pin", "phase": "once"},
     {"source": "controller", "command": "stick.down", "edge": "begin", "label": "thumbstick down", "operation": "release", "phase": "once"},
     {"source": "controller", "command": "stick.left", "edge": "begin", "label": "thumbstick left", "operation": "next", "phase": "once"},

@@ -49,7 +49,8 @@ class XrHandSource : public HandSource {
   void feed_joints(Hand h, const XrJointInput& in);
   // Controller poses become palm-only frames; buttons become triggers in `take_triggers()`:
   // "button.trigger" (the analog trigger with hysteresis), "button.squeeze", "button.a",
-  // "button.b", "button.menu", "button.stick" (its click); "stick.up" / "down" / "left" /
+  // "button.b", "button.menu", "button.menu_hold" (the menu button held for 1 s: a save),
+  // "button.stick" (its click); "stick.up" / "down" / "left" /
   // "right" (the thumbstick pushed that way, with hysteresis); "trackpad.up" / "down" / "left" /
   // "right" / "center" (the region clicked, held until the click ends); "palm_up" (the
   // controller rolled so that the palm faces up).
@@ -65,9 +66,11 @@ class XrHandSource : public HandSource {
   void stick_edges(Hand h, const XrControllerInput& in);
   void pad_edges(Hand h, const XrControllerInput& in);
   void palm_up_edge(Hand h, const XrControllerInput& in);
+  void menu_hold_edge(Hand h, const XrControllerInput& in);
   bool trigger_down_[2] = {false, false};
-  int stick_dir_[2] = {-1, -1};   // 0 up, 1 down, 2 left, 3 right; -1 centred
-  int pad_region_[2] = {-1, -1};  // as stick_dir_, 4 centre; -1 not clicked
+  double menu_since_[2] = {-1, -1};  // when the menu button went down; -1: up
+  int stick_dir_[2] = {-1, -1};      // 0 up, 1 down, 2 left, 3 right; -1 centred
+  int pad_region_[2] = {-1, -1};     // as stick_dir_, 4 centre; -1 not clicked
   bool palm_up_[2] = {false, false};
   std::vector<std::pair<std::string, bool>> buttons_[2];
   double last_time_ = -1;

@@ -29,6 +29,7 @@ constexpr const char* kDirections[5] = {"up", "down", "left", "right", "center"}
 constexpr double kStickEnter = 0.7, kStickLeave = 0.4;    // stick deflection hysteresis
 constexpr double kPadCentre = 0.5;                        // trackpad: centre region radius
 constexpr double kPalmUpEnter = 0.7, kPalmUpLeave = 0.5;  // palm normal . up
+constexpr double kMenuHoldSeconds = 1.0;  // the menu button held this long: "button.menu_hold"
 
 // The direction (0 up, 1 down, 2 left, 3 right) of the dominant axis of (x, y).
 int direction(double x, double y) {
@@ -91,6 +92,18 @@ void XrHandSource::palm_up_edge(Hand h, const XrControllerInput& in) {
   edge(h, "palm_up", on, in.time);
 }
 
+// The menu button held for kMenuHoldSeconds: one begin per press (its press alone is
+// "button.menu"), the end when it is let go.
+void XrHandSource::menu_hold_edge(Hand h, const XrControllerInput& in) {
+  double& since = menu_since_[static_cast<int>(h)];
+  const bool down = in.menu && in.active;
+  if (!down)
+    since = -1;
+  else if (since < 0)
+    since = in.time;
+  edge(h, "button.menu_hold", down && in.time - since >= kMenuHoldSeconds, in.time);
+}
+
 void XrHandSource::feed_controller(Hand h, const XrControllerInput& in) {
   HandFrame f;
   f.hand = h;
@@ -111,6 +124,7 @@ void XrHandSource::feed_controller(Hand h, const XrControllerInput& in) {
   edge(h, "button.a", in.a && in.active, in.time);
   edge(h, "button.b", in.b && in.active, in.time);
   edge(h, "button.menu", in.menu && in.active, in.time);
+  menu_hold_edge(h, in);
   edge(h, "button.stick", in.stick_click && in.active, in.time);
   stick_edges(h, in);
   pad_edges(h, in);

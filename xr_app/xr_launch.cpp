@@ -325,8 +325,8 @@ void add_record_option(CLI::App& cli, std::string& dir, double& checkpoint_every
                  "hands.csv (external hands)");
   cli.add_option("--checkpoint-every", checkpoint_every,
                  "with --record: a checkpoint of the World every this many seconds of session "
-                 "time (0: none, the default), from which drape replay and --resume start; the "
-                 "solver restarts at each (a re-cook: a hitch at fine resolutions)")
+                 "time (0: none), from which drape replay and --resume start; it holds the "
+                 "solver's state, so the session goes on as without it")
       ->check(CLI::Range(0.0, 3600.0))
       ->capture_default_str();
 }

@@ -10,7 +10,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "sim/runtime/byte_io.hpp"
+#include "sim/core/byte_io.hpp"
 #include "sim/runtime/journal.hpp"
 
 namespace drape::sim {
@@ -20,7 +20,7 @@ namespace {
 constexpr char kMagic[8] = {'D', 'R', 'A', 'P', 'E', 'C', 'K', 'P'};
 constexpr size_t kPreamble = 12;           // magic + format
 constexpr uint32_t kMaxRecord = 1u << 30;  // a larger length is a corrupt record
-enum Kind : uint8_t { kHeader = 1, kWorld = 2, kOps = 3, kEntry = 4, kEnd = 5 };
+enum Kind : uint8_t { kHeader = 1, kWorld = 2, kOps = 3, kEntry = 4, kEnd = 5, kSolver = 6 };
 
 // ---- lists -------------------------------------------------------------------------------
 
@@ -435,7 +435,8 @@ ByteWriter header_payload(const WorldCheckpoint& c) {
 struct Decoder {
   const std::string& source;
   WorldCheckpoint& out;
-  bool world = false, ops = false, end = false;
+  uint32_t format = kCheckpointFormat;
+  bool world = false, ops = false, solver = false, end = false;
   uint32_t undo_expected = 0, redo_expected = 0;
   std::deque<HistoryEntry> undo, redo;
 };
@@ -472,6 +473,16 @@ std::string decode_ops(ByteReader& in, Decoder& d) {
   return check_ops(d.out.ops, d.out.cloth.num_vertices());
 }
 
+std::string decode_solver(ByteReader& in, Decoder& d) {
+  if (d.format < kCheckpointFormat) return "a solver record in a file of format 1";
+  if (!d.ops || d.solver) return "the solver's state must follow the operations, once";
+  d.out.solver = in.str();
+  in.array<unsigned char>(d.out.solver_state);
+  if (!in.ok || in.i != in.n) return "the solver record is malformed";
+  d.solver = true;
+  return "";
+}
+
 std::string decode_entry(ByteReader& in, Decoder& d) {
   const uint8_t stack = in.u8();
   HistoryEntry e;
@@ -487,6 +498,7 @@ std::string decode_end(ByteReader& in, Decoder& d) {
   d.redo_expected = in.u32();
   if (!in.ok || in.i != in.n) return "the end record is malformed";
   if (!d.world || !d.ops) return "the end record comes before the world and the operations";
+  if (d.format >= kCheckpointFormat && !d.solver) return "the end record comes before the solver";
   if (d.undo.size() != d.undo_expected || d.redo.size() != d.redo_expected)
     return "the end record counts other history entries than the file holds";
   d.end = true;
@@ -497,8 +509,9 @@ std::string decode_record(const unsigned char* p, uint32_t len, size_t index, De
                           std::string& field) {
   ByteReader in{p, len};
   const uint8_t kind = in.u8();
-  static const char* names[] = {"kind", "header", "world", "operations", "history", "end"};
-  field = names[kind <= kEnd ? kind : 0];
+  static const char* names[] = {"kind",    "header", "world", "operations",
+                                "history", "end",    "solver"};
+  field = names[kind <= kSolver ? kind : 0];
   if ((index == 0) != (kind == kHeader)) return "the header must be the first record, once";
   switch (kind) {
     case kHeader:
@@ -511,6 +524,8 @@ std::string decode_record(const unsigned char* p, uint32_t len, size_t index, De
       return decode_entry(in, d);
     case kEnd:
       return decode_end(in, d);
+    case kSolver:
+      return decode_solver(in, d);
     default:
       return "a record of unknown kind " + std::to_string(kind);
   }
@@ -559,6 +574,11 @@ std::vector<unsigned char> encode_checkpoint(const WorldCheckpoint& c) {
   o.u8(kOps);
   put_ops(o, c.ops);
   put_record(file, o);
+  ByteWriter sv;
+  sv.u8(kSolver);
+  sv.str(c.solver);
+  sv.array(c.solver_state.data(), c.solver_state.size());
+  put_record(file, sv);
   for (uint8_t stack = 0; stack < 2; ++stack) {
     for (const auto& e : stack == 0 ? c.undo : c.redo) {
       ByteWriter h;
@@ -582,10 +602,12 @@ std::string decode_checkpoint(const unsigned char* p, size_t n, const std::strin
   if (n < kPreamble || std::memcmp(p, kMagic, 8) != 0)
     return at(source, 0, "magic") + "not a drape checkpoint (no \"DRAPECKP\" at its start)";
   ByteReader pre{p + 8, 4};
-  if (const uint32_t fmt = pre.u32(); fmt != kCheckpointFormat)
+  const uint32_t fmt = pre.u32();
+  if (fmt != kCheckpointFormat && fmt != kCheckpointFormatNoSolver)
     return at(source, 8, "format") + "version " + std::to_string(fmt) + " (this program reads " +
-           std::to_string(kCheckpointFormat) + ")";
-  Decoder d{source, out};
+           std::to_string(kCheckpointFormatNoSolver) + " and " + std::to_string(kCheckpointFormat) +
+           ")";
+  Decoder d{source, out, fmt};
   size_t pos = kPreamble, records = 0;
   while (pos < n && !d.end) {
     uint32_t len = 0;
@@ -655,6 +677,10 @@ std::shared_ptr<WorldCheckpoint> CheckpointTaker::take(
   c->paused = w.paused;
   c->ops = ops.state();
   c->ops.last_cut = CutResult{};
+  if (w.solver) {
+    c->solver = w.solver->name();
+    c->solver_state = w.solver->save_state(w.cloth);
+  }
   std::map<uint64_t, std::shared_ptr<const HistoryEntry>> kept;
   for (const HistoryEntry& e : ops.history().undo_entries()) c->undo.push_back(entry(e, kept));
   for (const HistoryEntry& e : ops.history().redo_entries()) c->redo.push_back(entry(e, kept));
@@ -662,7 +688,7 @@ std::shared_ptr<WorldCheckpoint> CheckpointTaker::take(
   return c;
 }
 
-void restore_checkpoint(const WorldCheckpoint& c, World& w, OperationController& ops) {
+std::string restore_checkpoint(const WorldCheckpoint& c, World& w, OperationController& ops) {
   w.cloth = c.cloth;
   auto form = w.scene.form;
   w.scene = c.scene;
@@ -675,6 +701,11 @@ void restore_checkpoint(const WorldCheckpoint& c, World& w, OperationController&
   for (const auto& e : c.undo) undo.push_back(*e);
   for (const auto& e : c.redo) redo.push_back(*e);
   ops.history().restore_entries(std::move(undo), std::move(redo));
+  if (c.solver_state.empty()) return "";
+  if (!w.solver || w.solver->name() != c.solver)
+    return "the checkpoint holds the state of the " + c.solver + " solver, the World runs " +
+           (w.solver ? "the " + w.solver->name() + " solver" : "none");
+  return w.solver->restore_state(c.solver_state, w.cloth);
 }
 
 // ---- the writer thread -------------------------------------------------------------------

@@ -8,14 +8,16 @@
 // journal (a u32 payload length, a u32 CRC32 of the payload, the payload, whose first byte is its
 // kind): the header (the journal header's fields that rebuild the static scene — the form, the
 // solver — the tick and the operation controller's step), the world (cloth and scene objects),
-// the operations' state, one record per history entry (undo stack, then redo stack, oldest
-// first) and the end (the entry counts). A checkpoint without its end record is incomplete and
-// is not used; loading it says where it stops.
+// the operations' state, the solver's state (format 2), one record per history entry (undo
+// stack, then redo stack, oldest first) and the end (the entry counts). A checkpoint without its
+// end record is incomplete and is not used; loading it says where it stops.
 //
-// The solver's own state (warm starts, which pieces sleep, the static finish in progress) is not
-// in the checkpoint: the sim restarts its solver at each checkpoint (a fresh one of the same
-// configuration), in the live session and in every replay alike (the journal records the tick),
-// so a session resumed from a checkpoint reaches bit for bit the state of the uninterrupted one.
+// The solver's state (Solver::save_state: XPBD's warm starts, which pieces sleep and how far
+// they settled, the finish's anchors, the single-precision anchors) is in the checkpoint from
+// format 2 on: a World restored from it steps on bit for bit as the World it was taken from, so
+// taking a checkpoint changes nothing in the session. A checkpoint of format 1 (written by
+// sessions that restarted their solver at each checkpoint) is read as well and restores a fresh
+// solver, as those sessions did.
 #pragma once
 
 #include <condition_variable>
@@ -31,7 +33,8 @@
 
 namespace drape::sim {
 
-inline constexpr uint32_t kCheckpointFormat = 1;
+inline constexpr uint32_t kCheckpointFormat = 2;
+inline constexpr uint32_t kCheckpointFormatNoSolver = 1;  // still read
 
 struct WorldCheckpoint {
   std::map<std::string, std::string> header;  // the journal's header fields
@@ -42,6 +45,9 @@ struct WorldCheckpoint {
   bool paused = false;
   OperationsState ops;  // without last_cut (a result kept for tests)
   std::vector<std::shared_ptr<const HistoryEntry>> undo, redo;
+  // The solver's name and Solver::save_state (empty: nothing to carry, or a format-1 file).
+  std::string solver;
+  std::vector<unsigned char> solver_state;
 };
 
 // Takes checkpoints on the sim thread: copies the world's cloth, scene and operations, and each
@@ -71,8 +77,10 @@ std::string load_checkpoint(const std::string& path, WorldCheckpoint& out);
 std::string write_checkpoint_file(const std::string& path, const WorldCheckpoint& c);
 
 // Puts a checkpoint's state into a World built from its header (form, fresh solver) and into the
-// controller installed on it (operations, history, step).
-void restore_checkpoint(const WorldCheckpoint& c, World& w, OperationController& ops);
+// controller installed on it (operations, history, step), the solver's state into its solver.
+// Returns "" or why the solver's state does not fit the World's solver (another solver, another
+// configuration); the World then has the checkpoint's state with a fresh solver.
+std::string restore_checkpoint(const WorldCheckpoint& c, World& w, OperationController& ops);
 
 // The checkpoint files' writer thread: submit() never blocks the sim thread; a checkpoint not yet
 // started when a newer one comes is dropped for it. Keeps the newest `keep` files it wrote in its

@@ -17,6 +17,7 @@
 
 #include <atomic>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "sim/core/cloth.hpp"
@@ -77,6 +78,10 @@ class EquilibriumFinisher {
   void anchor(const Cloth& cloth, const std::vector<int>& group);
   FinisherStats cycle(Cloth& cloth, const SceneObjects& scene, const std::vector<int>& group,
                       const EnergyOptions& energy_options, ThreadPool* pool);
+  // Friction's anchors (what carries from one cycle to the next; empty before the first), for
+  // saving and restoring a solver's state.
+  const std::vector<Vec3>& anchors() const { return anchor_; }
+  void set_anchors(std::vector<Vec3> a) { anchor_ = std::move(a); }
 
  private:
   FinisherOptions opt_;

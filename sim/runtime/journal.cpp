@@ -7,7 +7,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "sim/runtime/byte_io.hpp"
+#include "sim/core/byte_io.hpp"
 
 namespace drape::sim {
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "sim/core/cloth.hpp"
 #include "sim/core/scene_objects.hpp"
@@ -29,6 +30,22 @@ class Solver {
   virtual StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) = 0;
   // The solver's worker threads, for work around its steps (the watchdog's checks), or null.
   virtual ThreadPool* pool() { return nullptr; }
+  // The state the solver carries from one step to the next beyond the cloth (XPBD: warm-start
+  // multipliers, the pieces' sleep and settling, the static finish in progress, the
+  // single-precision anchors), as bytes, for its next step on `cloth`. restore_state() puts it
+  // into a solver of the same configuration, with that cloth: the solver then steps on bit for
+  // bit as the saved one would (a session's checkpoints, sim/ops/checkpoint.hpp). Only XPBD (the
+  // session's solver) implements it; the others save nothing, and a checkpoint restores them as
+  // fresh ones. restore_state() returns "" or why the bytes do not fit (the solver is then as a
+  // fresh one).
+  virtual std::vector<unsigned char> save_state(const Cloth& cloth) const {
+    (void)cloth;
+    return {};
+  }
+  virtual std::string restore_state(const std::vector<unsigned char>& bytes, const Cloth& cloth) {
+    (void)cloth;
+    return bytes.empty() ? "" : "the " + name() + " solver keeps no state to restore";
+  }
 };
 
 }  // namespace drape::sim

@@ -25,6 +25,13 @@ class WatchdogSolver : public Solver {
   std::string name() const override { return inner_->name(); }
   StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) override;
   ThreadPool* pool() override { return inner_->pool(); }
+  // The inner solver's (the watchdog saves the cloth before each step: nothing of its own).
+  std::vector<unsigned char> save_state(const Cloth& cloth) const override {
+    return inner_->save_state(cloth);
+  }
+  std::string restore_state(const std::vector<unsigned char>& bytes, const Cloth& cloth) override {
+    return inner_->restore_state(bytes, cloth);
+  }
   Solver& inner() { return *inner_; }
   int total_rollbacks() const { return total_rollbacks_; }
 

@@ -380,4 +380,12 @@ void position_error(const std::vector<Vec3>& a, const std::vector<Vec3>& b, doub
   rms = n ? std::sqrt(s / n) : 0;
 }
 
+World testbed_world(Testbed t, std::unique_ptr<Solver> solver) {
+  World w;
+  w.cloth = std::move(t.cloth);
+  w.scene = std::move(t.objects);
+  w.solver = std::move(solver);
+  return w;
+}
+
 }  // namespace drape::sim

@@ -10,6 +10,7 @@
 #include "sim/core/cloth.hpp"
 #include "sim/core/scene_objects.hpp"
 #include "sim/energy/energy.hpp"
+#include "sim/runtime/world.hpp"
 #include "sim/solvers/solver.hpp"
 
 namespace drape::sim {
@@ -83,5 +84,8 @@ const std::vector<std::string>& stress_case_names();
 // RMS and max vertex distance (m) between two position arrays of equal size.
 void position_error(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double& rms,
                     double& max);
+
+// A World of the testbed's cloth and objects, stepped by `solver`.
+World testbed_world(Testbed t, std::unique_ptr<Solver> solver);
 
 }  // namespace drape::sim

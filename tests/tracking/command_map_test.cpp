@@ -95,6 +95,9 @@ TEST(CommandMap, EveryControllerBindingPerProfile) {
   }
   EXPECT_EQ(c("button.a", Hand::Right, "oculus/touch"), "cut toggle");
   EXPECT_EQ(c("button.b", Hand::Left, "valve/index"), "undo once");
+  // The menu held 1 s saves the session, on every profile with a menu button.
+  for (const char* p : {"oculus/touch", "htc/vive", "microsoft/motion", "khr/simple"})
+    EXPECT_EQ(c("button.menu_hold", Hand::Left, p), "save once") << p;
   // khr/simple: select = pinch, menu = undo (not stop).
   EXPECT_EQ(c("button.menu", Hand::Right, "khr/simple"), "undo once");
   // Vive: trackpad regions (on click) for what it lacks (a stick, A/B).

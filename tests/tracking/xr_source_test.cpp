@@ -1,6 +1,6 @@
 // The XR adapter's controller triggers (tracking/xr_source.cpp): buttons' edges, the
 // thumbstick's directions with hysteresis, the trackpad's region taken at its click, the
-// controller rolled palm up.
+// controller rolled palm up, the menu button held 1 s.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -36,6 +36,24 @@ TEST(XrSource, ButtonsGiveEdgesWhileTheControllerIsActive) {
   const auto t = xr.take_triggers();
   EXPECT_EQ(names(t), "button.menu+ button.stick+ button.menu- button.stick- ");
   for (const auto& tr : t) EXPECT_EQ(tr.hand, Hand::Left);
+}
+
+// The menu held 1 s: "button.menu_hold" once (after "button.menu"), ended when let go; a
+// shorter press none; the hold starts again from the next press.
+TEST(XrSource, MenuHeldOneSecondIsItsOwnTrigger) {
+  XrHandSource xr;
+  auto feed = [&](double t, bool menu) {
+    auto c = held(t);
+    c.menu = menu;
+    xr.feed_controller(Hand::Left, c);
+  };
+  for (double t = 0; t < 0.95; t += 0.1) feed(t, true);  // 0.9 s: not yet
+  feed(0.95, false);
+  EXPECT_EQ(names(xr.take_triggers()), "button.menu+ button.menu- ");
+  for (double t = 1.0; t < 2.25; t += 0.1) feed(t, true);  // held 1.2 s
+  feed(2.3, false);
+  EXPECT_EQ(names(xr.take_triggers()),
+            "button.menu+ button.menu_hold+ button.menu- button.menu_hold- ");
 }
 
 TEST(XrSource, StickDirectionsWithHysteresis) {

@@ -2,7 +2,7 @@
 # `drape run` at a desk: a display (Xvfb), no headset runtime configured, so the app runs live
 # in the simulated runtime's window (DRAPE_MOCK_WINDOW, docs/mock-window.md) with no scenario.
 # A person's input as real X events (xdotool, XTEST).
-#   drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin|scene] [--update-golden]
+#   drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin|save|scene] [--update-golden]
 # free (default): the sim on its own 90 Hz thread, a 12² cloth; the mouse over the cloth, the
 #   left button held (pinch), a drag, the release, Escape. Checks
 #   * the runtime put the hand on the depth the app submitted (DRAPE_MOCK_WINDOW_LOG: z is the
@@ -22,6 +22,11 @@
 #   trigger) and the golden image live_pin.png; then the left button pinches, and P (the right
 #   hand pointing) writes the pattern mid-session into out/pattern/session-1/ (the log line with
 #   its tick; with --no-pattern no session-2 at the end).
+# save: lock step, in the oculus/touch profile (Tab): F5 (a tap) holds the left controller's menu
+#   button for 1.1 s (the window's frames); held 1 s, the app saves the session into
+#   out/saved_session.drape (xr_session.txt: the controller's "menu held 1 s -> save" and the
+#   save's line with its tick). `drape open` of that file in the window starts from its tick and
+#   exits 0; the file's saved tick is the one the log names.
 # scene: the scene's options (--fabric, --form, --mesh, --start, --resolution): bad values exit 2
 #   naming the option and file before a window opens; good ones run 20 live frames; a fakenect
 #   recording as the hands (--hands kinect --kinect-record) runs live to its last frame.
@@ -36,8 +41,9 @@ case "$MODE" in
   # The cloth's image without the feedback panel and the pattern board (each has its own tests).
   golden | pin) ARGS=(--resolution 16 --eye-size 256 --sim-lock-step --state-hashes
     --no-feedback-panel --no-board) ;;
+  save) ARGS=(--resolution 16 --eye-size 128 --sim-lock-step --no-board) ;;
   scene) ;;
-  *) echo "usage: drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin|scene] [--update-golden]"; exit 2 ;;
+  *) echo "usage: drape_live_test.sh DRAPE_EXE OUTDIR [free|golden|pin|save|scene] [--update-golden]"; exit 2 ;;
 esac
 rm -rf "$OUT" && mkdir -p "$OUT/home"
 source "$(dirname "$0")/window_test_lib.sh"
@@ -255,6 +261,17 @@ case "$MODE" in
     xdotool keyup p
     frames 60
     ;;
+  save)
+    frames 60
+    to_profile oculus
+    [ -e "$OUT/out/saved_session.drape" ] && fail "a saved session before F5"
+    xdotool key F5
+    expect "F5 holds the menu button" "f('buttons')[4] == '1'"
+    frames 60
+    expect "the menu button is held for its 100 frames, then let go" "f('buttons')[4] == '0'"
+    for _ in $(seq 100); do [ -s "$OUT/out/saved_session.drape" ] && break; sleep 0.1; done
+    [ -s "$OUT/out/saved_session.drape" ] || fail "no out/saved_session.drape after F5"
+    ;;
 esac
 
 # --- Escape ends the session; the app writes its outputs and exits 0
@@ -338,6 +355,23 @@ d = os.path.dirname(sys.argv[1]) + "/pattern/"
 assert os.path.getsize(d + "session-1/report.json") > 0 and os.path.getsize(d + "session-1/pattern.dxf") > 0
 assert not os.path.exists(d + "session-2"), "--no-pattern: no pattern at the end"'
     compare_golden live_pin
+    ;;
+  save)
+    session_check "F5 held the menu: a save from the controller (its press: stop)" '
+assert re.search(r"controller button\.menu begin hand left -> stop once", session), "no menu press"
+m = re.search(r"frame (\d+): controller button\.menu_hold begin hand left -> save once", session)
+assert m, "no menu held -> save"
+assert re.search(r"^save: frame " + m.group(1) + r": saving the session$", session, re.M), "no save"'
+    saved=$OUT/out/saved_session.drape
+    tick=$(sed -n "s|^save: the session at tick \([0-9]*\) saved to $saved .*|\1|p" "$SESSION")
+    [ -n "$tick" ] || fail "no save line naming $saved in $SESSION"
+    # The saved file opens: `drape open` in the window starts from its tick and runs 20 frames.
+    "$EXE" open "$saved" --out "$OUT/opened" --no-record --no-pattern --voice off --frames 20 \
+      --sim-lock-step --eye-size 128 >"$OUT/open.out" 2>&1 ||
+      fail "drape open $saved exited with $?: $(tail -3 "$OUT/open.out")"
+    grep -qE "^drape open: $saved: the session at tick $tick( |$)" "$OUT/open.out" ||
+      fail "drape open did not start from the saved tick $tick: $(grep open: "$OUT/open.out")"
+    echo "ok: F5 saved the session at tick $tick; drape open started from it"
     ;;
 esac
 echo PASS

@@ -11,7 +11,10 @@
 #         uninterrupted run's journal replays to from the start at that tick (drape replay
 #         --until-tick --from-start), and, given the uninterrupted run's inputs after that tick
 #         (its journal's records spliced after the killed journal's whole records), it reaches
-#         the uninterrupted run's final state hash. Most resumes start from a checkpoint.
+#         the uninterrupted run's final state hash. The kills fall after the first checkpoint
+#         (from a quarter of the journal on): at least 18 of the 20 resumes must start from a
+#         checkpoint (one killed between a checkpoint's journal record and its file's rename
+#         starts from the one before; before any file is written, from the start).
 #   tee   --record with --voice FILE.wav and --hands trace FILE: audio.wav holds the audio as
 #         captured (a prefix of the recording, sample for sample) and hands.csv the external
 #         tracker's frames as received (a prefix of the trace, in its format).
@@ -28,7 +31,9 @@
 # record with a message naming the byte offset, and that a bad header is an error naming the
 # file and the field. lock records with a checkpoint every 0.5 s: the replay starts from the
 # newest, equals the replay from the start, and a newest checkpoint cut off mid-record is named
-# (byte offset) and passed over for the one before it, to the same final state.
+# (byte offset) and passed over for the one before it, to the same final state. lock and kill
+# also record the session without checkpoints: it ends at the same state hash as with them
+# (checkpoints hold the solver's state; the sim goes on through them unchanged).
 # usage: drape_record_test.sh DRAPE_EXE MODE WORKDIR
 set -u
 exe=$1 mode=$2 work=$3
@@ -146,6 +151,16 @@ grep -q "pinned_added [1-9]" "$rec/session.txt" || fail "no pin in $rec/session.
 grep -q "^sim: cut: .* pieces" "$rec/session.txt" || fail "no cut in $rec/session.txt"
 grep -q -- "-> undo" "$rec/session.txt" || fail "no undo trigger in $rec/session.txt"
 grep -q "\"final_state_hash\": \"$rhash\"" "$rec/meta.json" || fail "meta.json lacks the final hash"
+if [ "$mode" = lock ] || [ "$mode" = kill ]; then
+  "$exe" xr --scenario assets/scenarios/record_replay.json --eye-size 64 --cloth-res 16 \
+    --record "$work/no_checkpoints" --checkpoint-every 0 >"$work/nock.log" 2>&1 ||
+    fail "drape xr --checkpoint-every 0 exited with $?"
+  nock=$(sed -n 's/^drape xr: final state hash \([0-9a-f]*\) at tick \([0-9]*\)$/\1 \2/p' "$work/nock.log")
+  ls "$work/no_checkpoints" | grep -q checkpoint && fail "checkpoints written with --checkpoint-every 0"
+  [ "$nock" = "$rhash $rtick" ] ||
+    fail "without checkpoints the session ends at '$nock', with a checkpoint every 0.5 s at '$rhash $rtick'"
+  echo "without checkpoints: the same final state $nock"
+fi
 
 "$exe" replay "$rec" >"$work/replay.out" 2>"$work/replay.err"
 rc=$?
@@ -253,12 +268,12 @@ if [ "$mode" = kill ]; then
   killed=0 tries=0 from_checkpoint=0
   while [ $killed -lt 20 ] && [ $tries -lt 40 ]; do
     tries=$((tries + 1))
-    at=$(awk -v t="$journal_bytes" -v r="$RANDOM" 'BEGIN { printf "%d", t * (0.15 + 0.7 * r / 32768) }')
+    at=$(awk -v t="$journal_bytes" -v r="$RANDOM" 'BEGIN { printf "%d", t * (0.25 + 0.6 * r / 32768) }')
     kill_once $tries "$at" && killed=$((killed + 1))
   done
   [ $killed -ge 20 ] || fail "only $killed of $tries runs were killed mid-session"
   echo "$killed kills, $from_checkpoint resumed from a checkpoint"
-  [ $from_checkpoint -ge 10 ] || fail "only $from_checkpoint of $killed resumes started from a checkpoint"
+  [ $from_checkpoint -ge 18 ] || fail "only $from_checkpoint of $killed resumes started from a checkpoint"
   echo "PASS"
   exit 0
 fi

@@ -138,7 +138,7 @@ class DrapingSession : public SessionContent {
   // last whole record; `first_tick` the ticks it ran.
   sim::Result<sim::World> resume_world(uint64_t& first_tick);
   // With the journal open: a checkpoint every opt_.checkpoint_every_s of session time, taken by
-  // the sim thread at a tick's start (journal record, copy, fresh solver), written by
+  // the sim thread at a tick's start (journal record, copy with the solver's state), written by
   // checkpoints_'s thread into the record directory.
   void install_checkpoints(sim::World& w);
   // "save session": the sim copies the session at its next tick; a thread writes it whole into
@@ -209,7 +209,7 @@ class DrapingSession : public SessionContent {
   std::shared_ptr<sim::JournalWriter> journal_;
   uint64_t resume_inputs_end_ = 0;                      // a resumed journal: append from this byte
   std::unique_ptr<sim::CheckpointWriter> checkpoints_;  // the checkpoint files' writer thread
-  // The longest a checkpoint took on the sim thread (ms: journal record, copy, fresh solver).
+  // The longest a checkpoint took on the sim thread (ms: journal record, copy, solver state).
   std::shared_ptr<std::atomic<double>> checkpoint_cost_ = std::make_shared<std::atomic<double>>(0);
   std::vector<std::future<std::string>> saves_;         // "save session": each save's message
   uint64_t opened_tick_ = 0;                            // drape open: the saved session's tick

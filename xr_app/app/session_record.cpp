@@ -47,6 +47,9 @@ sim::JournalHeader journal_header(const XrAppOptions& opt) {
   f["substeps"] = std::to_string(kSubsteps);
   f["lock_step"] = opt.sim_lock_step ? "1" : "0";
   f["self_collision"] = opt.self_collision ? "1" : "0";
+  // Checkpoints hold the solver's state and the sim goes on with its solver through them
+  // (journals without the field restarted the solver at each checkpoint).
+  f["solver_state"] = "1";
   // A session opened from a saved file (drape open) has no start to replay from: its journal
   // starts from the file's copy (checkpoint record and file in the session directory).
   if (!opt.open_file.empty()) f["opened"] = opt.open_file;
@@ -155,9 +158,10 @@ uint64_t replay_end(const sim::JournalContents& j, uint64_t until_tick, ReplayRe
 }
 
 // The scene fields a checkpoint must share with its journal (the program's version may differ
-// after a resume by a newer build; a saved session opened may run in another sim mode).
+// after a resume by a newer build; a saved session opened may run in another sim mode, and may
+// have been saved before checkpoints held the solver's state).
 bool same_session(std::map<std::string, std::string> a, std::map<std::string, std::string> b) {
-  for (const char* k : {"version", "opened", "lock_step"}) {
+  for (const char* k : {"version", "opened", "lock_step", "solver_state"}) {
     a.erase(k);
     b.erase(k);
   }
@@ -199,14 +203,15 @@ std::optional<sim::WorldCheckpoint> newest_checkpoint(const std::string& dir,
   return std::nullopt;
 }
 
-// The sim restarts its solver at each checkpoint the journal records after `after`, as the
-// recorded session did when it took them.
+// Journals recorded before checkpoints held the solver's state (no header field
+// `solver_state`): the sim restarted its solver at each checkpoint the journal records after
+// `after`, and so does their replay.
 void restart_solver_at_checkpoints(sim::World& w, const sim::JournalContents& j, uint64_t after) {
   std::set<uint64_t> ticks;
   for (const auto& c : j.checkpoints)
     if (c.tick > after) ticks.insert(c.tick);
   w.at_tick_start = nullptr;
-  if (ticks.empty()) return;
+  if (ticks.empty() || j.header.field("solver_state") == "1") return;
   w.at_tick_start = [ticks](sim::World& wd) {
     if (!ticks.count(wd.tick)) return;
     auto s = make_session_solver(true);
@@ -244,7 +249,10 @@ ReplayResult replay_journal(const std::string& dir, uint64_t until_tick,
   ops->install(w.value());
   const uint64_t end = replay_end(j, until_tick, r);
   if (auto c = from_start ? std::nullopt : newest_checkpoint(dir, j, end, r.notes)) {
-    sim::restore_checkpoint(*c, w.value(), *ops);
+    if (std::string e = sim::restore_checkpoint(*c, w.value(), *ops); !e.empty()) {
+      r.error = dir + "/" + sim::checkpoint_file_name(c->tick) + ": field 'solver': " + e;
+      return r;
+    }
     r.start_tick = c->tick;
     r.checkpoint = sim::checkpoint_file_name(c->tick);
   } else if (!j.header.field("opened").empty()) {
@@ -372,6 +380,9 @@ sim::Result<sim::World> DrapingSession::resume_world(uint64_t& first_tick) {
     cfg.finish_thread = true;
     auto solver = sim::make_solver(kSolver, cfg);
     if (!solver) return sim::Error{"resume: solver: " + solver.error()};
+    // The replayed solver's state goes on in it (sleep, settling, anchors).
+    const std::string e = solver.value()->restore_state(w->solver->save_state(w->cloth), w->cloth);
+    if (!e.empty()) rep_.note("resume: " + e + " (the solver starts afresh)");
     w->solver = std::move(solver.value());
   }
   return std::move(*w);
@@ -379,12 +390,11 @@ sim::Result<sim::World> DrapingSession::resume_world(uint64_t& first_tick) {
 
 namespace {
 
-// On the sim thread at the start of a checkpoint's tick: the journal's record first (a replay
-// restarts its solver there), then the copy, the fresh solver and the copy handed to the writer
-// (the old solver with it, to end off the sim thread).
+// On the sim thread at the start of a checkpoint's tick: the journal's record first, then the
+// copy of the World (its solver's state included) handed to the writer.
 void take_checkpoint(sim::World& w, sim::OperationController& ops, sim::JournalWriter& journal,
                      sim::CheckpointTaker& taker, sim::CheckpointWriter& writer,
-                     const std::map<std::string, std::string>& header, bool finish_in_tick) {
+                     const std::map<std::string, std::string>& header) {
   for (const std::string& e : writer.take_errors()) w.report("checkpoint: " + e);
   const std::string file = sim::checkpoint_file_name(w.tick);
   if (std::string e = journal.write(sim::JournalCheckpoint{w.tick, file}); !e.empty()) {
@@ -392,12 +402,7 @@ void take_checkpoint(sim::World& w, sim::OperationController& ops, sim::JournalW
     journal.close();
     return;
   }
-  auto solver = make_session_solver(finish_in_tick);
-  if (!solver) throw std::runtime_error("checkpoint: solver: " + solver.error());
-  auto c = taker.take(w, ops, header);
-  std::shared_ptr<sim::Solver> old = std::move(w.solver);
-  w.solver = std::move(solver.value());
-  writer.submit(std::move(c), file, std::move(old));
+  writer.submit(taker.take(w, ops, header), file);
 }
 
 }  // namespace
@@ -409,11 +414,11 @@ void DrapingSession::install_checkpoints(sim::World& w) {
   checkpoints_ = std::make_unique<sim::CheckpointWriter>(opt_.record_dir);
   auto taker = std::make_shared<sim::CheckpointTaker>();
   w.at_tick_start = [every, taker, journal = journal_, ops = ops_, writer = checkpoints_.get(),
-                     header = journal_header(opt_).fields, in_tick = opt_.sim_lock_step,
+                     header = journal_header(opt_).fields,
                      cost = checkpoint_cost_](sim::World& world) {
     if (world.tick == 0 || world.tick % every != 0 || !journal->is_open()) return;
     const auto t0 = std::chrono::steady_clock::now();
-    take_checkpoint(world, *ops, *journal, *taker, *writer, header, in_tick);
+    take_checkpoint(world, *ops, *journal, *taker, *writer, header);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     cost->store(std::max(cost->load(), ms));

@@ -67,7 +67,8 @@ sim::Result<sim::World> DrapingSession::open_world(uint64_t& first_tick) {
   if (!w) return sim::Error{"open: " + opt_.open_file + ": " + w.error()};
   ops_ = std::make_shared<sim::OperationController>();
   ops_->install(w.value());
-  sim::restore_checkpoint(c, w.value(), *ops_);
+  if (std::string e = sim::restore_checkpoint(c, w.value(), *ops_); !e.empty())
+    return sim::Error{"open: " + opt_.open_file + ": field 'solver': " + e};
   first_tick = opened_tick_ = c.tick;
   rep_.note("open: " + opt_.open_file + ": the session at tick " + std::to_string(c.tick) + " (" +
             std::to_string(c.undo.size()) + " undo steps, " + std::to_string(c.redo.size()) +

@@ -111,10 +111,10 @@ struct XrAppOptions {
   // When set: the session is recorded there (docs/sessions.md): journal.bin (the sim's inputs,
   // written from the sim thread), meta.json and, at the end, session.txt.
   std::string record_dir;
-  // With record_dir: a World checkpoint every this many seconds of session time (0: none), at
-  // which the sim restarts its solver (sim/ops/checkpoint.hpp). Off unless asked for: the
-  // restart re-cooks the cloth (a hitch of tens of ms at 128^2) and perturbs a moving drape.
-  double checkpoint_every_s = 0;
+  // With record_dir: a World checkpoint every this many seconds of session time (0: none),
+  // solver state included (sim/ops/checkpoint.hpp): the session goes on exactly as without it,
+  // and a resume replays at most this much of the journal (docs/sessions.md: the cost).
+  double checkpoint_every_s = 10;
   // When set: the session resumes the one recorded there (its scene options are the journal's):
   // its journal replayed to its last whole record, then the session goes on, appending to it.
   std::string resume_dir;

@@ -61,15 +61,16 @@ enum Key {
   kLeft,
   kRight,
   kEnter,
+  kF5,
   kKeys
 };
 constexpr int kGlfwKeys[kKeys] = {
-    GLFW_KEY_W,    GLFW_KEY_A,  GLFW_KEY_S,          GLFW_KEY_D,           GLFW_KEY_Q,
-    GLFW_KEY_E,    GLFW_KEY_F,  GLFW_KEY_1,          GLFW_KEY_2,           GLFW_KEY_3,
-    GLFW_KEY_4,    GLFW_KEY_M,  GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT, GLFW_KEY_Z,
-    GLFW_KEY_X,    GLFW_KEY_C,  GLFW_KEY_G,          GLFW_KEY_U,           GLFW_KEY_T,
-    GLFW_KEY_P,    GLFW_KEY_UP, GLFW_KEY_DOWN,       GLFW_KEY_LEFT,        GLFW_KEY_RIGHT,
-    GLFW_KEY_ENTER};
+    GLFW_KEY_W,     GLFW_KEY_A,  GLFW_KEY_S,          GLFW_KEY_D,           GLFW_KEY_Q,
+    GLFW_KEY_E,     GLFW_KEY_F,  GLFW_KEY_1,          GLFW_KEY_2,           GLFW_KEY_3,
+    GLFW_KEY_4,     GLFW_KEY_M,  GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT, GLFW_KEY_Z,
+    GLFW_KEY_X,     GLFW_KEY_C,  GLFW_KEY_G,          GLFW_KEY_U,           GLFW_KEY_T,
+    GLFW_KEY_P,     GLFW_KEY_UP, GLFW_KEY_DOWN,       GLFW_KEY_LEFT,        GLFW_KEY_RIGHT,
+    GLFW_KEY_ENTER, GLFW_KEY_F5};
 
 double seconds_now() {
   return static_cast<double>(now_ns()) * 1e-9;
@@ -170,6 +171,7 @@ struct Window {
   size_t cycle_at = 0;
   bool cycle_ready = false;
   bool quit_sent = false;
+  int64_t menu_until = -1;  // F5: the menu button is held until this frame
   FILE* log_file = nullptr;
   std::string shown_title;
 
@@ -556,6 +558,14 @@ void init_profile_cycle(Window* w, Session* s, Instance* inst) {
 }
 }  // namespace
 
+// F5 (a tap) holds the menu button for kMenuHoldFrames of the runtime's frames: 1.1 s of its
+// frame time, past the 1 s for which the drape app saves the session (button.menu_hold).
+constexpr int64_t kMenuHoldFrames = 100;
+bool menu_held(Window* w, const RawInput& r, int64_t frame) {
+  if (r.key[kF5].presses > 0 || r.key[kF5].down) w->menu_until = frame + kMenuHoldFrames;
+  return frame < w->menu_until;
+}
+
 void window_wait_frame(Session* s, int64_t frame) {
   Window* w = s->window.get();
   Instance* inst = instance_of(s);
@@ -577,6 +587,7 @@ void window_wait_frame(Session* s, int64_t frame) {
   // A key is on for this frame when it is down or was pressed since the last one.
   auto on = [&](Key k) { return r.key[k].down || r.key[k].presses > 0; };
   auto held = [&](Key k) { return static_cast<float>(std::min(r.key[k].held, 0.25)); };
+  const bool menu = on(kM) || menu_held(w, r, frame);
 
   init_profile_cycle(w, s, inst);
   if (w->cycle_ready && w->cycle.size() > 1 && r.tab > 0) {
@@ -677,7 +688,7 @@ void window_wait_frame(Session* s, int64_t frame) {
     ck.inputs["trigger/touch"] = {k.pinch, 0};
     ck.inputs["select/click"] = {k.pinch, 0};
     ck.inputs["squeeze/value"] = {k.fist, 0};
-    ck.inputs["menu/click"] = {on(kM) ? 1.f : 0.f, 0};
+    ck.inputs["menu/click"] = {menu ? 1.f : 0.f, 0};
     if (h == 1) {
       ck.inputs["a/click"] = {on(k1) ? 1.f : 0.f, 0};
       ck.inputs["b/click"] = {on(k2) ? 1.f : 0.f, 0};
@@ -699,7 +710,7 @@ void window_wait_frame(Session* s, int64_t frame) {
                                                             : std::string()) +
       " | WASD/QE move, right-drag look, R reset, LMB pinch, F fist, Z/X/C/G/U/T "
       "gestures, arrows/Enter stick, wheel depth, Shift left hand, Tab profile, "
-      "V eyes, Esc quit";
+      "F5 menu held 1.1 s (save), V eyes, Esc quit";
   if (title != w->shown_title) {
     w->shown_title = title;
     std::lock_guard<std::mutex> g(w->mu);
@@ -721,7 +732,7 @@ void window_wait_frame(Session* s, int64_t frame) {
                  w->yaw, w->pitch, act ? "right" : "left", L.x, L.y, L.z, R.x, R.y, R.z,
                  w->hands[0].pinch > 0.5f, w->hands[1].pinch > 0.5f, w->hands[0].fist > 0.5f,
                  w->hands[1].fist > 0.5f, w->hands[0].wheel, w->hands[1].wheel, hd.z, on(k1),
-                 on(k2), on(k3), on(k4), on(kM), over ? "in" : "out", eye, depth,
+                 on(k2), on(k3), on(k4), menu, over ? "in" : "out", eye, depth,
                  w->both ? "both" : "left", profile.c_str(), gesture_name(w->hands[0]),
                  gesture_name(w->hands[1]), hd.stick.x, hd.stick.y, hd.stick_click ? 1 : 0);
     std::fflush(w->log_file);

@@ -581,7 +581,6 @@ void XpbdSolver::renew_anchors(Step& c) {
   if (!cooked_f32_ || !c.padded) return;
   const int n = c.n;
   const auto& x = c.x;
-  const xpbd::Kernels& K = c.K;
   const double* xd = reinterpret_cast<const double*>(x.data());
   bool renew = anchors_.size() != static_cast<size_t>(3 * (n + scratch_slots_));
   const double reach2 = kAnchorReach * kAnchorReach;
@@ -591,16 +590,23 @@ void XpbdSolver::renew_anchors(Step& c) {
   if (!renew) return;
   anchors_.assign(xd, xd + 3 * n);
   anchors_.resize(3 * (n + scratch_slots_), 0.0);  // the scratch vertices (their P4f: 0)
+  anchor_terms();
+  ++anchor_renewals_;
+}
+
+void XpbdSolver::anchor_terms() {
+  const xpbd::Kernels& K = *kern_;
+  const bool wide = tlanes_ == 16;
   pool_->parallel_for(float_tri_packs(), [&](int b, int e, int) {
-    if (c.wide_t)
+    if (wide)
       K.anchor_triangles16(tri_packs16_.data(), b, e, anchors_.data(), tri_anchor8_.data());
     else
       K.anchor_triangles(tri_packs8_.data(), b, e, anchors_.data(), tri_anchor8_.data());
   });
+  const xpbd::RowPacksT<float> rp8 = row_packs8_.view();
   pool_->parallel_for(row_packs8_.packs(), [&](int b, int e, int) {
-    K.anchor_rows(c.rp8, b, e, anchors_.data(), row_anchor8_.data());
+    K.anchor_rows(rp8, b, e, anchors_.data(), row_anchor8_.data());
   });
-  ++anchor_renewals_;
 }
 
 void XpbdSolver::substep(Step& c) {

@@ -39,6 +39,13 @@ class XpbdSolver : public Solver {
   std::string name() const override { return "xpbd"; }
   StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) override;
   ThreadPool* pool() override { return pool_.get(); }
+  // What carries from one step to the next (xpbd_state.cpp): the warm-start multipliers (with
+  // warm_start > 0; else they start at zero in every substep), the last substep's length, the
+  // single-precision anchors and the rest scheduler's state. The element data are cooked again
+  // from the cloth on restore (the same cloth: the same data); contacts, self-collision pairs
+  // and the inverse masses are found again at every frame's start.
+  std::vector<unsigned char> save_state(const Cloth& cloth) const override;
+  std::string restore_state(const std::vector<unsigned char>& bytes, const Cloth& cloth) override;
   XpbdOptions& options() { return opt_; }
   int frozen_count() const { return rest_.frozen_count(); }
   // Ties (xpbd_ties.hpp: a sewn garment's seams), projected tie_passes times after the elements
@@ -134,6 +141,8 @@ class XpbdSolver : public Solver {
   // The step's phases, in the order step() and substep() run them.
   bool begin_frame(Step& c);    // wake, finish, settling checks; false: everything sleeps
   void renew_anchors(Step& c);  // single precision: new anchors once a vertex left its own
+  void anchor_terms();          // the elements' terms at the anchors (anchors_)
+  std::string read_state(ByteReader& in, const Cloth& cloth);
   void substep(Step& c);
   void detect_contacts(Step& c);
   void set_masses(Step& c);  // w and the bending blocks' inverses

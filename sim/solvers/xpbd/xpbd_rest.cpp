@@ -21,6 +21,83 @@ void RestScheduler::reset(int pieces, std::vector<int> piece_of) {
   finish_.assign(num_pieces_, 0);
 }
 
+void RestScheduler::save(ByteWriter& o) const {
+  o.i32(num_pieces_);
+  o.i32(frozen_count_);
+  o.u8(masses_dirty_ ? 1 : 0);
+  o.array(piece_of_.data(), piece_of_.size());
+  o.array(rest_.data(), rest_.size());
+  o.array(frozen_.data(), frozen_.size());
+  o.array(awake_.data(), awake_.size());
+  o.array(scale_.data(), scale_.size());
+  o.array(slow_.data(), slow_.size());
+  o.array(full_.data(), full_.size());
+  o.array(fixed_prev_.data(), fixed_prev_.size());
+  o.array(reinterpret_cast<const double*>(motion_.data()), motion_.size(), 4);
+  o.array(group_.data(), group_.size());
+  o.array(coarse_done_.data(), coarse_done_.size());
+  std::vector<int> finish = finish_;
+  for (int& f : finish)
+    if (f == kFinishing) f = 0;  // the job is not saved: it starts again
+  o.array(finish.data(), finish.size());
+  o.u8(finisher_ ? 1 : 0);
+  if (finisher_) {
+    const auto& a = finisher_->anchors();
+    o.array(reinterpret_cast<const double*>(a.data()), a.size(), 3);
+  }
+}
+
+bool RestScheduler::restore(ByteReader& in) {
+  const int pieces = in.i32();
+  frozen_count_ = in.i32();
+  masses_dirty_ = in.u8() != 0;
+  std::vector<int> piece_of;
+  in.array<int>(piece_of);
+  if (!in.ok || pieces != num_pieces_ || piece_of != piece_of_) return false;
+  in.array<int>(rest_);
+  in.array<uint8_t>(frozen_);
+  in.array<uint8_t>(awake_);
+  in.array<double>(scale_);
+  in.array<int>(slow_);
+  in.array<int>(full_);
+  in.array<uint8_t>(fixed_prev_);
+  in.array<double>(motion_, 4);
+  in.array<int>(group_);
+  in.array<int>(coarse_done_);
+  in.array<int>(finish_);
+  const size_t np = static_cast<size_t>(num_pieces_);
+  for (const size_t s : {rest_.size(), frozen_.size(), awake_.size(), scale_.size(), slow_.size(),
+                         full_.size(), motion_.size(), coarse_done_.size(), finish_.size()})
+    if (s != np) return false;
+  if (fixed_prev_.size() != piece_of_.size() || frozen_count_ < 0) return false;
+  for (int g : group_)
+    if (g < -1 || g >= num_pieces_) return false;
+  for (int f : finish_)
+    if (f < -1) return false;
+  if (!all_finite(scale_.data(), scale_.size()) ||
+      !all_finite(reinterpret_cast<const double*>(motion_.data()), 4 * motion_.size()))
+    return false;
+  for (double sc : scale_)
+    if (sc < 1) return false;  // an inertia scale: 1 (own mass) or more
+  finisher_.reset();
+  if (in.u8() != 0) {
+    std::vector<Vec3> anchors;
+    in.array<double>(anchors, 3);
+    if (!all_finite(reinterpret_cast<const double*>(anchors.data()), 3 * anchors.size()))
+      return false;
+    finisher_ = std::make_unique<EquilibriumFinisher>();
+    finisher_->set_anchors(std::move(anchors));
+  }
+  return in.ok;
+}
+
+void RestScheduler::forget() {
+  finisher_.reset();
+  group_.clear();
+  frozen_count_ = 0;
+  masses_dirty_ = true;
+}
+
 double RestScheduler::settle_scale() const {
   double m = 1.0;
   for (double s : scale_) m = std::max(m, s);

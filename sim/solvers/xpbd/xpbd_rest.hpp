@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/core/byte_io.hpp"
 #include "sim/core/thread_pool.hpp"
 #include "sim/energy/energy.hpp"
 #include "sim/energy/self_collision.hpp"
@@ -89,6 +90,16 @@ class RestScheduler {
   // The static finish of sleeping pieces (XpbdOptions::finish), on the solver's pool or its own
   // thread.
   void finish_sleeping(Cloth& cloth, const SceneObjects& scene, ThreadPool* pool);
+
+  // The state carried from one step to the next (per piece: sleep, settling, corrections and
+  // finish cycles done; per vertex: fixed at the last step; the finish's friction anchors), for
+  // the solver's saved state (Solver::save_state). A finish job running on its own thread is not
+  // saved: its pieces are saved as not yet finished, and a restored scheduler starts the job
+  // again. restore() follows reset() for the same topology; false when the bytes do not fit it.
+  void save(ByteWriter& o) const;
+  bool restore(ByteReader& in);
+  // After a failed restore() and reset(): what reset() keeps goes too (as a fresh scheduler).
+  void forget();
 
   const CoarseStats& last_coarse() const { return coarse_last_; }
   int coarse_count() const { return coarse_count_; }

@@ -1,7 +1,8 @@
 // World checkpoints (sim/ops/checkpoint.cpp): the file round trip bit for bit, a world restored
-// from a checkpoint that goes on to exactly the state of the world it was taken from (the
-// solver restarted in both, as sessions do), history entries copied once, and files cut off,
-// corrupted or naming vertices the cloth lacks: errors naming the file, the byte and the field.
+// from a checkpoint that goes on to exactly the state of the world it was taken from (its
+// solver's state restored: checkpoint_solver_test.cpp), history entries copied once, and files cut
+// off, corrupted or naming vertices the cloth lacks: errors naming the file, the byte and the
+// field.
 #include "sim/ops/checkpoint.hpp"
 
 #include <gtest/gtest.h>
@@ -19,12 +20,6 @@ namespace {
 using testing::hand_at;
 using testing::Initial;
 using testing::tick;
-
-std::unique_ptr<Solver> fresh_solver() {
-  XpbdOptions o;
-  o.substeps = 20;
-  return std::make_unique<XpbdSolver>(o);
-}
 
 // A stroke across the 9 x 9 panel on its surface: between grid rows j and j + 1.
 std::vector<Vec3> across(const Cloth& c, int j) {
@@ -108,7 +103,6 @@ TEST(Checkpoint, RestoredWorldGoesOnToTheSameState) {
   const auto bytes = encode_checkpoint(*c);
   const uint64_t at_checkpoint = state_hash(a.w.cloth);
   const size_t strokes = a.c.state().cut_strokes.size();
-  a.w.solver = fresh_solver();  // the session restarts its solver at the checkpoint
   Session::go_on(a.w, a.c, 30);
   EXPECT_NE(state_hash(a.w.cloth), at_checkpoint);
   // The stroke drawn across the checkpoint ended, then the first cut was undone too.
@@ -121,8 +115,7 @@ TEST(Checkpoint, RestoredWorldGoesOnToTheSameState) {
   ctl.install(w);
   WorldCheckpoint back;
   ASSERT_EQ(decode_checkpoint(bytes.data(), bytes.size(), "mem", back), "");
-  restore_checkpoint(back, w, ctl);
-  w.solver = fresh_solver();
+  ASSERT_EQ(restore_checkpoint(back, w, ctl), "");
   Session::go_on(w, ctl, 30);
   EXPECT_EQ(state_hash(w.cloth), state_hash(a.w.cloth));
   EXPECT_EQ(ctl.history().undo_size(), a.c.history().undo_size());

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <map>
@@ -15,6 +17,26 @@
 #include "sim/core/types.hpp"
 
 namespace drape::sim {
+
+// Scalars of arithmetic type T (double, float, integers) as little-endian bytes: a copy of the
+// memory on a little-endian host, byte by byte otherwise.
+template <class T>
+void copy_little_endian(unsigned char* to, const unsigned char* from, size_t count) {
+  if constexpr (std::endian::native == std::endian::little) {
+    if (count > 0) std::memcpy(to, from, count * sizeof(T));
+  } else {
+    for (size_t k = 0; k < count; ++k)
+      for (size_t b = 0; b < sizeof(T); ++b)
+        to[k * sizeof(T) + b] = from[k * sizeof(T) + sizeof(T) - 1 - b];
+  }
+}
+
+// True when the n doubles from p are all finite (a state read back must not bring NaN or inf).
+inline bool all_finite(const double* p, size_t n) {
+  for (size_t k = 0; k < n; ++k)
+    if (!std::isfinite(p[k])) return false;
+  return true;
+}
 
 struct ByteWriter {
   std::vector<unsigned char> b;
@@ -59,6 +81,15 @@ struct ByteWriter {
     f64(h.orientation.z());
     vec3(h.tip);
     f64(h.radius);
+  }
+  // An array of `count` items of `per_item` scalars T each (a Vec3 is 3 doubles): the item
+  // count, then the scalars.
+  template <class T>
+  void array(const T* v, size_t count, size_t per_item = 1) {
+    u32(static_cast<uint32_t>(count));
+    const size_t at = b.size(), scalars = count * per_item;
+    b.resize(at + scalars * sizeof(T));
+    copy_little_endian<T>(b.data() + at, reinterpret_cast<const unsigned char*>(v), scalars);
   }
 };
 
@@ -126,6 +157,17 @@ struct ByteReader {
     h.tip = vec3();
     h.radius = f64();
     return h;
+  }
+  // An array written by ByteWriter::array into `out` (items of `per_item` scalars T): false
+  // (and `ok` false) when the count exceeds the bytes left.
+  template <class T, class Item>
+  bool array(std::vector<Item>& out, size_t per_item = 1) {
+    const uint32_t c = count(per_item * sizeof(T));
+    if (!ok || sizeof(Item) != per_item * sizeof(T)) return ok = false;
+    out.resize(c);
+    copy_little_endian<T>(reinterpret_cast<unsigned char*>(out.data()), p + i, c * per_item);
+    i += c * per_item * sizeof(T);
+    return true;
   }
 };
 
