@@ -66,11 +66,12 @@ class XrHandSource : public HandSource {
   void stick_edges(Hand h, const XrControllerInput& in);
   void pad_edges(Hand h, const XrControllerInput& in);
   void palm_up_edge(Hand h, const XrControllerInput& in);
-  void menu_hold_edge(Hand h, const XrControllerInput& in);
+  void menu_edges(Hand h, const XrControllerInput& in);
   bool trigger_down_[2] = {false, false};
-  double menu_since_[2] = {-1, -1};  // when the menu button went down; -1: up
-  int stick_dir_[2] = {-1, -1};      // 0 up, 1 down, 2 left, 3 right; -1 centred
-  int pad_region_[2] = {-1, -1};     // as stick_dir_, 4 centre; -1 not clicked
+  double menu_since_[2] = {-1, -1};     // when the menu button went down; -1: up
+  bool menu_held_[2] = {false, false};  // this press reached kMenuHoldSeconds (no tap)
+  int stick_dir_[2] = {-1, -1};         // 0 up, 1 down, 2 left, 3 right; -1 centred
+  int pad_region_[2] = {-1, -1};        // as stick_dir_, 4 centre; -1 not clicked
   bool palm_up_[2] = {false, false};
   std::vector<std::pair<std::string, bool>> buttons_[2];
   double last_time_ = -1;

@@ -92,16 +92,26 @@ void XrHandSource::palm_up_edge(Hand h, const XrControllerInput& in) {
   edge(h, "palm_up", on, in.time);
 }
 
-// The menu button held for kMenuHoldSeconds: one begin per press (its press alone is
-// "button.menu"), the end when it is let go.
-void XrHandSource::menu_hold_edge(Hand h, const XrControllerInput& in) {
-  double& since = menu_since_[static_cast<int>(h)];
+// The menu button: a press let go before kMenuHoldSeconds is a tap, "button.menu" (begin and
+// end when it is let go); a press held that long is "button.menu_hold" alone (begin at the
+// second, end when let go). Holding the button to save therefore never also stops or undoes; a
+// controller lost while the button is down gives neither.
+void XrHandSource::menu_edges(Hand h, const XrControllerInput& in) {
+  const int i = static_cast<int>(h);
+  double& since = menu_since_[i];
   const bool down = in.menu && in.active;
-  if (!down)
+  if (down && since < 0) since = in.time;
+  const bool held = down && in.time - since >= kMenuHoldSeconds;
+  if (held) menu_held_[i] = true;
+  if (!down && since >= 0) {
+    if (in.active && !menu_held_[i]) {
+      edge(h, "button.menu", true, in.time);
+      edge(h, "button.menu", false, in.time);
+    }
     since = -1;
-  else if (since < 0)
-    since = in.time;
-  edge(h, "button.menu_hold", down && in.time - since >= kMenuHoldSeconds, in.time);
+    menu_held_[i] = false;
+  }
+  edge(h, "button.menu_hold", held, in.time);
 }
 
 void XrHandSource::feed_controller(Hand h, const XrControllerInput& in) {
@@ -123,8 +133,7 @@ void XrHandSource::feed_controller(Hand h, const XrControllerInput& in) {
   edge(h, "button.squeeze", in.squeeze && in.active, in.time);
   edge(h, "button.a", in.a && in.active, in.time);
   edge(h, "button.b", in.b && in.active, in.time);
-  edge(h, "button.menu", in.menu && in.active, in.time);
-  menu_hold_edge(h, in);
+  menu_edges(h, in);
   edge(h, "button.stick", in.stick_click && in.active, in.time);
   stick_edges(h, in);
   pad_edges(h, in);
