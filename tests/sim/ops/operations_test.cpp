@@ -42,6 +42,14 @@ struct Ops : ::testing::TestWithParam<Initial> {
     c->set_hands(w, hands);
   }
   void trig(const char* name, TriggerPhase ph, int hand = 1) { c->trigger(w, name, ph, hand); }
+  // The parametric 9AR dress form in the scene (what map and smooth act on).
+  void add_form_9ar() {
+    auto m = measurements_for_size("9AR");
+    ASSERT_TRUE(m.ok()) << m.error();
+    auto form = DressForm::from_measurements(*m);
+    ASSERT_TRUE(form.ok()) << form.error();
+    w.scene.form = std::make_shared<const DressForm>(std::move(*form));
+  }
   void run(int ticks) {
     for (int i = 0; i < ticks; ++i) {
       c->set_hands(w, hands);
@@ -597,11 +605,7 @@ TEST_P(Ops, MapWithoutFormIsRefusedWithAReason) {
 
 TEST_P(Ops, MapOntoTheFormAlongCentreFront) {
   SetUpWorld(2);
-  auto m = measurements_for_size("9AR");
-  ASSERT_TRUE(m.ok()) << m.error();
-  auto form = DressForm::from_measurements(*m);
-  ASSERT_TRUE(form.ok()) << form.error();
-  w.scene.form = std::make_shared<const DressForm>(std::move(*form));
+  ASSERT_NO_FATAL_FAILURE(add_form_9ar());
   const DressForm& f = *w.scene.form;
   const uint64_t h0 = state_hash(w.cloth);
   trig("map", TriggerPhase::kBegin);
@@ -640,11 +644,7 @@ TEST_P(Ops, MapOntoTheFormAlongCentreFront) {
 // with the top edge and the centre line (the lines the design pipeline's relaxation holds).
 TEST_P(Ops, MapFromBehindTheFormPutsTheGrainOnCentreBack) {
   SetUpWorld(2);
-  auto m = measurements_for_size("9AR");
-  ASSERT_TRUE(m.ok()) << m.error();
-  auto form = DressForm::from_measurements(*m);
-  ASSERT_TRUE(form.ok()) << form.error();
-  w.scene.form = std::make_shared<const DressForm>(std::move(*form));
+  ASSERT_NO_FATAL_FAILURE(add_form_9ar());
   const DressForm& f = *w.scene.form;
   set(1, Vec3(0.1, 1.0, -0.5));  // behind the form
   trig("map", TriggerPhase::kBegin, 1);
