@@ -989,21 +989,25 @@ void XpbdSolver::project_self_after_sweep(Step& c) {
   if (self_.contacts().empty()) return;
   self_moved_.clear();
   self_.project(c.cloth, c.x, c.w, c.scene.offset, &self_moved_);
-  for (const int i : self_moved_)
+  refresh_velocities(c, self_moved_);
+}
+
+// The velocities of free vertices moved after the element sweep, computed again from their
+// corrected positions as velocities() does (the sweep has already set them from the old ones).
+void XpbdSolver::refresh_velocities(Step& c, const std::vector<int>& moved) {
+  for (const int i : moved)
     if (c.w[i] > 0)
       c.S.v[i] = ((c.scale[c.piece_of[i]] > 1.0 ? c.damp_settle : c.damp) / c.h) *
                  (c.x[i] - c.S.x_prev[i]);
 }
 
 // Ties in a substep run as one element sweep: projected after it, then the velocities of the
-// vertices they moved computed again from their corrected positions, as velocities() does.
+// vertices they moved computed again.
 void XpbdSolver::project_ties_after_sweep(Step& c) {
   if (ties_.empty()) return;
   tie_moved_.clear();
   for (int p = 0; p < tie_passes_; ++p) xpbd::project_ties(ties_, c.x, c.w, &tie_moved_);
-  for (const int i : tie_moved_)
-    c.S.v[i] =
-        ((c.scale[c.piece_of[i]] > 1.0 ? c.damp_settle : c.damp) / c.h) * (c.x[i] - c.S.x_prev[i]);
+  refresh_velocities(c, tie_moved_);
 }
 
 void XpbdSolver::project_hinges(const Step& c, int b, int e) {

@@ -155,6 +155,7 @@ class XpbdSolver : public Solver {
   void project_bending_springs(Step& c);  // hinges, springs, contacts, self-collision
   void project_self_after_sweep(Step& c);
   void project_ties_after_sweep(Step& c);
+  void refresh_velocities(Step& c, const std::vector<int>& moved);
   void velocities(const Step& c, int b, int e, int wk);
   void update_pieces(Step& c);  // the pieces' motion sums
   void schedule_rest(Step& c);  // settling and sleep
