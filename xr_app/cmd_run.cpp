@@ -350,6 +350,7 @@ int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
   o.app.api_layers = app::loader_api_layers();
   if (o.app.record_dir.empty() && o.record) o.app.record_dir = default_record_dir(o.out);
   if (!app::prepare_record_dir("drape run", o.app.record_dir)) return 2;
+  if (!app::resolve_garment("drape run", o.app)) return 2;
   if (!o.app.record_dir.empty())
     std::printf("drape run: recording the session into %s\n", o.app.record_dir.c_str());
   std::printf("drape run: live, %d x %d %s cloth, start %s, form %s, eyes %d px\n", o.app.cloth_res,
@@ -578,6 +579,7 @@ int run_xr(XrRunOptions& o) {
   o.app.commands_path = app::commands_file("");
   o.app.api_layers = app::loader_api_layers();
   if (!app::prepare_record_dir("drape run", o.app.record_dir)) return 2;
+  if (!app::resolve_garment("drape run", o.app)) return 2;
   std::printf("drape run: runtime manifest %s, scenario %s, live voice %s\n",
               manifest.empty() ? "(system active runtime)" : manifest.c_str(), o.scenario.c_str(),
               o.app.voice_input.empty() ? "off" : o.app.voice_input.c_str());

@@ -201,6 +201,7 @@ int cmd_xr(int argc, char** argv) {
                               opt.hands_key))
     return 2;
   if (!app::prepare_record_dir("drape xr", opt.record_dir)) return 2;
+  if (!app::resolve_garment("drape xr", opt)) return 2;
   std::fprintf(stderr, "drape xr: runtime manifest: %s\n",
                manifest.empty() ? "(system active runtime)" : manifest.c_str());
   std::fprintf(stderr, "drape xr: live voice: %s\n",

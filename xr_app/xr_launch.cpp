@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "sim/core/fabric.hpp"
 #include "xr_app/paths.hpp"
 
 namespace drape::app {
@@ -109,6 +110,13 @@ void add_app_options(CLI::App& cli, XrAppOptions& opt) {
                           "no feedback panel over the scene (tests of the cloth's image)"},
                          {"--no-board", &opt.pattern_board,
                           "no live pattern board beside the form (its cost: drape bench board)"}});
+  cli.add_option("--garment", opt.garment,
+                 "instead of the panel, the sewn garment of a skirt design (assets/designs/ by "
+                 "name, or a design file) on the form, simulated with its seams as ties")
+      ->type_name("NAME|FILE.json");
+  cli.add_option("--garment-fabric", opt.garment_fabric,
+                 "with --garment: a fabric of assets/fabrics.json (default: the design's)")
+      ->type_name("NAME");
   cli.add_option_function<std::string>(
          "--assets", [](const std::string& dir) { set_assets_dir(dir); },
          "the assets directory (default: <exe dir>/../share/drape/assets)")
@@ -329,6 +337,33 @@ void add_record_option(CLI::App& cli, std::string& dir, double& checkpoint_every
                  "solver's state, so the session goes on as without it")
       ->check(CLI::Range(0.0, 3600.0))
       ->capture_default_str();
+}
+
+bool resolve_garment(const char* command, XrAppOptions& opt) {
+  auto bad = [&](const std::string& why) {
+    std::fprintf(stderr, "%s: %s\n", command, why.c_str());
+    return false;
+  };
+  if (opt.garment.empty())
+    return opt.garment_fabric.empty() || bad("--garment-fabric: needs --garment");
+  if (!opt.record_dir.empty() || !opt.resume_dir.empty() || !opt.open_file.empty())
+    return bad("--garment: a garment session is not recorded, resumed or opened");
+  const bool named =
+      opt.garment.find('/') == std::string::npos && opt.garment.find(".json") == std::string::npos;
+  const std::string path = named ? asset("designs/" + opt.garment + ".json").string() : opt.garment;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    return bad("--garment: no such design: " + opt.garment + " (" + path + ")");
+  opt.garment = path;
+  if (opt.fabrics_path.empty()) opt.fabrics_path = asset("fabrics.json").string();
+  if (!opt.garment_fabric.empty()) {
+    auto f = sim::load_fabric(opt.fabrics_path, opt.garment_fabric);
+    if (!f) return bad("--garment-fabric " + opt.garment_fabric + ": " + f.error());
+  }
+  // The board and the end's pattern read a draped panel, not a sewn garment.
+  opt.pattern_board = false;
+  opt.export_pattern = false;
+  return true;
 }
 
 bool prepare_record_dir(const char* command, const std::string& dir) {

@@ -100,5 +100,10 @@ void add_record_option(CLI::App& cli, std::string& dir, double& checkpoint_every
 // After parsing: creates `dir` (when set) and checks that a file can be written there; else
 // prints "<command>: --record DIR: ..." and returns false.
 bool prepare_record_dir(const char* command, const std::string& dir);
+// After parsing --garment NAME|FILE (add_app_options): the design file (a name is looked up in
+// the assets' designs/), the fabrics file, no board or end-of-session pattern (they read a
+// draped panel); false (printed "<command>: --garment...: ...") for a missing design or fabric,
+// --garment-fabric without --garment, or a garment with --record, --resume or open.
+bool resolve_garment(const char* command, XrAppOptions& opt);
 
 }  // namespace drape::app

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "sim/core/types.hpp"
+#include "sim/form/dress_form.hpp"
 #include "sim/testbeds/testbed.hpp"
 #include "xr_app/app/xr_app.hpp"
 
@@ -24,5 +25,10 @@ bool is_desk_start(const std::string& name);
 // the form of opt.form_* in the start state opt.start. Errors: "--fabric: <file>: ...", "--form
 // <file>: ...", "--mesh <file>: ...", "--start: ...".
 sim::Result<sim::Testbed> make_desk_scene(const XrAppOptions& opt);
+
+// The scene's parts on their own: the fabric opt.fabric of opt.fabrics_path (the built-in muslin
+// when no file is given) and the form of opt.form_*; errors as make_desk_scene's.
+sim::Result<sim::FabricParams> desk_fabric(const XrAppOptions& opt);
+sim::Result<sim::DressForm> desk_form(const XrAppOptions& opt);
 
 }  // namespace drape::app

@@ -18,6 +18,7 @@
 #include "sim/solvers/solver_factory.hpp"
 #include "sim/testbeds/testbed.hpp"
 #include "xr_app/app/desk_scene.hpp"
+#include "xr_app/app/garment_scene.hpp"
 #include "xr_app/app/session_pattern_export.hpp"
 #include "xr_app/app/session_record.hpp"
 #include "xr_app/output_files.hpp"
@@ -133,6 +134,7 @@ bool DrapingSession::create(const VulkanDevice& device) {
     rep_.r.error = w.error();
     return false;
   }
+  if (!opt_.garment.empty()) rep_.note(garment_status(w.value(), 0) + " (" + opt_.garment + ")");
   sim_ = std::make_unique<sim::SimThread>(std::move(w.value()), so);
   reader_ = sim_->make_reader();
   start_sim();
@@ -445,6 +447,7 @@ void DrapingSession::finish() {
   rep_.r.final_ticks = sim_->ticks();
   rep_.r.final_state_hash = sim::state_hash(w.cloth);
   rep_.r.has_final_state = true;
+  if (!opt_.garment.empty()) rep_.note(garment_status(w, rep_.r.final_ticks));
   if (journal_) close_record();
   if (ops_ && !opt_.out_dir.empty()) write_outputs(w);
 }

@@ -15,6 +15,7 @@
 #include "sim/testbeds/testbed.hpp"
 #include "xr_app/app/desk_scene.hpp"
 #include "xr_app/app/draping_session.hpp"
+#include "xr_app/app/garment_scene.hpp"
 
 #ifndef DRAPE_VERSION
 #define DRAPE_VERSION "unknown"
@@ -115,6 +116,7 @@ uint64_t checkpoint_ticks(double seconds) {
 }
 
 sim::Result<sim::World> make_session_world(const XrAppOptions& opt, bool finish_in_tick) {
+  if (!opt.garment.empty()) return make_garment_world(opt);  // its own solver (XPBD, ties)
   auto scene = opt.start.empty() ? sim::Result<sim::Testbed>(sim::make_form_drape(opt.cloth_res))
                                  : make_desk_scene(opt);
   if (!scene) return sim::Error{"scene: " + scene.error()};
