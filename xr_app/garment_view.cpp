@@ -11,6 +11,7 @@
 #include "render/camera.hpp"
 #include "render/image_io.hpp"
 #include "render/renderer.hpp"
+#include "xr_app/fit_map_legend.hpp"
 #endif
 
 namespace drape::app {
@@ -53,7 +54,7 @@ std::string write_fit_map(const std::string& png_path, const sim::Cloth& cloth,
   const int w = opt.tile_width, h = opt.tile_height;
   render::Image out;
   out.width = 2 * w;
-  out.height = 2 * h;
+  out.height = 2 * h + opt.legend_height;
   out.rgba.assign(static_cast<size_t>(out.width) * out.height * 4, 255);
   const float fov = 30.0f;
   for (int row = 0; row < 2; ++row)
@@ -74,6 +75,9 @@ std::string write_fit_map(const std::string& png_path, const sim::Cloth& cloth,
         std::copy_n(img->px(0, y), 4 * w,
                     &out.rgba[(static_cast<size_t>(row * h + y) * out.width + col * w) * 4]);
     }
+  if (std::string e = draw_fit_map_legend(out, 2 * h, {opt.ease_range_m, opt.strain_range});
+      !e.empty())
+    return png_path + ": " + e;
   return render::write_png(png_path, out);
 }
 #else

@@ -21,11 +21,13 @@ struct FitMapOptions {
   int tile_width = 480, tile_height = 640;  // pixels of each of the four views
   float ease_range_m = 0.02f;
   float strain_range = 0.05f;
+  int legend_height = 120;  // pixels of the legend under the views (fit_map_legend.hpp)
 };
 
 // Writes a PNG of four views of the cloth on the form: ease front, ease back (top row), strain
-// front, strain back (bottom row). "" or an error naming the file (or saying that this build has
-// no renderer).
+// front, strain back (bottom row), and under them the legend: each map's colour bar with its
+// range labelled (ease in mm, strain in %). "" or an error naming the file (or saying that this
+// build has no renderer).
 std::string write_fit_map(const std::string& png_path, const sim::Cloth& cloth,
                           std::shared_ptr<const sim::DressForm> form,
                           const FitMapOptions& opt = {});

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # `drape pattern --simulate`: the tight skirt sewn and draped on the form by XPBD writes its
-# simulated glTF, the fit map PNG (its signature and size read back), garment_sim.json (at rest,
-# seams closed, nothing in the form) and a scene file; a bodice design, an unknown fabric and
+# simulated glTF, the fit map PNG (its signature and size read back, its legend's colour bars and
+# labels: png_pixels.py legend), garment_sim.json (at rest, seams closed, nothing in the form)
+# and a scene file; a bodice design, an unknown fabric and
 # --fabric without --simulate are clear errors that write nothing.
 # usage: drape_pattern_simulate_test.sh DRAPE_EXE
 set -u
 exe=$(realpath "$1")
+here=$(cd "$(dirname "$0")" && pwd)
 source "$(dirname "$0")/cli_test_lib.sh"
 cli_test_setup drape_pattern_simulate
 
@@ -22,14 +24,16 @@ for f in pattern.svg report.json garment.gltf garment_sim.gltf fit_map.png garme
   garment_scene.json; do
   [ -s "sk/$f" ] || fail "sk/$f missing"
 done
-# The fit map is a PNG of two tiles by two (480 x 640 each).
-/usr/bin/python3 - sk/fit_map.png <<'PY' || fail "fit_map.png is not a 960 x 1280 PNG"
+# The fit map is a PNG of two tiles by two (480 x 640 each) over a legend of 120 rows.
+/usr/bin/python3 - sk/fit_map.png <<'PY' || fail "fit_map.png is not a 960 x 1400 PNG"
 import struct, sys
 b = open(sys.argv[1], "rb").read(24)
 assert b[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
 w, h = struct.unpack(">II", b[16:24])
-assert (w, h) == (960, 1280), (w, h)
+assert (w, h) == (960, 1400), (w, h)
 PY
+# The legend: each map's colour bar, its ends the map's ends, and its labels.
+/usr/bin/python3 "$here/png_pixels.py" legend sk/fit_map.png || fail "fit_map.png's legend"
 /usr/bin/python3 - sk/garment_sim.json <<'PY' || fail "garment_sim.json out of bounds"
 import json, sys
 j = json.load(open(sys.argv[1]))

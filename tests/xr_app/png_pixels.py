@@ -108,6 +108,14 @@ def check_legend(path):
         dark = sum(max(p) < 80 for p in bar)
         expect(ramp >= 2000, f"{name}: {ramp} pixels of its colour bar (>= 2000)")
         expect(dark >= 200, f"{name}: {dark} dark pixels of its labels (>= 200)")
+        # The bar's ends along its fullest row: ease red (tight) to blue (loose), strain blue
+        # (compressed) to red (stretched).
+        row = max(legend, key=lambda r: sum(saturated(r[x]) for x in half))
+        ends = [row[x] for x in half if saturated(row[x])]
+        red = lambda p: p[0] > p[2] + 80
+        blue = lambda p: p[2] > p[0] + 50
+        first, last = (red, blue) if name == "ease" else (blue, red)
+        expect(first(ends[0]) and last(ends[-1]), f"{name}: its bar runs {ends[0]} .. {ends[-1]}")
 
 
 if __name__ == "__main__":
