@@ -326,6 +326,20 @@ bool write_live_json(const std::string& path, const drape::app::XrAppResult& r,
   return static_cast<bool>(out);
 }
 
+// The live session's scene, as the first line says it.
+void print_live_scene(const drape::app::XrAppOptions& a) {
+  const char* form = !a.form_mesh.empty()           ? a.form_mesh.c_str()
+                     : !a.form_measurements.empty() ? a.form_measurements.c_str()
+                                                    : a.form_size.c_str();
+  if (a.garment.empty())
+    std::printf("drape run: live, %d x %d %s cloth, start %s, form %s, eyes %d px\n", a.cloth_res,
+                a.cloth_res, a.fabric.c_str(), a.start.c_str(), form, a.eye_size);
+  else
+    std::printf(
+        "drape run: live, the garment of %s (fabric %s), form %s, eyes %d px\n", a.garment.c_str(),
+        a.garment_fabric.empty() ? "the design's" : a.garment_fabric.c_str(), form, a.eye_size);
+}
+
 // Live at a desk: the simulated runtime's window (DRAPE_MOCK_WINDOW, docs/mock-window.md) is the
 // headset; the person drives the head and hands with mouse and keyboard, no scenario, the sim
 // on its own 90 Hz clock, until Escape or the window is closed (or --frames).
@@ -348,17 +362,17 @@ int run_live(XrRunOptions& o, const std::string& manifest, bool simulated) {
   o.app.sim_lock_step = o.lock_step;
   o.app.commands_path = app::commands_file("");
   o.app.api_layers = app::loader_api_layers();
+  // A journal's header names the panel's scene only: a garment session is not recorded.
+  if (!o.app.garment.empty() && o.app.record_dir.empty() && o.record) {
+    o.record = false;
+    std::printf("drape run: --garment: the session is not recorded (no journal of a garment)\n");
+  }
   if (o.app.record_dir.empty() && o.record) o.app.record_dir = default_record_dir(o.out);
   if (!app::prepare_record_dir("drape run", o.app.record_dir)) return 2;
   if (!app::resolve_garment("drape run", o.app)) return 2;
   if (!o.app.record_dir.empty())
     std::printf("drape run: recording the session into %s\n", o.app.record_dir.c_str());
-  std::printf("drape run: live, %d x %d %s cloth, start %s, form %s, eyes %d px\n", o.app.cloth_res,
-              o.app.cloth_res, o.app.fabric.c_str(), o.app.start.c_str(),
-              !o.app.form_mesh.empty()           ? o.app.form_mesh.c_str()
-              : !o.app.form_measurements.empty() ? o.app.form_measurements.c_str()
-                                                 : o.app.form_size.c_str(),
-              o.app.eye_size);
+  print_live_scene(o.app);
   if (simulated)
     std::printf(
         "drape run: live in the simulated runtime's window (%s): the mouse moves the right hand, "

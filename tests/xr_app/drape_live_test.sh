@@ -27,9 +27,10 @@
 #   out/saved_session.drape (xr_session.txt: the controller's "menu held 1 s -> save", no menu
 #   tap, and the save's line with its tick). `drape open` of that file in the window starts from its tick and
 #   exits 0; the file's saved tick is the one the log names.
-# scene: the scene's options (--fabric, --form, --mesh, --start, --resolution): bad values exit 2
-#   naming the option and file before a window opens; good ones run 20 live frames; a fakenect
-#   recording as the hands (--hands kinect --kinect-record) runs live to its last frame.
+# scene: the scene's options (--fabric, --form, --mesh, --start, --resolution, --garment): bad
+#   values exit 2 naming the option and file before a window opens; good ones (the sewn garment
+#   too) run 20 live frames; a fakenect recording as the hands (--hands kinect --kinect-record)
+#   runs live to its last frame.
 # --update-golden: the screenshots become the golden images (look at them before committing).
 set -uo pipefail
 EXE="$1" OUT="$2" MODE="${3:-free}"
@@ -76,6 +77,7 @@ if [ "$MODE" = scene ]; then
   bad "--mesh: no such file: nowhere.obj" --mesh nowhere.obj
   bad "--start: 'upside' is none of spread|rolled|pinned-top" --start upside
   bad "--resolution: Value 300 not in range 4 to 256" --resolution 300
+  bad "--garment: no such design: nosuch" --garment nosuch
   echo '{"bust_girth": -1}' >"$OUT/bad_form.json"
   bad "--form $OUT/bad_form.json: $OUT/bad_form.json" --form "$OUT/bad_form.json"
   "$EXE" form --size 11AR --export "$OUT/form.obj" >/dev/null || fail "drape form --export"
@@ -95,6 +97,9 @@ if [ "$MODE" = scene ]; then
   good "form $(cd "$(dirname "$0")/../.." && pwd)/assets/forms/7AR.json" \
     --form "$(cd "$(dirname "$0")/../.." && pwd)/assets/forms/7AR.json"
   good "form $OUT/form.obj" --mesh "$OUT/form.obj" --start spread
+  # The sewn garment instead of the panel (docs/xr.md, "The sewn garment in the app").
+  good "live, the garment of" --garment tight-skirt
+  grep -q "^garment: tick 0: 9516 vertices" "$OUT/good/xr_session.txt" || fail "--garment: not loaded"
   # --hands kinect --kinect-record: the program runs itself again under fakenect and still goes
   # live in the window; the recording's end is the session's status, and it runs to its last frame.
   python3 "$(dirname "$0")/kinect_record.py" "$OUT/rec" "$OUT/kinect.json" 0.11 1.15 0.115 \
