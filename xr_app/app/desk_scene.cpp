@@ -15,6 +15,16 @@ namespace {
 
 constexpr double kPanel = 0.5;  // m, the panel's side
 
+sim::Result<sim::FabricParams> desk_fabric(const XrAppOptions& o) {
+  if (o.fabrics_path.empty()) {
+    if (o.fabric == sim::FabricParams{}.name) return sim::FabricParams{};
+    return sim::make_error("--fabric", "no fabrics file to find '" + o.fabric + "' in");
+  }
+  auto f = sim::load_fabric(o.fabrics_path, o.fabric);
+  if (!f) return sim::make_error("--fabric " + o.fabric, f.error());
+  return f;
+}
+
 // Whether every vertex lies outside the form's contact shell (with 2 mm to spare).
 bool clear_of_form(const sim::Testbed& s) {
   for (const sim::Vec3& x : s.cloth.state.x)
@@ -54,16 +64,6 @@ void place_start(sim::Testbed& s, const std::string& start, int res, const sim::
 }
 
 }  // namespace
-
-sim::Result<sim::FabricParams> desk_fabric(const XrAppOptions& o) {
-  if (o.fabrics_path.empty()) {
-    if (o.fabric == sim::FabricParams{}.name) return sim::FabricParams{};
-    return sim::make_error("--fabric", "no fabrics file to find '" + o.fabric + "' in");
-  }
-  auto f = sim::load_fabric(o.fabrics_path, o.fabric);
-  if (!f) return sim::make_error("--fabric " + o.fabric, f.error());
-  return f;
-}
 
 sim::Result<sim::DressForm> desk_form(const XrAppOptions& o) {
   if (!o.form_mesh.empty()) {

@@ -26,9 +26,7 @@ bool is_desk_start(const std::string& name);
 // <file>: ...", "--mesh <file>: ...", "--start: ...".
 sim::Result<sim::Testbed> make_desk_scene(const XrAppOptions& opt);
 
-// The scene's parts on their own: the fabric opt.fabric of opt.fabrics_path (the built-in muslin
-// when no file is given) and the form of opt.form_*; errors as make_desk_scene's.
-sim::Result<sim::FabricParams> desk_fabric(const XrAppOptions& opt);
+// The scene's form on its own: that of opt.form_*; errors as make_desk_scene's.
 sim::Result<sim::DressForm> desk_form(const XrAppOptions& opt);
 
 }  // namespace drape::app

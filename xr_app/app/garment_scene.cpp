@@ -15,14 +15,19 @@
 namespace drape::app {
 namespace {
 
-// The fabric of the garment: opt.garment_fabric when given, else the design's; from the fabrics
-// file (none: only the built-in muslin).
+// The fabric of the garment: opt.garment_fabric when given, else the design's `own`; from the
+// fabrics file (none: only the built-in muslin).
 sim::Result<sim::FabricParams> garment_fabric(const XrAppOptions& opt, const std::string& own) {
-  XrAppOptions o = opt;
-  o.fabric = opt.garment_fabric.empty() ? own : opt.garment_fabric;
-  auto f = desk_fabric(o);
-  if (!f && opt.garment_fabric.empty())
-    return sim::make_error("--garment " + opt.garment, "the design's fabric: " + f.error());
+  const std::string name = opt.garment_fabric.empty() ? own : opt.garment_fabric;
+  const std::string what = opt.garment_fabric.empty()
+                               ? "--garment " + opt.garment + ": the design's fabric " + name
+                               : "--garment-fabric " + name;
+  if (opt.fabrics_path.empty()) {
+    if (name == sim::FabricParams{}.name) return sim::FabricParams{};
+    return sim::make_error(what, "no fabrics file to find it in");
+  }
+  auto f = sim::load_fabric(opt.fabrics_path, name);
+  if (!f) return sim::make_error(what, f.error());
   return f;
 }
 
