@@ -13,7 +13,7 @@
 #     the form's cover above it; the frame before the toggle (140) has under a tenth of them
 #     (png_pixels.py garment).
 # Bad input: an unknown design or fabric, --garment-fabric alone and a bodice design are errors
-# naming the option.
+# naming the option. A save asked for (scenarios/garment_save.json: the menu held 1 s) is refused.
 # usage: drape_garment_xr_test.sh DRAPE_EXE
 set -u
 exe=$(realpath "$1")
@@ -58,4 +58,14 @@ grep -q "^colour map: strain" "$log" && grep -q "^colour map: ease" "$log" ||
   fail "the colour map was not toggled to strain and ease"
 /usr/bin/python3 "$here/png_pixels.py" garment frames/frame_000140.png frames/frame_000230.png ||
   fail "the frames do not show the garment on the form"
+# Asked to save (the menu held 1 s): a garment session is not saved, and says so.
+unset DRAPE_MOCK_WRITE_FRAMES
+expect 0 "exiting" -- xr --garment tight-skirt --scenario "$here/scenarios/garment_save.json" \
+  --frames 130 --eye-size 64 --no-feedback-panel --out "$work/save"
+cp save/xr_session.txt out.txt
+grep -q "button.menu_hold begin hand left -> save once" save/xr_session.txt || fail "no save asked"
+grep -q "^save: frame [0-9]*: a garment session is not saved" save/xr_session.txt ||
+  fail "the save was not refused"
+[ ! -e save/saved_session.drape ] || fail "a garment session was saved"
+echo "ok: a garment session is not saved"
 echo "all ok"

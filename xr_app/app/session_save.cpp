@@ -17,6 +17,11 @@ constexpr const char* kSavedName = "saved_session.drape";
 
 void DrapingSession::save_session(int64_t frame) {
   if (!sim_ || !ops_) return;
+  if (!opt_.garment.empty()) {  // a saved session's header names the panel's scene only
+    rep_.note("save: frame " + std::to_string(frame) + ": a garment session is not saved");
+    feedback_.refused(frame, "save: a garment session is not saved");
+    return;
+  }
   auto taken = std::make_shared<std::promise<std::shared_ptr<sim::WorldCheckpoint>>>();
   std::future<std::shared_ptr<sim::WorldCheckpoint>> copy = taken->get_future();
   sim_->post([taken, ops = ops_, header = journal_header(opt_).fields](sim::World& w) {
