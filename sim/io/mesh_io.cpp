@@ -80,7 +80,7 @@ bool ply_header_closed(const char* p, size_t n, std::string& error) {
 // followed by that many numbers. assimp 5.2 reads a body whose tokens do not line up with the
 // header in ways that can allocate without bound (fuzz_mesh: an 1158-byte file whose vertex
 // line carried one number too many made it request ~18 GB before failing; seed
-// fuzz/corpus/mesh/regress_ply_ascii_misaligned). Binary and non-PLY data pass unchecked here;
+// fuzz/corpus/mesh_ply/regress_ply_ascii_misaligned). Binary and non-PLY data pass unchecked here;
 // false with `error` set.
 bool ply_ascii_body_consistent(const char* p, size_t n, std::string& error) {
   size_t i = 0;
@@ -194,7 +194,7 @@ const aiScene* postprocess(Assimp::Importer& imp, const aiScene* scene, std::str
       }
       // assimp 5.2's Triangulate (ear clipping) ran for more than two minutes on 96 faces of
       // 31019 corners each, from a mangled PLY list count (fuzz_mesh timeout, seed
-      // fuzz/corpus/mesh/regress_ply_huge_face). A face cannot have more corners
+      // fuzz/corpus/mesh_ply/regress_ply_huge_face). A face cannot have more corners
       // than its mesh has vertices, and no form needs a polygon of more than kMaxCorners.
       if (face.mNumIndices > std::min(mesh->mNumVertices, kMaxCorners)) {
         error = "mesh " + std::to_string(m) + " face " + std::to_string(i) + " has " +
@@ -239,6 +239,20 @@ void configure(Assimp::Importer& imp) {
     imp.UnregisterLoader(b);
     delete b;
   }
+}
+
+// The importer of this thread, configured once: building an Assimp::Importer creates every
+// importer and post-processing step assimp has (and configure() deletes most of them again),
+// which cost more than reading a small file (fuzz_mesh_glb: 0.16 ms a call on a 26-byte non-GLB input, 0.10 ms with one importer). The
+// scene of the last read is freed by the caller (read_scene) so that none outlives a load.
+Assimp::Importer& thread_importer() {
+  thread_local Assimp::Importer imp;
+  thread_local bool configured = false;
+  if (!configured) {
+    configure(imp);
+    configured = true;
+  }
+  return imp;
 }
 
 void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, TriMesh& out,
@@ -311,6 +325,25 @@ Result<TriMesh> convert(const aiScene* scene, const std::string& name,
   return out;
 }
 
+// Reads with this thread's importer (`read` calls ReadFile or ReadFileFromMemory on it),
+// validates and post-processes, converts, then frees the importer's scene.
+template <class Read>
+Result<TriMesh> read_scene(const std::string& name, Read read) {
+  Assimp::Importer& imp = thread_importer();
+  const aiScene* scene = nullptr;
+  try {
+    scene = read(imp);
+  } catch (const std::exception& e) {  // assimp reports through the return value; be safe
+    imp.FreeScene();
+    return make_error(name, std::string("cannot be read as a mesh: ") + e.what());
+  }
+  std::string error;
+  scene = postprocess(imp, scene, error);
+  Result<TriMesh> out = convert(scene, name, error);
+  imp.FreeScene();
+  return out;
+}
+
 }  // namespace
 
 Result<TriMesh> load_mesh(const std::string& path) {
@@ -335,17 +368,7 @@ Result<TriMesh> load_mesh(const std::string& path) {
     }
     if (!ply_ascii_body_consistent(head.data(), head.size(), error)) return make_error(path, error);
   }
-  Assimp::Importer imp;
-  configure(imp);
-  const aiScene* scene = nullptr;
-  try {
-    scene = imp.ReadFile(path, 0);
-  } catch (const std::exception& e) {  // assimp reports through the return value; be safe
-    return make_error(path, std::string("cannot be read as a mesh: ") + e.what());
-  }
-  std::string error;
-  scene = postprocess(imp, scene, error);
-  return convert(scene, path, error);
+  return read_scene(path, [&](Assimp::Importer& imp) { return imp.ReadFile(path, 0); });
 }
 
 Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char* hint,
@@ -358,17 +381,9 @@ Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char*
     if (!ply_ascii_body_consistent(static_cast<const char*>(data), size, error))
       return make_error(name, error);
   }
-  Assimp::Importer imp;
-  configure(imp);
-  const aiScene* scene = nullptr;
-  try {
-    scene = imp.ReadFileFromMemory(data, size, 0, hint ? hint : "");
-  } catch (const std::exception& e) {
-    return make_error(name, std::string("cannot be read as a mesh: ") + e.what());
-  }
-  std::string error;
-  scene = postprocess(imp, scene, error);
-  return convert(scene, name, error);
+  return read_scene(name, [&](Assimp::Importer& imp) {
+    return imp.ReadFileFromMemory(data, size, 0, hint ? hint : "");
+  });
 }
 
 std::string write_meshes(const std::string& path, const std::vector<TriMesh>& meshes) {

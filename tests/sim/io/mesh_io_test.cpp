@@ -190,7 +190,7 @@ TEST(MeshIo, ClothToMesh) {
 }  // namespace drape::sim
 
 // assimp 5.2's PLY reader hangs on a header that never ends (fuzz_mesh timeout, seed
-// fuzz/corpus/mesh/regress_ply_no_end_header): rejected with a clear error, file or memory.
+// fuzz/corpus/mesh_ply/regress_ply_no_end_header): rejected with a clear error, file or memory.
 TEST(MeshIo, PlyHeaderWithoutEndHeaderIsAnErrorNotAHang) {
   const std::string ply =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
@@ -218,10 +218,10 @@ TEST(MeshIo, PlyHeaderWithoutEndHeaderIsAnErrorNotAHang) {
 }
 
 // A PLY element count larger than the file (fuzz_mesh: assimp tried to allocate 57 GB, seed
-// fuzz/corpus/mesh/regress_ply_huge_count) is rejected before assimp.
+// fuzz/corpus/mesh_ply/regress_ply_huge_count) is rejected before assimp.
 // An ASCII PLY body whose numbers do not line up with its header (fuzz_mesh: one number too many
 // on a vertex line; assimp 5.2 then requested ~18 GB before failing, seed
-// fuzz/corpus/mesh/regress_ply_ascii_misaligned) is a clear error naming the element and entry,
+// fuzz/corpus/mesh_ply/regress_ply_ascii_misaligned) is a clear error naming the element and entry,
 // before assimp reads it; so is a body with numbers left over.
 TEST(MeshIo, PlyAsciiBodyThatDoesNotMatchItsHeaderIsAnError) {
   const std::string head =
@@ -243,7 +243,7 @@ TEST(MeshIo, PlyAsciiBodyThatDoesNotMatchItsHeaderIsAnError) {
       << err;
   drape::sim::expect_ply_loads(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "ok.ply", 1);
   // The fuzzer's file itself, from the corpus: rejected quickly, without the allocation.
-  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/fuzz/corpus/mesh/regress_ply_ascii_misaligned",
+  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/fuzz/corpus/mesh_ply/regress_ply_ascii_misaligned",
                    std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_GT(bytes.size(), 1000u);
@@ -268,7 +268,7 @@ TEST(MeshIo, PlyElementCountBeyondTheFileIsAnError) {
 
 // A face with more corners than its mesh has vertices (fuzz_mesh: a mangled list count gave 96
 // faces of 31019 corners and assimp's Triangulate hung; seed
-// fuzz/corpus/mesh/regress_ply_huge_face) is a clear error, quickly.
+// fuzz/corpus/mesh_ply/regress_ply_huge_face) is a clear error, quickly.
 TEST(MeshIo, PlyFaceWithMoreCornersThanVerticesIsAnErrorNotAHang) {
   std::string ply =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
