@@ -20,6 +20,8 @@
 #include <sstream>
 #include <string_view>
 
+#include "sim/io/obj_importer.hpp"
+
 namespace drape::sim {
 
 namespace {
@@ -231,6 +233,8 @@ void configure(Assimp::Importer& imp) {
       if (d && d->mFileExtensions &&
           std::string_view(d->mFileExtensions).find(ext) != std::string_view::npos)
         keep = true;
+    // assimp's OBJ importer gives way to the project's (obj_importer.hpp says why).
+    if (d && d->mName && std::string_view(d->mName) == "Wavefront Object Importer") keep = false;
     if (!keep) drop.push_back(imp.GetImporter(i));
   }
   // UnregisterLoader gives the importer back without deleting it (assimp 5.2): it is ours now
@@ -239,12 +243,14 @@ void configure(Assimp::Importer& imp) {
     imp.UnregisterLoader(b);
     delete b;
   }
+  imp.RegisterLoader(make_obj_importer().release());  // the importer owns it
 }
 
 // The importer of this thread, configured once: building an Assimp::Importer creates every
 // importer and post-processing step assimp has (and configure() deletes most of them again),
-// which cost more than reading a small file (fuzz_mesh_glb: 0.16 ms a call on a 26-byte non-GLB input, 0.10 ms with one importer). The
-// scene of the last read is freed by the caller (read_scene) so that none outlives a load.
+// which cost more than reading a small file (fuzz_mesh_glb: 0.16 ms a call on a 26-byte non-GLB
+// input, 0.10 ms with one importer). The scene of the last read is freed by the caller (read_scene)
+// so that none outlives a load.
 Assimp::Importer& thread_importer() {
   thread_local Assimp::Importer imp;
   thread_local bool configured = false;
