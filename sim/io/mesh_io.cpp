@@ -174,6 +174,42 @@ bool ply_ascii_body_consistent(const char* p, size_t n, std::string& error) {
   return true;
 }
 
+// assimp 5.2's binary glTF readers allocate the length a chunk header claims before they
+// compare it with the file (fuzz_mesh_glb: a 1688-byte GLB whose JSON chunk claimed 0xffff01e4
+// bytes made it request 4 GB; seed fuzz/corpus/mesh_glb/regress_glb_huge_chunk). Data that
+// starts with the magic "glTF" must declare a total length within `file_size`, and every chunk
+// header among the `n` bytes at hand a length within that total; false with `error` set.
+bool glb_lengths_fit(const char* p, size_t n, uint64_t file_size, std::string& error) {
+  if (n < 4 || std::string_view(p, 4) != "glTF") return true;
+  auto u32 = [&](size_t at) {
+    uint32_t v = 0;
+    for (int b = 3; b >= 0; --b) v = (v << 8) | static_cast<unsigned char>(p[at + b]);
+    return v;
+  };
+  if (n < 20) {
+    error = "GLB: the file ends inside its header";
+    return false;
+  }
+  const uint64_t total = u32(8);
+  if (total > file_size) {
+    error = "GLB header: a length of " + std::to_string(total) + " bytes, the file has " +
+            std::to_string(file_size);
+    return false;
+  }
+  auto chunk_fits = [&](uint64_t at, uint64_t len, uint64_t head) {
+    if (total >= at + head && len <= total - at - head) return true;
+    error = "GLB: a chunk at byte " + std::to_string(at) + " claims " + std::to_string(len) +
+            " bytes, past the length in the header (" + std::to_string(total) + ")";
+    return false;
+  };
+  // glTF 1.0's binary header holds the JSON's length after the total (the JSON at byte 20);
+  // 2.0's chunks follow the 12-byte header, each after its length and type.
+  if (u32(4) == 1) return chunk_fits(12, u32(12), 8);
+  for (uint64_t at = 12; at + 8 <= std::min<uint64_t>(n, total); at += 8 + u32(at))
+    if (!chunk_fits(at, u32(at), 8)) return false;
+  return true;
+}
+
 // Validates the raw scene (assimp's own checks, then face sizes and indices) before any step
 // that assumes a valid scene; returns the post-processed scene or nullptr with `error` set.
 const aiScene* postprocess(Assimp::Importer& imp, const aiScene* scene, std::string& error) {
@@ -373,6 +409,7 @@ Result<TriMesh> load_mesh(const std::string& path) {
       in.read(head.data() + (1u << 20), static_cast<std::streamsize>(size - (1u << 20)));
     }
     if (!ply_ascii_body_consistent(head.data(), head.size(), error)) return make_error(path, error);
+    if (!glb_lengths_fit(head.data(), head.size(), size, error)) return make_error(path, error);
   }
   return read_scene(path, [&](Assimp::Importer& imp) { return imp.ReadFile(path, 0); });
 }
@@ -385,6 +422,8 @@ Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char*
     if (!ply_header_closed(static_cast<const char*>(data), size, error))
       return make_error(name, error);
     if (!ply_ascii_body_consistent(static_cast<const char*>(data), size, error))
+      return make_error(name, error);
+    if (!glb_lengths_fit(static_cast<const char*>(data), size, size, error))
       return make_error(name, error);
   }
   return read_scene(name, [&](Assimp::Importer& imp) {

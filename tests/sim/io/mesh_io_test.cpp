@@ -186,6 +186,35 @@ TEST(MeshIo, ClothToMesh) {
   ASSERT_EQ(back->uv.size(), 4u);
 }
 
+// A GLB chunk claiming more bytes than the file has (fuzz_mesh_glb: a 1688-byte file whose JSON
+// chunk claimed 0xffff01e4 bytes made assimp request 4 GB; seed
+// fuzz/corpus/mesh_glb/regress_glb_huge_chunk) is a clear error before assimp, as is a header
+// length beyond the file; the valid file still loads, from memory and from disk.
+TEST(MeshIo, GlbLengthsBeyondTheFileAreAnErrorNotAnAllocation) {
+  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/fuzz/corpus/mesh_glb/regress_glb_huge_chunk",
+                   std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(bytes.size(), 1688u);
+  auto r = load_mesh_from_memory(bytes.data(), bytes.size(), "glb", "huge_chunk.glb");
+  ASSERT_FALSE(r.ok());
+  std::printf("%s\n", r.error().c_str());
+  EXPECT_NE(r.error().find("huge_chunk.glb: GLB: a chunk at byte 12 claims 4294902244 bytes"),
+            std::string::npos)
+      << r.error();
+  const std::string glb = (tmp_dir() / "valid.glb").string();
+  ASSERT_EQ(write_meshes(glb, {tetra("t", Vec3::Zero())}), "");
+  std::ifstream vin(glb, std::ios::binary);
+  std::string valid((std::istreambuf_iterator<char>(vin)), std::istreambuf_iterator<char>());
+  ASSERT_TRUE(load_mesh_from_memory(valid.data(), valid.size(), "glb", "v.glb").ok());
+  ASSERT_TRUE(load_mesh(glb).ok());
+  // The header's total length one byte past the file: rejected, naming the file on disk.
+  valid[8] = static_cast<char>(static_cast<unsigned char>(valid[8]) + 1);
+  const std::string longer = write_text("longer.glb", valid);
+  auto l = load_mesh(longer);
+  ASSERT_FALSE(l.ok());
+  EXPECT_NE(l.error().find(longer + ": GLB header: a length of"), std::string::npos) << l.error();
+}
+
 }  // namespace
 }  // namespace drape::sim
 
