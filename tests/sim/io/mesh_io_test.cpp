@@ -213,6 +213,16 @@ TEST(MeshIo, GlbLengthsBeyondTheFileAreAnErrorNotAnAllocation) {
   auto l = load_mesh(longer);
   ASSERT_FALSE(l.ok());
   EXPECT_NE(l.error().find(longer + ": GLB header: a length of"), std::string::npos) << l.error();
+  // A total length of 0 (fuzz_mesh_glb: assimp then requested 2.6 GB; seed
+  // fuzz/corpus/mesh_glb/regress_glb_zero_length).
+  std::ifstream zin(std::string(DRAPE_SOURCE_DIR) + "/fuzz/corpus/mesh_glb/regress_glb_zero_length",
+                    std::ios::binary);
+  const std::string zero((std::istreambuf_iterator<char>(zin)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(zero.size(), 1690u);
+  auto z = load_mesh_from_memory(zero.data(), zero.size(), "glb", "zero.glb");
+  ASSERT_FALSE(z.ok());
+  EXPECT_NE(z.error().find("zero.glb: GLB header: a length of 0 bytes"), std::string::npos)
+      << z.error();
 }
 
 }  // namespace
