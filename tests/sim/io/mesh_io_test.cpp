@@ -26,6 +26,21 @@ std::string write_text(const std::string& name, const std::string& text) {
   return p.string();
 }
 
+// The bytes of a file of the repository (`rel` from its root), e.g. a fuzzer's seed.
+std::string source_file(const std::string& rel) {
+  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/" + rel, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// Loading `bytes` from memory as `format` under `name` fails with an error containing `part`.
+void expect_memory_error(const std::string& bytes, const char* format, const std::string& name,
+                         const std::string& part) {
+  auto r = load_mesh_from_memory(bytes.data(), bytes.size(), format, name);
+  ASSERT_FALSE(r.ok()) << name;
+  std::printf("%s\n", r.error().c_str());
+  EXPECT_NE(r.error().find(part), std::string::npos) << r.error();
+}
+
 TriMesh tetra(const std::string& name, Vec3 shift) {
   TriMesh m;
   m.name = name;
@@ -191,16 +206,10 @@ TEST(MeshIo, ClothToMesh) {
 // fuzz/corpus/mesh_glb/regress_glb_huge_chunk) is a clear error before assimp, as is a header
 // length beyond the file; the valid file still loads, from memory and from disk.
 TEST(MeshIo, GlbLengthsBeyondTheFileAreAnErrorNotAnAllocation) {
-  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/fuzz/corpus/mesh_glb/regress_glb_huge_chunk",
-                   std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  ASSERT_EQ(bytes.size(), 1688u);
-  auto r = load_mesh_from_memory(bytes.data(), bytes.size(), "glb", "huge_chunk.glb");
-  ASSERT_FALSE(r.ok());
-  std::printf("%s\n", r.error().c_str());
-  EXPECT_NE(r.error().find("huge_chunk.glb: GLB: a chunk at byte 12 claims 4294902244 bytes"),
-            std::string::npos)
-      << r.error();
+  const std::string huge = source_file("fuzz/corpus/mesh_glb/regress_glb_huge_chunk");
+  ASSERT_EQ(huge.size(), 1688u);
+  expect_memory_error(huge, "glb", "huge_chunk.glb",
+                      "huge_chunk.glb: GLB: a chunk at byte 12 claims 4294902244 bytes");
   const std::string glb = (tmp_dir() / "valid.glb").string();
   ASSERT_EQ(write_meshes(glb, {tetra("t", Vec3::Zero())}), "");
   std::ifstream vin(glb, std::ios::binary);
@@ -215,14 +224,9 @@ TEST(MeshIo, GlbLengthsBeyondTheFileAreAnErrorNotAnAllocation) {
   EXPECT_NE(l.error().find(longer + ": GLB header: a length of"), std::string::npos) << l.error();
   // A total length of 0 (fuzz_mesh_glb: assimp then requested 2.6 GB; seed
   // fuzz/corpus/mesh_glb/regress_glb_zero_length).
-  std::ifstream zin(std::string(DRAPE_SOURCE_DIR) + "/fuzz/corpus/mesh_glb/regress_glb_zero_length",
-                    std::ios::binary);
-  const std::string zero((std::istreambuf_iterator<char>(zin)), std::istreambuf_iterator<char>());
+  const std::string zero = source_file("fuzz/corpus/mesh_glb/regress_glb_zero_length");
   ASSERT_EQ(zero.size(), 1690u);
-  auto z = load_mesh_from_memory(zero.data(), zero.size(), "glb", "zero.glb");
-  ASSERT_FALSE(z.ok());
-  EXPECT_NE(z.error().find("zero.glb: GLB header: a length of 0 bytes"), std::string::npos)
-      << z.error();
+  expect_memory_error(zero, "glb", "zero.glb", "zero.glb: GLB header: a length of 0 bytes");
 }
 
 }  // namespace
