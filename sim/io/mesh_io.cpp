@@ -177,8 +177,9 @@ bool ply_ascii_body_consistent(const char* p, size_t n, std::string& error) {
 // assimp 5.2's binary glTF readers allocate the length a chunk header claims before they
 // compare it with the file (fuzz_mesh_glb: a 1688-byte GLB whose JSON chunk claimed 0xffff01e4
 // bytes made it request 4 GB; seed fuzz/corpus/mesh_glb/regress_glb_huge_chunk). Data that
-// starts with the magic "glTF" must declare a total length within `file_size`, and every chunk
-// header among the `n` bytes at hand a length within that total; false with `error` set.
+// starts with the magic "glTF" must declare a total length of 20 bytes or more within
+// `file_size`, and every chunk header among the `n` bytes at hand a length within that total;
+// false with `error` set.
 bool glb_lengths_fit(const char* p, size_t n, uint64_t file_size, std::string& error) {
   if (n < 4 || std::string_view(p, 4) != "glTF") return true;
   auto u32 = [&](size_t at) {
@@ -284,21 +285,6 @@ void configure(Assimp::Importer& imp) {
   imp.RegisterLoader(make_obj_importer().release());  // the importer owns it
 }
 
-// The importer of this thread, configured once: building an Assimp::Importer creates every
-// importer and post-processing step assimp has (and configure() deletes most of them again),
-// which cost more than reading a small file (fuzz_mesh_glb: 0.16 ms a call on a 26-byte non-GLB
-// input, 0.10 ms with one importer). The scene of the last read is freed by the caller (read_scene)
-// so that none outlives a load.
-Assimp::Importer& thread_importer() {
-  thread_local Assimp::Importer imp;
-  thread_local bool configured = false;
-  if (!configured) {
-    configure(imp);
-    configured = true;
-  }
-  return imp;
-}
-
 void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, TriMesh& out,
              bool& bad_index) {
   const aiMatrix4x4 m = parent * node->mTransformation;
@@ -369,23 +355,23 @@ Result<TriMesh> convert(const aiScene* scene, const std::string& name,
   return out;
 }
 
-// Reads with this thread's importer (`read` calls ReadFile or ReadFileFromMemory on it),
-// validates and post-processes, converts, then frees the importer's scene.
+// Reads with a new, configured importer (`read` calls ReadFile or ReadFileFromMemory on it),
+// validates and post-processes, converts. The importer is not kept between files: assimp 5.2's
+// importers keep state from one file to the next (fuzz_mesh_ply corrupted the heap within
+// 10 000 executions when one importer read them all).
 template <class Read>
 Result<TriMesh> read_scene(const std::string& name, Read read) {
-  Assimp::Importer& imp = thread_importer();
+  Assimp::Importer imp;
+  configure(imp);
   const aiScene* scene = nullptr;
   try {
     scene = read(imp);
   } catch (const std::exception& e) {  // assimp reports through the return value; be safe
-    imp.FreeScene();
     return make_error(name, std::string("cannot be read as a mesh: ") + e.what());
   }
   std::string error;
   scene = postprocess(imp, scene, error);
-  Result<TriMesh> out = convert(scene, name, error);
-  imp.FreeScene();
-  return out;
+  return convert(scene, name, error);
 }
 
 }  // namespace
