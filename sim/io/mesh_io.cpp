@@ -35,6 +35,14 @@ constexpr unsigned kMaxCorners = 1024;
 constexpr unsigned kImportFlags =
     aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType;
 
+// Whether `p` starts with "ply" in any case: assimp takes each letter in either case
+// (fuzz_mesh_ply: a header starting "plYply" passed the checks below unchecked and hung assimp).
+bool ply_magic(const char* p) {
+  return std::tolower(static_cast<unsigned char>(p[0])) == 'p' &&
+         std::tolower(static_cast<unsigned char>(p[1])) == 'l' &&
+         std::tolower(static_cast<unsigned char>(p[2])) == 'y';
+}
+
 // assimp 5.2's PLY reader loops forever on a header without an "end_header" line (found by
 // fuzz_mesh: a 510-byte file hung the loader for > 30 s). Data that assimp would read as PLY
 // (it starts with "ply") must close its header within the first MiB, use only the header
@@ -42,7 +50,7 @@ constexpr unsigned kImportFlags =
 bool ply_header_closed(const char* p, size_t n, std::string& error) {
   size_t i = 0;
   while (i < n && std::isspace(static_cast<unsigned char>(p[i]))) ++i;
-  if (n - i < 3 || std::string_view(p + i, 3) != "ply") return true;
+  if (n - i < 3 || !ply_magic(p + i)) return true;
   const size_t limit = std::min(n, size_t{1} << 20);
   size_t line = i;
   for (size_t k = i; k <= limit; ++k) {
@@ -94,7 +102,7 @@ bool ply_header_closed(const char* p, size_t n, std::string& error) {
 bool ply_ascii_body_consistent(const char* p, size_t n, std::string& error) {
   size_t i = 0;
   while (i < n && std::isspace(static_cast<unsigned char>(p[i]))) ++i;
-  if (n - i < 3 || std::string_view(p + i, 3) != "ply") return true;
+  if (n - i < 3 || !ply_magic(p + i)) return true;
   struct Element {
     std::string name;
     unsigned long long count = 0;

@@ -308,6 +308,9 @@ TEST(MeshIo, PlyElementCountBeyondTheFileIsAnError) {
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nprloat z\n"
       "end_header\n0 0 0\n1 0 0\n0 1 0\n";
   EXPECT_NE(drape::sim::ply_load_error(mangled, "kw.ply").find("prloat"), std::string::npos);
+  EXPECT_NE(drape::sim::ply_load_error("plYply\nformat ascii 1.0\nend_head\n", "case.ply")
+                .find("PLY header"),
+            std::string::npos);
   const std::string fraction =
       "ply\nformat ascii 1.0\nelement vertexascii 1.0\nproperty float x\nend_header\n0\n";
   EXPECT_NE(drape::sim::ply_load_error(fraction, "count.ply").find("is not \"element NAME COUNT\""),
