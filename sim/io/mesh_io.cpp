@@ -20,6 +20,8 @@
 #include <sstream>
 #include <string_view>
 
+#include "sim/io/obj_importer.hpp"
+
 namespace drape::sim {
 
 namespace {
@@ -33,6 +35,14 @@ constexpr unsigned kMaxCorners = 1024;
 constexpr unsigned kImportFlags =
     aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType;
 
+// Whether `p` starts with "ply" in any case: assimp takes each letter in either case
+// (fuzz_mesh_ply: a header starting "plYply" passed the checks below unchecked and hung assimp).
+bool ply_magic(const char* p) {
+  return std::tolower(static_cast<unsigned char>(p[0])) == 'p' &&
+         std::tolower(static_cast<unsigned char>(p[1])) == 'l' &&
+         std::tolower(static_cast<unsigned char>(p[2])) == 'y';
+}
+
 // assimp 5.2's PLY reader loops forever on a header without an "end_header" line (found by
 // fuzz_mesh: a 510-byte file hung the loader for > 30 s). Data that assimp would read as PLY
 // (it starts with "ply") must close its header within the first MiB, use only the header
@@ -40,7 +50,7 @@ constexpr unsigned kImportFlags =
 bool ply_header_closed(const char* p, size_t n, std::string& error) {
   size_t i = 0;
   while (i < n && std::isspace(static_cast<unsigned char>(p[i]))) ++i;
-  if (n - i < 3 || std::string_view(p + i, 3) != "ply") return true;
+  if (n - i < 3 || !ply_magic(p + i)) return true;
   const size_t limit = std::min(n, size_t{1} << 20);
   size_t line = i;
   for (size_t k = i; k <= limit; ++k) {
@@ -63,7 +73,14 @@ bool ply_header_closed(const char* p, size_t n, std::string& error) {
       const std::string count(l.substr(sp + 1));
       char* end = nullptr;
       const unsigned long long c = std::strtoull(count.c_str(), &end, 10);
-      if (end && *end == '\0' && c > n) {
+      // A count that is not a whole number hangs assimp (fuzz_mesh_ply: "element vertexascii
+      // 1.0", a 242-byte file, ran past 30 s).
+      if (sp <= 8 || count.empty() || !end || *end != '\0') {
+        error =
+            "PLY header: \"" + std::string(l.substr(0, 40)) + "\" is not \"element NAME COUNT\"";
+        return false;
+      }
+      if (c > n) {
         error =
             "PLY header: \"" + std::string(l) + "\" declares more entries than the file has bytes";
         return false;
@@ -80,12 +97,12 @@ bool ply_header_closed(const char* p, size_t n, std::string& error) {
 // followed by that many numbers. assimp 5.2 reads a body whose tokens do not line up with the
 // header in ways that can allocate without bound (fuzz_mesh: an 1158-byte file whose vertex
 // line carried one number too many made it request ~18 GB before failing; seed
-// fuzz/corpus/mesh/regress_ply_ascii_misaligned). Binary and non-PLY data pass unchecked here;
+// fuzz/corpus/mesh_ply/regress_ply_ascii_misaligned). Binary and non-PLY data pass unchecked here;
 // false with `error` set.
 bool ply_ascii_body_consistent(const char* p, size_t n, std::string& error) {
   size_t i = 0;
   while (i < n && std::isspace(static_cast<unsigned char>(p[i]))) ++i;
-  if (n - i < 3 || std::string_view(p + i, 3) != "ply") return true;
+  if (n - i < 3 || !ply_magic(p + i)) return true;
   struct Element {
     std::string name;
     unsigned long long count = 0;
@@ -172,6 +189,45 @@ bool ply_ascii_body_consistent(const char* p, size_t n, std::string& error) {
   return true;
 }
 
+// assimp 5.2's binary glTF readers allocate the length a chunk header claims before they
+// compare it with the file (fuzz_mesh_glb: a 1688-byte GLB whose JSON chunk claimed 0xffff01e4
+// bytes made it request 4 GB; seed fuzz/corpus/mesh_glb/regress_glb_huge_chunk). Data that
+// starts with the magic "glTF" must declare a total length of 20 bytes or more within
+// `file_size`, and every chunk header among the `n` bytes at hand a length within that total;
+// false with `error` set.
+bool glb_lengths_fit(const char* p, size_t n, uint64_t file_size, std::string& error) {
+  if (n < 4 || std::string_view(p, 4) != "glTF") return true;
+  auto u32 = [&](size_t at) {
+    uint32_t v = 0;
+    for (int b = 3; b >= 0; --b) v = (v << 8) | static_cast<unsigned char>(p[at + b]);
+    return v;
+  };
+  if (n < 20) {
+    error = "GLB: the file ends inside its header";
+    return false;
+  }
+  // The total must hold the header and a chunk's (assimp subtracts the header from it
+  // unchecked: fuzz_mesh_glb, a total of 0 made it request 2.6 GB; seed regress_glb_zero_length).
+  const uint64_t total = u32(8);
+  if (total < 20 || total > file_size) {
+    error = "GLB header: a length of " + std::to_string(total) +
+            " bytes (at least 20), the file has " + std::to_string(file_size);
+    return false;
+  }
+  auto chunk_fits = [&](uint64_t at, uint64_t len, uint64_t head) {
+    if (total >= at + head && len <= total - at - head) return true;
+    error = "GLB: a chunk at byte " + std::to_string(at) + " claims " + std::to_string(len) +
+            " bytes, past the length in the header (" + std::to_string(total) + ")";
+    return false;
+  };
+  // glTF 1.0's binary header holds the JSON's length after the total (the JSON at byte 20);
+  // 2.0's chunks follow the 12-byte header, each after its length and type.
+  if (u32(4) == 1) return chunk_fits(12, u32(12), 8);
+  for (uint64_t at = 12; at + 8 <= std::min<uint64_t>(n, total); at += 8 + u32(at))
+    if (!chunk_fits(at, u32(at), 8)) return false;
+  return true;
+}
+
 // Validates the raw scene (assimp's own checks, then face sizes and indices) before any step
 // that assumes a valid scene; returns the post-processed scene or nullptr with `error` set.
 const aiScene* postprocess(Assimp::Importer& imp, const aiScene* scene, std::string& error) {
@@ -194,7 +250,7 @@ const aiScene* postprocess(Assimp::Importer& imp, const aiScene* scene, std::str
       }
       // assimp 5.2's Triangulate (ear clipping) ran for more than two minutes on 96 faces of
       // 31019 corners each, from a mangled PLY list count (fuzz_mesh timeout, seed
-      // fuzz/corpus/mesh/regress_ply_huge_face). A face cannot have more corners
+      // fuzz/corpus/mesh_ply/regress_ply_huge_face). A face cannot have more corners
       // than its mesh has vertices, and no form needs a polygon of more than kMaxCorners.
       if (face.mNumIndices > std::min(mesh->mNumVertices, kMaxCorners)) {
         error = "mesh " + std::to_string(m) + " face " + std::to_string(i) + " has " +
@@ -231,6 +287,8 @@ void configure(Assimp::Importer& imp) {
       if (d && d->mFileExtensions &&
           std::string_view(d->mFileExtensions).find(ext) != std::string_view::npos)
         keep = true;
+    // assimp's OBJ importer gives way to the project's (obj_importer.hpp says why).
+    if (d && d->mName && std::string_view(d->mName) == "Wavefront Object Importer") keep = false;
     if (!keep) drop.push_back(imp.GetImporter(i));
   }
   // UnregisterLoader gives the importer back without deleting it (assimp 5.2): it is ours now
@@ -239,6 +297,7 @@ void configure(Assimp::Importer& imp) {
     imp.UnregisterLoader(b);
     delete b;
   }
+  imp.RegisterLoader(make_obj_importer().release());  // the importer owns it
 }
 
 void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, TriMesh& out,
@@ -311,6 +370,25 @@ Result<TriMesh> convert(const aiScene* scene, const std::string& name,
   return out;
 }
 
+// Reads with a new, configured importer (`read` calls ReadFile or ReadFileFromMemory on it),
+// validates and post-processes, converts. The importer is not kept between files: assimp 5.2's
+// importers keep state from one file to the next (fuzz_mesh_ply corrupted the heap within
+// 10 000 executions when one importer read them all).
+template <class Read>
+Result<TriMesh> read_scene(const std::string& name, Read read) {
+  Assimp::Importer imp;
+  configure(imp);
+  const aiScene* scene = nullptr;
+  try {
+    scene = read(imp);
+  } catch (const std::exception& e) {  // assimp reports through the return value; be safe
+    return make_error(name, std::string("cannot be read as a mesh: ") + e.what());
+  }
+  std::string error;
+  scene = postprocess(imp, scene, error);
+  return convert(scene, name, error);
+}
+
 }  // namespace
 
 Result<TriMesh> load_mesh(const std::string& path) {
@@ -334,18 +412,9 @@ Result<TriMesh> load_mesh(const std::string& path) {
       in.read(head.data() + (1u << 20), static_cast<std::streamsize>(size - (1u << 20)));
     }
     if (!ply_ascii_body_consistent(head.data(), head.size(), error)) return make_error(path, error);
+    if (!glb_lengths_fit(head.data(), head.size(), size, error)) return make_error(path, error);
   }
-  Assimp::Importer imp;
-  configure(imp);
-  const aiScene* scene = nullptr;
-  try {
-    scene = imp.ReadFile(path, 0);
-  } catch (const std::exception& e) {  // assimp reports through the return value; be safe
-    return make_error(path, std::string("cannot be read as a mesh: ") + e.what());
-  }
-  std::string error;
-  scene = postprocess(imp, scene, error);
-  return convert(scene, path, error);
+  return read_scene(path, [&](Assimp::Importer& imp) { return imp.ReadFile(path, 0); });
 }
 
 Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char* hint,
@@ -357,18 +426,12 @@ Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char*
       return make_error(name, error);
     if (!ply_ascii_body_consistent(static_cast<const char*>(data), size, error))
       return make_error(name, error);
+    if (!glb_lengths_fit(static_cast<const char*>(data), size, size, error))
+      return make_error(name, error);
   }
-  Assimp::Importer imp;
-  configure(imp);
-  const aiScene* scene = nullptr;
-  try {
-    scene = imp.ReadFileFromMemory(data, size, 0, hint ? hint : "");
-  } catch (const std::exception& e) {
-    return make_error(name, std::string("cannot be read as a mesh: ") + e.what());
-  }
-  std::string error;
-  scene = postprocess(imp, scene, error);
-  return convert(scene, name, error);
+  return read_scene(name, [&](Assimp::Importer& imp) {
+    return imp.ReadFileFromMemory(data, size, 0, hint ? hint : "");
+  });
 }
 
 std::string write_meshes(const std::string& path, const std::vector<TriMesh>& meshes) {

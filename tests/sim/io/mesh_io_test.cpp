@@ -26,6 +26,21 @@ std::string write_text(const std::string& name, const std::string& text) {
   return p.string();
 }
 
+// The bytes of a file of the repository (`rel` from its root), e.g. a fuzzer's seed.
+std::string source_file(const std::string& rel) {
+  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/" + rel, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// Loading `bytes` from memory as `format` under `name` fails with an error containing `part`.
+void expect_memory_error(const std::string& bytes, const char* format, const std::string& name,
+                         const std::string& part) {
+  auto r = load_mesh_from_memory(bytes.data(), bytes.size(), format, name);
+  ASSERT_FALSE(r.ok()) << name;
+  std::printf("%s\n", r.error().c_str());
+  EXPECT_NE(r.error().find(part), std::string::npos) << r.error();
+}
+
 TriMesh tetra(const std::string& name, Vec3 shift) {
   TriMesh m;
   m.name = name;
@@ -186,11 +201,39 @@ TEST(MeshIo, ClothToMesh) {
   ASSERT_EQ(back->uv.size(), 4u);
 }
 
+// A GLB chunk claiming more bytes than the file has (fuzz_mesh_glb: a 1688-byte file whose JSON
+// chunk claimed 0xffff01e4 bytes made assimp request 4 GB; seed
+// fuzz/corpus/mesh_glb/regress_glb_huge_chunk) is a clear error before assimp, as is a header
+// length beyond the file; the valid file still loads, from memory and from disk.
+TEST(MeshIo, GlbLengthsBeyondTheFileAreAnErrorNotAnAllocation) {
+  const std::string huge = source_file("fuzz/corpus/mesh_glb/regress_glb_huge_chunk");
+  ASSERT_EQ(huge.size(), 1688u);
+  expect_memory_error(huge, "glb", "huge_chunk.glb",
+                      "huge_chunk.glb: GLB: a chunk at byte 12 claims 4294902244 bytes");
+  const std::string glb = (tmp_dir() / "valid.glb").string();
+  ASSERT_EQ(write_meshes(glb, {tetra("t", Vec3::Zero())}), "");
+  std::ifstream vin(glb, std::ios::binary);
+  std::string valid((std::istreambuf_iterator<char>(vin)), std::istreambuf_iterator<char>());
+  ASSERT_TRUE(load_mesh_from_memory(valid.data(), valid.size(), "glb", "v.glb").ok());
+  ASSERT_TRUE(load_mesh(glb).ok());
+  // The header's total length one byte past the file: rejected, naming the file on disk.
+  valid[8] = static_cast<char>(static_cast<unsigned char>(valid[8]) + 1);
+  const std::string longer = write_text("longer.glb", valid);
+  auto l = load_mesh(longer);
+  ASSERT_FALSE(l.ok());
+  EXPECT_NE(l.error().find(longer + ": GLB header: a length of"), std::string::npos) << l.error();
+  // A total length of 0 (fuzz_mesh_glb: assimp then requested 2.6 GB; seed
+  // fuzz/corpus/mesh_glb/regress_glb_zero_length).
+  const std::string zero = source_file("fuzz/corpus/mesh_glb/regress_glb_zero_length");
+  ASSERT_EQ(zero.size(), 1690u);
+  expect_memory_error(zero, "glb", "zero.glb", "zero.glb: GLB header: a length of 0 bytes");
+}
+
 }  // namespace
 }  // namespace drape::sim
 
 // assimp 5.2's PLY reader hangs on a header that never ends (fuzz_mesh timeout, seed
-// fuzz/corpus/mesh/regress_ply_no_end_header): rejected with a clear error, file or memory.
+// fuzz/corpus/mesh_ply/regress_ply_no_end_header): rejected with a clear error, file or memory.
 TEST(MeshIo, PlyHeaderWithoutEndHeaderIsAnErrorNotAHang) {
   const std::string ply =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
@@ -218,10 +261,10 @@ TEST(MeshIo, PlyHeaderWithoutEndHeaderIsAnErrorNotAHang) {
 }
 
 // A PLY element count larger than the file (fuzz_mesh: assimp tried to allocate 57 GB, seed
-// fuzz/corpus/mesh/regress_ply_huge_count) is rejected before assimp.
+// fuzz/corpus/mesh_ply/regress_ply_huge_count) is rejected before assimp.
 // An ASCII PLY body whose numbers do not line up with its header (fuzz_mesh: one number too many
 // on a vertex line; assimp 5.2 then requested ~18 GB before failing, seed
-// fuzz/corpus/mesh/regress_ply_ascii_misaligned) is a clear error naming the element and entry,
+// fuzz/corpus/mesh_ply/regress_ply_ascii_misaligned) is a clear error naming the element and entry,
 // before assimp reads it; so is a body with numbers left over.
 TEST(MeshIo, PlyAsciiBodyThatDoesNotMatchItsHeaderIsAnError) {
   const std::string head =
@@ -242,12 +285,13 @@ TEST(MeshIo, PlyAsciiBodyThatDoesNotMatchItsHeaderIsAnError) {
   EXPECT_NE(err.find("element \"vertex\" entry 2 of 3: \"x\" is not a number"), std::string::npos)
       << err;
   drape::sim::expect_ply_loads(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "ok.ply", 1);
-  // The fuzzer's file itself, from the corpus: rejected quickly, without the allocation.
-  std::ifstream in(std::string(DRAPE_SOURCE_DIR) + "/fuzz/corpus/mesh/regress_ply_ascii_misaligned",
-                   std::ios::binary);
+  // The fuzzer's file itself (fuzz_mesh_ply's seed): rejected quickly, without the allocation.
+  std::ifstream in(
+      std::string(DRAPE_SOURCE_DIR) + "/fuzz/corpus/mesh_ply/regress_ply_ascii_misaligned",
+      std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_GT(bytes.size(), 1000u);
-  auto r = drape::sim::load_mesh_from_memory(bytes.data() + 1, bytes.size() - 1, "ply", "fz.ply");
+  auto r = drape::sim::load_mesh_from_memory(bytes.data(), bytes.size(), "ply", "fz.ply");
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().find("PLY body"), std::string::npos) << r.error();
 }
@@ -264,11 +308,18 @@ TEST(MeshIo, PlyElementCountBeyondTheFileIsAnError) {
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nprloat z\n"
       "end_header\n0 0 0\n1 0 0\n0 1 0\n";
   EXPECT_NE(drape::sim::ply_load_error(mangled, "kw.ply").find("prloat"), std::string::npos);
+  EXPECT_NE(drape::sim::ply_load_error("plYply\nformat ascii 1.0\nend_head\n", "case.ply")
+                .find("PLY header"),
+            std::string::npos);
+  const std::string fraction =
+      "ply\nformat ascii 1.0\nelement vertexascii 1.0\nproperty float x\nend_header\n0\n";
+  EXPECT_NE(drape::sim::ply_load_error(fraction, "count.ply").find("is not \"element NAME COUNT\""),
+            std::string::npos);
 }
 
 // A face with more corners than its mesh has vertices (fuzz_mesh: a mangled list count gave 96
 // faces of 31019 corners and assimp's Triangulate hung; seed
-// fuzz/corpus/mesh/regress_ply_huge_face) is a clear error, quickly.
+// fuzz/corpus/mesh_ply/regress_ply_huge_face) is a clear error, quickly.
 TEST(MeshIo, PlyFaceWithMoreCornersThanVerticesIsAnErrorNotAHang) {
   std::string ply =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
