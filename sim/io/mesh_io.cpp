@@ -75,7 +75,14 @@ bool ply_header_closed(const char* p, size_t n, std::string& error) {
       const unsigned long long c = std::strtoull(count.c_str(), &end, 10);
       // A count that is not a whole number hangs assimp (fuzz_mesh_ply: "element vertexascii
       // 1.0", a 242-byte file, ran past 30 s).
-      if (sp <= 8 || count.empty() || !end || *end != '\0') {
+      // The name is one word that starts with a letter: assimp reads a name of digits as a
+      // count (fuzz_mesh_ply: "element 4444...4444vertex 49" asked for 11.4 GB).
+      const std::string_view name = sp > 8 ? l.substr(8, sp - 8) : std::string_view{};
+      const bool word = !name.empty() && std::isalpha(static_cast<unsigned char>(name[0])) &&
+                        std::all_of(name.begin(), name.end(), [](char ch) {
+                          return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+                        });
+      if (!word || count.empty() || !end || *end != '\0') {
         error =
             "PLY header: \"" + std::string(l.substr(0, 40)) + "\" is not \"element NAME COUNT\"";
         return false;

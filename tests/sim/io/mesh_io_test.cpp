@@ -315,6 +315,11 @@ TEST(MeshIo, PlyElementCountBeyondTheFileIsAnError) {
       "ply\nformat ascii 1.0\nelement vertexascii 1.0\nproperty float x\nend_header\n0\n";
   EXPECT_NE(drape::sim::ply_load_error(fraction, "count.ply").find("is not \"element NAME COUNT\""),
             std::string::npos);
+  // A name of digits, which assimp reads as a count (seed regress_ply_digit_name).
+  const std::string digits =
+      "ply\nformat ascii 1.0\nelement 44444444444444vertex 1\nproperty float x\nend_header\n0\n";
+  EXPECT_NE(drape::sim::ply_load_error(digits, "name.ply").find("is not \"element NAME COUNT\""),
+            std::string::npos);
 }
 
 // A face with more corners than its mesh has vertices (fuzz_mesh: a mangled list count gave 96
