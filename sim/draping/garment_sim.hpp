@@ -38,6 +38,9 @@ struct GarmentSimOptions {
   double contact_offset = 0.002;    // m the cloth is kept off the form (SceneObjects::offset)
   int tie_passes = 2;               // tie projections per substep
   double band = 0.006;              // m: half height of the waist and hip bands of the fit
+  // The waist band a band's height above the simulated waist seam instead of below it: a
+  // bodice has no cloth below its waist seam.
+  bool waist_band_above = false;
 };
 
 // Ease and strain in one band of heights (the waist, the hip): over the cloth's vertices there.
@@ -50,7 +53,7 @@ struct FitBand {
   // cloth contact_offset off it: its girth is that of the geometric garment plus 2 pi offset.
   double girth_expected_mm = 0;
   double girth_error_pct = 0;  // girth_mm against girth_expected_mm
-  int vertices = 0;
+  int vertices = 0;  // 0: no cloth at y (a bodice at the hip, a skirt at the bust): no girths
 };
 
 struct GarmentSimResult {
@@ -71,6 +74,7 @@ struct GarmentSimResult {
   // How far the sewn waist seam (its mean height) came down from the geometric placement (mm).
   double waist_seam_drop_mm = 0;
   FitBand waist, hip;
+  FitBand bust;  // at the form's bust line (a bodice, a dress)
   std::string to_json() const;
 };
 
