@@ -3,7 +3,9 @@
 // remeshed flat pieces are its material coordinates, so its triangles rest at their pattern
 // shape), the side seams and dart legs as hard ties (xpbd_ties.hpp; the centre seams are
 // already one vertex), draped on the dress form by the real-time solver (XPBD, Coulomb friction
-// on the form's cover, as the app drapes) from the geometric placement, run until it rests.
+// on the form's cover, as the app drapes) from the geometric placement (pushed the contact offset
+// off the form), run until it rests. The bodice and the dresses come as such a Garment too
+// (BodiceResult::garment, dress_garment in bodice.hpp).
 // Then the fit: ease (distance of the cloth from the form) and strain (stretch of each triangle
 // against its flat pattern), the seams' largest gap and the sewn girths.
 #pragma once
