@@ -47,11 +47,109 @@ void print_bodice(const drape::sim::BodiceReport& r) {
   print_checks(r.checks);
 }
 
+// What --simulate needs besides the pipeline's result: the form (shared with the solver's scene),
+// how a scene file names it, the fabric and the solver's limits.
+struct SimulateRequest {
+  std::shared_ptr<const drape::sim::DressForm> form;
+  nlohmann::json scene_form;  // null: no scene file (a form the scene files cannot name)
+  drape::sim::FabricParams fabric;
+  std::string fabric_name;
+  bool fabric_given = false;  // --fabric named it (else the design's)
+  drape::sim::GarmentSimOptions options;
+};
+
+// A sewn garment simulated on the form (--simulate): garment_sim.gltf, fit_map.png,
+// garment_sim.json and garment_scene.json into dir, their names appended to `files`; "" or an
+// error naming the file. `ease` (m) is the design's (the girths' section centres).
+std::string simulate_garment_files(const std::string& dir, const drape::sim::Garment& garment,
+                                   const std::string& name, double ease, const SimulateRequest& rq,
+                                   const drape::sim::GarmentSimOptions& options,
+                                   std::vector<std::string>& files,
+                                   std::optional<drape::sim::GarmentSimResult>* out) {
+  namespace ds = drape::sim;
+  const ds::MappingSurface surf(*rq.form, ease, true);
+  auto sim = ds::simulate_garment(garment, rq.form, surf, rq.fabric, options);
+  if (!sim) return sim.error();
+  const std::string o = dir + "/";
+  ds::TriMesh mesh = ds::garment_to_mesh(garment, name + " (simulated)");
+  mesh.vertices = sim->cloth.state.x;
+  if (std::string e = ds::write_meshes(o + "garment_sim.gltf", {mesh}); !e.empty()) return e;
+  // Without a renderer (a build without one, no Vulkan device) the fit map is left out with a
+  // note; the simulation's other files are still written.
+  const std::string map_error = drape::app::write_fit_map(o + "fit_map.png", sim->cloth, rq.form);
+  if (!map_error.empty())
+    std::fprintf(stderr, "drape pattern: note: fit map not written: %s\n", map_error.c_str());
+  nlohmann::json j = nlohmann::json::parse(sim->to_json());
+  j["design"] = name;
+  j["fabric"] = rq.fabric_name;
+  std::ofstream f(o + "garment_sim.json");
+  f << j.dump(2) << "\n";
+  if (!f) return o + "garment_sim.json: write failed";
+  if (!rq.scene_form.is_null())
+    if (std::string e = drape::app::write_garment_scene(
+            o + "garment_scene.json", "garment_sim.gltf", rq.scene_form, *rq.form);
+        !e.empty())
+      return e;
+  for (const char* f : {"garment_sim.gltf", "garment_sim.json"}) files.push_back(f);
+  if (map_error.empty()) files.push_back("fit_map.png");
+  if (!rq.scene_form.is_null()) files.push_back("garment_scene.json");
+  *out = std::move(*sim);
+  return "";
+}
+
+// The skirt's sewn garment simulated (simulate_garment_files).
+std::string simulate_and_write(const std::string& dir, drape::sim::PipelineResult& pr,
+                               const SimulateRequest& rq,
+                               std::optional<drape::sim::GarmentSimResult>* out) {
+  return simulate_garment_files(dir, pr.garment, pr.design.name, pr.design.ease, rq, rq.options,
+                                pr.report.files, out);
+}
+
+void print_simulation(const drape::sim::GarmentSimResult& s, const std::string& fabric) {
+  std::printf(
+      "simulated garment (xpbd, %s): %d vertices, %zu seam ties; %d frames (%s), %.1f ms, "
+      "%.2f ms/frame\n",
+      fabric.c_str(), s.cloth.num_vertices(), s.ties.size(), s.frames,
+      s.at_rest ? "at rest" : "NOT at rest", s.wall_ms, s.ms_per_frame);
+  std::printf("  seam gap max %.3f mm (start %.3f mm); deepest into the form %.3f mm\n",
+              s.seam_gap_max_mm, s.seam_gap_start_mm, s.penetration_max_mm);
+  std::printf("  strain max %.2f %%, rms %.2f %%, median %.2f %%, 95th percentile %.2f %%\n",
+              s.strain_max_pct, s.strain_rms_pct, s.strain_median_pct, s.strain_p95_pct);
+  std::printf("  waist seam %.1f mm below its geometric place\n", s.waist_seam_drop_mm);
+  for (const auto* b : {&s.waist, &s.hip, &s.bust}) {
+    const char* name = b == &s.waist ? "waist" : b == &s.hip ? "hip" : "bust";
+    if (!b->vertices) {
+      std::printf("  %-5s (y %.3f m) no cloth there\n", name, b->y);
+      continue;
+    }
+    std::printf(
+        "  %-5s (y %.3f m) ease max %.2f mm, mean %.2f mm; girth %.2f mm vs geometric %.2f mm + "
+        "2 pi offset = %.2f mm: %+.3f %%\n",
+        name, b->y, b->ease_max_mm, b->ease_mean_mm, b->girth_mm, b->girth_geometric_mm,
+        b->girth_expected_mm, b->girth_error_pct);
+  }
+}
+
+// With --simulate and no --fabric: the bodice design's fabric preset. false (and a message)
+// when fabrics.json lacks it.
+bool take_design_fabric(SimulateRequest& rq, const std::string& name) {
+  if (rq.fabric_given) return true;
+  auto f = drape::sim::load_fabric(drape::app::asset("fabrics.json").string(), name);
+  if (!f) {
+    std::fprintf(stderr, "drape pattern: --simulate: fabric %s: %s\n", name.c_str(),
+                 f.error().c_str());
+    return false;
+  }
+  rq.fabric = *f;
+  rq.fabric_name = name;
+  return true;
+}
+
 // The bodice and the dress (design files of "type" bodice or dress): drape, check, export.
 int run_upper_body(const std::string& type, const std::string& design_path,
                    const drape::sim::DressForm& form, const std::string& form_name,
                    const drape::sim::FabricParams& fabric, const std::string& out,
-                   const drape::sim::PipelineOptions& opt) {
+                   const drape::sim::PipelineOptions& opt, SimulateRequest* rq) {
   namespace ds = drape::sim;
   std::ifstream f(design_path);
   std::stringstream ss;
@@ -72,9 +170,12 @@ int run_upper_body(const std::string& type, const std::string& design_path,
   if (opt.ease >= 0) dress->bodice.ease = opt.ease;
   if (opt.seam_allowance >= 0) dress->bodice.seam_allowance = opt.seam_allowance;
   if (opt.relax_iterations >= 0) dress->bodice.relax_iterations = opt.relax_iterations;
+  if (rq && !take_design_fabric(*rq, dress->bodice.fabric)) return 1;
   auto bodice = ds::drape_bodice(dress->bodice, form);
   if (!bodice) return std::fprintf(stderr, "drape pattern: %s\n", bodice.error().c_str()), 1;
   std::vector<ds::PatternPiece> pieces = bodice->pieces;
+  // The cloth to simulate: the bodice, or the bodice and the skirt sewn at the waist.
+  ds::Garment garment = bodice->garment;
   std::optional<ds::DressReport> dr;
   if (type == "dress") {
     dress->skirt.form = form_name;
@@ -84,20 +185,29 @@ int run_upper_body(const std::string& type, const std::string& design_path,
     auto skirt = ds::run_pattern_pipeline(dress->skirt, form, fabric, skirt_opt);
     if (!skirt) return std::fprintf(stderr, "drape pattern: %s\n", skirt.error().c_str()), 1;
     dr = ds::dress_report(*bodice, *skirt);
+    auto g = ds::dress_garment(bodice->garment, skirt->garment);
+    if (!g) return std::fprintf(stderr, "drape pattern: %s\n", g.error().c_str()), 1;
+    garment = std::move(*g);
     for (ds::PatternPiece pc : skirt->pieces) {
       pc.name = "Skirt " + pc.name;
       pieces.push_back(pc);
     }
   }
   std::vector<std::string> files;
+  std::optional<ds::GarmentSimResult> sim;
   const std::string failed = drape::app::write_whole(out, [&](const std::string& dir) {
     files.clear();
     std::vector<std::string> names = {"pattern.svg", "pattern.dxf", "pattern_a4.pdf",
                                       "pattern_letter.pdf", "report.json"};
     const std::string json =
         dr ? ds::dress_report_json(*dr, names) : ds::bodice_report_json(bodice->report, names);
-    return ds::write_pattern_files(dir, pieces, dress->name, dress->bodice.seam_allowance, json,
-                                   &files);
+    std::string e = ds::write_pattern_files(dir, pieces, dress->name, dress->bodice.seam_allowance,
+                                            json, &files);
+    if (!e.empty() || !rq) return e;
+    ds::GarmentSimOptions so = rq->options;
+    so.waist_band_above = type != "dress";  // a bodice has no cloth below its waist seam
+    return simulate_garment_files(dir, garment, dress->name, dress->bodice.ease, *rq, so, files,
+                                  &sim);
   });
   if (!failed.empty()) {
     std::fprintf(stderr, "drape pattern: %s (the pattern files already in %s are kept)\n",
@@ -116,81 +226,8 @@ int run_upper_body(const std::string& type, const std::string& design_path,
   std::printf("  wrote %s/{", out.c_str());
   for (size_t i = 0; i < files.size(); ++i) std::printf("%s%s", i ? "," : "", files[i].c_str());
   std::printf("}\n");
+  if (sim) print_simulation(*sim, rq->fabric_name);
   return 0;
-}
-
-// What --simulate needs besides the pipeline's result: the form (shared with the solver's scene),
-// how a scene file names it, the fabric and the solver's limits.
-struct SimulateRequest {
-  std::shared_ptr<const drape::sim::DressForm> form;
-  nlohmann::json scene_form;  // null: no scene file (a form the scene files cannot name)
-  drape::sim::FabricParams fabric;
-  std::string fabric_name;
-  drape::sim::GarmentSimOptions options;
-};
-
-// The sewn garment simulated on the form (--simulate): garment_sim.gltf, fit_map.png,
-// garment_sim.json and garment_scene.json into dir; "" or an error naming the file.
-std::string simulate_and_write(const std::string& dir, drape::sim::PipelineResult& pr,
-                               const SimulateRequest& rq,
-                               std::optional<drape::sim::GarmentSimResult>* out) {
-  namespace ds = drape::sim;
-  const ds::MappingSurface surf(*rq.form, pr.design.ease, true);
-  auto sim = ds::simulate_garment(pr.garment, rq.form, surf, rq.fabric, rq.options);
-  if (!sim) return sim.error();
-  const std::string o = dir + "/";
-  ds::TriMesh mesh = ds::garment_to_mesh(pr.garment, pr.design.name + " (simulated)");
-  mesh.vertices = sim->cloth.state.x;
-  if (std::string e = ds::write_meshes(o + "garment_sim.gltf", {mesh}); !e.empty()) return e;
-  // Without a renderer (a build without one, no Vulkan device) the fit map is left out with a
-  // note; the simulation's other files are still written.
-  const std::string map_error = drape::app::write_fit_map(o + "fit_map.png", sim->cloth, rq.form);
-  if (!map_error.empty())
-    std::fprintf(stderr, "drape pattern: note: fit map not written: %s\n", map_error.c_str());
-  nlohmann::json j = nlohmann::json::parse(sim->to_json());
-  j["design"] = pr.design.name;
-  j["fabric"] = rq.fabric_name;
-  std::ofstream f(o + "garment_sim.json");
-  f << j.dump(2) << "\n";
-  if (!f) return o + "garment_sim.json: write failed";
-  if (!rq.scene_form.is_null())
-    if (std::string e = drape::app::write_garment_scene(
-            o + "garment_scene.json", "garment_sim.gltf", rq.scene_form, *rq.form);
-        !e.empty())
-      return e;
-  for (const char* f : {"garment_sim.gltf", "garment_sim.json"}) pr.report.files.push_back(f);
-  if (map_error.empty()) pr.report.files.push_back("fit_map.png");
-  if (!rq.scene_form.is_null()) pr.report.files.push_back("garment_scene.json");
-  *out = std::move(*sim);
-  return "";
-}
-
-// --simulate with a bodice or dress design: refused (their sewn garment has no flat pattern).
-int simulate_refused(const std::string& design, const std::string& type) {
-  std::fprintf(stderr,
-               "drape pattern: --simulate: %s is a %s design; the simulation takes the sewn "
-               "skirts only (the bodice's sewn garment has no flat pattern to rest on)\n",
-               design.c_str(), type.c_str());
-  return 1;
-}
-
-void print_simulation(const drape::sim::GarmentSimResult& s, const std::string& fabric) {
-  std::printf(
-      "simulated garment (xpbd, %s): %d vertices, %zu seam ties; %d frames (%s), %.1f ms, "
-      "%.2f ms/frame\n",
-      fabric.c_str(), s.cloth.num_vertices(), s.ties.size(), s.frames,
-      s.at_rest ? "at rest" : "NOT at rest", s.wall_ms, s.ms_per_frame);
-  std::printf("  seam gap max %.3f mm (start %.3f mm); deepest into the form %.3f mm\n",
-              s.seam_gap_max_mm, s.seam_gap_start_mm, s.penetration_max_mm);
-  std::printf("  strain max %.2f %%, rms %.2f %%, median %.2f %%, 95th percentile %.2f %%\n",
-              s.strain_max_pct, s.strain_rms_pct, s.strain_median_pct, s.strain_p95_pct);
-  std::printf("  waist seam %.1f mm below its geometric place\n", s.waist_seam_drop_mm);
-  for (const auto* b : {&s.waist, &s.hip})
-    std::printf(
-        "  %-5s (y %.3f m) ease max %.2f mm, mean %.2f mm; girth %.2f mm vs geometric %.2f mm + "
-        "2 pi offset = %.2f mm: %+.3f %%\n",
-        b == &s.waist ? "waist" : "hip", b->y, b->ease_max_mm, b->ease_mean_mm, b->girth_mm,
-        b->girth_geometric_mm, b->girth_expected_mm, b->girth_error_pct);
 }
 
 // The options of --simulate; returns --fabric's option (counted: given or not).
@@ -229,6 +266,7 @@ bool prepare_simulate(SimulateRequest& rq, const drape::sim::DressForm& form,
     }
     rq.fabric = *f;
     rq.fabric_name = fabric_name;
+    rq.fabric_given = true;
   }
   rq.form = std::make_shared<const drape::sim::DressForm>(form);
   namespace fs = std::filesystem;
@@ -352,11 +390,12 @@ int run_pattern(int argc, char** argv) {
     fabric = *f;
   else
     std::fprintf(stderr, "drape pattern: note: %s; using the default muslin\n", f.error().c_str());
-  if (*type != "skirt" && simulate) return simulate_refused(design, *type);
-  if (*type != "skirt") return run_upper_body(*type, design_path, *form, d->form, fabric, out, opt);
   if (simulate && !prepare_simulate(rq, *form, fabric, d->fabric,
                                     o_fabric->count() ? sim_fabric : "", mesh, vit, form_name))
     return 1;
+  if (*type != "skirt")
+    return run_upper_body(*type, design_path, *form, d->form, fabric, out, opt,
+                          simulate ? &rq : nullptr);
   std::optional<drape::sim::GarmentSimResult> sim;
   // The pattern's files replace those of an earlier run only when every one was written: a full
   // disk leaves the earlier pattern whole (output_files.hpp).

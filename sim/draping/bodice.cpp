@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -421,8 +422,10 @@ BodicePieceReport measure_piece(const DrapedPiece& p, const PatternPiece& pc,
 // The sewn bodice on the form: every zone of every piece and its mirror image, nodes at the
 // same place on the form joined (the seams and the closed darts), each edge at its flat
 // length, relaxed (Gauss-Seidel) against the form; then its girths.
+// `node_vertex` gets the sewn vertex of every zone node, in the order piece, zone (centre,
+// side), half (right, mirror image), node.
 Garment sew_bodice(const std::vector<DrapedPiece>& pieces, const MappingSurface& surf,
-                   double mirror_x, int iterations) {
+                   double mirror_x, int iterations, std::vector<int>* node_vertex) {
   Garment g;
   std::map<std::array<long long, 3>, int> id;
   std::vector<Edge> edges;
@@ -442,6 +445,7 @@ Garment sew_bodice(const std::vector<DrapedPiece>& pieces, const MappingSurface&
           if (half) q.x() = 2 * mirror_x - q.x();
           v[i] = vertex(q);
         }
+        node_vertex->insert(node_vertex->end(), v.begin(), v.end());
         for (const Edge& e : zone_edges(*z))
           edges.push_back({v[e.a], v[e.b], (z->flat[e.b] - z->flat[e.a]).norm(), e.stiffness});
         for (int r = 0; r + 1 < z->rows; ++r)
@@ -466,6 +470,122 @@ Garment sew_bodice(const std::vector<DrapedPiece>& pieces, const MappingSurface&
   g.vertex_piece.assign(g.x.size(), 0);
   g.piece_names = {"Bodice"};
   return g;
+}
+
+// The cells of one zone as triangles of the vertices `id` (counter-clockwise in the flat
+// pattern; `mirrored`: the flat pattern's mirror image, the winding turned). Where a zone's
+// bounding lines meet (the neckline's corner, the dart's end on the shoulder) a row's nodes are
+// one vertex: the cells' triangles with a vertex twice are left out.
+void add_zone_triangles(const Zone& z, const std::vector<int>& id, bool mirrored, Garment& g) {
+  const auto add = [&](int a, int b, int c) {
+    if (a == b || b == c || a == c) return;
+    g.triangles.push_back(mirrored ? std::array<int32_t, 3>{a, c, b} : std::array{a, b, c});
+  };
+  for (int r = 0; r + 1 < z.rows; ++r)
+    for (int c = 0; c + 1 < z.cols; ++c) {
+      const int a = id[z.at(r, c)], b = id[z.at(r, c + 1)], s = id[z.at(r + 1, c + 1)],
+                t = id[z.at(r + 1, c)];
+      add(a, b, s);
+      add(a, s, t);
+    }
+}
+
+// Where the bodice's vertices come from while its cloth is built (bodice_cloth).
+struct ClothBuild {
+  const Garment& welded;
+  const std::vector<int>& node_vertex;
+  std::vector<int> first;  // per sewn vertex: the cloth vertex made for it first (-1: none)
+  double min_gap = 0;      // m: nodes of a row nearer than this are one vertex
+  Garment g;
+};
+
+// The vertices of one zone's half (`half` 1: the mirror image; `k` the zone's first node in
+// node_vertex, `right` the right half's vertices): a node at a sewn vertex this half already has
+// at the same flat point is that vertex (a collapsed row); the mirror image of a centre-line node
+// (its own image, flat x = 0) is the right half's vertex; otherwise a new vertex, tied onto the
+// first one made at its sewn vertex (dart legs, apex, side and shoulder seams).
+std::vector<int> zone_vertices(ClothBuild& cb, const Zone& z, size_t k, int half,
+                               const std::vector<int>& right, int piece) {
+  Garment& g = cb.g;
+  std::map<int, int> here;  // sewn vertex -> this half's vertex
+  std::vector<int> id(z.flat.size());
+  for (size_t i = 0; i < id.size(); ++i) {
+    const int w = cb.node_vertex[k + (half ? id.size() : 0) + i];
+    const Vec2 m(half ? -z.flat[i].x() : z.flat[i].x(), z.flat[i].y());
+    if (auto it = here.find(w); it != here.end() && (g.material[it->second] - m).norm() < 1e-7) {
+      id[i] = it->second;
+      continue;
+    }
+    if (half && cb.node_vertex[k + i] == w && std::abs(z.flat[i].x()) < 1e-9) {
+      id[i] = here[w] = right[i];
+      continue;
+    }
+    // A node nearer than min_gap to the one before it in its row, flat and sewn (where the zone's
+    // bounding lines nearly meet) is that node's vertex: their cells would be slivers a fraction of
+    // a mm across, which the solver cannot hold at their rest shape (they stretched thousands of
+    // per cent and kept the cloth from coming to rest). Its seam, if any, is tied there.
+    if (i % z.cols != 0 && (z.flat[i] - z.flat[i - 1]).norm() < cb.min_gap &&
+        (cb.welded.x[w] - g.x[id[i - 1]]).norm() < cb.min_gap) {
+      id[i] = here[w] = id[i - 1];
+      if (cb.first[w] < 0)
+        cb.first[w] = id[i];
+      else if (cb.first[w] != id[i])
+        g.ties.push_back({id[i], cb.first[w], cb.first[w], 0.0});
+      continue;
+    }
+    id[i] = here[w] = static_cast<int>(g.x.size());
+    g.x.push_back(cb.welded.x[w]);
+    g.material.push_back(m);
+    g.vertex_piece.push_back(piece);
+    if (static_cast<int>(i) < z.cols) g.waist_vertices.push_back(id[i]);
+    if (cb.first[w] < 0)
+      cb.first[w] = id[i];
+    else
+      g.ties.push_back({id[i], cb.first[w], cb.first[w], 0.0});
+  }
+  return id;
+}
+
+// The sewn bodice as cloth (BodiceResult::garment): per zone and half the zone's nodes at their
+// sewn (welded) placement with the zone's flat points as material coordinates (zone_vertices).
+Garment bodice_cloth(const std::vector<DrapedPiece>& pieces, const Garment& welded,
+                     const std::vector<int>& node_vertex, const BodiceDesign& d) {
+  // Nodes of a row nearer than a quarter of a column step are one vertex.
+  ClothBuild cb{
+      welded, node_vertex, std::vector<int>(welded.x.size(), -1), 0.25 * d.column_step, {}};
+  size_t k = 0;
+  for (size_t pi = 0; pi < pieces.size(); ++pi)
+    for (const Zone* z : {&pieces[pi].centre, &pieces[pi].side}) {
+      std::vector<int> right;
+      for (int half = 0; half < 2; ++half) {
+        const int pid = static_cast<int>(cb.g.piece_names.size());
+        cb.g.piece_names.push_back(d.pieces[pi].name +
+                                   (z == &pieces[pi].centre ? " centre" : " side") +
+                                   (half ? " (left)" : " (right)"));
+        const std::vector<int> id = zone_vertices(cb, *z, k, half, right, pid);
+        if (!half) right = id;
+        add_zone_triangles(*z, id, half == 1, cb.g);
+      }
+      k += 2 * z->flat.size();
+    }
+  cb.g.seams.push_back("bodice: " + std::to_string(cb.g.ties.size()) +
+                       " ties (dart legs, side and shoulder seams); centre lines one vertex");
+  return std::move(cb.g);
+}
+
+// The skirt's waist seam as segments (edges of its triangles with both ends waist vertices).
+std::vector<std::pair<int, int>> waist_segments(const Garment& skirt) {
+  std::vector<uint8_t> on(skirt.x.size(), 0);
+  for (int v : skirt.waist_vertices) on[v] = 1;
+  std::vector<std::pair<int, int>> seg;
+  for (const auto& t : skirt.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (on[a] && on[b] && a < b) seg.emplace_back(a, b);
+    }
+  std::sort(seg.begin(), seg.end());
+  seg.erase(std::unique(seg.begin(), seg.end()), seg.end());
+  return seg;
 }
 
 FitCheck check(const std::string& name, const std::string& unit, double value, double target,
@@ -738,7 +858,10 @@ Result<BodiceResult> drape_bodice(const BodiceDesign& d, const DressForm& form) 
   }
   rep.form_bust_girth_mm = form.girth_at(lm.bust_y) * 1000;
   rep.form_waist_girth_mm = form.girth_at(lm.waist_y) * 1000;
-  const Garment g = sew_bodice(draped, surf, surf.centre(lm.waist_y).x(), d.sew_iterations);
+  std::vector<int> node_vertex;
+  const Garment g =
+      sew_bodice(draped, surf, surf.centre(lm.waist_y).x(), d.sew_iterations, &node_vertex);
+  R.garment = bodice_cloth(draped, g, node_vertex, d);
   rep.sewn_bust_girth_mm = garment_girth(g, surf, lm.bust_y) * 1000;
   rep.sewn_waist_girth_mm = garment_girth(g, surf, lm.waist_y + 0.5 * d.row_step) * 1000;
   add_checks(rep, rep.form_bust_girth_mm + rep.ease_mm,
@@ -778,6 +901,41 @@ std::string bodice_report_json(const BodiceReport& r, const std::vector<std::str
   json j = bodice_json(r);
   j["files"] = files;
   return j.dump(2);
+}
+
+Result<Garment> dress_garment(const Garment& bodice, const Garment& skirt) {
+  const std::vector<std::pair<int, int>> seg = waist_segments(skirt);
+  if (seg.empty() || bodice.waist_vertices.empty())
+    return Error{"dress_garment: the bodice or the skirt has no waist seam"};
+  Garment g = bodice;
+  const int n = static_cast<int>(g.x.size());
+  g.x.insert(g.x.end(), skirt.x.begin(), skirt.x.end());
+  g.material.insert(g.material.end(), skirt.material.begin(), skirt.material.end());
+  for (auto t : skirt.triangles) g.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
+  const int np = static_cast<int>(g.piece_names.size());
+  for (int p : skirt.vertex_piece) g.vertex_piece.push_back(p + np);
+  for (const std::string& s : skirt.piece_names) g.piece_names.push_back("Skirt " + s);
+  for (const SeamTie& t : skirt.ties) g.ties.push_back({t.a + n, t.b0 + n, t.b1 + n, t.t});
+  g.waist_vertices.clear();
+  for (int v : skirt.waist_vertices) g.waist_vertices.push_back(v + n);
+  for (int v : bodice.waist_vertices) {
+    SeamTie best{v, 0, 0, 0};
+    double best_d = std::numeric_limits<double>::infinity();
+    for (const auto& [a, b] : seg) {
+      const Vec3 ab = skirt.x[b] - skirt.x[a];
+      if (ab.squaredNorm() < 1e-18) continue;
+      const double t = std::clamp((bodice.x[v] - skirt.x[a]).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+      const double dist = (bodice.x[v] - skirt.x[a] - t * ab).norm();
+      if (dist < best_d) best_d = dist, best = {v, a + n, b + n, t};
+    }
+    g.ties.push_back(best);
+  }
+  g.merged_vertices = bodice.merged_vertices + skirt.merged_vertices;
+  g.seams = bodice.seams;
+  g.seams.insert(g.seams.end(), skirt.seams.begin(), skirt.seams.end());
+  g.seams.push_back("waist seam: " + std::to_string(bodice.waist_vertices.size()) +
+                    " bodice vertices tied onto the skirt's waist");
+  return g;
 }
 
 DressReport dress_report(const BodiceResult& bodice, const PipelineResult& skirt) {

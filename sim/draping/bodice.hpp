@@ -20,6 +20,7 @@
 
 #include "sim/draping/pattern_extract.hpp"
 #include "sim/draping/pattern_pipeline.hpp"
+#include "sim/draping/sew.hpp"
 
 namespace drape::sim {
 
@@ -102,6 +103,13 @@ struct BodiceReport {
 struct BodiceResult {
   std::vector<PatternPiece> pieces;  // right halves, counter-clockwise, darts as folded
   BodiceReport report;
+  // The sewn bodice as cloth for the simulation (garment_sim.hpp): every zone of every piece
+  // (centre and side, right half and its mirror image) its own vertices with the zone's flat
+  // pattern as material coordinates, at the geometrically relaxed placement on the form; the
+  // two halves of a zone one vertex on the centre line (the same flat point); the dart legs,
+  // side seams and shoulder seams hard ties between nodes the zones share on the form; the waist
+  // row as waist_vertices.
+  Garment garment;
 };
 
 // Drapes the bodice on the form and measures it; writes nothing.
@@ -124,6 +132,11 @@ std::string write_pattern_files(const std::string& out_dir, const std::vector<Pa
 
 std::string bodice_report_json(const BodiceReport& r, const std::vector<std::string>& files);
 std::string dress_report_json(const DressReport& r, const std::vector<std::string>& files);
+
+// The sewn dress as cloth for the simulation: the bodice's garment and the skirt's (its own
+// ties kept, indices moved on) in one, each bodice waist vertex tied to the nearest point of the
+// skirt's waist seam (the waist seam as ties); the skirt's waist vertices are the dress's.
+Result<Garment> dress_garment(const Garment& bodice, const Garment& skirt);
 
 // Joins the bodice's and the skirt's pieces into the dress's report: waist seams compared.
 DressReport dress_report(const BodiceResult& bodice, const PipelineResult& skirt);

@@ -29,6 +29,7 @@ FitBand fit_band(const GarmentSimResult& r, const Garment& geometric, const Mapp
     ++b.vertices;
   }
   b.ease_mean_mm = b.vertices ? sum / b.vertices : 0;
+  if (!b.vertices) return b;
   Garment sim = geometric;
   sim.x = r.cloth.state.x;
   b.girth_mm = garment_girth(sim, surf, y) * 1000;
@@ -146,6 +147,12 @@ Result<GarmentSimResult> simulate_garment(const Garment& garment,
   GarmentSimResult r;
   r.cloth = garment_cloth(garment, fabric);
   if (std::string e = r.cloth.validate(); !e.empty()) return Error{"simulate_garment: " + e};
+  // The geometric garment lies on the form; the contacts keep the cloth contact_offset off it.
+  // Left on the form, the first substep's contacts would move every vertex the offset out in
+  // 1/(90 substeps) s, a speed the later substeps carry on (the bodice flew 35 mm off the form in
+  // its first frame): the cloth starts the offset off the form instead.
+  for (Vec3& p : r.cloth.state.x) form->push_outside(p, opt.contact_offset);
+  r.cloth.state.x_prev = r.cloth.state.x;
   for (const SeamTie& t : garment.ties) r.ties.push_back({t.a, t.b0, t.b1, t.t});
   r.seam_gap_start_mm = xpbd::max_tie_gap(r.ties, r.cloth.state.x) * 1000;
   SceneObjects scene;
@@ -178,15 +185,18 @@ Result<GarmentSimResult> simulate_garment(const Garment& garment,
     return garment.waist_vertices.empty() ? lm.waist_y : y / garment.waist_vertices.size();
   };
   r.waist_seam_drop_mm = (seam_y(garment.x) - seam_y(r.cloth.state.x)) * 1000;
-  const double waist_band_y = seam_y(r.cloth.state.x) - opt.band;
+  const double waist_band_y =
+      seam_y(r.cloth.state.x) + (opt.waist_band_above ? opt.band : -opt.band);
   r.waist = fit_band(r, garment, surf, waist_band_y, opt.contact_offset, opt.band);
   r.hip = fit_band(r, garment, surf, lm.hip_y, opt.contact_offset, opt.band);
+  r.bust = fit_band(r, garment, surf, lm.bust_y, opt.contact_offset, opt.band);
   return r;
 }
 
 std::string GarmentSimResult::to_json() const {
   using json = nlohmann::json;
   const auto band = [](const FitBand& b) {
+    if (!b.vertices) return json(nullptr);  // no cloth at that height
     return json{{"y_m", b.y},
                 {"ease_max_mm", b.ease_max_mm},
                 {"ease_mean_mm", b.ease_mean_mm},
@@ -216,6 +226,7 @@ std::string GarmentSimResult::to_json() const {
   j["waist_seam_drop_mm"] = waist_seam_drop_mm;
   j["waist"] = band(waist);
   j["hip"] = band(hip);
+  j["bust"] = band(bust);
   return j.dump(2);
 }
 

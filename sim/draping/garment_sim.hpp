@@ -3,7 +3,9 @@
 // remeshed flat pieces are its material coordinates, so its triangles rest at their pattern
 // shape), the side seams and dart legs as hard ties (xpbd_ties.hpp; the centre seams are
 // already one vertex), draped on the dress form by the real-time solver (XPBD, Coulomb friction
-// on the form's cover, as the app drapes) from the geometric placement, run until it rests.
+// on the form's cover, as the app drapes) from the geometric placement (pushed the contact offset
+// off the form), run until it rests. The bodice and the dresses come as such a Garment too
+// (BodiceResult::garment, dress_garment in bodice.hpp).
 // Then the fit: ease (distance of the cloth from the form) and strain (stretch of each triangle
 // against its flat pattern), the seams' largest gap and the sewn girths.
 #pragma once
@@ -38,6 +40,9 @@ struct GarmentSimOptions {
   double contact_offset = 0.002;    // m the cloth is kept off the form (SceneObjects::offset)
   int tie_passes = 2;               // tie projections per substep
   double band = 0.006;              // m: half height of the waist and hip bands of the fit
+  // The waist band a band's height above the simulated waist seam instead of below it: a
+  // bodice has no cloth below its waist seam.
+  bool waist_band_above = false;
 };
 
 // Ease and strain in one band of heights (the waist, the hip): over the cloth's vertices there.
@@ -50,7 +55,7 @@ struct FitBand {
   // cloth contact_offset off it: its girth is that of the geometric garment plus 2 pi offset.
   double girth_expected_mm = 0;
   double girth_error_pct = 0;  // girth_mm against girth_expected_mm
-  int vertices = 0;
+  int vertices = 0;  // 0: no cloth at y (a bodice at the hip, a skirt at the bust): no girths
 };
 
 struct GarmentSimResult {
@@ -71,6 +76,7 @@ struct GarmentSimResult {
   // How far the sewn waist seam (its mean height) came down from the geometric placement (mm).
   double waist_seam_drop_mm = 0;
   FitBand waist, hip;
+  FitBand bust;  // at the form's bust line (a bodice, a dress)
   std::string to_json() const;
 };
 

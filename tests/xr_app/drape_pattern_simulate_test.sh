@@ -2,8 +2,8 @@
 # `drape pattern --simulate`: the tight skirt sewn and draped on the form by XPBD writes its
 # simulated glTF, the fit map PNG (its signature and size read back, its legend's colour bars and
 # labels: png_pixels.py legend), garment_sim.json (at rest, seams closed, nothing in the form)
-# and a scene file; a bodice design, an unknown fabric and
-# --fabric without --simulate are clear errors that write nothing.
+# and a scene file; so does the bodice (its bust band measured, no hip band: no cloth there); an
+# unknown fabric and --fabric without --simulate are clear errors that write nothing.
 # usage: drape_pattern_simulate_test.sh DRAPE_EXE
 set -u
 exe=$(realpath "$1")
@@ -15,8 +15,6 @@ expect 1 "--fabric: needs --simulate" -- pattern --design tight-skirt --fabric m
 [ ! -e bad1 ] || fail "bad1 written"
 expect 1 "--fabric silk" "no preset 'silk'" -- pattern --design tight-skirt --simulate --fabric silk --out bad2
 [ ! -e bad2 ] || fail "bad2 written"
-expect 1 "--simulate: bodice is a bodice design" -- pattern --design bodice --simulate --out bad3
-[ ! -e bad3 ] || fail "bad3 written"
 
 expect 0 "simulated garment (xpbd, muslin)" "(at rest)" "seam gap max" -- \
   pattern --design tight-skirt --simulate --out sk
@@ -41,5 +39,22 @@ assert j["at_rest"], "not at rest"
 assert j["seam_gap_max_mm"] < 0.5, j["seam_gap_max_mm"]
 assert j["penetration_max_mm"] < 0.5, j["penetration_max_mm"]
 assert j["frames"] > 0 and j["ms_per_frame"] > 0
+PY
+# The bodice: simulated (no longer refused), at rest, seams closed, its bust girth measured.
+expect 0 "simulated garment (xpbd, muslin)" "(at rest)" "bust  (y" "hip   (y 0.780 m) no cloth" -- \
+  pattern --design bodice --simulate --out bo
+for f in pattern.svg report.json garment_sim.gltf fit_map.png garment_sim.json; do
+  [ -s "bo/$f" ] || fail "bo/$f missing"
+done
+/usr/bin/python3 - bo/garment_sim.json <<'PY' || fail "bodice garment_sim.json out of bounds"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["design"] == "bodice", j["design"]
+assert j["at_rest"], "not at rest"
+assert j["seam_gap_max_mm"] < 0.5, j["seam_gap_max_mm"]
+assert j["penetration_max_mm"] < 0.5, j["penetration_max_mm"]
+assert j["hip"] is None, j["hip"]
+for band in ("waist", "bust"):
+    assert abs(j[band]["girth_error_pct"]) < 1.0, (band, j[band])
 PY
 echo "all ok"
