@@ -19,6 +19,7 @@
 #include <memory>
 #include <sstream>
 #include <string_view>
+#include <vector>
 
 #include "sim/io/obj_importer.hpp"
 
@@ -43,56 +44,82 @@ bool ply_magic(const char* p) {
          std::tolower(static_cast<unsigned char>(p[2])) == 'y';
 }
 
-// assimp 5.2's PLY reader loops forever on a header without an "end_header" line (found by
-// fuzz_mesh: a 510-byte file hung the loader for > 30 s). Data that assimp would read as PLY
-// (it starts with "ply") must close its header within the first MiB, use only the header
-// keywords and declare no element count above the file's size; false with `error` set.
+// A PLY name (element or property): one word that starts with a letter.
+bool ply_word(std::string_view w) {
+  return !w.empty() && std::isalpha(static_cast<unsigned char>(w[0])) &&
+         std::all_of(w.begin(), w.end(), [](char ch) {
+           return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+         });
+}
+
+bool ply_type(std::string_view t) {
+  static constexpr std::string_view kTypes[] = {
+      "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
+      "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+  return std::find(std::begin(kTypes), std::end(kTypes), t) != std::end(kTypes);
+}
+
+std::vector<std::string_view> ply_tokens(std::string_view l) {
+  std::vector<std::string_view> t;
+  for (size_t a = 0; a < l.size();) {
+    const size_t b = std::min(l.find(' ', a), l.size());
+    if (b > a) t.push_back(l.substr(a, b - a));
+    a = b + 1;
+  }
+  return t;
+}
+
+// What is wrong with one header line after the magic ("" when nothing): assimp 5.2 hangs or
+// allocates without bound on lines outside the format's grammar (fuzz_mesh, fuzz_mesh_ply: a
+// mangled "property" line, a blank line, "element vertexascii 1.0", a name of digits read as an
+// 11.4 GB count, an element count of 57 GB), so each line is held to it. `n` is the file's size.
+std::string ply_header_line_error(std::string_view l, size_t n) {
+  const std::string quoted = "\"" + std::string(l.substr(0, 40)) + "\"";
+  if (l.empty()) return "PLY header: an empty line before end_header";
+  const std::vector<std::string_view> t = ply_tokens(l);
+  const std::string_view kw = t[0];
+  if (kw == "comment" || kw == "obj_info") return "";
+  if (kw == "format") {
+    const bool ok =
+        t.size() == 3 &&
+        (t[1] == "ascii" || t[1] == "binary_little_endian" || t[1] == "binary_big_endian") &&
+        t[2] == "1.0";
+    return ok ? "" : "PLY header: " + quoted + " is not \"format ascii|binary_* 1.0\"";
+  }
+  if (kw == "property") {
+    const bool scalar = t.size() == 3 && ply_type(t[1]) && ply_word(t[2]);
+    const bool list =
+        t.size() == 5 && t[1] == "list" && ply_type(t[2]) && ply_type(t[3]) && ply_word(t[4]);
+    return scalar || list ? "" : "PLY header: " + quoted + " is not \"property TYPE NAME\"";
+  }
+  if (kw != "element") return "PLY header: unknown line " + quoted;
+  char* end = nullptr;
+  const std::string count = t.size() == 3 ? std::string(t[2]) : std::string();
+  const unsigned long long c = std::strtoull(count.c_str(), &end, 10);
+  if (!ply_word(t.size() == 3 ? t[1] : "") || count.empty() || *end != '\0' || count[0] == '-')
+    return "PLY header: " + quoted + " is not \"element NAME COUNT\"";
+  // Every entry takes at least one byte of the file: a count above its size is a lie.
+  if (c > n)
+    return "PLY header: \"" + std::string(l) + "\" declares more entries than the file has bytes";
+  return "";
+}
+
+// Data that assimp would read as PLY (it starts with "ply") must close its header within the
+// first MiB with an "end_header" line (assimp 5.2 loops forever without one) and keep every
+// header line to the format's grammar (ply_header_line_error); false with `error` set.
 bool ply_header_closed(const char* p, size_t n, std::string& error) {
   size_t i = 0;
   while (i < n && std::isspace(static_cast<unsigned char>(p[i]))) ++i;
   if (n - i < 3 || !ply_magic(p + i)) return true;
   const size_t limit = std::min(n, size_t{1} << 20);
   size_t line = i;
-  for (size_t k = i; k <= limit; ++k) {
-    if (k < limit && p[k] != '\n') continue;
+  for (size_t k = i; k < limit; ++k) {
+    if (p[k] != '\n') continue;
     std::string_view l(p + line, k - line);
-    while (!l.empty() && std::isspace(static_cast<unsigned char>(l.back()))) l.remove_suffix(1);
+    while (!l.empty() && (l.back() == '\r' || l.back() == ' ')) l.remove_suffix(1);
     if (l == "end_header") return true;
-    // Every header line is one of the format's keywords (assimp hangs on some it does not
-    // know, e.g. a mangled "property" line: fuzz_mesh).
-    const std::string_view kw = l.substr(0, l.find(' '));
-    if (line > i && !l.empty() && kw != "format" && kw != "comment" && kw != "obj_info" &&
-        kw != "element" && kw != "property") {
-      error = "PLY header: unknown line \"" + std::string(l.substr(0, 40)) + "\"";
-      return false;
-    }
-    // "element NAME COUNT": every entry takes at least one byte of the file, so a count above
-    // the file's size is a lie (assimp would allocate it: fuzz_mesh found a 57 GB request).
-    if (l.substr(0, 8) == "element ") {
-      const size_t sp = l.rfind(' ');
-      const std::string count(l.substr(sp + 1));
-      char* end = nullptr;
-      const unsigned long long c = std::strtoull(count.c_str(), &end, 10);
-      // A count that is not a whole number hangs assimp (fuzz_mesh_ply: "element vertexascii
-      // 1.0", a 242-byte file, ran past 30 s).
-      // The name is one word that starts with a letter: assimp reads a name of digits as a
-      // count (fuzz_mesh_ply: "element 4444...4444vertex 49" asked for 11.4 GB).
-      const std::string_view name = sp > 8 ? l.substr(8, sp - 8) : std::string_view{};
-      const bool word = !name.empty() && std::isalpha(static_cast<unsigned char>(name[0])) &&
-                        std::all_of(name.begin(), name.end(), [](char ch) {
-                          return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
-                        });
-      if (!word || count.empty() || !end || *end != '\0') {
-        error =
-            "PLY header: \"" + std::string(l.substr(0, 40)) + "\" is not \"element NAME COUNT\"";
-        return false;
-      }
-      if (c > n) {
-        error =
-            "PLY header: \"" + std::string(l) + "\" declares more entries than the file has bytes";
-        return false;
-      }
-    }
+    if (line > i) error = ply_header_line_error(l, n);
+    if (!error.empty()) return false;
     line = k + 1;
   }
   error = "PLY header has no end_header line";

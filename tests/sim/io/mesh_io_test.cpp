@@ -315,6 +315,18 @@ TEST(MeshIo, PlyElementCountBeyondTheFileIsAnError) {
       "ply\nformat ascii 1.0\nelement vertexascii 1.0\nproperty float x\nend_header\n0\n";
   EXPECT_NE(drape::sim::ply_load_error(fraction, "count.ply").find("is not \"element NAME COUNT\""),
             std::string::npos);
+  // An empty line in the header (seed regress_ply_blank_line).
+  const std::string blank =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\n\nend_header\n0\n";
+  EXPECT_NE(drape::sim::ply_load_error(blank, "blank.ply").find("an empty line"),
+            std::string::npos);
+  // Property types and formats outside the grammar (seed regress_ply_bad_types).
+  const std::string types =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty &loat y\nend_header\n0\n";
+  EXPECT_NE(drape::sim::ply_load_error(types, "t.ply").find("is not \"property TYPE NAME\""),
+            std::string::npos);
+  const std::string format = "ply\nformat zv_\nelement vertex 1\nproperty float y\nend_header\n0\n";
+  EXPECT_NE(drape::sim::ply_load_error(format, "f.ply").find("is not \"format"), std::string::npos);
   // A name of digits, which assimp reads as a count (seed regress_ply_digit_name).
   const std::string digits =
       "ply\nformat ascii 1.0\nelement 44444444444444vertex 1\nproperty float x\nend_header\n0\n";
