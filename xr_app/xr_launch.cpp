@@ -110,9 +110,10 @@ void add_app_options(CLI::App& cli, XrAppOptions& opt) {
                           "no feedback panel over the scene (tests of the cloth's image)"},
                          {"--no-board", &opt.pattern_board,
                           "no live pattern board beside the form (its cost: drape bench board)"}});
-  cli.add_option("--garment", opt.garment,
-                 "instead of the panel, the sewn garment of a skirt design (assets/designs/ by "
-                 "name, or a design file) on the form, simulated with its seams as ties")
+  cli.add_option(
+         "--garment", opt.garment,
+         "instead of the panel, the sewn garment of a skirt or bodice design (assets/designs/ by "
+         "name, or a design file) on the form, simulated with its seams as ties")
       ->type_name("NAME|FILE.json");
   cli.add_option("--garment-fabric", opt.garment_fabric,
                  "with --garment: a fabric of assets/fabrics.json (default: the design's)")

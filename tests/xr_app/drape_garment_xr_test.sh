@@ -12,7 +12,7 @@
 #     map's colours, in a box centred on the form, narrower than the form's surroundings, with
 #     the form's cover above it; the frame before the toggle (140) has under a tenth of them
 #     (png_pixels.py garment).
-# Bad input: an unknown design or fabric, --garment-fabric alone and a bodice design are errors
+# Bad input: an unknown design or fabric, --garment-fabric alone and a dress design are errors
 # naming the option. A save asked for (scenarios/garment_save.json: the menu held 1 s) is refused.
 # usage: drape_garment_xr_test.sh DRAPE_EXE
 set -u
@@ -29,8 +29,8 @@ expect 2 "--garment: no such design: nosuch" -- xr --garment nosuch --frames 2
 expect 2 "--garment-fabric silk" "no preset 'silk'" -- \
   xr --garment tight-skirt --garment-fabric silk --frames 2
 expect 2 "--garment-fabric: needs --garment" -- xr --garment-fabric denim --frames 2
-expect 1 "--garment" "a bodice design; the live garment takes the skirt designs" -- \
-  xr --garment bodice --frames 2 --eye-size 64
+expect 1 "--garment" "a dress design; the live garment takes skirts and the bodice" -- \
+  xr --garment dress --frames 2 --eye-size 64
 
 export DRAPE_MOCK_WRITE_FRAMES=$work/frames DRAPE_MOCK_WRITE_EVERY=10
 mkdir -p frames

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 
 #include "sim/core/fabric.hpp"
 #include "sim/draping/bodice.hpp"
@@ -31,14 +33,32 @@ sim::Result<sim::FabricParams> garment_fabric(const XrAppOptions& opt, const std
   return f;
 }
 
+// The bodice design's sewn bodice on `form`: its zones' flat pattern as rest, its darts' legs,
+// side and shoulder seams as ties (drape_bodice).
+sim::Result<sim::Garment> sewn_bodice(const XrAppOptions& opt, const sim::DressForm& form,
+                                      sim::FabricParams& fabric) {
+  std::ifstream in(opt.garment, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  auto d = sim::parse_bodice_design(text.str(), opt.garment);
+  if (!d) return sim::make_error("--garment", d.error());
+  auto f = garment_fabric(opt, d->fabric);
+  if (!f) return sim::Error{f.error()};
+  fabric = *f;
+  auto b = sim::drape_bodice(*d, form);
+  if (!b) return sim::make_error("--garment " + opt.garment, b.error());
+  return std::move(b->garment);
+}
+
 // The design's sewn garment on `form` (the pipeline writes no files).
 sim::Result<sim::Garment> sewn_garment(const XrAppOptions& opt, const sim::DressForm& form,
                                        sim::FabricParams& fabric) {
   auto type = sim::design_type(opt.garment);
   if (!type) return sim::make_error("--garment", type.error());
+  if (*type == "bodice") return sewn_bodice(opt, form, fabric);
   if (*type != "skirt")
     return sim::make_error("--garment " + opt.garment,
-                           "a " + *type + " design; the live garment takes the skirt designs");
+                           "a " + *type + " design; the live garment takes skirts and the bodice");
   auto d = sim::load_design(opt.garment);
   if (!d) return sim::make_error("--garment", d.error());
   auto f = garment_fabric(opt, d->fabric);
