@@ -327,6 +327,11 @@ TEST(MeshIo, PlyElementCountBeyondTheFileIsAnError) {
             std::string::npos);
   const std::string format = "ply\nformat zv_\nelement vertex 1\nproperty float y\nend_header\n0\n";
   EXPECT_NE(drape::sim::ply_load_error(format, "f.ply").find("is not \"format"), std::string::npos);
+  // A NUL after the magic (seed regress_ply_magic_nul).
+  const std::string nul = std::string("ply") + '\0' +
+                          "format ascii 1.0\nelement vertex 1\nproperty float y\nend_header\n0\n";
+  EXPECT_NE(drape::sim::ply_load_error(nul, "nul.ply").find("the first line is not"),
+            std::string::npos);
   // A name of digits, which assimp reads as a count (seed regress_ply_digit_name).
   const std::string digits =
       "ply\nformat ascii 1.0\nelement 44444444444444vertex 1\nproperty float x\nend_header\n0\n";
