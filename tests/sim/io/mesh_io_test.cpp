@@ -311,32 +311,30 @@ TEST(MeshIo, PlyElementCountBeyondTheFileIsAnError) {
   EXPECT_NE(drape::sim::ply_load_error("plYply\nformat ascii 1.0\nend_head\n", "case.ply")
                 .find("PLY header"),
             std::string::npos);
-  const std::string fraction =
-      "ply\nformat ascii 1.0\nelement vertexascii 1.0\nproperty float x\nend_header\n0\n";
-  EXPECT_NE(drape::sim::ply_load_error(fraction, "count.ply").find("is not \"element NAME COUNT\""),
-            std::string::npos);
-  // An empty line in the header (seed regress_ply_blank_line).
-  const std::string blank =
-      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\n\nend_header\n0\n";
-  EXPECT_NE(drape::sim::ply_load_error(blank, "blank.ply").find("an empty line"),
-            std::string::npos);
-  // Property types and formats outside the grammar (seed regress_ply_bad_types).
-  const std::string types =
-      "ply\nformat ascii 1.0\nelement vertex 1\nproperty &loat y\nend_header\n0\n";
-  EXPECT_NE(drape::sim::ply_load_error(types, "t.ply").find("is not \"property TYPE NAME\""),
-            std::string::npos);
-  const std::string format = "ply\nformat zv_\nelement vertex 1\nproperty float y\nend_header\n0\n";
-  EXPECT_NE(drape::sim::ply_load_error(format, "f.ply").find("is not \"format"), std::string::npos);
-  // A NUL after the magic (seed regress_ply_magic_nul).
-  const std::string nul = std::string("ply") + '\0' +
-                          "format ascii 1.0\nelement vertex 1\nproperty float y\nend_header\n0\n";
-  EXPECT_NE(drape::sim::ply_load_error(nul, "nul.ply").find("the first line is not"),
-            std::string::npos);
-  // A name of digits, which assimp reads as a count (seed regress_ply_digit_name).
-  const std::string digits =
-      "ply\nformat ascii 1.0\nelement 44444444444444vertex 1\nproperty float x\nend_header\n0\n";
-  EXPECT_NE(drape::sim::ply_load_error(digits, "name.ply").find("is not \"element NAME COUNT\""),
-            std::string::npos);
+  // Header lines outside PLY's grammar, each found by fuzz_mesh_ply (seeds regress_ply_*):
+  // a count that is no whole number, a blank line (blank_line), a bad property type and format
+  // (bad_types), a NUL after the magic (magic_nul), a name of digits read as a count
+  // (digit_name).
+  const std::string tail = "property float y\nend_header\n0\n";
+  const struct {
+    const char* file;
+    std::string ply;
+    const char* error;
+  } cases[] = {
+      {"count.ply", "ply\nformat ascii 1.0\nelement vertexascii 1.0\n" + tail,
+       "is not \"element NAME COUNT\""},
+      {"blank.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\n\nend_header\n0\n",
+       "an empty line"},
+      {"t.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty &loat y\nend_header\n0\n",
+       "is not \"property TYPE NAME\""},
+      {"f.ply", "ply\nformat zv_\nelement vertex 1\n" + tail, "is not \"format"},
+      {"nul.ply", std::string("ply") + '\0' + "format ascii 1.0\nelement vertex 1\n" + tail,
+       "the first line is not"},
+      {"name.ply", "ply\nformat ascii 1.0\nelement 44444444444444vertex 1\n" + tail,
+       "is not \"element NAME COUNT\""},
+  };
+  for (const auto& c : cases)
+    EXPECT_NE(drape::sim::ply_load_error(c.ply, c.file).find(c.error), std::string::npos) << c.file;
 }
 
 // A face with more corners than its mesh has vertices (fuzz_mesh: a mangled list count gave 96
