@@ -1,8 +1,13 @@
 // Real fabrics against the virtual drape tester (docs/fabrics.md): for each of the five fabrics
 // of the measured calibration set (shared data real-drape.md: Cusick tests of a 0.30 m specimen
-// on a 0.18 m disc), the bending fitted to the measured DC alone, then the node count and R_min /
-// R_max predicted at that bending beside the measured ones. Writes out/bench/fabrics.csv and
-// .json, the fitted presets (out/bench/fabrics_presets.json) and a DC-against-resolution table
+// on a 0.18 m disc) two calibrations, each preset then draped on fresh seeds beside the measured
+// figures:
+//   dc        the bending fitted to the measured DC alone (warp/weft 1.6): the node count and
+//             R_min / R_max are predictions
+//   dc+depth  the warp/weft ratio fitted to the measured fold depth R_max - R_min too, B to DC
+//             at each ratio: the node count is a prediction (the presets of assets/fabrics.json)
+// Writes out/bench/fabrics.csv and .json (a row per fabric and fit), the dc+depth presets
+// (out/bench/fabrics_presets.json) and a DC-against-resolution table
 // (out/bench/fabrics_convergence.csv). Usage: fabrics_bench [--resolution N] [--seeds K]
 // [--convergence 10,15,20,30] [--only NAME].
 #include <CLI/CLI.hpp>
@@ -37,22 +42,23 @@ constexpr Measured kFabrics[] = {
 
 struct Row {
   const Measured* m;
+  const char* fit;  // "dc" or "dc+depth"
   CalibrationResult cal;
   drape::sim::DrapeSeries check;  // the fitted preset on fresh seeds
 };
 
 void print_table(const std::vector<Row>& rows) {
-  std::printf("\n%-14s %5s | %6s %6s %5s | %5s %5s | %6s %6s | %6s %6s | %9s %9s | %5s\n", "fabric",
-              "g/m2", "DC", "sim", "sd", "nodes", "sim", "Rmin", "sim", "Rmax", "sim", "B_warp",
-              "B_weft", "s");
+  std::printf("\n%-14s %-8s %5s | %6s %6s %5s | %5s %5s | %6s %6s | %6s %6s | %9s %9s %5s | %5s\n",
+              "fabric", "fit", "g/m2", "DC", "sim", "sd", "nodes", "sim", "Rmin", "sim", "Rmax",
+              "sim", "B_warp", "B_weft", "ratio", "s");
   for (const Row& r : rows) {
     const auto& s = r.check;
     std::printf(
-        "%-14s %5.0f | %6.3f %6.3f %5.3f | %5d %5.1f | %6.1f %6.1f | %6.1f %6.1f | %9.3g %9.3g | "
-        "%5.1f\n",
-        r.m->name, r.m->gsm, r.m->dc, s.dc_mean, s.dc_sd, r.m->nodes, s.nodes_mean, r.m->rmin_mm,
-        s.rmin_mean * 1e3, r.m->rmax_mm, s.rmax_mean * 1e3, r.cal.fabric.bending_warp,
-        r.cal.fabric.bending_weft, r.cal.seconds);
+        "%-14s %-8s %5.0f | %6.3f %6.3f %5.3f | %5d %5.1f | %6.1f %6.1f | %6.1f %6.1f | %9.3g "
+        "%9.3g %5.2f | %5.1f\n",
+        r.m->name, r.fit, r.m->gsm, r.m->dc, s.dc_mean, s.dc_sd, r.m->nodes, s.nodes_mean,
+        r.m->rmin_mm, s.rmin_mean * 1e3, r.m->rmax_mm, s.rmax_mean * 1e3, r.cal.fabric.bending_warp,
+        r.cal.fabric.bending_weft, r.cal.ratio, r.cal.seconds);
   }
 }
 
@@ -60,16 +66,17 @@ void write_outputs(const std::vector<Row>& rows) {
   std::ofstream csv("out/bench/fabrics.csv");
   csv << "fabric,density_gsm,dc_measured,dc_sim,dc_sim_sd,nodes_measured,nodes_sim,"
          "rmin_measured_mm,rmin_sim_mm,rmax_measured_mm,rmax_sim_mm,bending_warp,bending_weft,"
-         "seconds\n";
+         "seconds,fit,warp_weft_ratio\n";
   nlohmann::ordered_json js = nlohmann::ordered_json::array();
   for (const Row& r : rows) {
     const auto& s = r.check;
     char line[512];
     std::snprintf(line, sizeof line,
-                  "%s,%.0f,%.3f,%.4f,%.4f,%d,%.2f,%.1f,%.2f,%.1f,%.2f,%.4g,%.4g,%.1f\n", r.m->name,
-                  r.m->gsm, r.m->dc, s.dc_mean, s.dc_sd, r.m->nodes, s.nodes_mean, r.m->rmin_mm,
-                  s.rmin_mean * 1e3, r.m->rmax_mm, s.rmax_mean * 1e3, r.cal.fabric.bending_warp,
-                  r.cal.fabric.bending_weft, r.cal.seconds);
+                  "%s,%.0f,%.3f,%.4f,%.4f,%d,%.2f,%.1f,%.2f,%.1f,%.2f,%.4g,%.4g,%.1f,%s,%.3f\n",
+                  r.m->name, r.m->gsm, r.m->dc, s.dc_mean, s.dc_sd, r.m->nodes, s.nodes_mean,
+                  r.m->rmin_mm, s.rmin_mean * 1e3, r.m->rmax_mm, s.rmax_mean * 1e3,
+                  r.cal.fabric.bending_warp, r.cal.fabric.bending_weft, r.cal.seconds, r.fit,
+                  r.cal.ratio);
     csv << line;
     js.push_back({{"fabric", r.m->name},
                   {"density_gsm", r.m->gsm},
@@ -85,6 +92,9 @@ void write_outputs(const std::vector<Row>& rows) {
                   {"bending_warp", r.cal.fabric.bending_warp},
                   {"bending_weft", r.cal.fabric.bending_weft},
                   {"seconds", r.cal.seconds},
+                  {"fit", r.fit},
+                  {"warp_weft_ratio", r.cal.ratio},
+                  {"ratio_fits", r.cal.ratio_fits},
                   {"calibration_dc", r.cal.series.dc_mean},
                   {"evaluations", r.cal.steps.size()}});
   }
@@ -125,6 +135,36 @@ void convergence(const Row& row, const std::vector<int>& resolutions, int seeds,
   std::printf("wrote out/bench/fabrics_convergence.csv\n");
 }
 
+// One fabric's calibration (`fit`: "dc" or "dc+depth", o.fold_depth set for the latter), its
+// preset then draped on `seeds` fresh seeds; the dc+depth preset saved to
+// out/bench/fabrics_presets.json.
+drape::sim::Result<Row> fit_fabric(const Measured& m, const char* fit, const CalibrationOptions& o,
+                                   int seeds) {
+  auto cal = drape::sim::calibrate_bending(m.gsm, m.dc, o);
+  if (!cal) return drape::sim::Error{cal.error()};
+  std::printf("%-14s %-8s fitted in %.1f s, %zu evaluations (B, ratio, DC, depth mm):", m.name, fit,
+              cal->seconds, cal->steps.size());
+  for (const auto& st : cal->steps)
+    std::printf(" (%.3g, %.2f, %.3f, %.1f)", st.bending, st.ratio, st.dc, st.depth * 1e3);
+  std::printf("\n");
+  drape::sim::DrapeTestOptions t = o.test;
+  t.seed = 100;
+  auto check = drape::sim::run_drape_series(cal->fabric, t, seeds, o.threads);
+  if (!check) return drape::sim::Error{check.error()};
+  if (o.fold_depth > 0) {
+    char src[256];
+    std::snprintf(src, sizeof src,
+                  "measured DC %.3f, R_max - R_min %.1f mm (real-drape.md); tester DC %.3f sd "
+                  "%.3f, R_max - R_min %.1f mm",
+                  m.dc, m.rmax_mm - m.rmin_mm, check->dc_mean, check->dc_sd,
+                  (check->rmax_mean - check->rmin_mean) * 1e3);
+    const std::string e =
+        drape::sim::save_fabric_preset("out/bench/fabrics_presets.json", m.name, cal->fabric, src);
+    if (!e.empty()) return drape::sim::Error{e};
+  }
+  return Row{&m, fit, std::move(*cal), std::move(*check)};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -153,32 +193,21 @@ int main(int argc, char** argv) {
   std::vector<Row> rows;
   for (const Measured& m : kFabrics) {
     if (!only.empty() && only != m.name) continue;
-    auto cal = drape::sim::calibrate_bending(m.gsm, m.dc, opt);
-    if (!cal) {
-      std::fprintf(stderr, "%s: %s\n", m.name, cal.error().c_str());
-      return 1;
+    for (const char* fit : {"dc", "dc+depth"}) {
+      CalibrationOptions o = opt;
+      if (std::string(fit) == "dc+depth") o.fold_depth = (m.rmax_mm - m.rmin_mm) * 1e-3;
+      auto row = fit_fabric(m, fit, o, check_seeds);
+      if (!row) {
+        std::fprintf(stderr, "%s (%s): %s\n", m.name, fit, row.error().c_str());
+        return 1;
+      }
+      rows.push_back(std::move(*row));
     }
-    std::printf("%-14s fitted in %.1f s, %zu evaluations:", m.name, cal->seconds,
-                cal->steps.size());
-    for (const auto& st : cal->steps) std::printf(" (%.3g, %.3f)", st.bending, st.dc);
-    std::printf("\n");
-    drape::sim::DrapeTestOptions t = opt.test;
-    t.seed = 100;
-    auto check = drape::sim::run_drape_series(cal->fabric, t, check_seeds, opt.threads);
-    if (!check) {
-      std::fprintf(stderr, "%s: %s\n", m.name, check.error().c_str());
-      return 1;
-    }
-    char src[256];
-    std::snprintf(src, sizeof src, "measured DC %.3f (real-drape.md); tester DC %.3f sd %.3f", m.dc,
-                  check->dc_mean, check->dc_sd);
-    drape::sim::save_fabric_preset("out/bench/fabrics_presets.json", m.name, cal->fabric, src);
-    rows.push_back({&m, std::move(*cal), std::move(*check)});
   }
   print_table(rows);
   write_outputs(rows);
   for (const Row& r : rows)
-    if (r.m->name == conv_fabric || (!only.empty() && !conv.empty())) {
+    if (r.m->name == conv_fabric || (!only.empty() && !conv.empty() && r.fit[2] == '+')) {
       convergence(r, conv, conv_seeds, opt.test);
       break;
     }

@@ -126,6 +126,7 @@ int run_test(const std::string& spec, DrapeTestOptions o, int seeds, int threads
 struct CalibrateArgs {
   double density = 0, dc = 0;
   int nodes = -1;
+  double rmin_mm = 0, rmax_mm = 0;  // measured mean R_min / R_max: the ratio fitted to their gap
   std::string name = "calibrated", out, photo;
 };
 
@@ -155,13 +156,21 @@ bool figures_from_photo(CalibrateArgs& a, const DrapeTestOptions& t) {
   return true;
 }
 
-int run_calibrate(CalibrateArgs a, const drape::sim::CalibrationOptions& opt) {
+int run_calibrate(CalibrateArgs a, drape::sim::CalibrationOptions opt) {
   if ((a.dc > 0) == !a.photo.empty()) {
     std::fprintf(stderr,
                  "drape fabric calibrate: give the measured DC (--dc) or a photo "
                  "(--photo), one of them\n");
     return 2;
   }
+  if ((a.rmin_mm > 0) != (a.rmax_mm > 0) || a.rmax_mm < a.rmin_mm) {
+    std::fprintf(stderr,
+                 "drape fabric calibrate: --rmin and --rmax go together, R_min below R_max "
+                 "(got %g and %g mm)\n",
+                 a.rmin_mm, a.rmax_mm);
+    return 2;
+  }
+  opt.fold_depth = (a.rmax_mm - a.rmin_mm) * 1e-3;
   if (!a.photo.empty() && !figures_from_photo(a, opt.test)) return 1;
   auto cal = drape::sim::calibrate_bending(a.density, a.dc, opt);
   if (!cal) {
@@ -169,20 +178,27 @@ int run_calibrate(CalibrateArgs a, const drape::sim::CalibrationOptions& opt) {
     return 1;
   }
   for (const auto& st : cal->steps)
-    std::printf("  bending %.4g N m -> DC %.4f\n", st.bending, st.dc);
+    std::printf("  bending %.4g N m, warp/weft %.2f -> DC %.4f, fold depth %.1f mm\n", st.bending,
+                st.ratio, st.dc, st.depth * 1e3);
   const auto& s = cal->series;
   std::printf(
-      "fitted in %.1f s (%zu evaluations of %d drapes): bending warp %.4g weft %.4g N m, "
-      "DC %.4f (target %.4f, residual %+.4f)\n",
+      "fitted in %.1f s (%zu evaluations of %d drapes): bending warp %.4g weft %.4g N m "
+      "(ratio %.2f), DC %.4f (target %.4f, residual %+.4f)\n",
       cal->seconds, cal->steps.size(), opt.seeds, cal->fabric.bending_warp,
-      cal->fabric.bending_weft, s.dc_mean, a.dc, cal->residual);
+      cal->fabric.bending_weft, cal->ratio, s.dc_mean, a.dc, cal->residual);
+  if (opt.fold_depth > 0)
+    std::printf("fold depth R_max - R_min %.1f mm (measured %.1f, residual %+.1f mm)\n",
+                (s.rmax_mean - s.rmin_mean) * 1e3, opt.fold_depth * 1e3, cal->depth_residual * 1e3);
   std::printf("predicted: nodes %.2f%s, R_min %.1f mm, R_max %.1f mm\n", s.nodes_mean,
               a.nodes > 0 ? (" (measured " + std::to_string(a.nodes) + ")").c_str() : "",
               s.rmin_mean * 1e3, s.rmax_mean * 1e3);
   if (a.out.empty()) return 0;
-  char src[200];
-  std::snprintf(src, sizeof src, "drape fabric calibrate: measured DC %.3f, tester DC %.4f", a.dc,
-                s.dc_mean);
+  char src[256];
+  int at = std::snprintf(
+      src, sizeof src, "drape fabric calibrate: measured DC %.3f, tester DC %.4f", a.dc, s.dc_mean);
+  if (opt.fold_depth > 0)
+    std::snprintf(src + at, sizeof src - at, "; fold depth measured %.1f mm, tester %.1f mm",
+                  opt.fold_depth * 1e3, (s.rmax_mean - s.rmin_mean) * 1e3);
   if (std::string e = drape::sim::save_fabric_preset(a.out, a.name, cal->fabric, src); !e.empty()) {
     std::fprintf(stderr, "drape fabric calibrate: %s\n", e.c_str());
     return 1;
@@ -222,10 +238,17 @@ int run(int argc, char** argv) {
       ->type_name("FILE.png|.jpg");
   cal->add_option("--nodes", ca.nodes, "measured node count (reported beside the prediction)")
       ->check(CLI::Range(1, 60));
+  cal->add_option("--rmin", ca.rmin_mm,
+                  "measured mean R_min (mm), with --rmax: the warp/weft "
+                  "ratio fitted to the fold depth R_max - R_min")
+      ->check(drape::app::positive_up_to(1000));
+  cal->add_option("--rmax", ca.rmax_mm, "measured mean R_max (mm)")
+      ->check(drape::app::positive_up_to(1000));
   cal->add_option("--name", ca.name, "preset name")->capture_default_str();
   cal->add_option("--out", ca.out, "fabrics JSON to add the preset to (created if missing)");
   cal->add_option("--seeds", copt.seeds, "drapes per evaluation")->check(CLI::Range(1, 64));
-  cal->add_option("--ratio", copt.warp_weft_ratio, "bending warp / weft")
+  cal->add_option("--ratio", copt.warp_weft_ratio,
+                  "bending warp / weft (the first tried with --rmin/--rmax)")
       ->check(drape::app::positive_up_to(100))
       ->capture_default_str();
   add_tester_options(*cal, copt.test);

@@ -25,53 +25,99 @@ double logit(double p) {
   return std::log(p / (1 - p));
 }
 
-// One evaluation: the mean DC over the seeds at bending b (geometric mean).
-Result<DrapeSeries> evaluate(const FabricParams& base, double b, const CalibrationOptions& o,
-                             std::vector<CalibrationStep>& steps) {
-  auto s = run_drape_series(with_bending(base, b, o.warp_weft_ratio), o.test, o.seeds, o.threads);
-  if (s) steps.push_back({b, s->dc_mean});
-  return s;
-}
-
 struct Point {
   double logb, f;  // log B, logit(DC_sim) - logit(DC_target)
 };
 
-// Regula falsi with the Illinois modification on f(log B); `lo` has f < 0, `hi` f > 0.
-Result<DrapeSeries> refine(Point lo, Point hi, DrapeSeries best, double& best_b,
-                           const FabricParams& base, double target, const CalibrationOptions& o,
-                           std::vector<CalibrationStep>& steps) {
-  int side = 0;
-  while (std::abs(best.dc_mean - target) > o.dc_tolerance &&
-         static_cast<int>(steps.size()) < o.max_evaluations) {
-    const double x = hi.logb - hi.f * (hi.logb - lo.logb) / (hi.f - lo.f);
-    auto s = evaluate(base, std::exp(x), o, steps);
-    if (!s) return s;
-    const Point p{x, logit(s->dc_mean) - logit(target)};
-    if (std::abs(s->dc_mean - target) < std::abs(best.dc_mean - target)) {
-      best = *s;
-      best_b = std::exp(x);
-    }
-    if (p.f < 0) {
-      lo = p;
-      if (side == -1) hi.f *= 0.5;
-      side = -1;
-    } else {
-      hi = p;
-      if (side == 1) lo.f *= 0.5;
-      side = 1;
-    }
+double depth(const DrapeSeries& s) {
+  return s.rmax_mean - s.rmin_mean;
+}
+
+// The search for B at one warp/weft ratio: its evaluations (appended to `steps`), the one
+// nearest the target DC.
+struct LevelSearch {
+  const FabricParams& base;
+  double target, ratio;
+  const CalibrationOptions& o;
+  std::vector<CalibrationStep>& steps;
+  size_t first = steps.size();
+  DrapeSeries best;
+  double best_b = 0;
+
+  bool more() const {
+    return static_cast<int>(steps.size() - first) < o.max_evaluations &&
+           (best_b == 0 || std::abs(best.dc_mean - target) > o.dc_tolerance);
   }
-  return best;
+  // The mean DC over the seeds at B = exp(logb).
+  Result<Point> eval(double logb) {
+    const double b = std::exp(logb);
+    auto s = run_drape_series(with_bending(base, b, ratio), o.test, o.seeds, o.threads);
+    if (!s) return Error{s.error()};
+    steps.push_back({b, ratio, s->dc_mean, depth(*s)});
+    if (best_b == 0 || std::abs(s->dc_mean - target) < std::abs(best.dc_mean - target)) {
+      best = *s;
+      best_b = b;
+    }
+    return Point{logb, logit(s->dc_mean) - logit(target)};
+  }
+  // Regula falsi with the Illinois modification on f(log B); `lo` has f < 0, `hi` f > 0.
+  std::string refine(Point lo, Point hi) {
+    int side = 0;
+    while (more()) {
+      auto p = eval(hi.logb - hi.f * (hi.logb - lo.logb) / (hi.f - lo.f));
+      if (!p) return p.error();
+      if (p->f < 0) {
+        lo = *p;
+        if (side == -1) hi.f *= 0.5;
+        side = -1;
+      } else {
+        hi = *p;
+        if (side == 1) lo.f *= 0.5;
+        side = 1;
+      }
+    }
+    return {};
+  }
+  // From B = b0, stepping by `factor` in B until the target lies between two evaluations, then
+  // refined.
+  std::string run(double b0, double factor) {
+    auto a = eval(std::log(b0));
+    if (!a) return a.error();
+    Point c = *a;
+    while (more() && (a->f < 0) == (c.f < 0)) {
+      *a = c;
+      auto n = eval(a->logb + (a->f < 0 ? 1 : -1) * std::log(factor));
+      if (!n) return n.error();
+      c = *n;
+    }
+    if ((a->f < 0) != (c.f < 0)) return refine(a->f < 0 ? *a : c, a->f < 0 ? c : *a);
+    return {};
+  }
+};
+
+std::string check_inputs(double density_gsm, double dc, const CalibrationOptions& o) {
+  if (!(density_gsm > 0) || !std::isfinite(density_gsm) || density_gsm > 5000)
+    return "density must be in (0, 5000] g/m^2";
+  if (!(dc > 0 && dc < 1)) return "DC must be in (0, 1)";
+  if (!(o.warp_weft_ratio > 0)) return "warp/weft ratio must be > 0";
+  if (!(o.fold_depth >= 0 && o.fold_depth < 0.5 * o.test.specimen_diameter))
+    return "fold depth must be in [0, the specimen's radius)";
+  if (o.fold_depth > 0 && !(o.min_ratio > 0 && o.min_ratio < o.max_ratio))
+    return "the warp/weft ratios searched must be 0 < min < max";
+  return {};
+}
+
+// A fit's distance from the targets, each error in units of its tolerance.
+double miss(const DrapeSeries& s, double dc, const CalibrationOptions& o) {
+  return std::abs(s.dc_mean - dc) / o.dc_tolerance +
+         std::abs(depth(s) - o.fold_depth) / o.depth_tolerance;
 }
 }  // namespace
 
 Result<CalibrationResult> calibrate_bending(double density_gsm, double dc,
                                             const CalibrationOptions& o) {
-  if (!(density_gsm > 0) || !std::isfinite(density_gsm) || density_gsm > 5000)
-    return make_error("calibrate", "density must be in (0, 5000] g/m^2");
-  if (!(dc > 0 && dc < 1)) return make_error("calibrate", "DC must be in (0, 1)");
-  if (!(o.warp_weft_ratio > 0)) return make_error("calibrate", "warp/weft ratio must be > 0");
+  if (std::string e = check_inputs(density_gsm, dc, o); !e.empty())
+    return make_error("calibrate", e);
   const auto t0 = std::chrono::steady_clock::now();
   CalibrationResult res;
   res.dc_target = dc;
@@ -80,33 +126,40 @@ Result<CalibrationResult> calibrate_bending(double density_gsm, double dc,
   // Start from a bending length c = (B / w)^(1/3) of 3 cm (w: weight per area), a mid-range
   // cloth, and step by 8x in B (2x in c) until the target lies between two evaluations.
   const double w = base.areal_density * kGravity0;
-  double b = w * std::pow(0.03, 3);
-  auto first = evaluate(base, b, o, res.steps);
-  if (!first) return Error{first.error()};
-  Point a{std::log(b), logit(first->dc_mean) - logit(dc)};
-  DrapeSeries best = *first;
-  double best_b = b;
-  Point c = a;
-  while (static_cast<int>(res.steps.size()) < o.max_evaluations &&
-         std::abs(best.dc_mean - dc) > o.dc_tolerance && (a.f < 0) == (c.f < 0)) {
-    a = c;
-    b = std::exp(a.logb) * (a.f < 0 ? 8.0 : 0.125);
-    auto s = evaluate(base, b, o, res.steps);
-    if (!s) return Error{s.error()};
-    c = {std::log(b), logit(s->dc_mean) - logit(dc)};
-    if (std::abs(s->dc_mean - dc) < std::abs(best.dc_mean - dc)) {
-      best = *s;
-      best_b = b;
+  LevelSearch fit{base, dc, o.warp_weft_ratio, o, res.steps};
+  if (std::string e = fit.run(w * std::pow(0.03, 3), 8.0); !e.empty()) return Error{e};
+  res.ratio_fits = 1;
+  DrapeSeries best = fit.best;
+  double best_b = fit.best_b, best_r = o.warp_weft_ratio;
+  if (o.fold_depth > 0) {
+    // The ratio: the depth probed at twice (or half) the ratio with B kept (DC barely moves
+    // with the ratio), the ratio interpolated in log(ratio) to the measured depth (within
+    // [min_ratio, max_ratio] and 4x of the first), then B fitted to DC again there from the
+    // first fit's (steps of 1.5x).
+    const double r0 = std::log(o.warp_weft_ratio), d0 = depth(fit.best);
+    const double r1 = r0 + (d0 < o.fold_depth ? 1 : -1) * std::log(2.0);
+    LevelSearch probe{base, dc, std::exp(r1), o, res.steps};
+    auto p = probe.eval(std::log(fit.best_b));
+    if (!p) return Error{p.error()};
+    const double d1 = depth(probe.best), slope = (d1 - d0) / (r1 - r0);
+    double r = slope > 0 ? r0 + (o.fold_depth - d0) / slope
+                         : (std::abs(d1 - o.fold_depth) < std::abs(d0 - o.fold_depth) ? r1 : r0);
+    r = std::clamp(r, r0 - std::log(4.0), r0 + std::log(4.0));
+    r = std::clamp(r, std::log(o.min_ratio), std::log(o.max_ratio));
+    LevelSearch next{base, dc, std::exp(r), o, res.steps};
+    if (std::string e = next.run(fit.best_b, 1.5); !e.empty()) return Error{e};
+    res.ratio_fits = 2;
+    if (miss(next.best, dc, o) < miss(best, dc, o)) {
+      best = next.best;
+      best_b = next.best_b;
+      best_r = std::exp(r);
     }
   }
-  if ((a.f < 0) != (c.f < 0)) {
-    auto r = refine(a.f < 0 ? a : c, a.f < 0 ? c : a, best, best_b, base, dc, o, res.steps);
-    if (!r) return Error{r.error()};
-    best = *r;
-  }
-  res.fabric = with_bending(base, best_b, o.warp_weft_ratio);
+  res.fabric = with_bending(base, best_b, best_r);
+  res.ratio = best_r;
   res.series = std::move(best);
   res.residual = res.series.dc_mean - dc;
+  if (o.fold_depth > 0) res.depth_residual = depth(res.series) - o.fold_depth;
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }

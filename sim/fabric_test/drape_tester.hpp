@@ -19,9 +19,11 @@ namespace drape::sim {
 struct DrapeTestOptions {
   double specimen_diameter = 0.30;  // m
   double disc_diameter = 0.18;      // m
-  // Rings of vertices from the centre to the rim (edge length ~ specimen radius / rings). 20
-  // (7.5 mm) keeps one run near a second on one core; docs/fabrics.md has the convergence.
-  int resolution = 20;
+  // Rings of vertices from the centre to the rim (edge length ~ specimen radius / rings). 30
+  // (5 mm) resolves the folds: the node count grows with the rings (7 at 20 rings where 8 to 9
+  // were measured) and a drape stays near two seconds on one core; docs/fabrics.md has the
+  // convergence.
+  int resolution = 30;
   // Radial spacing of the rings at the disc's rim, as a fraction of the nominal edge (1:
   // uniform). The overhang bends hardest just past the rim, over about a bending length
   // (B / w)^(1/3) ~ 2 cm: with uniform rings DC climbs by 0.10 between 20 and 40 rings, with

@@ -10,7 +10,7 @@ exe=$1
 cli_test_setup drape_fabric_test
 expect 0 test calibrate -- fabric --help
 expect 0 --fabric --specimen --disc --resolution --seed --seeds --out -- fabric test --help
-expect 0 --density --dc --nodes --out -- fabric calibrate --help
+expect 0 --density --dc --nodes --rmin --rmax --out -- fabric calibrate --help
 expect 2 "A subcommand is required" -- fabric
 expect 2 "--fabric" -- fabric test
 expect 1 "no preset 'nosuch'" "muslin" -- fabric test --fabric nosuch
@@ -24,6 +24,8 @@ expect 2 "--density" -- fabric calibrate --density abc --dc 0.5
 expect 2 "--dc" -- fabric calibrate --density 120 --dc 1.5
 expect 2 "--dc" "--photo" -- fabric calibrate --density 120
 expect 2 "--dc" "--photo" -- fabric calibrate --density 120 --dc 0.5 --photo x.png
+expect 2 "--rmin and --rmax go together" -- fabric calibrate --density 120 --dc 0.5 --rmin 100
+expect 2 "R_min below R_max" -- fabric calibrate --density 120 --dc 0.5 --rmin 140 --rmax 100
 printf 'not a picture' > junk.png
 expect 1 "junk.png: cannot read it as an image" -- fabric calibrate --density 120 --photo junk.png
 expect 2 "--resolution" -- fabric test --fabric muslin --resolution 2
@@ -41,6 +43,14 @@ expect 0 "fitted in" "residual" "predicted: nodes" "wrote preset 'mine'" -- \
   fabric calibrate --density 120 --dc 0.5 --nodes 8 --resolution 6 --seeds 1 --name mine --out my.json
 expect 0 "fabric mine: 120 g/m^2" -- fabric test --fabric my.json:mine --resolution 6 --out res2
 expect 0 "fabric mine" -- fabric test --fabric my.json --resolution 6 --out res3
+# The warp/weft ratio fitted to a fold depth too: a second fit of B at the ratio found.
+expect 0 "warp/weft 1.60" "fold depth R_max - R_min" "measured 30.0" "wrote preset 'deep'" -- \
+  fabric calibrate --density 120 --dc 0.5 --rmin 110 --rmax 140 --resolution 6 --seeds 1 \
+  --name deep --out my.json
+grep -q '"deep"' my.json && grep -q '"mine"' my.json || fail "my.json lacks 'deep' or 'mine'"
+grep -q 'fold depth measured 30.0 mm' my.json || fail "the preset's source lacks the fold depth"
+ratio=$(sed -n 's/.*(ratio \([0-9.]*\)).*/\1/p' out.txt)
+awk -v r="$ratio" 'BEGIN { exit !(r != "" && r >= 1 && r <= 4) }' || fail "fitted ratio '$ratio' not in [1, 4]"
 # The tester's own shadow image as a photo: the drape dark on white, the specimen's circle
 # printed around it. Its DC is the drape's (printed by the test above) within 0.01.
 expect 0 "photo res/seed1_shadow.png" "fitted in" -- \
