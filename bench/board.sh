@@ -14,23 +14,9 @@
 set -euo pipefail
 ROOT="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
 shift || true
-FRAMES=300
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --frames) FRAMES="$2"; shift 2 ;;
-    -h | --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-    *) echo "bench board: unknown flag '$1' (--frames N)" >&2; exit 2 ;;
-  esac
-done
-[[ "$FRAMES" =~ ^[0-9]+$ && "$FRAMES" -ge 120 ]] || { echo "bench board: --frames: at least 120" >&2; exit 2; }
-cd "$ROOT"
-BUILD="${DRAPE_BUILD_DIR:-build}"
-EXE="$BUILD/bin/drape"
-[ -x "$EXE" ] || { echo "bench board: $EXE not built" >&2; exit 2; }
-WORK=out/bench/board
-rm -rf "$WORK" && mkdir -p "$WORK"
-export XR_RUNTIME_JSON="$ROOT/$BUILD/bin/drape_mock_runtime.json"
-unset DRAPE_MOCK_WRITE_FRAMES DRAPE_MOCK_FAST DRAPE_MOCK_END_AFTER_FRAMES DRAPE_MOCK_SCENARIO
+. "$ROOT/bench/lib.sh"
+bench_parse_frames board 300 120 100000 15 "$@"
+bench_mock_setup board
 for res in 64 128; do
   for board in on off; do
     flag=()

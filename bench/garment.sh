@@ -16,24 +16,9 @@
 set -euo pipefail
 ROOT="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
 shift || true
-FRAMES=400
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --frames) FRAMES="$2"; shift 2 ;;
-    -h | --help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-    *) echo "bench garment: unknown flag '$1' (--frames N)" >&2; exit 2 ;;
-  esac
-done
-[[ "$FRAMES" =~ ^[0-9]+$ && "$FRAMES" -ge 120 && "$FRAMES" -le 400 ]] ||
-  { echo "bench garment: --frames: 120 to 400 (the scenario's length)" >&2; exit 2; }
-cd "$ROOT"
-BUILD="${DRAPE_BUILD_DIR:-build}"
-EXE="$BUILD/bin/drape"
-[ -x "$EXE" ] || { echo "bench garment: $EXE not built" >&2; exit 2; }
-WORK=out/bench/garment
-rm -rf "$WORK" && mkdir -p "$WORK"
-export XR_RUNTIME_JSON="$ROOT/$BUILD/bin/drape_mock_runtime.json"
-unset DRAPE_MOCK_WRITE_FRAMES DRAPE_MOCK_FAST DRAPE_MOCK_END_AFTER_FRAMES DRAPE_MOCK_SCENARIO
+. "$ROOT/bench/lib.sh"
+bench_parse_frames garment 400 120 400 17 "$@"
+bench_mock_setup garment
 SCENARIO=tests/xr_app/scenarios/garment_pinch.json
 run() {  # run NAME ARGS...
   local name="$1"; shift

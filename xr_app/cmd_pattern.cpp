@@ -130,19 +130,23 @@ void print_simulation(const drape::sim::GarmentSimResult& s, const std::string& 
   }
 }
 
-// With --simulate and no --fabric: the bodice design's fabric preset. false (and a message)
-// when fabrics.json lacks it.
-bool take_design_fabric(SimulateRequest& rq, const std::string& name) {
-  if (rq.fabric_given) return true;
+// The preset `name` of the project's fabrics.json as the fabric to simulate. false (and a
+// message starting with `what`) when the file lacks it.
+bool set_fabric(SimulateRequest& rq, const std::string& name, const char* what) {
   auto f = drape::sim::load_fabric(drape::app::asset("fabrics.json").string(), name);
   if (!f) {
-    std::fprintf(stderr, "drape pattern: --simulate: fabric %s: %s\n", name.c_str(),
-                 f.error().c_str());
+    std::fprintf(stderr, "drape pattern: %s %s: %s\n", what, name.c_str(), f.error().c_str());
     return false;
   }
   rq.fabric = *f;
   rq.fabric_name = name;
   return true;
+}
+
+// With --simulate and no --fabric: the bodice design's fabric preset. false (and a message)
+// when fabrics.json lacks it.
+bool take_design_fabric(SimulateRequest& rq, const std::string& name) {
+  return rq.fabric_given || set_fabric(rq, name, "--simulate: fabric");
 }
 
 // The bodice and the dress (design files of "type" bodice or dress): drape, check, export.
@@ -258,14 +262,7 @@ bool prepare_simulate(SimulateRequest& rq, const drape::sim::DressForm& form,
   rq.fabric = design_fabric;
   rq.fabric_name = design_fabric_name;
   if (!fabric_name.empty()) {
-    auto f = drape::sim::load_fabric(drape::app::asset("fabrics.json").string(), fabric_name);
-    if (!f) {
-      std::fprintf(stderr, "drape pattern: --fabric %s: %s\n", fabric_name.c_str(),
-                   f.error().c_str());
-      return false;
-    }
-    rq.fabric = *f;
-    rq.fabric_name = fabric_name;
+    if (!set_fabric(rq, fabric_name, "--fabric")) return false;
     rq.fabric_given = true;
   }
   rq.form = std::make_shared<const drape::sim::DressForm>(form);
