@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "sim/core/strain.hpp"
 #include "sim/form/dress_form.hpp"
 
 namespace drape::render {
@@ -216,21 +217,10 @@ void material_strain(const std::vector<sim::Vec3f>& pos, const std::vector<sim::
   for (size_t t = 0; t + 2 < idx.size(); t += 3) {
     const uint32_t a = idx[t], b = idx[t + 1], c = idx[t + 2];
     if (a >= pos.size() || b >= pos.size() || c >= pos.size()) continue;
-    Eigen::Matrix2f dm;
-    dm.col(0) = mat[b] - mat[a];
-    dm.col(1) = mat[c] - mat[a];
-    const float area = 0.5f * std::abs(dm.determinant());
-    if (area < 1e-12f) continue;
-    Eigen::Matrix<float, 3, 2> ds;
-    ds.col(0) = pos[b] - pos[a];
-    ds.col(1) = pos[c] - pos[a];
-    const Eigen::Matrix<float, 3, 2> f = ds * dm.inverse();
-    const Eigen::Matrix2f cg = f.transpose() * f;  // right Cauchy-Green tensor
-    const float tr = cg.trace(), det = cg.determinant();
-    const float disc = std::sqrt(std::max(0.25f * tr * tr - det, 0.0f));
-    const float s1 = std::sqrt(std::max(0.5f * tr + disc, 0.0f)) - 1.0f;
-    const float s2 = std::sqrt(std::max(0.5f * tr - disc, 0.0f)) - 1.0f;
-    const float s = std::abs(s1) >= std::abs(s2) ? s1 : s2;
+    const sim::TriangleStrain<float> ts =
+        sim::triangle_strain_of(pos[a], pos[b], pos[c], mat[a], mat[b], mat[c], 1e-12f);
+    if (ts.area == 0) continue;
+    const float area = ts.area, s = ts.strain;
     for (uint32_t v : {a, b, c}) {
       strain[v] += area * s;
       weight[v] += area;

@@ -34,4 +34,18 @@ Result<std::map<std::string, FabricParams>> parse_fabric_presets(const std::stri
 // One preset by name from assets/fabrics.json (or the given file).
 Result<FabricParams> load_fabric(const std::string& path, const std::string& name);
 
+// Writes a preset's physical values into the JSON object `j` under the keys the presets use
+// (areal_density .. bending_weft, in that order); the caller adds its own (name, damping,
+// description, source).
+template <class Json>
+void put_fabric_values(Json& j, const FabricParams& f) {
+  j["areal_density"] = f.areal_density;
+  j["thickness"] = f.thickness;
+  j["stretch_warp"] = f.stretch_warp;
+  j["stretch_weft"] = f.stretch_weft;
+  j["shear"] = f.shear;
+  j["bending_warp"] = f.bending_warp;
+  j["bending_weft"] = f.bending_weft;
+}
+
 }  // namespace drape::sim

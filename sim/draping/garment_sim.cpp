@@ -1,7 +1,6 @@
 // The sewn garment draped on the form by XPBD (garment_sim.hpp).
 #include "sim/draping/garment_sim.hpp"
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -10,6 +9,7 @@
 #include <numeric>
 
 #include "sim/core/stopwatch.hpp"
+#include "sim/core/strain.hpp"
 #include "sim/form/dress_form.hpp"
 #include "sim/solvers/xpbd/solver_xpbd.hpp"
 
@@ -102,16 +102,9 @@ double triangle_strain(const Cloth& cloth, int t) {
   const auto& tri = cloth.topo.triangles[t];
   const auto& m = cloth.topo.material;
   const auto& x = cloth.state.x;
-  Eigen::Matrix2d dm;
-  dm.col(0) = m[tri[1]] - m[tri[0]];
-  dm.col(1) = m[tri[2]] - m[tri[0]];
-  if (std::abs(dm.determinant()) < 1e-14) return 0;
-  Eigen::Matrix<double, 3, 2> ds;
-  ds.col(0) = x[tri[1]] - x[tri[0]];
-  ds.col(1) = x[tri[2]] - x[tri[0]];
-  const Eigen::Matrix<double, 3, 2> f = ds * dm.inverse();
-  const Eigen::Vector2d s = Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(f).singularValues();
-  return std::abs(s(0) - 1) >= std::abs(s(1) - 1) ? s(0) - 1 : s(1) - 1;
+  return triangle_strain_of(x[tri[0]], x[tri[1]], x[tri[2]], m[tri[0]], m[tri[1]], m[tri[2]],
+                            0.5e-14)
+      .strain;
 }
 
 Cloth garment_cloth(const Garment& g, const FabricParams& fabric) {

@@ -180,15 +180,8 @@ std::string save_fabric_preset(const std::string& path, const std::string& name,
       if (!doc.is_object()) return path + ": top level is not an object, not overwritten";
     }
   }
-  doc[name] = {{"description", "calibrated with the virtual drape tester"},
-               {"_source", source},
-               {"areal_density", f.areal_density},
-               {"thickness", f.thickness},
-               {"stretch_warp", f.stretch_warp},
-               {"stretch_weft", f.stretch_weft},
-               {"shear", f.shear},
-               {"bending_warp", f.bending_warp},
-               {"bending_weft", f.bending_weft}};
+  doc[name] = {{"description", "calibrated with the virtual drape tester"}, {"_source", source}};
+  put_fabric_values(doc[name], f);
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);

@@ -332,15 +332,8 @@ std::string session_to_json(const SessionLog& log) {
   jc["flags"] = enc(c.state.flags);
   jc["time"] = base64_encode(&c.state.time, sizeof(double));
   const FabricParams& f = c.fabric;
-  jc["fabric"] = {{"name", f.name},
-                  {"areal_density", f.areal_density},
-                  {"thickness", f.thickness},
-                  {"stretch_warp", f.stretch_warp},
-                  {"stretch_weft", f.stretch_weft},
-                  {"shear", f.shear},
-                  {"bending_warp", f.bending_warp},
-                  {"bending_weft", f.bending_weft},
-                  {"damping", f.rayleigh_damping}};
+  jc["fabric"] = {{"name", f.name}, {"damping", f.rayleigh_damping}};
+  put_fabric_values(jc["fabric"], f);
   j["cloth"] = std::move(jc);
   std::vector<double> plates, boxes, spheres;
   for (const Plate& p : log.plates)
