@@ -573,19 +573,73 @@ Garment bodice_cloth(const std::vector<DrapedPiece>& pieces, const Garment& weld
   return std::move(cb.g);
 }
 
-// The skirt's waist seam as segments (edges of its triangles with both ends waist vertices).
-std::vector<std::pair<int, int>> waist_segments(const Garment& skirt) {
-  std::vector<uint8_t> on(skirt.x.size(), 0);
-  for (int v : skirt.waist_vertices) on[v] = 1;
-  std::vector<std::pair<int, int>> seg;
-  for (const auto& t : skirt.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const int a = t[k], b = t[(k + 1) % 3];
-      if (on[a] && on[b] && a < b) seg.emplace_back(a, b);
-    }
-  std::sort(seg.begin(), seg.end());
-  seg.erase(std::unique(seg.begin(), seg.end()), seg.end());
-  return seg;
+// A waist seam as a closed loop around the body: its vertices in the order of their angle about
+// a vertical axis through `centre`, and each one's place along the loop in quarters: q + f is
+// the fraction f of the arc length between the points where the loop crosses the angles
+// -pi + q pi/2 and -pi + (q + 1) pi/2 (the centre lines and the sides, roughly). Two loops sewn
+// together meet at equal places: arc length shared out in proportion within each quarter, as a
+// pattern maker walks one seam along the other.
+struct WaistLoop {
+  std::vector<int> v;
+  std::vector<double> place;
+};
+
+WaistLoop waist_loop(const std::vector<Vec3>& x, std::vector<int> verts, const Vec3& centre) {
+  std::sort(verts.begin(), verts.end());
+  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+  const auto angle = [&](int v) {
+    return std::atan2(x[v].x() - centre.x(), x[v].z() - centre.z());
+  };
+  std::sort(verts.begin(), verts.end(), [&](int a, int b) { return angle(a) < angle(b); });
+  const size_t n = verts.size();
+  WaistLoop L{verts, std::vector<double>(n, 0.0)};
+  if (n < 4) return L;
+  // Arc length at each vertex from the first; where the loop crosses each quarter angle.
+  std::vector<double> len(n + 1, 0.0);
+  for (size_t i = 0; i < n; ++i) len[i + 1] = len[i] + (x[verts[(i + 1) % n]] - x[verts[i]]).norm();
+  const double total = len[n];
+  std::array<double, 5> cross{};
+  for (int q = 0; q < 4; ++q) {
+    const double phi = -M_PI + q * M_PI / 2;
+    size_t i = 0;
+    while (i < n && angle(verts[i]) < phi) ++i;
+    // Between vertex i - 1 and i (wrapping): the crossing by angle, interpolated.
+    const size_t i0 = (i + n - 1) % n, i1 = i % n;
+    double a0 = angle(verts[i0]), a1 = angle(verts[i1]);
+    if (a1 <= a0) a1 += 2 * M_PI;
+    double p = phi;
+    if (p < a0) p += 2 * M_PI;
+    const double f = a1 > a0 ? std::clamp((p - a0) / (a1 - a0), 0.0, 1.0) : 0.0;
+    const double s0 = i == 0 ? len[n - 1] - total : len[i0];
+    cross[q] = s0 + f * (len[i0 + 1] - len[i0]);
+  }
+  cross[4] = cross[0] + total;
+  for (size_t i = 0; i < n; ++i) {
+    double s = len[i];
+    if (s < cross[0]) s += total;
+    int q = 0;
+    while (q < 3 && s >= cross[q + 1]) ++q;
+    L.place[i] = q + (s - cross[q]) / std::max(cross[q + 1] - cross[q], 1e-12);
+  }
+  return L;
+}
+
+// Ties every vertex of loop `from` onto loop `to` at the same place (between the two vertices of
+// `to` whose places hold it, wrapping at 4).
+void tie_loops(const WaistLoop& from, const WaistLoop& to, int from_offset, int to_offset,
+               std::vector<SeamTie>& ties) {
+  const size_t m = to.v.size();
+  if (m < 2) return;
+  for (size_t i = 0; i < from.v.size(); ++i) {
+    const double p = from.place[i];
+    size_t j = std::upper_bound(to.place.begin(), to.place.end(), p) - to.place.begin();
+    const size_t j0 = (j + m - 1) % m, j1 = j % m;
+    double p0 = to.place[j0], p1 = to.place[j1], pp = p;
+    if (p1 <= p0) p1 += 4;
+    if (pp < p0) pp += 4;
+    const double t = p1 > p0 ? std::clamp((pp - p0) / (p1 - p0), 0.0, 1.0) : 0.0;
+    ties.push_back({from.v[i] + from_offset, to.v[j0] + to_offset, to.v[j1] + to_offset, t});
+  }
 }
 
 FitCheck check(const std::string& name, const std::string& unit, double value, double target,
@@ -904,9 +958,15 @@ std::string bodice_report_json(const BodiceReport& r, const std::vector<std::str
 }
 
 Result<Garment> dress_garment(const Garment& bodice, const Garment& skirt) {
-  const std::vector<std::pair<int, int>> seg = waist_segments(skirt);
-  if (seg.empty() || bodice.waist_vertices.empty())
+  if (skirt.waist_vertices.size() < 4 || bodice.waist_vertices.size() < 4)
     return Error{"dress_garment: the bodice or the skirt has no waist seam"};
+  // The waist seam: both waists as loops about the skirt waist's centre, each vertex of one
+  // tied onto the other at the same place along the loop (WaistLoop).
+  Vec3 centre = Vec3::Zero();
+  for (int v : skirt.waist_vertices) centre += skirt.x[v];
+  centre /= static_cast<double>(skirt.waist_vertices.size());
+  const WaistLoop lb = waist_loop(bodice.x, bodice.waist_vertices, centre);
+  const WaistLoop ls = waist_loop(skirt.x, skirt.waist_vertices, centre);
   Garment g = bodice;
   const int n = static_cast<int>(g.x.size());
   g.x.insert(g.x.end(), skirt.x.begin(), skirt.x.end());
@@ -918,23 +978,13 @@ Result<Garment> dress_garment(const Garment& bodice, const Garment& skirt) {
   for (const SeamTie& t : skirt.ties) g.ties.push_back({t.a + n, t.b0 + n, t.b1 + n, t.t});
   g.waist_vertices.clear();
   for (int v : skirt.waist_vertices) g.waist_vertices.push_back(v + n);
-  for (int v : bodice.waist_vertices) {
-    SeamTie best{v, 0, 0, 0};
-    double best_d = std::numeric_limits<double>::infinity();
-    for (const auto& [a, b] : seg) {
-      const Vec3 ab = skirt.x[b] - skirt.x[a];
-      if (ab.squaredNorm() < 1e-18) continue;
-      const double t = std::clamp((bodice.x[v] - skirt.x[a]).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-      const double dist = (bodice.x[v] - skirt.x[a] - t * ab).norm();
-      if (dist < best_d) best_d = dist, best = {v, a + n, b + n, t};
-    }
-    g.ties.push_back(best);
-  }
+  tie_loops(lb, ls, 0, n, g.ties);
+  tie_loops(ls, lb, n, 0, g.ties);
   g.merged_vertices = bodice.merged_vertices + skirt.merged_vertices;
   g.seams = bodice.seams;
   g.seams.insert(g.seams.end(), skirt.seams.begin(), skirt.seams.end());
-  g.seams.push_back("waist seam: " + std::to_string(bodice.waist_vertices.size()) +
-                    " bodice vertices tied onto the skirt's waist");
+  g.seams.push_back("waist seam: " + std::to_string(lb.v.size()) + " bodice and " +
+                    std::to_string(ls.v.size()) + " skirt vertices tied at equal places");
   return g;
 }
 
