@@ -239,8 +239,11 @@ class BodyReader {
     if (pos_ == f_.size()) return;
     if (!ascii())
       fail("PLY body: " + std::to_string(left()) + " bytes more than the header declares");
+    size_t end = pos_;
+    while (end < f_.size() && end - pos_ < 20 && !std::isspace(static_cast<unsigned char>(f_[end])))
+      ++end;
     fail("PLY body: more data than the header declares (\"" +
-         std::string(f_.substr(pos_, std::min<size_t>(20, left()))) + "\" and after)");
+         std::string(f_.substr(pos_, end - pos_)) + "\" and after)");
   }
 
   [[noreturn]] void fail_here(const std::string& what) const {
@@ -251,6 +254,7 @@ class BodyReader {
   }
 
   static std::string number(double v) {
+    if (v == std::floor(v) && std::fabs(v) < 1e18) return std::to_string(static_cast<int64_t>(v));
     char buf[32];
     const auto [end, ec] = std::to_chars(buf, buf + sizeof(buf), v);
     return std::string(buf, ec == std::errc() ? end : buf);

@@ -243,9 +243,11 @@ TEST(PlyImporter, MalformedBodiesRejectedWithTheirPlace) {
     verts += number(i & 1) + " " + number(i >> 1 & 1) + " " + number(i >> 2) + "\n";
   const std::string faces = "4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n";
   expect_cube(ascii + verts + faces, "the plain ascii cube");
-  expect_ply_error(
-      ascii + verts + faces.substr(0, faces.size() - 6),
-      "element \"face\" entry 5 of 6, property \"vertex_indices\": the file ends here");
+  expect_ply_error(ascii + verts.substr(0, verts.size() - 2),
+                   "element \"vertex\" entry 7 of 8, property \"z\": the file ends here");
+  expect_ply_error(ascii + verts + faces.substr(0, faces.size() - 6),
+                   "element \"face\" entry 5 of 6, property \"vertex_indices\": a list of 4 "
+                   "items, more than the file's 3 bytes left hold");
   expect_ply_error(ascii + verts + faces + "7\n",
                    "PLY body: more data than the header declares (\"7\" and after)");
   std::string bad = ascii + verts + faces;
@@ -274,13 +276,21 @@ TEST(PlyImporter, MalformedBinaryBodiesRejectedBeforeAnyAllocation) {
   const std::vector<Elem> cube = {cube_vertices(), cube_faces("uint", "int")};
   const std::string le = write_ply("binary_little_endian", cube);
   expect_cube(le, "the plain binary cube");
+  const size_t first_face = header("binary_little_endian", cube).size() + 8 * 12;
+  // Cut inside the last vertex, its entries longer than their smallest size (a list each).
+  Elem tagged = cube_vertices();
+  tagged.props.insert(tagged.props.begin(), {"float", "tags", "uchar"});
+  for (auto& row : tagged.rows) row.insert(row.begin(), std::vector<double>{1, 2, 3});
+  const std::string cut = write_ply("binary_little_endian", {tagged, cube_faces()});
+  expect_ply_error(
+      cut.substr(0, header("binary_little_endian", {tagged, cube_faces()}).size() + 8 * 25 - 2),
+      "element \"vertex\" entry 7 of 8, property \"z\": the file ends inside it");
   expect_ply_error(le.substr(0, le.size() - 2),
-                   "element \"face\" entry 5 of 6, property "
-                   "\"vertex_indices\": the file ends inside it");
+                   "entry 5 of 6, property \"vertex_indices\": a list of 4 items, more than the "
+                   "file's 14 bytes left hold");
   expect_ply_error(le + '\n', "PLY body: 1 bytes more than the header declares");
   // A list count of four billion in a file of a few hundred bytes.
   std::string huge = le;
-  const size_t first_face = header("binary_little_endian", cube).size() + 8 * 12;
   huge.replace(first_face, 4, std::string("\x00\x28\x6b\xee", 4));  // 4 000 000 000
   expect_ply_error(huge,
                    "entry 0 of 6, property \"vertex_indices\": a list of 4000000000 items, "
