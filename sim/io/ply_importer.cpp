@@ -422,7 +422,7 @@ PlyData parse(std::string_view f) {
       read_vertices(r, e, d);
     } else if (e.name == "face") {
       read_faces(r, e, vertices, d);
-    } else {
+    } else if (!e.props.empty()) {  // an element of no properties holds no bytes to skip
       for (uint64_t i = 0; i < e.count; ++i) {
         r.at(e, i);
         for (const Property& p : e.props) skip(r, p);

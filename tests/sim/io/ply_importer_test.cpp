@@ -232,7 +232,8 @@ TEST(PlyImporter, OtherElementsAndPropertiesSkipped) {
   f.props.push_back({"float", "texcoord", "uchar"});
   for (auto& row : f.rows) row.push_back({1}), row.push_back({0, 0, 1, 0, 1, 1, 0, 1});
   Elem edge{"edge", {{"int", "vertex1", ""}, {"int", "vertex2", ""}}, {{{0}, {1}}, {{1}, {3}}}};
-  for (const char* fmt : kFormats) expect_cube(write_ply(fmt, {before, v, f, edge}), fmt);
+  const Elem marker{"marker", {}, std::vector<std::vector<std::vector<double>>>(5)};  // no bytes
+  for (const char* fmt : kFormats) expect_cube(write_ply(fmt, {before, marker, v, f, edge}), fmt);
 }
 
 // Body errors name the element, the entry and the property.
