@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "sim/io/obj_importer.hpp"
+#include "sim/io/ply_importer.hpp"
 
 namespace drape::sim {
 
@@ -35,196 +36,6 @@ constexpr unsigned kMaxCorners = 1024;
 // fuzz_mesh), and in one ReadFile call the validation does not run before it.
 constexpr unsigned kImportFlags =
     aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType;
-
-// Whether `p` starts with "ply" in any case: assimp takes each letter in either case
-// (fuzz_mesh_ply: a header starting "plYply" passed the checks below unchecked and hung assimp).
-bool ply_magic(const char* p) {
-  return std::tolower(static_cast<unsigned char>(p[0])) == 'p' &&
-         std::tolower(static_cast<unsigned char>(p[1])) == 'l' &&
-         std::tolower(static_cast<unsigned char>(p[2])) == 'y';
-}
-
-// A PLY name (element or property): one word that starts with a letter.
-bool ply_word(std::string_view w) {
-  return !w.empty() && std::isalpha(static_cast<unsigned char>(w[0])) &&
-         std::all_of(w.begin(), w.end(), [](char ch) {
-           return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
-         });
-}
-
-bool ply_type(std::string_view t) {
-  static constexpr std::string_view kTypes[] = {
-      "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
-      "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
-  return std::find(std::begin(kTypes), std::end(kTypes), t) != std::end(kTypes);
-}
-
-std::vector<std::string_view> ply_tokens(std::string_view l) {
-  std::vector<std::string_view> t;
-  for (size_t a = 0; a < l.size();) {
-    const size_t b = std::min(l.find(' ', a), l.size());
-    if (b > a) t.push_back(l.substr(a, b - a));
-    a = b + 1;
-  }
-  return t;
-}
-
-// What is wrong with one header line after the magic ("" when nothing): assimp 5.2 hangs or
-// allocates without bound on lines outside the format's grammar (fuzz_mesh, fuzz_mesh_ply: a
-// mangled "property" line, a blank line, "element vertexascii 1.0", a name of digits read as an
-// 11.4 GB count, an element count of 57 GB), so each line is held to it. `n` is the file's size.
-std::string ply_header_line_error(std::string_view l, size_t n) {
-  const std::string quoted = "\"" + std::string(l.substr(0, 40)) + "\"";
-  if (l.empty()) return "PLY header: an empty line before end_header";
-  const std::vector<std::string_view> t = ply_tokens(l);
-  const std::string_view kw = t[0];
-  if (kw == "comment" || kw == "obj_info") return "";
-  if (kw == "format") {
-    const bool ok =
-        t.size() == 3 &&
-        (t[1] == "ascii" || t[1] == "binary_little_endian" || t[1] == "binary_big_endian") &&
-        t[2] == "1.0";
-    return ok ? "" : "PLY header: " + quoted + " is not \"format ascii|binary_* 1.0\"";
-  }
-  if (kw == "property") {
-    const bool scalar = t.size() == 3 && ply_type(t[1]) && ply_word(t[2]);
-    const bool list =
-        t.size() == 5 && t[1] == "list" && ply_type(t[2]) && ply_type(t[3]) && ply_word(t[4]);
-    return scalar || list ? "" : "PLY header: " + quoted + " is not \"property TYPE NAME\"";
-  }
-  if (kw != "element") return "PLY header: unknown line " + quoted;
-  char* end = nullptr;
-  const std::string count = t.size() == 3 ? std::string(t[2]) : std::string();
-  const unsigned long long c = std::strtoull(count.c_str(), &end, 10);
-  if (!ply_word(t.size() == 3 ? t[1] : "") || count.empty() || *end != '\0' || count[0] == '-')
-    return "PLY header: " + quoted + " is not \"element NAME COUNT\"";
-  // Every entry takes at least one byte of the file: a count above its size is a lie.
-  if (c > n)
-    return "PLY header: \"" + std::string(l) + "\" declares more entries than the file has bytes";
-  return "";
-}
-
-// Data that assimp would read as PLY (it starts with "ply") must close its header within the
-// first MiB with an "end_header" line (assimp 5.2 loops forever without one) and keep every
-// header line to the format's grammar (ply_header_line_error); false with `error` set.
-bool ply_header_closed(const char* p, size_t n, std::string& error) {
-  size_t i = 0;
-  while (i < n && std::isspace(static_cast<unsigned char>(p[i]))) ++i;
-  if (n - i < 3 || !ply_magic(p + i)) return true;
-  const size_t limit = std::min(n, size_t{1} << 20);
-  size_t line = i;
-  for (size_t k = i; k < limit; ++k) {
-    if (p[k] != '\n') continue;
-    std::string_view l(p + line, k - line);
-    while (!l.empty() && (l.back() == '\r' || l.back() == ' ')) l.remove_suffix(1);
-    if (l == "end_header") return true;
-    // The magic stands alone on its line (fuzz_mesh_ply: "ply\0format ascii 1.0" read by
-    // assimp as two lines, by these checks as one, let an ASCII body past the body's check).
-    if (line == i && l.size() != 3) error = "PLY header: the first line is not \"ply\"";
-    if (line > i) error = ply_header_line_error(l, n);
-    if (!error.empty()) return false;
-    line = k + 1;
-  }
-  error = "PLY header has no end_header line";
-  return false;
-}
-
-// An ASCII PLY body must hold exactly what its header declares: per element entry, one number
-// per scalar property, and per list property a count (a whole number, at most kMaxCorners)
-// followed by that many numbers. assimp 5.2 reads a body whose tokens do not line up with the
-// header in ways that can allocate without bound (fuzz_mesh: an 1158-byte file whose vertex
-// line carried one number too many made it request ~18 GB before failing; seed
-// fuzz/corpus/mesh_ply/regress_ply_ascii_misaligned). Binary and non-PLY data pass unchecked here;
-// false with `error` set.
-bool ply_ascii_body_consistent(const char* p, size_t n, std::string& error) {
-  size_t i = 0;
-  while (i < n && std::isspace(static_cast<unsigned char>(p[i]))) ++i;
-  if (n - i < 3 || !ply_magic(p + i)) return true;
-  struct Element {
-    std::string name;
-    unsigned long long count = 0;
-    std::vector<bool> is_list;
-  };
-  std::vector<Element> elements;
-  bool ascii = false;
-  size_t line = i, body = n;
-  for (size_t k = i; k < n; ++k) {
-    if (p[k] != '\n') continue;
-    std::string_view l(p + line, k - line);
-    while (!l.empty() && std::isspace(static_cast<unsigned char>(l.back()))) l.remove_suffix(1);
-    line = k + 1;
-    if (l == "end_header") {
-      body = k + 1;
-      break;
-    }
-    if (l.substr(0, 7) == "format ") ascii = l.substr(7, 5) == "ascii";
-    if (l.substr(0, 8) == "element ") {
-      Element e;
-      const size_t sp = l.rfind(' ');
-      e.name = std::string(l.substr(8, sp > 8 ? sp - 8 : 0));
-      e.count = std::strtoull(std::string(l.substr(sp + 1)).c_str(), nullptr, 10);
-      elements.push_back(e);
-    } else if (l.substr(0, 9) == "property " && !elements.empty()) {
-      elements.back().is_list.push_back(l.substr(9, 5) == "list ");
-    }
-  }
-  if (!ascii || body >= n) return true;  // binary, or no body (the header check reports it)
-  size_t k = body;
-  auto next = [&](std::string_view& tok) {
-    while (k < n && std::isspace(static_cast<unsigned char>(p[k]))) ++k;
-    const size_t b = k;
-    while (k < n && !std::isspace(static_cast<unsigned char>(p[k]))) ++k;
-    tok = std::string_view(p + b, k - b);
-    return !tok.empty();
-  };
-  auto number = [](std::string_view tok) {
-    const std::string t(tok);
-    char* end = nullptr;
-    const double v = std::strtod(t.c_str(), &end);
-    return end && *end == '\0' && std::isfinite(v);
-  };
-  for (const Element& e : elements)
-    for (unsigned long long entry = 0; entry < e.count; ++entry)
-      for (size_t q = 0; q < e.is_list.size(); ++q) {
-        const std::string where = "PLY body: element \"" + e.name + "\" entry " +
-                                  std::to_string(entry) + " of " + std::to_string(e.count);
-        std::string_view tok;
-        if (!next(tok)) {
-          error = where + ": the file ends before it";
-          return false;
-        }
-        if (!number(tok)) {
-          error = where + ": \"" + std::string(tok.substr(0, 20)) + "\" is not a number";
-          return false;
-        }
-        if (!e.is_list[q]) continue;
-        const std::string t(tok);
-        char* end = nullptr;
-        const unsigned long c = std::strtoul(t.c_str(), &end, 10);
-        if (!end || *end != '\0') {
-          error = where + ": list count \"" + t.substr(0, 20) + "\" is not a whole number";
-          return false;
-        }
-        if (c > kMaxCorners) {
-          error =
-              where + ": a list of " + t + " corners (at most " + std::to_string(kMaxCorners) + ")";
-          return false;
-        }
-        for (unsigned long j = 0; j < c; ++j) {
-          if (!next(tok) || !number(tok)) {
-            error = where + ": its list of " + std::to_string(c) + " numbers is cut short";
-            return false;
-          }
-        }
-      }
-  std::string_view extra;
-  if (next(extra)) {
-    error = "PLY body: more numbers than the header declares (\"" +
-            std::string(extra.substr(0, 20)) + "\" and after)";
-    return false;
-  }
-  return true;
-}
 
 // assimp 5.2's binary glTF readers allocate the length a chunk header claims before they
 // compare it with the file (fuzz_mesh_glb: a 1688-byte GLB whose JSON chunk claimed 0xffff01e4
@@ -324,8 +135,10 @@ void configure(Assimp::Importer& imp) {
       if (d && d->mFileExtensions &&
           std::string_view(d->mFileExtensions).find(ext) != std::string_view::npos)
         keep = true;
-    // assimp's OBJ importer gives way to the project's (obj_importer.hpp says why).
+    // assimp's OBJ and PLY importers give way to the project's (obj_importer.hpp and
+    // ply_importer.hpp say why).
     if (d && d->mName && std::string_view(d->mName) == "Wavefront Object Importer") keep = false;
+    if (d && d->mFileExtensions && std::string_view(d->mFileExtensions) == "ply") keep = false;
     if (!keep) drop.push_back(imp.GetImporter(i));
   }
   // UnregisterLoader gives the importer back without deleting it (assimp 5.2): it is ours now
@@ -334,7 +147,8 @@ void configure(Assimp::Importer& imp) {
     imp.UnregisterLoader(b);
     delete b;
   }
-  imp.RegisterLoader(make_obj_importer().release());  // the importer owns it
+  imp.RegisterLoader(make_obj_importer().release());  // the importer owns them
+  imp.RegisterLoader(make_ply_importer().release());
 }
 
 void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, TriMesh& out,
@@ -441,15 +255,8 @@ Result<TriMesh> load_mesh(const std::string& path) {
     std::string head(static_cast<size_t>(std::min<std::uintmax_t>(size, 1u << 20)), '\0');
     in.read(head.data(), static_cast<std::streamsize>(head.size()));
     std::string error;
-    if (!ply_header_closed(head.data(), static_cast<size_t>(in.gcount()), error))
+    if (!glb_lengths_fit(head.data(), static_cast<size_t>(in.gcount()), size, error))
       return make_error(path, error);
-    // (An ASCII PLY's body is checked whole: read the rest of the file.)
-    if (size > head.size() && head.find("format ascii") != std::string::npos) {
-      head.resize(static_cast<size_t>(size));
-      in.read(head.data() + (1u << 20), static_cast<std::streamsize>(size - (1u << 20)));
-    }
-    if (!ply_ascii_body_consistent(head.data(), head.size(), error)) return make_error(path, error);
-    if (!glb_lengths_fit(head.data(), head.size(), size, error)) return make_error(path, error);
   }
   return read_scene(path, [&](Assimp::Importer& imp) { return imp.ReadFile(path, 0); });
 }
@@ -459,10 +266,6 @@ Result<TriMesh> load_mesh_from_memory(const void* data, size_t size, const char*
   if (!data || size == 0) return make_error(name, "empty file");
   {
     std::string error;
-    if (!ply_header_closed(static_cast<const char*>(data), size, error))
-      return make_error(name, error);
-    if (!ply_ascii_body_consistent(static_cast<const char*>(data), size, error))
-      return make_error(name, error);
     if (!glb_lengths_fit(static_cast<const char*>(data), size, size, error))
       return make_error(name, error);
   }
