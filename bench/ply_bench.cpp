@@ -19,24 +19,14 @@
 #include <fstream>
 #include <string>
 
+#include "bench/best_time.hpp"
 #include "sim/io/mesh_io.hpp"
 
 using namespace drape::sim;
 
 namespace {
 
-template <class F>
-double best_ms(int reps, F&& f) {
-  double best = 1e300;
-  for (int r = 0; r < reps; ++r) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    best = std::min(
-        best,
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  return best;
-}
+using drape::bench::best_ms;
 
 template <class T>
 void put(std::string& out, T v) {

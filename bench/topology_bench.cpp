@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/best_time.hpp"
 #include "sim/energy/energy.hpp"
 #include "sim/energy/self_collision.hpp"
 #include "sim/ops/cut.hpp"
@@ -26,18 +27,7 @@ using namespace drape::sim;
 
 namespace {
 
-template <class F>
-double best_ms(int reps, F&& f) {
-  double best = 1e300;
-  for (int r = 0; r < reps; ++r) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    best = std::min(
-        best,
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  return best;
-}
+using drape::bench::best_ms;
 
 struct Row {
   int res = 0;

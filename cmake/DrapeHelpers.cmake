@@ -9,6 +9,13 @@ if(DRAPE_ASAN)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 endif()
+# The fuzz build: every library with libFuzzer's coverage instrumentation (the targets link the
+# fuzzer itself, fuzz/CMakeLists.txt), AddressSanitizer and UBSan, so that a fuzz target is
+# guided by what the parser code it calls does, not only by its own source file.
+if(DRAPE_FUZZ)
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=address,undefined)
+endif()
 if(DRAPE_TSAN)
   add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)
   add_link_options(-fsanitize=thread)

@@ -3,13 +3,7 @@ drape_add_fuzzer(fuzz_measurements_json SOURCES ${CMAKE_SOURCE_DIR}/fuzz/fuzz_me
 drape_add_fuzzer(fuzz_fabric_json SOURCES ${CMAKE_SOURCE_DIR}/fuzz/fuzz_fabric_json.cpp LIBS drape_sim)
 # One mesh target per format the product reads (fuzz/fuzz_mesh.cpp; seeds in
 # fuzz/corpus/mesh_<format>/), so that each format's executions are counted on their own.
-# The project's own OBJ and PLY importers are compiled into each target with the fuzzer's
-# instrumentation (the libraries are built without it, so libFuzzer would see no coverage inside
-# them): the target's objects define make_obj_importer and make_ply_importer, so the linker takes
-# those and leaves the uninstrumented copies in drape_io's archive out.
 foreach(format obj ply stl glb)
-  drape_add_fuzzer(fuzz_mesh_${format} SOURCES ${CMAKE_SOURCE_DIR}/fuzz/fuzz_mesh.cpp
-    ${CMAKE_SOURCE_DIR}/sim/io/obj_importer.cpp ${CMAKE_SOURCE_DIR}/sim/io/ply_importer.cpp
-    LIBS drape_sim)
+  drape_add_fuzzer(fuzz_mesh_${format} SOURCES ${CMAKE_SOURCE_DIR}/fuzz/fuzz_mesh.cpp LIBS drape_sim)
   target_compile_definitions(fuzz_mesh_${format} PRIVATE DRAPE_FUZZ_MESH_FORMAT="${format}")
 endforeach()

@@ -2,11 +2,8 @@
 #include "sim/io/obj_importer.hpp"
 
 #include <assimp/importerdesc.h>
-#include <assimp/material.h>
 #include <assimp/scene.h>
 
-#include <assimp/IOStream.hpp>
-#include <assimp/IOSystem.hpp>
 #include <charconv>
 #include <climits>
 #include <cstdint>
@@ -14,6 +11,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "sim/io/importer_scene.hpp"
 
 namespace drape::sim {
 
@@ -198,20 +197,9 @@ class ObjImporter : public Assimp::BaseImporter {
 
  protected:
   void InternReadFile(const std::string& file, aiScene* scene, Assimp::IOSystem* io) override {
-    auto close = [io](Assimp::IOStream* s) { io->Close(s); };
-    std::unique_ptr<Assimp::IOStream, decltype(close)> in(io->Open(file, "rb"), close);
-    if (!in) throw std::runtime_error("OBJ: cannot open the file");
-    std::string text(in->FileSize(), '\0');
-    if (in->Read(text.data(), 1, text.size()) != text.size())
-      throw std::runtime_error("OBJ: cannot read the whole file");
+    const std::string text = io_detail::read_whole_file(io, file, "OBJ");
     const ObjData d = parse(text);
-    scene->mNumMeshes = 1;
-    scene->mMeshes = new aiMesh* [1] { make_mesh(d) };
-    scene->mNumMaterials = 1;
-    scene->mMaterials = new aiMaterial* [1] { new aiMaterial() };
-    scene->mRootNode = new aiNode("obj");
-    scene->mRootNode->mNumMeshes = 1;
-    scene->mRootNode->mMeshes = new unsigned[1]{0};
+    io_detail::set_one_mesh(scene, make_mesh(d), "obj");
   }
 };
 

@@ -2,7 +2,6 @@
 #include "sim/io/ply_importer.hpp"
 
 #include <assimp/importerdesc.h>
-#include <assimp/material.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
@@ -20,6 +19,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "sim/io/importer_scene.hpp"
 
 namespace drape::sim {
 
@@ -487,20 +488,9 @@ class PlyImporter : public Assimp::BaseImporter {
 
  protected:
   void InternReadFile(const std::string& file, aiScene* scene, Assimp::IOSystem* io) override {
-    auto close = [io](Assimp::IOStream* s) { io->Close(s); };
-    std::unique_ptr<Assimp::IOStream, decltype(close)> in(io->Open(file, "rb"), close);
-    if (!in) fail("PLY: cannot open the file");
-    std::string bytes(in->FileSize(), '\0');
-    if (in->Read(bytes.data(), 1, bytes.size()) != bytes.size())
-      fail("PLY: cannot read the whole file");
+    const std::string bytes = io_detail::read_whole_file(io, file, "PLY");
     const PlyData d = parse(bytes);
-    scene->mNumMeshes = 1;
-    scene->mMeshes = new aiMesh* [1] { make_mesh(d) };
-    scene->mNumMaterials = 1;
-    scene->mMaterials = new aiMaterial* [1] { new aiMaterial() };
-    scene->mRootNode = new aiNode("ply");
-    scene->mRootNode->mNumMeshes = 1;
-    scene->mRootNode->mMeshes = new unsigned[1]{0};
+    io_detail::set_one_mesh(scene, make_mesh(d), "ply");
   }
 };
 
