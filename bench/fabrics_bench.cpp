@@ -207,7 +207,8 @@ int main(int argc, char** argv) {
   print_table(rows);
   write_outputs(rows);
   for (const Row& r : rows)
-    if (r.m->name == conv_fabric || (!only.empty() && !conv.empty() && r.fit[2] == '+')) {
+    if (r.m->name == conv_fabric ||
+        (!only.empty() && !conv.empty() && std::string(r.fit) == "dc+depth")) {
       convergence(r, conv, conv_seeds, opt.test);
       break;
     }
