@@ -3,16 +3,17 @@
 // encoding again. Half the inputs get their records' CRCs made right first (the first byte's
 // low bit chooses), so mutations of the payloads reach the record decoders instead of stopping
 // at the CRC check. The solver's state of a checkpoint that decodes goes into the session's
-// solver (XPBD) with the checkpoint's cloth, when the cloth is small (restoring cooks it): its
-// reader (sim/solvers/xpbd/xpbd_state.cpp) must reject what does not fit with an error, and the
-// solver must then step (without the scene's objects: the solver's state is what is fuzzed).
+// solver (XPBD cooking cuts ahead) with the checkpoint's cloth, when the cloth is small
+// (restoring cooks it): its readers (sim/solvers/cook_ahead.cpp, sim/solvers/xpbd/xpbd_state.cpp)
+// must reject what does not fit with an error, and the solver must then step (without the
+// scene's objects: the solver's state is what is fuzzed).
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "sim/ops/checkpoint.hpp"
 #include "sim/runtime/journal.hpp"
-#include "sim/solvers/xpbd/solver_xpbd.hpp"
+#include "sim/solvers/cook_ahead.hpp"
 
 namespace {
 
@@ -50,7 +51,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     o.threads = 1;
     o.freeze = true;
     o.finish_thread = false;
-    drape::sim::XpbdSolver solver(o);
+    drape::sim::CookAheadSolver solver(
+        o, drape::sim::CookAheadOptions{
+               .ticks = 8, .idle_priority = false, .worker_threads = 1, .spare_energy = false});
     (void)solver.restore_state(c.solver_state, c.cloth);
     solver.step(c.cloth, drape::sim::SceneObjects{}, 1.0 / 90);
   }

@@ -855,13 +855,84 @@ CutResult cut_along(Cloth& cloth, const std::vector<Vec3>& stroke_points,
   return r;
 }
 
+namespace {
+
+// The vertices that lie in a triangle, bucketed by material position (cells of the grid's
+// spacing): the nearest vertex to a material point in O(vertices of a few cells) instead of
+// O(vertices).
+class MaterialBuckets {
+ public:
+  MaterialBuckets(const Cloth& cloth, const ClothIncidence& inc) : m_(cloth.topo.material) {
+    h_ = std::max(cloth.topo.spacing, 1e-4);
+    lo_ = Vec2::Constant(std::numeric_limits<double>::infinity());
+    Vec2 hi = -lo_;
+    const int n = cloth.num_vertices();
+    for (int32_t i = 0; i < n; ++i)
+      if (inc.count[i] > 0) lo_ = lo_.cwiseMin(m_[i]), hi = hi.cwiseMax(m_[i]);
+    if (!(hi.x() >= lo_.x())) return;  // no vertex in a triangle
+    nx_ = std::min(4096, static_cast<int>((hi.x() - lo_.x()) / h_) + 1);
+    ny_ = std::min(4096, static_cast<int>((hi.y() - lo_.y()) / h_) + 1);
+    start_.assign(static_cast<size_t>(nx_) * ny_ + 1, 0);
+    for (int32_t i = 0; i < n; ++i)
+      if (inc.count[i] > 0) ++start_[cell(m_[i]) + 1];
+    for (size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+    items_.resize(start_.back());
+    std::vector<int32_t> fill(start_.begin(), start_.end() - 1);
+    for (int32_t i = 0; i < n; ++i)
+      if (inc.count[i] > 0) items_[fill[cell(m_[i])]++] = i;
+  }
+  // The vertex `better` prefers among the nearest (better(i, d, best, d_best): i at squared
+  // distance d replaces best), or -1 when there is none. Rings of cells around q's are searched
+  // until no cell further out can hold a nearer vertex.
+  template <class Better>
+  int32_t nearest(const Vec2& q, Better better) const {
+    if (nx_ == 0) return -1;
+    const int cx = std::clamp(static_cast<int>(std::floor((q.x() - lo_.x()) / h_)), 0, nx_ - 1);
+    const int cy = std::clamp(static_cast<int>(std::floor((q.y() - lo_.y()) / h_)), 0, ny_ - 1);
+    int32_t best = -1;
+    double bd = std::numeric_limits<double>::infinity();
+    for (int r = 0; r <= std::max(nx_, ny_); ++r) {
+      for (int y = cy - r; y <= cy + r; ++y) {
+        if (y < 0 || y >= ny_) continue;
+        const bool edge_row = y == cy - r || y == cy + r;
+        for (int x = cx - r; x <= cx + r; x += edge_row ? 1 : 2 * std::max(r, 1)) {
+          if (x < 0 || x >= nx_) continue;
+          const size_t c = static_cast<size_t>(y) * nx_ + x;
+          for (int32_t k = start_[c]; k < start_[c + 1]; ++k) {
+            const int32_t i = items_[k];
+            const double d = (m_[i] - q).squaredNorm();
+            if (best < 0 || better(i, d, best, bd)) best = i, bd = d;
+          }
+        }
+      }
+      // Every vertex of ring r + 1 lies at least r cells from q.
+      const double reach = r * h_;
+      if (best >= 0 && bd < reach * reach - 1e-18) break;
+    }
+    return best;
+  }
+
+ private:
+  size_t cell(const Vec2& p) const {
+    const int x = std::clamp(static_cast<int>((p.x() - lo_.x()) / h_), 0, nx_ - 1);
+    const int y = std::clamp(static_cast<int>((p.y() - lo_.y()) / h_), 0, ny_ - 1);
+    return static_cast<size_t>(y) * nx_ + x;
+  }
+  const std::vector<Vec2>& m_;
+  double h_ = 0;
+  Vec2 lo_;
+  int nx_ = 0, ny_ = 0;
+  std::vector<int32_t> start_, items_;
+};
+
+}  // namespace
+
 CutResult cut_along_material(Cloth& cloth, const std::vector<Vec2>& stroke_uv) {
   const auto t0 = std::chrono::steady_clock::now();
   CutResult r;
   ensure_incidence(cloth);
   const ClothIncidence& I = cloth.incidence;
   std::vector<int32_t> anchors;
-  const auto& m = cloth.topo.material;
   // Densify to half the grid spacing so a stroke crossing an earlier cut has anchors on both
   // sides of it.
   std::vector<Vec2> dense;
@@ -876,18 +947,17 @@ CutResult cut_along_material(Cloth& cloth, const std::vector<Vec2>& stroke_uv) {
     dense.push_back(stroke_uv[i]);
   }
   const auto& labels = I.component;
+  const MaterialBuckets buckets(cloth, I);
   for (const Vec2& q : dense) {
-    int32_t best = -1;
-    double bd = std::numeric_limits<double>::infinity();
     const int32_t prev_label = anchors.empty() ? -2 : labels[anchors.back()];
-    for (int32_t i = 0; i < cloth.num_vertices(); ++i) {
-      if (I.count[i] == 0) continue;
-      const double d = (m[i] - q).squaredNorm();
-      // Among duplicates (same material point, after earlier cuts) stay in the current piece.
-      if (d < bd - 1e-18 ||
-          (d <= bd + 1e-18 && labels[i] == prev_label && labels[best] != prev_label))
-        bd = d, best = i;
-    }
+    const int32_t best = buckets.nearest(q, [&](int32_t i, double d, int32_t b, double bd) {
+      // Among duplicates (same material point, after earlier cuts) stay in the current piece;
+      // else the lowest index.
+      if (d < bd - 1e-18) return true;
+      if (d > bd + 1e-18) return false;
+      const bool in = labels[i] == prev_label, best_in = labels[b] == prev_label;
+      return in != best_in ? in : i < b;
+    });
     if (best >= 0) anchors.push_back(best);
     r.smooth_stroke_uv.push_back(q);
   }

@@ -1,5 +1,6 @@
 #include "sim/solvers/solver_factory.hpp"
 
+#include "sim/solvers/cook_ahead.hpp"
 #include "sim/solvers/solver_newton.hpp"
 #include "sim/solvers/solver_vbd.hpp"
 #include "sim/solvers/verlet_solver.hpp"
@@ -34,7 +35,10 @@ Result<std::unique_ptr<Solver>> make_solver(const std::string& name_in, const So
     o.freeze = cfg.freeze;
     o.finish_thread = cfg.finish_thread;
     o.settle = cfg.settle;
-    s = std::make_unique<XpbdSolver>(o);
+    if (cfg.cook_ahead_ticks > 0)
+      s = std::make_unique<CookAheadSolver>(o, CookAheadOptions{cfg.cook_ahead_ticks});
+    else
+      s = std::make_unique<XpbdSolver>(o);
   } else if (name == "newton") {
     NewtonOptions o;
     o.energy = eo;

@@ -27,6 +27,7 @@ namespace {
 constexpr int kTickRateHz = 90;
 constexpr int kSubsteps = 1;
 const char* kSolver = "default";
+constexpr int kCookAheadTicks = 8;
 constexpr int kSelfCollisionMinRes = 48;  // 10.6 mm edges on the 0.5 m panel
 }  // namespace
 
@@ -107,6 +108,9 @@ sim::Result<std::unique_ptr<sim::Solver>> make_session_solver(bool finish_in_tic
   // A lock-step run replays bit for bit: the static finish of a sleeping piece then runs one
   // cycle per tick instead of landing whenever its thread ends.
   solver_cfg.finish_thread = !finish_in_tick;
+  // A cut's new topology is cooked on a worker while the cloth steps on uncut for 8 ticks (per
+  // 32 768 triangles): no tick stalls on the cook, and a replay swaps at the same tick.
+  solver_cfg.cook_ahead_ticks = kCookAheadTicks;
   return sim::make_solver(kSolver, solver_cfg);
 }
 
@@ -377,10 +381,7 @@ sim::Result<sim::World> DrapingSession::resume_world(uint64_t& first_tick) {
   first_tick = r.ticks;
   if (!opt_.sim_lock_step) {
     // The replay ran the static finish in the tick; live, it lands from its own thread again.
-    sim::SolverConfig cfg;
-    cfg.freeze = true;
-    cfg.finish_thread = true;
-    auto solver = sim::make_solver(kSolver, cfg);
+    auto solver = make_session_solver(false);
     if (!solver) return sim::Error{"resume: solver: " + solver.error()};
     // The replayed solver's state goes on in it (sleep, settling, anchors).
     const std::string e = solver.value()->restore_state(w->solver->save_state(w->cloth), w->cloth);

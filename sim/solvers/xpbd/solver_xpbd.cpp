@@ -62,10 +62,11 @@ void XpbdSolver::cook(const Cloth& cloth) {
   eo.bending_matrix = false;
   // An incremental cook keeps the bending rows and blocks of the triangles the change did not
   // reach (ClothEnergy::update); everything else is cooked again as in a full cook.
+  ThreadPool* pool = cook_pool_ ? cook_pool_ : pool_.get();
   if (opt_.incremental_cook)
-    st.incremental = energy_.update(cloth, eo, pool_.get());
+    st.incremental = energy_.update(cloth, eo, pool);
   else
-    energy_.build(cloth, eo, pool_.get());
+    energy_.build(cloth, eo, pool);
   for (char r : energy_.rebuilt_triangles()) st.rebuilt_triangles += r;
   st.energy_ms = since(t);
   const int n = cloth.num_vertices();
@@ -535,10 +536,20 @@ struct XpbdSolver::Step {
   bool bending() const { return s % be == be - 1 || s == ns - 1; }
 };
 
+bool XpbdSolver::cooked_for(const Cloth& cloth) const {
+  return last_cook_.cooks > 0 && energy_.up_to_date(cloth) &&
+         opt_.single_precision == cooked_f32_ && opt_.kernels == cooked_kernels_;
+}
+
+void XpbdSolver::prepare(const Cloth& cloth, ThreadPool* cook_pool) {
+  if (cooked_for(cloth)) return;
+  cook_pool_ = cook_pool;
+  cook(cloth);
+  cook_pool_ = nullptr;
+}
+
 StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
-  if (!energy_.up_to_date(cloth) || opt_.single_precision != cooked_f32_ ||
-      opt_.kernels != cooked_kernels_)
-    cook(cloth);
+  prepare(cloth);
   rest_.mark_masses_dirty();  // pins, releases, wakes and finishes happen between frames
   energy_.set_form(&scene);
   Step c(*this, cloth, scene, dt);

@@ -39,6 +39,17 @@ class XpbdSolver : public Solver {
   std::string name() const override { return "xpbd"; }
   StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) override;
   ThreadPool* pool() override { return pool_.get(); }
+  // Cooks the element data of the cloth's topology unless they are cooked already (the first
+  // step does it otherwise): CookAheadSolver cooks a cut's topology this way on a worker thread
+  // while another solver steps on. Reads only the cloth's topology, fabric and masses. The
+  // energy's build runs on `cook_pool` (null: the calling thread alone), not on the solver's.
+  void prepare(const Cloth& cloth) { prepare(cloth, pool_.get()); }
+  void prepare(const Cloth& cloth, ThreadPool* cook_pool);
+  bool cooked_for(const Cloth& cloth) const;
+  // The energy a solver not yet stepped starts from: its first cook updates it for the cloth
+  // (XpbdOptions::incremental_cook: only the triangles the change reached) instead of building
+  // it whole. CookAheadSolver seeds the solver it cooks with the energy of the last one.
+  void seed_energy(ClothEnergy energy) { energy_ = std::move(energy); }
   // What carries from one step to the next (xpbd_state.cpp): the warm-start multipliers (with
   // warm_start > 0; else they start at zero in every substep), the last substep's length, the
   // single-precision anchors and the rest scheduler's state. The element data are cooked again
@@ -56,6 +67,7 @@ class XpbdSolver : public Solver {
     tie_passes_ = passes;
   }
   const std::vector<xpbd::Tie>& ties() const { return ties_; }
+  int tie_passes() const { return tie_passes_; }
   int contact_detections() const { return detections_; }
   // Single precision: how many times the anchors were renewed (XpbdOptions::single_precision).
   long anchor_renewals() const { return anchor_renewals_; }
@@ -299,7 +311,8 @@ class XpbdSolver : public Solver {
   int tie_passes_ = 2;
   std::vector<int> tie_moved_;  // vertices the last tie projection moved
   CookStats last_cook_;
-  int detections_ = 0;  // contact detections so far (for tests and the bench)
+  ThreadPool* cook_pool_ = nullptr;  // cook() spreads the energy's build over it (null: pool_)
+  int detections_ = 0;               // contact detections so far (for tests and the bench)
   double fresh_penetration_ = 0;
 };
 

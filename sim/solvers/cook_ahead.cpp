@@ -1,0 +1,325 @@
+// CookAheadSolver (see header): the edit's cook on a worker, the base stepped meanwhile, the
+// swap at a fixed step.
+#include "sim/solvers/cook_ahead.hpp"
+
+#if defined(__linux__)
+#include <pthread.h>
+#include <sched.h>
+#endif
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <functional>
+#include <unordered_map>
+
+#include "sim/core/cloth_io.hpp"
+#include "sim/core/thread_pool.hpp"
+
+namespace drape::sim {
+
+namespace {
+
+constexpr uint32_t kMagic = 0x48414b43;  // "CKAH" little-endian
+constexpr uint32_t kVersion = 1;
+constexpr int kTrianglesPerTicks = 32768;
+constexpr uint8_t kDriven = kFlagPinned | kFlagPinched | kFlagKinematic;
+
+bool same_values(const FabricParams& a, const FabricParams& b) {
+  return a.areal_density == b.areal_density && a.thickness == b.thickness &&
+         a.stretch_warp == b.stretch_warp && a.stretch_weft == b.stretch_weft &&
+         a.shear == b.shear && a.bending_warp == b.bending_warp &&
+         a.bending_weft == b.bending_weft && a.rayleigh_damping == b.rayleigh_damping;
+}
+
+// The topology, fabric and state of a cloth without its incidence (a solver does not read it).
+void copy_without_incidence(const Cloth& from, Cloth& to) {
+  to.topo = from.topo;
+  to.state = from.state;
+  to.fabric = from.fabric;
+  to.topology_version = from.topology_version;
+  to.incidence = ClothIncidence{};
+}
+
+}  // namespace
+
+CookAheadSolver::CookAheadSolver(XpbdOptions xpbd, CookAheadOptions opt)
+    : opt_(opt), active_(std::make_unique<XpbdSolver>(xpbd)) {}
+
+CookAheadSolver::~CookAheadSolver() {
+  join();
+  if (reaper_.joinable()) reaper_.join();
+}
+
+void CookAheadSolver::join() {
+  release();  // a worker not yet released would wait forever
+  if (worker_.joinable()) worker_.join();
+}
+
+int CookAheadSolver::ticks_for(const Cloth& cloth) const {
+  const int per = (cloth.topo.num_triangles() + kTrianglesPerTicks - 1) / kTrianglesPerTicks;
+  return std::max(1, opt_.ticks * std::max(1, per));
+}
+
+bool CookAheadSolver::map_onto_base(const Cloth& cloth) {
+  const int nb = base_.num_vertices(), nc = cloth.num_vertices();
+  if (!have_base_ || nc < nb || !same_values(cloth.fabric, base_.fabric)) return false;
+  if (cloth.topology_version == base_.topology_version && nc == nb) return false;
+  const auto& bt = base_.topo;
+  const auto& ct = cloth.topo;
+  for (int i = 0; i < nb; ++i)
+    if (ct.material[i] != bt.material[i] || ct.vertex_origin[i] != bt.vertex_origin[i])
+      return false;
+  // The base vertices of each origin a new vertex has.
+  std::unordered_map<int32_t, std::vector<int32_t>> of_origin;
+  for (int j = nb; j < nc; ++j) of_origin[ct.vertex_origin[j]];
+  for (int i = 0; i < nb; ++i)
+    if (auto it = of_origin.find(ct.vertex_origin[i]); it != of_origin.end())
+      it->second.push_back(i);
+  src_.resize(nc);
+  for (int i = 0; i < nb; ++i) src_[i] = i;
+  const auto& x = cloth.state.x;
+  for (int j = nb; j < nc; ++j) {
+    const auto& cand = of_origin[ct.vertex_origin[j]];
+    auto same = std::find_if(cand.begin(), cand.end(), [&](int32_t i) {
+      return std::memcmp(x[i].data(), x[j].data(), sizeof(double) * 3) == 0;
+    });
+    if (same == cand.end()) return false;
+    src_[j] = *same;
+  }
+  return true;
+}
+
+bool CookAheadSolver::mapped(const Cloth& cloth) {
+  if (cloth.topology_version != mapped_version_ || cloth.num_vertices() != mapped_n_) {
+    map_ok_ = map_onto_base(cloth);
+    mapped_version_ = cloth.topology_version;
+    mapped_n_ = cloth.num_vertices();
+  }
+  return map_ok_;
+}
+
+void CookAheadSolver::launch(std::function<void(ThreadPool&)> job) {
+  // The worker before this one (a spare energy's build) ends first, on the new thread: the step
+  // never waits for it.
+  released_.store(false, std::memory_order_relaxed);
+  worker_ = std::thread([this, prev = std::move(worker_), job = std::move(job)]() mutable {
+    if (prev.joinable()) prev.join();
+    // Not during the step that launched it: the cook's memory traffic would slow that step,
+    // which already carries the edit (measured: 7-11 ms instead of 5 at 128^2 on two cores).
+    released_.wait(false, std::memory_order_acquire);
+#if defined(__linux__)
+    // SCHED_IDLE (any user may choose it): the thread runs only on a core nothing else wants
+    // and yields it at once, so the ticks do not stretch. The pool made below inherits it.
+    if (opt_.idle_priority) {
+      sched_param none{};
+      pthread_setschedparam(pthread_self(), SCHED_IDLE, &none);
+    }
+#endif
+    if (opt_.worker_delay_ms > 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(opt_.worker_delay_ms));
+    ThreadPool pool(std::max(1, opt_.worker_threads));
+    job(pool);
+  });
+}
+
+void CookAheadSolver::release() {
+  released_.store(true, std::memory_order_release);
+  released_.notify_all();
+}
+
+void CookAheadSolver::start(const Cloth& cloth, int steps) {
+  copy_without_incidence(cloth, next_cloth_);
+  next_ = std::make_unique<XpbdSolver>(active_->options());
+  done_.store(false, std::memory_order_relaxed);
+  launch([this](ThreadPool& pool) {
+    if (spare_) next_->seed_energy(std::move(*spare_));
+    spare_.reset();
+    next_->prepare(next_cloth_, &pool);
+    done_.store(true, std::memory_order_release);
+  });
+  pending_ = true;
+  steps_left_ = steps;
+}
+
+void CookAheadSolver::start_spare(const Cloth& cloth) {
+  auto copy = std::make_shared<Cloth>();
+  copy_without_incidence(cloth, *copy);
+  launch([this, copy, o = active_->options()](ThreadPool& pool) {
+    XpbdSolver s(o);
+    s.prepare(*copy, &pool);
+    spare_ = std::make_unique<ClothEnergy>(s.energy());
+  });
+}
+
+void CookAheadSolver::adopt() {
+  if (!done_.load(std::memory_order_acquire)) ++waits_;
+  join();
+  next_->options() = active_->options();
+  next_->set_ties(active_->ties(), active_->tie_passes());
+  std::unique_ptr<XpbdSolver> old = std::move(active_);
+  active_ = std::move(next_);
+  base_ = std::move(next_cloth_);
+  next_cloth_ = Cloth{};
+  mapped_version_ = 0;
+  pending_ = false;
+  steps_left_ = 0;
+  adopted_ = true;
+  if (reaper_.joinable()) reaper_.join();
+  reaper_ = std::thread([p = std::move(old)]() mutable { p.reset(); });
+}
+
+void CookAheadSolver::keep_base(const Cloth& cloth) {
+  copy_without_incidence(cloth, base_);
+  have_base_ = true;
+  mapped_version_ = 0;
+}
+
+StepStats CookAheadSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
+  if (pending_) {
+    const bool edited_again = cloth.topology_version != next_cloth_.topology_version ||
+                              cloth.num_vertices() != next_cloth_.num_vertices();
+    // Another edit in the window must map onto the base too, or the pending one lands now.
+    if (steps_left_ > 0 && (!edited_again || mapped(cloth))) {
+      --steps_left_;
+      return step_base(cloth, scene, dt);
+    }
+    adopt();
+  }
+  const bool adopted = adopted_;
+  adopted_ = false;
+  if (!active_->cooked_for(cloth) && mapped(cloth)) {
+    ++edits_ahead_;
+    start(cloth, ticks_for(cloth) - 1);
+    const StepStats st = step_base(cloth, scene, dt);
+    release();  // the worker starts once the edit's own step is done (see launch())
+    return st;
+  }
+  if (have_base_ && !active_->cooked_for(cloth)) ++edits_in_step_;
+  StepStats st = active_->step(cloth, scene, dt);
+  // A new base (a cook in the step, or the one adopted): the next edit's cook starts from its
+  // energy, built again on a worker (the adopted solver's own is in use from now on).
+  const bool new_base = !have_base_ || base_.topology_version != cloth.topology_version ||
+                        base_.num_vertices() != cloth.num_vertices();
+  if (new_base) keep_base(cloth);
+  if ((new_base || adopted) && opt_.spare_energy) {
+    start_spare(base_);
+    release();
+  }
+  return st;
+}
+
+StepStats CookAheadSolver::step_base(Cloth& cloth, const SceneObjects& scene, double dt) {
+  ClothState& B = base_.state;
+  ClothState& C = cloth.state;
+  const int nb = base_.num_vertices(), nc = cloth.num_vertices();
+  for (int i = 0; i < nb; ++i) {
+    B.x[i] = C.x[i];
+    B.x_prev[i] = C.x_prev[i];
+    B.v[i] = C.v[i];
+    B.flags[i] = C.flags[i];
+    B.inv_mass[i] = B.mass[i] > 0 ? 1.0 / B.mass[i] : 0.0;
+  }
+  // A hand, pin or move on a new vertex acts on its base vertex.
+  for (int j = nb; j < nc; ++j) {
+    const uint8_t f = C.flags[j] & kDriven;
+    if (!f) continue;
+    const int s = src_[j];
+    B.flags[s] |= f;
+    B.x[s] = C.x[j];
+    B.x_prev[s] = C.x_prev[j];
+    B.v[s] = C.v[j];
+  }
+  B.time = C.time;
+  const StepStats st = active_->step(base_, scene, dt);
+  for (int i = 0; i < nb; ++i) {
+    C.x[i] = B.x[i];
+    C.x_prev[i] = B.x_prev[i];
+    C.v[i] = B.v[i];
+    C.flags[i] = static_cast<uint8_t>((C.flags[i] & ~kFlagFrozen) | (B.flags[i] & kFlagFrozen));
+  }
+  for (int j = nb; j < nc; ++j) {
+    if (C.flags[j] & kDriven) continue;
+    const int s = src_[j];
+    C.x[j] = B.x[s];
+    C.x_prev[j] = B.x_prev[s];
+    C.v[j] = B.v[s];
+    C.flags[j] = static_cast<uint8_t>((C.flags[j] & ~kFlagFrozen) | (B.flags[s] & kFlagFrozen));
+  }
+  C.time = B.time;
+  return st;
+}
+
+std::vector<unsigned char> CookAheadSolver::save_state(const Cloth& cloth) const {
+  if (!pending_) return active_->save_state(cloth);
+  ByteWriter o;
+  o.u32(kMagic);
+  o.u32(kVersion);
+  o.i32(steps_left_);
+  put_cloth(o, base_);
+  put_ints(o, src_);
+  const std::vector<unsigned char> a = active_->save_state(base_);
+  o.u32(static_cast<uint32_t>(a.size()));
+  o.b.insert(o.b.end(), a.begin(), a.end());
+  return o.b;
+}
+
+std::string CookAheadSolver::restore_state(const std::vector<unsigned char>& bytes,
+                                           const Cloth& cloth) {
+  join();
+  next_.reset();
+  spare_.reset();  // built for the cloth before the restore
+  pending_ = false;
+  steps_left_ = 0;
+  have_base_ = false;
+  mapped_version_ = 0;
+  const bool framed = bytes.size() >= 4 && bytes[0] == (kMagic & 0xff) &&
+                      bytes[1] == ((kMagic >> 8) & 0xff) && bytes[2] == ((kMagic >> 16) & 0xff) &&
+                      bytes[3] == (kMagic >> 24);
+  if (!framed) return active_->restore_state(bytes, cloth);
+  auto fail = [&](const std::string& why) {
+    active_ = std::make_unique<XpbdSolver>(active_->options());
+    return "cook-ahead state: " + why;
+  };
+  ByteReader in{bytes.data(), bytes.size()};
+  in.u32();
+  if (const uint32_t v = in.u32(); v != kVersion)
+    return fail("version " + std::to_string(v) + " (this program reads " +
+                std::to_string(kVersion) + ")");
+  const int steps = in.i32();
+  Cloth base;
+  get_cloth(in, base);
+  std::vector<int32_t> src;
+  get_ints(in, src);
+  const uint32_t len = in.count(1);
+  if (!in.ok) return fail("its bytes are malformed");
+  std::vector<unsigned char> a(bytes.begin() + static_cast<long>(in.i),
+                               bytes.begin() + static_cast<long>(in.i + len));
+  in.i += len;
+  if (in.i != in.n) return fail("its bytes are malformed");
+  if (steps < 0 || steps > ticks_for(cloth)) return fail("steps left out of range");
+  if (const std::string e = base.validate(); !e.empty()) return fail("base cloth: " + e);
+  const int nb = base.num_vertices();
+  if (static_cast<int>(src.size()) != cloth.num_vertices() || nb > cloth.num_vertices())
+    return fail("the base does not fit the cloth's " + std::to_string(cloth.num_vertices()) +
+                " vertices");
+  for (size_t j = 0; j < src.size(); ++j)
+    if (src[j] < 0 || src[j] >= nb || (static_cast<int>(j) < nb && src[j] != static_cast<int>(j)))
+      return fail("vertex " + std::to_string(j) + " maps onto no base vertex");
+  base_ = std::move(base);
+  src_ = std::move(src);
+  have_base_ = true;
+  map_ok_ = true;
+  mapped_version_ = cloth.topology_version;
+  mapped_n_ = cloth.num_vertices();
+  if (std::string e = active_->restore_state(a, base_); !e.empty()) {
+    have_base_ = false;
+    return fail(e);
+  }
+  active_->prepare(base_);
+  start(cloth, steps);
+  release();
+  return "";
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,119 @@
+// A cut without a stall: XPBD whose re-cook after a topology edit runs on a worker thread while
+// the solver steps on with the topology it has cooked.
+//
+// A cut (or slit) only adds vertices: it duplicates the vertices of its path, keeps every other
+// index and moves the triangles on one side onto the duplicates. The solver cooked for the cloth
+// before the edit (the base) is therefore still a valid model of that cloth with the edit not
+// yet made. When a step finds the topology changed that way, CookAheadSolver
+//   * copies the cloth and cooks a second XpbdSolver for it on a worker thread;
+//   * for the next `ticks` steps steps the base instead: each step copies the cloth's state of
+//     the base's vertices into the base cloth, steps it with the cooked solver and copies the
+//     result back; each new vertex follows the base vertex it was duplicated from (a hand,
+//     pin or move acting on a new vertex acts on that vertex);
+//   * at the step `ticks` after the edit adopts the new solver (waiting for the worker if it
+//     has not finished) and steps the cloth as it is.
+// The physical effect of the edit lands `ticks` steps late, always at the same step, whatever
+// the worker's speed: runs, replays and resumed checkpoints give the same result bit for bit.
+// `ticks` grows with the cloth (CookAheadOptions::ticks per 32 768 triangles) so the cook has
+// time to end on a machine as loaded as the one it ran on. Other edits (an undo that removes
+// vertices, a new cloth) are cooked in the step, as plain XPBD does.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "sim/solvers/solver.hpp"
+#include "sim/solvers/xpbd/solver_xpbd.hpp"
+
+namespace drape::sim {
+
+struct CookAheadOptions {
+  int ticks = 8;  // steps from the edit to the new topology's first step, per 32 768 triangles
+  // The worker cooks on worker_threads threads of its own, at idle priority (Linux SCHED_IDLE)
+  // with idle_priority: they take the time the ticks leave rather than stretching them.
+  bool idle_priority = true;
+  int worker_threads = 2;
+  // After each new base a worker builds its energy, from which the next cut's cook starts
+  // (incremental); false: that cook builds it whole.
+  bool spare_energy = true;
+  // Tests: the worker sleeps this long before it cooks (a slow or loaded machine; the result
+  // must not change, only the due step waits).
+  int worker_delay_ms = 0;
+};
+
+class CookAheadSolver : public Solver {
+ public:
+  explicit CookAheadSolver(XpbdOptions xpbd, CookAheadOptions opt = {});
+  ~CookAheadSolver() override;
+  std::string name() const override { return active_->name(); }
+  StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) override;
+  ThreadPool* pool() override { return active_->pool(); }
+  // Not pending: the XPBD solver's state as it saves it. Pending: the base cloth, the steps
+  // left and the XPBD solver's state on the base (restore cooks the edit again on the worker).
+  std::vector<unsigned char> save_state(const Cloth& cloth) const override;
+  std::string restore_state(const std::vector<unsigned char>& bytes, const Cloth& cloth) override;
+
+  // The solver stepping now (the base's while an edit is pending).
+  XpbdSolver& xpbd() { return *active_; }
+  const XpbdSolver& xpbd() const { return *active_; }
+  // An edit is pending: the base steps, the worker cooks; steps until the new topology's first.
+  bool pending() const { return pending_; }
+  int steps_left() const { return steps_left_; }
+  // Edits taken ahead (adopted or pending) and edits cooked in the step.
+  int edits_ahead() const { return edits_ahead_; }
+  int edits_in_step() const { return edits_in_step_; }
+  // Steps at which the worker had not finished when its topology was due (the step waited).
+  int waits() const { return waits_; }
+  // Steps from an edit of this cloth to its first step with the new topology.
+  int ticks_for(const Cloth& cloth) const;
+
+ private:
+  // Each vertex of `cloth` maps onto a base vertex: itself below the base's count, else the base
+  // vertex with its origin and (bit for bit) its position; false when one does not (the edit
+  // is then cooked in the step).
+  bool map_onto_base(const Cloth& cloth);
+  bool mapped(const Cloth& cloth);            // map_onto_base once per topology of the cloth
+  void start(const Cloth& cloth, int steps);  // the worker cooks `cloth`
+  void adopt();                               // the worker's solver becomes the active one
+  StepStats step_base(Cloth& cloth, const SceneObjects& scene, double dt);
+  void keep_base(const Cloth& cloth);  // the cloth the active solver is cooked for
+  void join();
+
+  CookAheadOptions opt_;
+  std::unique_ptr<XpbdSolver> active_, next_;
+  // The cloth the active solver is cooked for (topology, fabric, masses; the state of its
+  // vertices comes from the stepped cloth in each step), and each cloth vertex's base vertex.
+  Cloth base_;
+  bool have_base_ = false;
+  std::vector<int32_t> src_;
+  bool map_ok_ = false;
+  uint64_t mapped_version_ = 0;  // the topology src_ was made for (0: none)
+  int mapped_n_ = -1;
+  // The edit cooked by the worker: its cloth (kept as the next base) and the steps left.
+  bool pending_ = false;
+  bool adopted_ = false;  // adopt() ran in this step
+  int steps_left_ = 0;
+  Cloth next_cloth_;
+  std::thread worker_;
+  std::atomic<bool> done_{false};      // the worker has cooked
+  std::atomic<bool> released_{false};  // the worker may start (release())
+  // The energy of the base's topology, built by a worker after each new base (only workers
+  // touch it, one after the other): the next edit's cook updates it for the triangles the edit
+  // reached instead of building it whole.
+  std::unique_ptr<ClothEnergy> spare_;
+  void start_spare(const Cloth& cloth);  // a worker builds spare_ for a topology cooked in a step
+  // Starts `job` on a new worker thread (after the one before it ends), at idle priority, with a
+  // pool of its own.
+  void launch(std::function<void(ThreadPool&)> job);
+  void release();  // the step that launched the worker is done: it may start
+  // A solver retired by a swap is destroyed off the step (its threads are joined there).
+  std::thread reaper_;
+  int edits_ahead_ = 0, edits_in_step_ = 0, waits_ = 0;
+};
+
+}  // namespace drape::sim

@@ -1,0 +1,168 @@
+// CookAheadSolver: a cut's topology cooked on a worker while the cloth steps on uncut, adopted at
+// a fixed step. The swap must land at the same step and give the same cloth bit for bit however
+// slow the worker is, the cut's sides must stay together until then and part after it, a
+// checkpoint taken in the window must resume bit for bit, and malformed saved state must be
+// refused with a reason. (In the TSan build: "thread" in the name.)
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "sim/ops/cut.hpp"
+#include "sim/solvers/cook_ahead.hpp"
+#include "sim/testbeds/testbed.hpp"
+
+using namespace drape::sim;
+
+namespace {
+
+constexpr int kRes = 24;
+constexpr int kTicks = 4;
+
+XpbdOptions options(const Testbed& sc) {
+  XpbdOptions o;
+  o.air_drag = sc.air_drag;
+  o.threads = 2;
+  o.min_parallel_triangles = 0;
+  o.freeze = true;
+  o.finish_thread = false;  // the finish one cycle per step: the same frames on every run
+  return o;
+}
+
+// The form drape cut across at half its height (material space, between two grid rows).
+bool cut_across(Cloth& cloth) {
+  double umin = 1e9, umax = -1e9, vmin = 1e9, vmax = -1e9;
+  for (const Vec2& m : cloth.topo.material) {
+    umin = std::min(umin, m.x()), umax = std::max(umax, m.x());
+    vmin = std::min(vmin, m.y()), vmax = std::max(vmax, m.y());
+  }
+  const double v = 0.5 * (vmin + vmax) + 0.25 * (vmax - vmin) / (kRes - 1);
+  return cut_along_material(cloth, {Vec2(umin - 0.01, v), Vec2(umax + 0.01, v)}).ok;
+}
+
+// The largest distance between a vertex the cut made and the vertex it was duplicated from.
+double largest_gap(const Cloth& cloth, int before) {
+  double g = 0;
+  for (int j = before; j < cloth.num_vertices(); ++j)
+    g = std::max(g, (cloth.state.x[j] - cloth.state.x[cloth.topo.vertex_origin[j]]).norm());
+  return g;
+}
+
+struct CutRun {
+  uint64_t hash = 0;
+  int waits = 0, edits_ahead = 0, edits_in_step = 0;
+  int adopted_at = -1;  // steps after the cut's until the solver stepped the cut topology
+  double gap_at_swap = -1, gap_after = -1;
+};
+
+CutRun run(int worker_delay_ms) {
+  Testbed sc = make_scene("form", kRes);
+  CookAheadSolver s(options(sc),
+                    CookAheadOptions{.ticks = kTicks, .worker_delay_ms = worker_delay_ms});
+  for (int f = 0; f < 30; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  const int before = sc.cloth.num_vertices();
+  EXPECT_TRUE(cut_across(sc.cloth));
+  CutRun r;
+  for (int f = 0; f < 40; ++f) {
+    s.step(sc.cloth, sc.objects, 1.0 / 90);
+    if (r.adopted_at < 0 && !s.pending()) r.adopted_at = f;
+    if (f == kTicks - 1) r.gap_at_swap = largest_gap(sc.cloth, before);  // the window's last
+  }
+  r.gap_after = largest_gap(sc.cloth, before);
+  r.hash = state_hash(sc.cloth);
+  r.waits = s.waits();
+  r.edits_ahead = s.edits_ahead();
+  r.edits_in_step = s.edits_in_step();
+  return r;
+}
+
+}  // namespace
+
+TEST(CookAhead, TheCutLandsAtTheSameStepWhateverTheWorker) {
+  const CutRun fast = run(0);
+  const CutRun slow = run(300);  // the worker starts 0.3 s late: the due step waits for it
+  EXPECT_EQ(fast.edits_ahead, 1);
+  EXPECT_EQ(fast.edits_in_step, 0);
+  EXPECT_GE(slow.waits, 1);
+  // The cut's step and the next kTicks - 1 step the base; the kTicks-th steps the cut cloth.
+  EXPECT_EQ(fast.adopted_at, kTicks);
+  EXPECT_EQ(slow.adopted_at, kTicks);
+  EXPECT_EQ(fast.hash, slow.hash);
+}
+
+TEST(CookAhead, TheSidesStayTogetherUntilTheSwapAndPartAfter) {
+  const CutRun r = run(0);
+  std::printf("largest gap of the cut: %.3g mm at the window's last step, %.1f mm 35 steps later\n",
+              1e3 * r.gap_at_swap, 1e3 * r.gap_after);
+  EXPECT_EQ(r.gap_at_swap, 0.0) << "the new vertices follow their sources in the window";
+  EXPECT_GT(r.gap_after, 0.005) << "the cut's sides part once the cut topology steps";
+}
+
+TEST(CookAhead, TicksGrowWithTheCloth) {
+  CookAheadSolver s(XpbdOptions{}, CookAheadOptions{8});
+  Testbed small = make_scene("form", 128), large = make_scene("form", 256);
+  EXPECT_EQ(s.ticks_for(small.cloth), 8);   // 32 258 triangles
+  EXPECT_EQ(s.ticks_for(large.cloth), 32);  // 130 050 triangles
+}
+
+// A checkpoint in the window (the base stepping, the worker cooking) resumes bit for bit.
+TEST(CookAhead, AStateSavedInTheWindowResumesBitForBit) {
+  Testbed sc = make_scene("form", kRes);
+  CookAheadSolver s(options(sc), CookAheadOptions{kTicks});
+  for (int f = 0; f < 30; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  ASSERT_TRUE(cut_across(sc.cloth));
+  for (int f = 0; f < 2; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  ASSERT_TRUE(s.pending());
+  const std::vector<unsigned char> bytes = s.save_state(sc.cloth);
+  Cloth saved = sc.cloth;
+  for (int f = 0; f < 20; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+
+  CookAheadSolver r(options(sc), CookAheadOptions{kTicks});
+  ASSERT_EQ(r.restore_state(bytes, saved), "");
+  EXPECT_TRUE(r.pending());
+  EXPECT_EQ(r.steps_left(), kTicks - 2);
+  for (int f = 0; f < 20; ++f) r.step(saved, sc.objects, 1.0 / 90);
+  EXPECT_FALSE(r.pending());
+  EXPECT_EQ(state_hash(saved), state_hash(sc.cloth));
+}
+
+TEST(CookAhead, MalformedStateIsRefusedWithAReason) {
+  Testbed sc = make_scene("form", kRes);
+  CookAheadSolver s(options(sc), CookAheadOptions{kTicks});
+  for (int f = 0; f < 5; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  ASSERT_TRUE(cut_across(sc.cloth));
+  s.step(sc.cloth, sc.objects, 1.0 / 90);
+  ASSERT_TRUE(s.pending());
+  const std::vector<unsigned char> bytes = s.save_state(sc.cloth);
+  CookAheadSolver r(options(sc), CookAheadOptions{kTicks});
+  // Cut short, a wrong version, and a base that does not fit a cloth without the cut.
+  std::vector<unsigned char> shortened(bytes.begin(), bytes.begin() + bytes.size() / 2);
+  EXPECT_NE(r.restore_state(shortened, sc.cloth).find("cook-ahead state: its bytes are malformed"),
+            std::string::npos);
+  std::vector<unsigned char> version = bytes;
+  version[4] = 9;
+  EXPECT_NE(r.restore_state(version, sc.cloth).find("version 9"), std::string::npos);
+  Testbed uncut = make_scene("form", kRes);
+  EXPECT_NE(r.restore_state(bytes, uncut.cloth).find("does not fit"), std::string::npos);
+  // The refused solver steps on as a fresh one.
+  EXPECT_FALSE(r.pending());
+  r.step(sc.cloth, sc.objects, 1.0 / 90);
+  EXPECT_TRUE(sc.cloth.validate().empty());
+}
+
+// An edit that removes vertices (an undo of the cut) cannot step on the base: cooked in the step.
+TEST(CookAhead, AnUndoOfTheCutIsCookedInTheStep) {
+  Testbed sc = make_scene("form", kRes);
+  CookAheadSolver s(options(sc), CookAheadOptions{kTicks});
+  for (int f = 0; f < 10; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  const Cloth uncut = sc.cloth;
+  ASSERT_TRUE(cut_across(sc.cloth));
+  for (int f = 0; f < kTicks + 2; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  EXPECT_EQ(s.edits_ahead(), 1);
+  sc.cloth = uncut;
+  s.step(sc.cloth, sc.objects, 1.0 / 90);
+  EXPECT_FALSE(s.pending());
+  EXPECT_EQ(s.edits_in_step(), 1);
+  EXPECT_TRUE(s.xpbd().cooked_for(sc.cloth));
+}
