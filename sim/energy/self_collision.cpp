@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "sim/core/thread_pool.hpp"
+
 namespace drape::sim {
 
 namespace {
@@ -212,7 +214,7 @@ void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double 
 }
 
 int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double thickness,
-                          double margin) {
+                          double margin, ThreadPool* pool) {
   pairs_.clear();
   const auto& tris = cloth.topo.triangles;
   const int nt = static_cast<int>(tris.size());
@@ -284,51 +286,71 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
   // coordinates b1 = g1 . (p - a), b2 = g2 . (p - a) of p's projection (g = 0: degenerate):
   // each candidate then costs three dot products.
   pre_.resize(nt);
-  for (int t = 0; t < nt; ++t) {
-    if (!tri_active_[t]) continue;
-    TriFrame& f = pre_[t];
-    f.a = x[tris[t][0]];
-    const Vec3 e1 = x[tris[t][1]] - f.a, e2 = x[tris[t][2]] - f.a, N = e1.cross(e2);
-    const double n2 = N.squaredNorm();
-    if (n2 < 1e-24) {
-      f.n = f.g1 = f.g2 = Vec3::Zero();
-      continue;
+  auto frames = [&](int b, int e, int) {
+    for (int t = b; t < e; ++t) {
+      if (!tri_active_[t]) continue;
+      TriFrame& f = pre_[t];
+      f.a = x[tris[t][0]];
+      const Vec3 e1 = x[tris[t][1]] - f.a, e2 = x[tris[t][2]] - f.a, N = e1.cross(e2);
+      const double n2 = N.squaredNorm();
+      if (n2 < 1e-24) {
+        f.n = f.g1 = f.g2 = Vec3::Zero();
+        continue;
+      }
+      f.n = N / std::sqrt(n2);
+      f.g1 = e2.cross(N) / n2;
+      f.g2 = N.cross(e1) / n2;
     }
-    f.n = N / std::sqrt(n2);
-    f.g1 = e2.cross(N) / n2;
-    f.g2 = N.cross(e1) / n2;
-  }
-  // Pass 2: each vertex against the triangles of its cell's bucket.
+  };
+  if (pool)
+    pool->parallel_for(nt, frames);
+  else
+    frames(0, nt, 0);
+  // Pass 2: each vertex against the triangles of its cell's bucket. With a pool the vertices run
+  // in one contiguous part per thread, each into its own list, joined in part order: the pairs
+  // of one thread in the same order.
   auto fixed = [&](int v) {
     return (flags[v] & (kFlagPinned | kFlagPinched | kFlagKinematic)) != 0;
   };
-  for (int v = 0; v < n; ++v) {
-    if (!vertex_active_[v] || (flags[v] & (kFlagNoCollide | kFlagKinematic))) continue;
-    const Vec3& p = x[v];
-    const uint32_t bk = bucket(pack(coord(p.x()), coord(p.y()), coord(p.z())), mask);
-    const int32_t* e = entries_.data();
-    const Sphere* sph = spheres_.data();
-    const float px = float(p.x()), py = float(p.y()), pz = float(p.z());
-    for (int32_t q = table_start_[bk]; q < table_start_[bk + 1]; ++q) {
-      const Sphere& sq = sph[q];
-      const float dx = px - sq.x, dy = py - sq.y, dz = pz - sq.z;
-      if (sphere_test_ && dx * dx + dy * dy + dz * dz > sq.r * sq.r) continue;  // out of reach
-      const int t = e[q];
-      const auto& T = tris[t];
-      if (T[0] == v || T[1] == v || T[2] == v) continue;
-      const TriFrame& f = pre_[t];
-      const Vec3 r = p - f.a;
-      const double d = f.n.dot(r);
-      if (std::abs(d) >= reach || f.n.isZero()) continue;  // far from the plane (or degenerate)
-      const double b1 = f.g1.dot(r), b2 = f.g2.dot(r);
-      if (b1 < 0 || b2 < 0 || b1 + b2 > 1) continue;  // projects outside the triangle
-      if (fixed(v) && fixed(T[0]) && fixed(T[1]) && fixed(T[2])) continue;
-      // Skip duplicates (a triangle can sit in the bucket twice via two cells hashing alike).
-      bool dup = false;
-      for (int r = static_cast<int>(pairs_.size()) - 1; r >= 0 && pairs_[r].vertex == v; --r)
-        if (pairs_[r].triangle == t) dup = true;
-      if (!dup) pairs_.push_back({v, t, d >= 0 ? 1.0 : -1.0});
+  auto test = [&](int vb, int ve, std::vector<SelfContact>& out) {
+    for (int v = vb; v < ve; ++v) {
+      if (!vertex_active_[v] || (flags[v] & (kFlagNoCollide | kFlagKinematic))) continue;
+      const Vec3& p = x[v];
+      const uint32_t bk = bucket(pack(coord(p.x()), coord(p.y()), coord(p.z())), mask);
+      const int32_t* e = entries_.data();
+      const Sphere* sph = spheres_.data();
+      const float px = float(p.x()), py = float(p.y()), pz = float(p.z());
+      for (int32_t q = table_start_[bk]; q < table_start_[bk + 1]; ++q) {
+        const Sphere& sq = sph[q];
+        const float dx = px - sq.x, dy = py - sq.y, dz = pz - sq.z;
+        if (sphere_test_ && dx * dx + dy * dy + dz * dz > sq.r * sq.r) continue;  // out of reach
+        const int t = e[q];
+        const auto& T = tris[t];
+        if (T[0] == v || T[1] == v || T[2] == v) continue;
+        const TriFrame& f = pre_[t];
+        const Vec3 r = p - f.a;
+        const double d = f.n.dot(r);
+        if (std::abs(d) >= reach || f.n.isZero()) continue;  // far from the plane (or degenerate)
+        const double b1 = f.g1.dot(r), b2 = f.g2.dot(r);
+        if (b1 < 0 || b2 < 0 || b1 + b2 > 1) continue;  // projects outside the triangle
+        if (fixed(v) && fixed(T[0]) && fixed(T[1]) && fixed(T[2])) continue;
+        // Skip duplicates (a triangle can sit in the bucket twice via two cells hashing alike).
+        bool dup = false;
+        for (int k = static_cast<int>(out.size()) - 1; k >= 0 && out[k].vertex == v; --k)
+          if (out[k].triangle == t) dup = true;
+        if (!dup) out.push_back({v, t, d >= 0 ? 1.0 : -1.0});
+      }
     }
+  };
+  if (!pool || pool->size() < 2) {
+    test(0, n, pairs_);
+  } else {
+    part_pairs_.resize(pool->size());
+    pool->parallel_parts(n, [&](int vb, int ve, int part) {
+      part_pairs_[part].clear();
+      test(vb, ve, part_pairs_[part]);
+    });
+    for (const auto& part : part_pairs_) pairs_.insert(pairs_.end(), part.begin(), part.end());
   }
   return static_cast<int>(pairs_.size());
 }

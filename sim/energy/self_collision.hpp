@@ -26,6 +26,8 @@
 
 namespace drape::sim {
 
+class ThreadPool;  // sim/core/thread_pool.hpp
+
 struct SelfContact {
   int32_t vertex, triangle;
   double side;  // +1: the vertex is on the triangle's normal side, -1: behind it
@@ -36,7 +38,10 @@ class SelfCollision {
   // Finds the vertex-triangle pairs within thickness + margin of each other. Vertices that are
   // not free (pinned, kinematic, no-collide) still repel free ones; pairs of two fixed ends
   // are skipped. Returns the number of pairs.
-  int detect(const Cloth& cloth, const std::vector<Vec3>& x, double thickness, double margin);
+  // With a pool, the triangles' frames and the vertex tests run on it (the same pairs in the
+  // same order).
+  int detect(const Cloth& cloth, const std::vector<Vec3>& x, double thickness, double margin,
+             ThreadPool* pool = nullptr);
   // One projection pass over the pairs: pushes apart those closer than `thickness`. w: inverse
   // mass per vertex (0 = fixed). Returns the largest correction applied (m). moved (optional)
   // gets the vertices of every pair it corrected appended (repeats included).
@@ -58,6 +63,7 @@ class SelfCollision {
 
  private:
   std::vector<SelfContact> pairs_;
+  std::vector<std::vector<SelfContact>> part_pairs_;  // per pool part (detect with a pool)
   // The hash: table_start_[b] .. table_start_[b + 1] index entries_ (triangle ids).
   std::vector<int32_t> table_start_, entries_, fill_;
   struct Sphere {

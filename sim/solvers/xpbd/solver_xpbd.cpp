@@ -435,7 +435,7 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
   }
   fresh_penetration_ = energy_.detect_contacts(cloth, scene, pool_.get());
   if (scene.self_collision)
-    self_.detect(cloth, cloth.state.x, scene.offset, energy_.options().contact_margin);
+    self_.detect(cloth, cloth.state.x, scene.offset, energy_.options().contact_margin, pool_.get());
   ++detections_;           // (x_det_ is taken at the end, after the snap)
   contacts_fresh_ = true;  // the first substep reuses them (same positions)
   const bool all_frozen = rest_.wake(cloth, energy_);
@@ -663,7 +663,7 @@ void XpbdSolver::detect_contacts(Step& c) {
   c.st.max_penetration =
       std::max(c.st.max_penetration, energy_.detect_contacts(c.cloth, c.scene, pool_.get()));
   if (c.scene.self_collision) {
-    self_.detect(c.cloth, c.x, c.scene.offset, c.margin);
+    self_.detect(c.cloth, c.x, c.scene.offset, c.margin, pool_.get());
     rest_.skip_rest_of_self_touching(c.cloth, self_.contacts());
   }
   rest_.unsettle_pushed(c.x, energy_);
