@@ -279,12 +279,7 @@ CutTicks bench_cut_ticks(int res, int threads, Cook mode, int ahead_ticks) {
     s.step(sc.cloth, sc.objects, 1.0 / 90);
   }
   prepare_for_cuts(sc.cloth);
-  double umin = 1e9, umax = -1e9, vmin = 1e9, vmax = -1e9;
-  for (const Vec2& m : sc.cloth.topo.material) {
-    umin = std::min(umin, m.x()), umax = std::max(umax, m.x());
-    vmin = std::min(vmin, m.y()), vmax = std::max(vmax, m.y());
-  }
-  const double v = 0.5 * (vmin + vmax) + 0.25 * (vmax - vmin) / res;  // between two grid rows
+  const double at = 0.5 + 0.25 / res;  // between two grid rows
   std::vector<double> ticks;
   CutTicks r;
   r.res = res;
@@ -295,8 +290,7 @@ CutTicks bench_cut_ticks(int res, int threads, Cook mode, int ahead_ticks) {
     std::this_thread::sleep_until(next);
     next += period;
     const auto t0 = std::chrono::steady_clock::now();
-    if (k == kBefore &&
-        !cut_along_material(sc.cloth, {Vec2(umin - 0.01, v), Vec2(umax + 0.01, v)}).ok)
+    if (k == kBefore && !cut_across_material(sc.cloth, at).ok)
       std::fprintf(stderr, "the cut across %d^2 failed\n", res);
     s.step(sc.cloth, sc.objects, 1.0 / 90);
     ticks.push_back(
@@ -331,13 +325,7 @@ void cook_probe(int res, bool full) {
   o.incremental_cook = !full;
   XpbdSolver s(o);
   for (int f = 0; f < 2; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
-  double umin = 1e9, umax = -1e9, vmin = 1e9, vmax = -1e9;
-  for (const Vec2& m : sc.cloth.topo.material) {
-    umin = std::min(umin, m.x()), umax = std::max(umax, m.x());
-    vmin = std::min(vmin, m.y()), vmax = std::max(vmax, m.y());
-  }
-  const double v = 0.5 * (vmin + vmax) + 0.25 * (vmax - vmin) / res;
-  if (!cut_along_material(sc.cloth, {Vec2(umin - 0.01, v), Vec2(umax + 0.01, v)}).ok)
+  if (!cut_across_material(sc.cloth, 0.5 + 0.25 / res).ok)
     std::fprintf(stderr, "the cut across %d^2 failed\n", res);
   s.step(sc.cloth, sc.objects, 1.0 / 90);
   const auto& k = s.last_cook();

@@ -25,6 +25,18 @@ struct FabricParams {
   double rayleigh_damping = 0.0;
 };
 
+// The stiffnesses (stretch, shear, bending) of a and b are equal: what the energy is built from.
+inline bool same_stiffness(const FabricParams& a, const FabricParams& b) {
+  return a.stretch_warp == b.stretch_warp && a.stretch_weft == b.stretch_weft &&
+         a.shear == b.shear && a.bending_warp == b.bending_warp && a.bending_weft == b.bending_weft;
+}
+// Every physical value of a and b is equal (the stiffnesses, density, thickness and damping; the
+// name aside).
+inline bool same_values(const FabricParams& a, const FabricParams& b) {
+  return same_stiffness(a, b) && a.areal_density == b.areal_density && a.thickness == b.thickness &&
+         a.rayleigh_damping == b.rayleigh_damping;
+}
+
 // Loads every preset of a fabrics JSON file. Each value is checked: present, finite, positive
 // (damping may be 0). Errors name the file and the field, e.g. "fabrics.json: muslin.shear: ...".
 Result<std::map<std::string, FabricParams>> load_fabric_presets(const std::string& path);

@@ -227,10 +227,6 @@ bool same_bending_cook(const EnergyOptions& a, const EnergyOptions& b) {
          a.curvature_smoothing == b.curvature_smoothing &&
          a.rigid_boundary_hinges == b.rigid_boundary_hinges && a.bending_matrix == b.bending_matrix;
 }
-bool same_fabric(const FabricParams& a, const FabricParams& b) {
-  return a.stretch_warp == b.stretch_warp && a.stretch_weft == b.stretch_weft &&
-         a.shear == b.shear && a.bending_warp == b.bending_warp && a.bending_weft == b.bending_weft;
-}
 // to[b] |= from[a] and to[a] |= from[b] for each pair (a, b) of triangles sharing a hinge.
 void spread(const std::vector<std::array<int32_t, 2>>& pairs, const std::vector<char>& from,
             std::vector<char>& to) {
@@ -249,9 +245,9 @@ bool ClothEnergy::update(const Cloth& cloth, const EnergyOptions& opt, ThreadPoo
                         !opt.bending_matrix && opt.model == EnergyOptions::Model::kFem &&
                         opt.bending && opt.bending_model == EnergyOptions::Bending::kTensor &&
                         opt.curvature_estimator == EnergyOptions::Curvature::kBlended &&
-                        opt.curvature_smoothing <= 1 && same_fabric(built_fabric_, cloth.fabric) &&
-                        built_all_triangles_ && nt == num_triangles() &&
-                        static_cast<int>(built_rigid_.size()) == nt;
+                        opt.curvature_smoothing <= 1 &&
+                        same_stiffness(built_fabric_, cloth.fabric) && built_all_triangles_ &&
+                        nt == num_triangles() && static_cast<int>(built_rigid_.size()) == nt;
   if (!eligible || !mark_changed(cloth, opt)) {
     build(cloth, opt, pool);
     return false;

@@ -974,6 +974,13 @@ CutResult cut_along_material(Cloth& cloth, const std::vector<Vec2>& stroke_uv) {
   return r;
 }
 
+CutResult cut_across_material(Cloth& cloth, double at) {
+  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec2& m : cloth.topo.material) lo = lo.cwiseMin(m), hi = hi.cwiseMax(m);
+  const double v = lo.y() + at * (hi.y() - lo.y());
+  return cut_along_material(cloth, {Vec2(lo.x() - 0.01, v), Vec2(hi.x() + 0.01, v)});
+}
+
 namespace {
 int find_root(std::vector<int32_t>& p, int32_t i) {
   while (p[i] != i) i = p[i] = p[p[i]];

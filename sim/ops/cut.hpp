@@ -84,6 +84,11 @@ CutResult cut_along(Cloth& cloth, const std::vector<Vec3>& stroke_points,
 // The same from a stroke given in material space (u, v): for predetermined lines and tests.
 CutResult cut_along_material(Cloth& cloth, const std::vector<Vec2>& stroke_uv);
 
+// A straight stroke across the whole cloth along u, from 1 cm before its smallest material u to
+// 1 cm past its largest, at v = vmin + at (vmax - vmin) over the cloth's material extent; cut
+// with cut_along_material. For benchmarks and tests that cut a cloth in two.
+CutResult cut_across_material(Cloth& cloth, double at);
+
 // Connected components of the mesh (vertices joined by triangle edges; isolated vertices
 // count as their own component only when `count_isolated`).
 int count_components(const Cloth& cloth, bool count_isolated = false);

@@ -25,13 +25,6 @@ constexpr uint32_t kVersion = 1;
 constexpr int kTrianglesPerTicks = 32768;
 constexpr uint8_t kDriven = kFlagPinned | kFlagPinched | kFlagKinematic;
 
-bool same_values(const FabricParams& a, const FabricParams& b) {
-  return a.areal_density == b.areal_density && a.thickness == b.thickness &&
-         a.stretch_warp == b.stretch_warp && a.stretch_weft == b.stretch_weft &&
-         a.shear == b.shear && a.bending_warp == b.bending_warp &&
-         a.bending_weft == b.bending_weft && a.rayleigh_damping == b.rayleigh_damping;
-}
-
 // The topology, fabric and state of a cloth without its incidence (a solver does not read it).
 void copy_without_incidence(const Cloth& from, Cloth& to) {
   to.topo = from.topo;
@@ -131,11 +124,19 @@ void CookAheadSolver::release() {
 void CookAheadSolver::start(const Cloth& cloth, int steps) {
   copy_without_incidence(cloth, next_cloth_);
   next_ = std::make_unique<XpbdSolver>(active_->options());
+  // The base steps as it was cooked: a vertex let go in the window (pinned when the base was
+  // kept) has its own inverse mass; the step reads it only for free vertices.
+  ClothState& B = base_.state;
+  for (int i = 0; i < base_.num_vertices(); ++i)
+    B.inv_mass[i] = B.mass[i] > 0 ? 1.0 / B.mass[i] : 0.0;
   done_.store(false, std::memory_order_relaxed);
-  launch([this](ThreadPool& pool) {
+  launch([this, spare = opt_.spare_energy](ThreadPool& pool) {
     if (spare_) next_->seed_energy(std::move(*spare_));
     spare_.reset();
     next_->prepare(next_cloth_, &pool);
+    // The next edit's cook starts from this topology's energy: a copy made here, before the
+    // cooked solver steps, instead of a second build after the swap.
+    if (spare) spare_ = std::make_unique<ClothEnergy>(next_->energy());
     done_.store(true, std::memory_order_release);
   });
   pending_ = true;
@@ -164,7 +165,6 @@ void CookAheadSolver::adopt() {
   mapped_version_ = 0;
   pending_ = false;
   steps_left_ = 0;
-  adopted_ = true;
   if (reaper_.joinable()) reaper_.join();
   reaper_ = std::thread([p = std::move(old)]() mutable { p.reset(); });
 }
@@ -186,8 +186,6 @@ StepStats CookAheadSolver::step(Cloth& cloth, const SceneObjects& scene, double 
     }
     adopt();
   }
-  const bool adopted = adopted_;
-  adopted_ = false;
   if (!active_->cooked_for(cloth) && mapped(cloth)) {
     ++edits_ahead_;
     start(cloth, ticks_for(cloth) - 1);
@@ -197,12 +195,13 @@ StepStats CookAheadSolver::step(Cloth& cloth, const SceneObjects& scene, double 
   }
   if (have_base_ && !active_->cooked_for(cloth)) ++edits_in_step_;
   StepStats st = active_->step(cloth, scene, dt);
-  // A new base (a cook in the step, or the one adopted): the next edit's cook starts from its
-  // energy, built again on a worker (the adopted solver's own is in use from now on).
+  // A new base cooked in the step: the next edit's cook starts from its energy, built on a
+  // worker. An adopted base is no new base here: the worker that cooked it kept a copy of its
+  // energy (start()).
   const bool new_base = !have_base_ || base_.topology_version != cloth.topology_version ||
                         base_.num_vertices() != cloth.num_vertices();
   if (new_base) keep_base(cloth);
-  if ((new_base || adopted) && opt_.spare_energy) {
+  if (new_base && opt_.spare_energy) {
     start_spare(base_);
     release();
   }
@@ -218,7 +217,6 @@ StepStats CookAheadSolver::step_base(Cloth& cloth, const SceneObjects& scene, do
     B.x_prev[i] = C.x_prev[i];
     B.v[i] = C.v[i];
     B.flags[i] = C.flags[i];
-    B.inv_mass[i] = B.mass[i] > 0 ? 1.0 / B.mass[i] : 0.0;
   }
   // A hand, pin or move on a new vertex acts on its base vertex.
   for (int j = nb; j < nc; ++j) {

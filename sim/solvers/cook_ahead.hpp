@@ -38,8 +38,9 @@ struct CookAheadOptions {
   // with idle_priority: they take the time the ticks leave rather than stretching them.
   bool idle_priority = true;
   int worker_threads = 2;
-  // After each new base a worker builds its energy, from which the next cut's cook starts
-  // (incremental); false: that cook builds it whole.
+  // The next cut's cook starts from the current topology's energy (incremental): the cook's
+  // worker copies the energy it cooked, and a topology cooked in a step has its energy built on
+  // a worker; false: that cook builds it whole.
   bool spare_energy = true;
   // Tests: the worker sleeps this long before it cooks (a slow or loaded machine; the result
   // must not change, only the due step waits).
@@ -96,7 +97,6 @@ class CookAheadSolver : public Solver {
   int mapped_n_ = -1;
   // The edit cooked by the worker: its cloth (kept as the next base) and the steps left.
   bool pending_ = false;
-  bool adopted_ = false;  // adopt() ran in this step
   int steps_left_ = 0;
   Cloth next_cloth_;
   std::thread worker_;

@@ -30,15 +30,9 @@ XpbdOptions options(const Testbed& sc) {
   return o;
 }
 
-// The form drape cut across at half its height (material space, between two grid rows).
-bool cut_across(Cloth& cloth) {
-  double umin = 1e9, umax = -1e9, vmin = 1e9, vmax = -1e9;
-  for (const Vec2& m : cloth.topo.material) {
-    umin = std::min(umin, m.x()), umax = std::max(umax, m.x());
-    vmin = std::min(vmin, m.y()), vmax = std::max(vmax, m.y());
-  }
-  const double v = 0.5 * (vmin + vmax) + 0.25 * (vmax - vmin) / (kRes - 1);
-  return cut_along_material(cloth, {Vec2(umin - 0.01, v), Vec2(umax + 0.01, v)}).ok;
+// The form drape cut across at `at` of its height (material space, between two grid rows).
+bool cut_across(Cloth& cloth, double at = 0.5) {
+  return cut_across_material(cloth, at + 0.25 / (kRes - 1)).ok;
 }
 
 // The largest distance between a vertex the cut made and the vertex it was duplicated from.
@@ -56,18 +50,27 @@ struct CutRun {
   double gap_at_swap = -1, gap_after = -1;
 };
 
-CutRun run(int worker_delay_ms) {
+// The form drape cut across at half its height after 30 steps and stepped 40 more; with
+// second_cut, cut again at a quarter of its height after the first cut's step (inside its
+// window). The gaps are those of the last cut.
+CutRun run(int worker_delay_ms, bool second_cut = false) {
   Testbed sc = make_scene("form", kRes);
   CookAheadSolver s(options(sc),
                     CookAheadOptions{.ticks = kTicks, .worker_delay_ms = worker_delay_ms});
   for (int f = 0; f < 30; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
-  const int before = sc.cloth.num_vertices();
+  int before = sc.cloth.num_vertices();
   EXPECT_TRUE(cut_across(sc.cloth));
+  // The second cut's window opens when the first cut's topology is adopted.
+  const int swap = second_cut ? 2 * kTicks : kTicks;
   CutRun r;
   for (int f = 0; f < 40; ++f) {
+    if (second_cut && f == 1) {
+      before = sc.cloth.num_vertices();
+      EXPECT_TRUE(cut_across(sc.cloth, 0.25));
+    }
     s.step(sc.cloth, sc.objects, 1.0 / 90);
     if (r.adopted_at < 0 && !s.pending()) r.adopted_at = f;
-    if (f == kTicks - 1) r.gap_at_swap = largest_gap(sc.cloth, before);  // the window's last
+    if (f == swap - 1) r.gap_at_swap = largest_gap(sc.cloth, before);  // the window's last
   }
   r.gap_after = largest_gap(sc.cloth, before);
   r.hash = state_hash(sc.cloth);
@@ -165,4 +168,24 @@ TEST(CookAhead, AnUndoOfTheCutIsCookedInTheStep) {
   EXPECT_FALSE(s.pending());
   EXPECT_EQ(s.edits_in_step(), 1);
   EXPECT_TRUE(s.xpbd().cooked_for(sc.cloth));
+}
+
+// A second cut inside the window maps onto the same base: the base steps on until the first
+// cut's topology is adopted, whose window then opens again for the second. Both land ahead (no
+// cook in a step), the second's sides stay together until its own swap, and the result does not
+// depend on the worker's speed.
+TEST(CookAhead, ASecondCutInTheWindowLandsAheadToo) {
+  const CutRun fast = run(0, true), slow = run(200, true);
+  std::printf("second cut: gap %.3g mm at its window's last step, %.1f mm after; adopted at %d\n",
+              1e3 * fast.gap_at_swap, 1e3 * fast.gap_after, fast.adopted_at);
+  EXPECT_EQ(fast.edits_ahead, 2);
+  EXPECT_EQ(fast.edits_in_step, 0);
+  EXPECT_EQ(slow.edits_ahead, 2);
+  EXPECT_EQ(slow.edits_in_step, 0);
+  EXPECT_GE(slow.waits, 1);
+  EXPECT_EQ(fast.adopted_at, 2 * kTicks);
+  EXPECT_EQ(slow.adopted_at, 2 * kTicks);
+  EXPECT_EQ(fast.gap_at_swap, 0.0);
+  EXPECT_GT(fast.gap_after, 0.005);
+  EXPECT_EQ(fast.hash, slow.hash);
 }
