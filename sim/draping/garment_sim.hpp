@@ -18,6 +18,7 @@
 #include "sim/core/scene_objects.hpp"
 #include "sim/draping/mapping.hpp"
 #include "sim/draping/sew.hpp"
+#include "sim/solvers/xpbd/xpbd_options.hpp"
 #include "sim/solvers/xpbd/xpbd_ties.hpp"
 
 namespace drape::sim {
@@ -86,6 +87,11 @@ Result<GarmentSimResult> simulate_garment(const Garment& garment,
                                           std::shared_ptr<const DressForm> form,
                                           const MappingSurface& surf, const FabricParams& fabric,
                                           const GarmentSimOptions& opt = {});
+
+// The XPBD options a sewn garment drapes with (opt's substeps and threads; no coarse correction
+// and no static finish, which know no ties; double-precision kernels). Sleep (freeze) stays off:
+// simulate_garment steps to its own rest test; the live app turns it on.
+XpbdOptions garment_xpbd_options(const GarmentSimOptions& opt);
 
 // The principal stretch furthest from 1, minus 1, of triangle t of the cloth (flat pattern ->
 // positions).

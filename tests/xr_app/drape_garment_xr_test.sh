@@ -45,7 +45,7 @@ echo "$end"
 read -r nv nt nties <<<"$(sed -n 's/.*: \([0-9]*\) vertices, \([0-9]*\) triangles, \([0-9]*\) seam ties.*/\1 \2 \3/p' <<<"$start")"
 [ "${nv:-0}" -gt 5000 ] && [ "${nt:-0}" -gt 10000 ] && [ "${nties:-0}" -gt 500 ] ||
   fail "the garment: $nv vertices, $nt triangles, $nties ties"
-read -r gap inside <<<"$(sed -n 's/.*seam gap max \([0-9.]*\) mm, \([0-9.]*\) mm in the form/\1 \2/p' <<<"$end")"
+read -r gap inside <<<"$(sed -n 's/.*seam gap max \([0-9.]*\) mm, \([0-9.]*\) mm in the form.*/\1 \2/p' <<<"$end")"
 /usr/bin/python3 -c "import sys; sys.exit(not (float('$gap') < 1.0 and float('$inside') < 1.0))" ||
   fail "after 240 ticks: seam gap $gap mm, $inside mm in the form (bounds 1 mm)"
 grep -q "^garment: tick 240: $nv vertices, $nt triangles, $nties seam ties" "$log" ||

@@ -87,11 +87,11 @@ void drop_ties_on_new_topology(sim::World& w, sim::XpbdSolver* solver) {
 
 std::unique_ptr<sim::XpbdSolver> make_garment_solver(std::vector<sim::xpbd::Tie> ties) {
   const sim::GarmentSimOptions g;
-  sim::XpbdOptions xo;
-  xo.substeps = g.substeps;
-  xo.threads = g.threads;
-  xo.coarse_factor = 0;
-  xo.single_precision = false;
+  sim::XpbdOptions xo = sim::garment_xpbd_options(g);
+  // The garment at rest sleeps (its seams join its pieces into one: it sleeps and wakes as a
+  // whole) and costs a contact check per tick until a hand or a pin moves it.
+  xo.freeze = true;
+  xo.rest_holds_at_detection = true;
   auto s = std::make_unique<sim::XpbdSolver>(xo);
   s->set_ties(std::move(ties), g.tie_passes);
   return s;
@@ -132,10 +132,11 @@ std::string garment_status(const sim::World& w, uint64_t tick) {
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "garment: tick %llu: %d vertices, %d triangles, %zu seam ties, seam gap max "
-                "%.3f mm, %.3f mm in the form",
+                "%.3f mm, %.3f mm in the form, %d vertices asleep",
                 static_cast<unsigned long long>(tick), w.cloth.num_vertices(),
                 w.cloth.topo.num_triangles(), s->ties().size(),
-                sim::xpbd::max_tie_gap(s->ties(), w.cloth.state.x) * 1000, inside * 1000);
+                sim::xpbd::max_tie_gap(s->ties(), w.cloth.state.x) * 1000, inside * 1000,
+                s->frozen_count());
   return buf;
 }
 

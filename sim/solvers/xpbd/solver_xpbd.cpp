@@ -346,10 +346,11 @@ void XpbdSolver::cook_hinges_springs(int n) {
   apply_order(springs_, order);
 }
 
-// The connected pieces (union-find over the elements' vertices) and the sweep blocks of one
-// piece. A bending block's stencil (the vertices of its triangle's hinges and its edge
-// neighbours' hinges) lies in triangles joined edge to edge with its own, so the triangles join
-// every vertex a block joins: the blocks are not walked (a million entries at 128^2).
+// The connected pieces (union-find over the elements' vertices, and the ties with sleep on) and
+// the sweep blocks of one piece. A bending block's stencil (the vertices of its triangle's hinges
+// and its edge neighbours' hinges) lies in triangles joined edge to edge with its own, so the
+// triangles join every vertex a block joins: the blocks are not walked (a million entries at
+// 128^2).
 void XpbdSolver::cook_pieces(int n) {
   std::vector<int> parent(n);
   for (int i = 0; i < n; ++i) parent[i] = i;
@@ -361,6 +362,13 @@ void XpbdSolver::cook_pieces(int n) {
   for (const Tri& T : tris_) join(T.v[0], T.v[1]), join(T.v[1], T.v[2]);
   for (const Hinge& H : hinges_) join(H.v[0], H.v[2]), join(H.v[0], H.v[3]);
   for (const Spring& Sp : springs_) join(Sp.v[0], Sp.v[1]);
+  // With sleep, a seam's two sides are one piece: a piece asleep on one side would hold the
+  // other's ties still. Without it each side settles on its own (the garment's measured fit).
+  if (opt_.freeze)
+    for (const xpbd::Tie& t : ties_)
+      if (std::max({t.a, t.b0, t.b1}) < n && std::min({t.a, t.b0, t.b1}) >= 0)
+        join(t.a, t.b0), join(t.a, t.b1);
+  pieces_stale_ = false;
   std::vector<int> piece_of(n, -1);
   std::vector<int> id(n, -1);
   int pieces = 0;
@@ -527,6 +535,7 @@ struct XpbdSolver::Step {
 
   int s = 0;              // the substep
   bool copy_det = false;  // contacts detected: the prediction copies x to x_det_
+  bool fresh = false;     // the substep projects freshly detected contacts
   bool gravity_only = true;
   Vec3 gk = Vec3::Zero();  // gravity (zero when off)
   bool fused = false;      // the substep runs as one sweep (sweep())
@@ -542,7 +551,10 @@ bool XpbdSolver::cooked_for(const Cloth& cloth) const {
 }
 
 void XpbdSolver::prepare(const Cloth& cloth, ThreadPool* cook_pool) {
-  if (cooked_for(cloth)) return;
+  if (cooked_for(cloth)) {
+    if (pieces_stale_) cook_pieces(cloth.num_vertices());
+    return;
+  }
   cook_pool_ = cook_pool;
   cook(cloth);
   cook_pool_ = nullptr;
@@ -651,6 +663,7 @@ void XpbdSolver::substep(Step& c) {
 void XpbdSolver::detect_contacts(Step& c) {
   c.copy_det = false;
   if (c.s == 0 && contacts_fresh_) c.st.max_penetration = fresh_penetration_;
+  c.fresh = c.s == 0 && contacts_fresh_;
   bool detect = c.s == 0 ? !contacts_fresh_ : true;
   if (c.s > 0 && opt_.reuse_contacts) {
     // Some vertex more than half the margin from where contacts were last detected (tested per
@@ -659,6 +672,7 @@ void XpbdSolver::detect_contacts(Step& c) {
     for (char m : moved_part_) detect = detect || m;
   }
   if (!detect) return;
+  c.fresh = true;
   const auto t0 = std::chrono::steady_clock::now();
   c.st.max_penetration =
       std::max(c.st.max_penetration, energy_.detect_contacts(c.cloth, c.scene, pool_.get()));
@@ -1224,15 +1238,18 @@ void XpbdSolver::collect_retests(Step& c) {
 
 void XpbdSolver::update_pieces(Step& c) {
   if (!(opt_.settle || opt_.freeze)) return;
-  if (c.fused)
+  // The sweep's sums are of the velocities before the ties moved the seams' vertices after it:
+  // with ties, the sums of the final velocities.
+  if (c.fused && ties_.empty())
     rest_.sum_motion(block_motion_);
   else
     rest_.sum_motion(c.w, c.S.v, c.S.mass);
 }
 
 void XpbdSolver::schedule_rest(Step& c) {
-  rest_.settle_pieces();
-  rest_.freeze_pieces(c.cloth, c.s);
+  const bool hold = c.fresh && opt_.rest_holds_at_detection;
+  rest_.settle_pieces(hold);
+  rest_.freeze_pieces(c.cloth, c.s, hold);
 }
 
 }  // namespace drape::sim

@@ -61,10 +61,13 @@ class XpbdSolver : public Solver {
   int frozen_count() const { return rest_.frozen_count(); }
   // Ties (xpbd_ties.hpp: a sewn garment's seams), projected tie_passes times after the elements
   // in every substep; the velocities of the vertices they move follow their corrected positions.
-  // Indices refer to the cloth the solver steps; kept until set again.
+  // Indices refer to the cloth the solver steps; kept until set again. With freeze, tied
+  // vertices belong to one piece (they sleep, settle and wake together): new ties make the
+  // pieces again at the next step.
   void set_ties(std::vector<xpbd::Tie> ties, int passes = 2) {
     ties_ = std::move(ties);
     tie_passes_ = passes;
+    pieces_stale_ = true;
   }
   const std::vector<xpbd::Tie>& ties() const { return ties_; }
   int tie_passes() const { return tie_passes_; }
@@ -309,6 +312,7 @@ class XpbdSolver : public Solver {
   std::vector<int> self_moved_;  // vertices the last self-collision projection moved
   std::vector<xpbd::Tie> ties_;
   int tie_passes_ = 2;
+  bool pieces_stale_ = false;   // the ties changed since the pieces were made
   std::vector<int> tie_moved_;  // vertices the last tie projection moved
   CookStats last_cook_;
   ThreadPool* cook_pool_ = nullptr;  // cook() spreads the energy's build over it (null: pool_)

@@ -266,7 +266,7 @@ void RestScheduler::sum_motion(
     }
 }
 
-void RestScheduler::settle_pieces() {
+void RestScheduler::settle_pieces(bool hold) {
   if (!opt_.settle) return;
   const double exit2 = opt_.settle_exit_speed * opt_.settle_exit_speed;
   for (int p = 0; p < num_pieces_; ++p) {
@@ -284,12 +284,15 @@ void RestScheduler::settle_pieces() {
         slow_[p] = 0;
       }
     } else {
-      slow_[p] = pm.max_v2 < opt_.settle_speed * opt_.settle_speed ? slow_[p] + 1 : 0;
+      if (pm.max_v2 < opt_.settle_speed * opt_.settle_speed)
+        ++slow_[p];
+      else if (!hold)
+        slow_[p] = 0;
     }
   }
 }
 
-void RestScheduler::freeze_pieces(Cloth& cloth, int s) {
+void RestScheduler::freeze_pieces(Cloth& cloth, int s, bool hold) {
   if (!opt_.freeze) return;
   auto& S = cloth.state;
   const int n = cloth.num_vertices();
@@ -309,7 +312,10 @@ void RestScheduler::freeze_pieces(Cloth& cloth, int s) {
       settled_long = ++full_[p] >= opt_.settle_sleep_steps;
       if (moving && pm.m > 0 && pm.mv2_capped < v2 * pm.m) moving = false;
     }
-    rest_[p] = moving ? 0 : rest_[p] + 1;
+    if (!moving)
+      ++rest_[p];
+    else if (!hold)
+      rest_[p] = 0;
     if (rest_[p] >= opt_.freeze_steps || settled_long) {
       frozen_[p] = 1;
       masses_dirty_ = true;

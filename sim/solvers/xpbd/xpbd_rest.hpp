@@ -82,8 +82,10 @@ class RestScheduler {
   void sum_motion(const std::vector<std::vector<std::pair<int, PieceMotion>>>& block_runs);
   // After the substep's motion sums: settling starts, grows or ends (settle), pieces fall
   // asleep (freeze) and their vertices get the frozen flag (substep s of the frame).
-  void settle_pieces();
-  void freeze_pieces(Cloth& cloth, int s);
+  // hold: the substep projected freshly detected contacts and a fast piece keeps its count of
+  // slow substeps (XpbdOptions::rest_holds_at_detection).
+  void settle_pieces(bool hold = false);
+  void freeze_pieces(Cloth& cloth, int s, bool hold = false);
 
   // The coarse correction of the pieces due for it (XpbdOptions::coarse_factor).
   void coarse_step(Cloth& cloth, const SceneObjects& scene, ClothEnergy& energy);

@@ -102,3 +102,33 @@ TEST(XpbdTies, TwoPanelsTiedHangAsOne) {
     }
   }
 }
+
+// With sleep on, tied panels are one piece: they fall asleep together, and moving A's pinned row
+// wakes B too (a B asleep on its own would hold A's seam still).
+TEST(XpbdTies, TiedPanelsSleepAndWakeAsOne) {
+  TwoPanels p = two_panels();
+  XpbdOptions o;
+  o.single_precision = false;
+  o.freeze = true;
+  o.finish = false;
+  o.rest_holds_at_detection = true;
+  XpbdSolver s(o);
+  s.set_ties(p.ties);
+  SceneObjects scene;
+  const int free_vertices = p.cloth.num_vertices() - 9;
+  int asleep_at = -1;
+  for (int f = 0; f < 1800 && asleep_at < 0; ++f) {
+    s.step(p.cloth, scene, 1.0 / 90);
+    if (s.frozen_count() == free_vertices) asleep_at = f;
+    // Never one panel asleep without the other.
+    ASSERT_TRUE(s.frozen_count() == 0 || s.frozen_count() == free_vertices) << "frame " << f;
+  }
+  std::printf("tied panels asleep at frame %d\n", asleep_at);
+  ASSERT_GE(asleep_at, 0) << "the tied panels never fell asleep";
+  for (int i = 0; i < 9; ++i) p.cloth.state.x[8 * 9 + i] += Vec3(0, 0, 0.01);  // A's top row
+  s.step(p.cloth, scene, 1.0 / 90);
+  EXPECT_EQ(s.frozen_count(), 0);
+  double vb = 0;
+  for (int i = p.na; i < p.cloth.num_vertices(); ++i) vb = std::max(vb, p.cloth.state.v[i].norm());
+  EXPECT_GT(vb, 0.0) << "panel B moves with A";
+}
