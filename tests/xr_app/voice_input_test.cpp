@@ -21,11 +21,13 @@ namespace {
 const std::string kDir = std::string(DRAPE_BINARY_DIR) + "/xr_test_out/voice_input";
 
 // "pin here" after `lead_s` of silence, 1 s of silence after it (16 kHz mono).
-std::string speech(double lead_s) {
-  const std::string wav = kDir + "/pin.wav";
+std::string speech(double lead_s, const std::string& name) {
+  // One file per test: ctest runs the tests of this file as processes side by side, and one
+  // rewriting a recording another streams would cut that stream short.
+  const std::string wav = kDir + "/" + name + ".wav";
   const std::string cmd = "set -e; mkdir -p '" + kDir + "'; cd '" + kDir +
-                          "'; espeak-ng -s 140 -w pin_22k.wav 'pin here'; sox pin_22k.wav -r "
-                          "16000 -c 1 -b 16 pin.wav pad " +
+                          "'; espeak-ng -s 140 -w " + name + "_22k.wav 'pin here'; sox " + name +
+                          "_22k.wav -r 16000 -c 1 -b 16 " + name + ".wav pad " +
                           std::to_string(lead_s) + " 1";
   return std::system(cmd.c_str()) == 0 ? wav : "";
 }
@@ -53,7 +55,7 @@ class FailingDevice : public tr::AudioInput {
 }  // namespace
 
 TEST(VoiceInput, StreamsARecordingAtRealTimeAndCountsTheLatencyInFrames) {
-  const std::string wav = speech(1.0);
+  const std::string wav = speech(1.0, "stream");
   ASSERT_FALSE(wav.empty()) << "espeak-ng/sox failed";
   VoiceInput in(wav);
   EXPECT_EQ(in.name(), "recording '" + wav + "'");
@@ -87,7 +89,7 @@ TEST(VoiceInput, StreamsARecordingAtRealTimeAndCountsTheLatencyInFrames) {
 }
 
 TEST(VoiceInput, ADeviceFailingMidStreamIsAStatusNamingIt) {
-  const std::string wav = speech(1.0);
+  const std::string wav = speech(1.0, "failing");
   ASSERT_FALSE(wav.empty()) << "espeak-ng/sox failed";
   VoiceInput in("microphone (ALSA 'hw:5,0')",
                 std::make_unique<FailingDevice>(wav, tr::kVoiceRate / 2));
