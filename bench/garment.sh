@@ -11,9 +11,9 @@
 #   garment_rest   garment_lock played for 1200 ticks: the garment settles and falls asleep
 # Per run: step_wall_ms and step_cpu_ms (the solver's step per tick, p50 / p99), tick_interval_ms
 # (free sim: the tick-start intervals, p50 / p99, i.e. the rate it reaches), frame_ms p50, the
-# ratio of the step's p50 to the panel's and the garment's vertices asleep at the end. Writes out/bench/garment.json and out/bench/garment.csv
-# and prints a table with the machine's load (CPU work on shared cores). Env: DRAPE_BUILD_DIR
-# (default build).
+# ratio of the step's p50 to the panel's and the garment's vertices asleep at the end. Writes
+# out/bench/garment.json and out/bench/garment.csv and prints a table with the machine's load
+# (CPU work on shared cores). Env: DRAPE_BUILD_DIR (default build).
 set -euo pipefail
 ROOT="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
 shift || true
@@ -66,7 +66,7 @@ for name in ("garment_lock", "garment_free", "panel64_free", "garment_rest"):
         "seam_gap_end_mm": float(m.group(4)) if m else nan,
         "asleep_end": int(m.group(5)) if m else 0,
     })
-panel = rows[2]["step_wall_ms_p50"]
+panel = next(r for r in rows if r["run"] == "panel64_free")["step_wall_ms_p50"]
 for r in rows:
     r["step_p50_vs_panel64"] = r["step_wall_ms_p50"] / panel
 print(f"{'run':<13} {'verts':>6} {'ties':>5} {'ticks':>5} {'step wall p50/p99 ms':>21} "

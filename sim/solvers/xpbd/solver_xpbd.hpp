@@ -65,9 +65,10 @@ class XpbdSolver : public Solver {
   // vertices belong to one piece (they sleep, settle and wake together): new ties make the
   // pieces again at the next step.
   void set_ties(std::vector<xpbd::Tie> ties, int passes = 2) {
+    // (No ties before or after, as at each cook-ahead swap of the panel: the pieces stand.)
+    if (!ties_.empty() || !ties.empty()) pieces_stale_ = true;
     ties_ = std::move(ties);
     tie_passes_ = passes;
-    pieces_stale_ = true;
   }
   const std::vector<xpbd::Tie>& ties() const { return ties_; }
   int tie_passes() const { return tie_passes_; }
