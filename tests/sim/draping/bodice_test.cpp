@@ -1,6 +1,7 @@
 // The basic bodice and the dress: the draped bodice's fit checks (widths against the form's
 // arcs, piece areas against the draped areas, sewn girths), its darts, its seams matching
-// front to back, the dress's waist seams matching, and the design files' errors.
+// front to back, its seam lines' fairness, the dress's waist seams matching, and the design
+// files' errors.
 #include "sim/draping/bodice.hpp"
 
 #include <gtest/gtest.h>
@@ -94,19 +95,22 @@ TEST(Bodice, DartsTakeOutTheExcessAndTheirLegsMatch) {
                 p.name.c_str(), p.waist_dart_mm, p.waist_dart_legs_mm[0], p.waist_dart_legs_mm[1],
                 p.shoulder_dart_mm, p.shoulder_dart_legs_mm[0], p.shoulder_dart_legs_mm[1]);
     ASSERT_EQ(pc.darts.size(), 2u);
-    // Both darts open (the form curves over the bust and the blade) and point at one apex. The
-    // 9AR form takes its back waist shaping mostly at the side: the back waist dart is small.
-    EXPECT_GT(p.waist_dart_mm, 2.0) << p.name;
+    // The shoulder darts open (the form curves over the bust and the blade), both darts point
+    // at one apex, and no dart's legs cross. The 9AR form takes its back waist shaping at the
+    // side: with the waist row at its length on the form the back waist dart is under 1 mm.
+    EXPECT_GE(p.waist_dart_mm, 0.0) << p.name;
     EXPECT_GT(p.shoulder_dart_mm, 10.0) << p.name;
     EXPECT_LT((pc.outline[pc.darts[0].tip] - pc.outline[pc.darts[1].tip]).norm(), 1e-9);
-    // Each dart's legs are sewn together: measured within 3 % of each other (the flat
-    // relaxation's strain along the dart line; a pattern maker eases the difference).
-    EXPECT_NEAR(p.waist_dart_legs_mm[0], p.waist_dart_legs_mm[1], 0.03 * p.waist_dart_legs_mm[0]);
+    // Each dart's legs are sewn together: both held at the dart line's length on the form in
+    // the flat relaxation, within 0.5 % of each other (measured 0.2 % at most; 2.7 % with the
+    // legs relaxed like the rest of the cloth).
+    EXPECT_NEAR(p.waist_dart_legs_mm[0], p.waist_dart_legs_mm[1], 0.005 * p.waist_dart_legs_mm[0]);
     EXPECT_NEAR(p.shoulder_dart_legs_mm[0], p.shoulder_dart_legs_mm[1],
-                0.03 * p.shoulder_dart_legs_mm[0]);
+                0.005 * p.shoulder_dart_legs_mm[0]);
   }
   // The front's darts are bigger than the back's (the bust is rounder than the blade).
   const auto& r = d.result.report.pieces;
+  EXPECT_GT(r[0].waist_dart_mm, 10.0);
   EXPECT_GT(r[0].waist_dart_mm, r[1].waist_dart_mm);
 }
 
@@ -114,10 +118,11 @@ TEST(Bodice, FrontAndBackSeamsMatch) {
   const BodiceReport& r = bodice_on_9ar().result.report;
   std::printf("side seam mismatch %.2f mm, shoulder %.2f mm\n", r.side_seam_mismatch_mm,
               r.shoulder_seam_mismatch_mm);
-  // Measured +7.2 (side) and -1.4 mm (shoulder) on the 9AR form (each zone's flat strain along
-  // the seam): within what a pattern maker eases, not yet within the widths' 2 mm.
-  EXPECT_LT(std::abs(r.side_seam_mismatch_mm), 8.0);
-  EXPECT_LT(std::abs(r.shoulder_seam_mismatch_mm), 8.0);
+  // Sewn together, the seams match within the widths' 2 mm (measured +0.35 mm side, -0.47 mm
+  // shoulder on the 9AR form; +7.2 and -1.4 mm with the seams relaxed like the rest of the
+  // cloth, which stretched the front's side seam over the bust).
+  EXPECT_LT(std::abs(r.side_seam_mismatch_mm), 2.0);
+  EXPECT_LT(std::abs(r.shoulder_seam_mismatch_mm), 2.0);
   // A bodice's proportions on the 9AR form: side seam 15-25 cm, shoulder 9-16 cm.
   for (const BodicePieceReport& p : r.pieces) {
     EXPECT_GT(p.side_mm, 150.0);
@@ -125,6 +130,19 @@ TEST(Bodice, FrontAndBackSeamsMatch) {
     EXPECT_GT(p.shoulder_mm, 90.0);
     EXPECT_LT(p.shoulder_mm, 160.0);
   }
+}
+
+// The seam lines are fair: no turn above 5 deg/mm (an 11.5 mm radius) but on the front
+// shoulder dart's leg at the side zone (17.8 deg/mm: a row beside the apex's key row, 1 mm
+// apart, folds over in the flat relaxation and shifts its neighbours; 58 deg/mm before the
+// outline left out points a millimetre from the last).
+TEST(Bodice, SeamLinesAreFair) {
+  for (const BodicePieceReport& p : bodice_on_9ar().result.report.pieces)
+    for (const auto& [line, deg_per_mm] : p.fairness_deg_per_mm) {
+      std::printf("%s %s %.2f deg/mm\n", p.name.c_str(), line.c_str(), deg_per_mm);
+      const bool known_kink = p.name == "Bodice front" && line == "dart2_leg2";
+      EXPECT_LT(deg_per_mm, known_kink ? 20.0 : 5.0) << p.name << " " << line;
+    }
 }
 
 TEST(Bodice, OutlineIsClosedCounterClockwiseWithEveryLine) {
