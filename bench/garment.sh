@@ -9,6 +9,9 @@
 #   garment_free   the sim on its own thread at 90 Hz (the live default of `drape run`)
 #   panel64_free   the 64^2 panel of the default scene on its own thread
 #   garment_rest   garment_lock played for 1200 ticks: the garment settles and falls asleep
+#   dress_lock     the dress (`--garment dress`: bodice and tight skirt sewn at the waist) in lock
+#                  step under the same scenario
+#   dress_rest     dress_lock played for 1200 ticks
 # Per run: step_wall_ms and step_cpu_ms (the solver's step per tick, p50 / p99), tick_interval_ms
 # (free sim: the tick-start intervals, p50 / p99, i.e. the rate it reaches), frame_ms p50, the
 # ratio of the step's p50 to the panel's and the garment's vertices asleep at the end. Writes
@@ -32,8 +35,10 @@ run garment_lock --garment tight-skirt
 run garment_free --garment tight-skirt --sim-free
 run panel64_free --cloth-res 64 --sim-free
 # The same pinch played for 1200 ticks in lock step: the garment settles and falls asleep.
-sed 's/"end_after_frames": [0-9]*/"end_after_frames": 1200/' "$SCENARIO" >"$WORK/garment_rest.json"
-SCENARIO="$WORK/garment_rest.json" FRAMES=1200 run garment_rest --garment tight-skirt
+sed 's/"end_after_frames": [0-9]*/"end_after_frames": 1200/' "$SCENARIO" >"$WORK/scenario_rest.json"
+SCENARIO="$WORK/scenario_rest.json" FRAMES=1200 run garment_rest --garment tight-skirt
+run dress_lock --garment dress
+SCENARIO="$WORK/scenario_rest.json" FRAMES=1200 run dress_rest --garment dress
 echo "== done ($(uptime | sed 's/.*load/load/'))"
 /usr/bin/python3 - "$WORK" <<'PY'
 import csv, json, re, sys
@@ -44,7 +49,8 @@ def q(prof, stage, p):
     return prof.get(stage, {}).get(p, nan)
 
 rows = []
-for name in ("garment_lock", "garment_free", "panel64_free", "garment_rest"):
+for name in ("garment_lock", "garment_free", "panel64_free", "garment_rest", "dress_lock",
+             "dress_rest"):
     j = json.load(open(f"{work}/{name}.json"))
     prof = j["profile_ms"]
     log = open(f"{work}/{name}/xr_session.txt").read()

@@ -112,8 +112,9 @@ void add_app_options(CLI::App& cli, XrAppOptions& opt) {
                           "no live pattern board beside the form (its cost: drape bench board)"}});
   cli.add_option(
          "--garment", opt.garment,
-         "instead of the panel, the sewn garment of a skirt or bodice design (assets/designs/ by "
-         "name, or a design file) on the form, simulated with its seams as ties")
+         "instead of the panel, the sewn garment of a skirt, bodice or dress design "
+         "(assets/designs/ by name, or a design file) on the form, simulated with its seams as "
+         "ties")
       ->type_name("NAME|FILE.json");
   cli.add_option("--garment-fabric", opt.garment_fabric,
                  "with --garment: a fabric of assets/fabrics.json (default: the design's)")

@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "sim/core/stopwatch.hpp"
@@ -551,6 +552,13 @@ struct ClothBuild {
   std::vector<int> first;  // per sewn vertex: the cloth vertex made for it first (-1: none)
   double min_gap = 0;      // m: nodes of a row nearer than this are one vertex
   Garment g;
+  std::set<std::pair<int, int>> tied;  // (vertex, the vertex it is tied onto)
+  // Ties `v` onto `onto` once: the nodes of a collapsed row are one vertex, and a tie per node
+  // would repeat the same tie (28 times at the back's neck point, where the repeated ties made
+  // that vertex shake at 1-4 m/s for good in the live solver).
+  void tie(int v, int onto) {
+    if (tied.emplace(v, onto).second) g.ties.push_back({v, onto, onto, 0.0});
+  }
 };
 
 // The vertices of one zone's half (`half` 1: the mirror image; `k` the zone's first node in
@@ -584,7 +592,7 @@ std::vector<int> zone_vertices(ClothBuild& cb, const Zone& z, size_t k, int half
       if (cb.first[w] < 0)
         cb.first[w] = id[i];
       else if (cb.first[w] != id[i])
-        g.ties.push_back({id[i], cb.first[w], cb.first[w], 0.0});
+        cb.tie(id[i], cb.first[w]);
       continue;
     }
     id[i] = here[w] = static_cast<int>(g.x.size());
@@ -595,7 +603,7 @@ std::vector<int> zone_vertices(ClothBuild& cb, const Zone& z, size_t k, int half
     if (cb.first[w] < 0)
       cb.first[w] = id[i];
     else
-      g.ties.push_back({id[i], cb.first[w], cb.first[w], 0.0});
+      cb.tie(id[i], cb.first[w]);
   }
   return id;
 }
@@ -605,8 +613,8 @@ std::vector<int> zone_vertices(ClothBuild& cb, const Zone& z, size_t k, int half
 Garment bodice_cloth(const std::vector<DrapedPiece>& pieces, const Garment& welded,
                      const std::vector<int>& node_vertex, const BodiceDesign& d) {
   // Nodes of a row nearer than a quarter of a column step are one vertex.
-  ClothBuild cb{
-      welded, node_vertex, std::vector<int>(welded.x.size(), -1), 0.25 * d.column_step, {}};
+  ClothBuild cb{welded, node_vertex, std::vector<int>(welded.x.size(), -1), 0.25 * d.column_step,
+                {},     {}};
   size_t k = 0;
   for (size_t pi = 0; pi < pieces.size(); ++pi)
     for (const Zone* z : {&pieces[pi].centre, &pieces[pi].side}) {

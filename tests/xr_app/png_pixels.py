@@ -3,6 +3,7 @@ package on the test machines): an 8-bit RGB or RGBA PNG decoded (all five row fi
 pixels counted by class.
 
   png_pixels.py garment FRAME_NONE FRAME_EASE   the live garment's frames (drape_garment_xr_test)
+  png_pixels.py dress FRAME_NONE FRAME_EASE     the same for a dress (from the shoulders down)
   png_pixels.py legend FIT_MAP                  the fit map's legend (drape_pattern_simulate_test)
 
 Each check prints what it measured and exits 1 naming the check that failed."""
@@ -70,7 +71,7 @@ def expect(ok, what):
         sys.exit(1)
 
 
-def check_garment(none_path, ease_path):
+def check_garment(none_path, ease_path, dress=False):
     w, h, none = read_png(none_path)
     _, _, ease = read_png(ease_path)
     coloured = [(x, y) for y in range(h) for x in range(w) if saturated(ease[y][x])]
@@ -91,8 +92,15 @@ def check_garment(none_path, ease_path):
     cx = (x0 + x1) / 2
     expect(abs(cx - w / 2) < 0.1 * w, f"the garment's columns {x0}..{x1} centred (the form's)")
     expect(x1 - x0 < 0.4 * w, f"the garment {x1 - x0} px wide (< {0.4 * w:.0f}: on the form)")
-    form_above = sum(beige(none[y][x]) for y in range(0, y0) for x in range(x0, x1 + 1))
-    expect(form_above >= 300, f"{form_above} pixels of the form above the garment's top row {y0}")
+    if dress:
+        # A dress covers the form from the shoulders to below the hip: taller than a skirt, its
+        # top in the upper third of the frame, and under the neck little of the form is seen.
+        expect(y1 - y0 > 0.35 * h, f"the dress {y1 - y0} px tall (> {0.35 * h:.0f})")
+        expect(y0 < h / 3, f"the dress's top row {y0} in the upper third (< {h / 3:.0f})")
+    else:
+        form_above = sum(beige(none[y][x]) for y in range(0, y0) for x in range(x0, x1 + 1))
+        expect(form_above >= 300,
+               f"{form_above} pixels of the form above the garment's top row {y0}")
     changed = sum(none[y][x] != ease[y][x] for x, y in coloured)
     expect(changed >= 0.9 * len(coloured), f"{changed} of them differ from the frame without it")
 
@@ -119,8 +127,8 @@ def check_legend(path):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) == 4 and sys.argv[1] == "garment":
-        check_garment(sys.argv[2], sys.argv[3])
+    if len(sys.argv) == 4 and sys.argv[1] in ("garment", "dress"):
+        check_garment(sys.argv[2], sys.argv[3], dress=sys.argv[1] == "dress")
     elif len(sys.argv) == 3 and sys.argv[1] == "legend":
         check_legend(sys.argv[2])
     else:

@@ -13,6 +13,7 @@
 #include "sim/draping/pattern_pipeline.hpp"
 #include "sim/form/dress_form.hpp"
 #include "xr_app/app/desk_scene.hpp"
+#include "xr_app/paths.hpp"
 
 namespace drape::app {
 namespace {
@@ -50,15 +51,38 @@ sim::Result<sim::Garment> sewn_bodice(const XrAppOptions& opt, const sim::DressF
   return std::move(b->garment);
 }
 
+// The dress design's sewn dress on `form`: its bodice (sewn_bodice's) and its skirt (the
+// pattern pipeline's) joined at the waist by ties at equal places along the waist loop
+// (dress_garment), as `drape pattern --design dress --simulate` sews it. The dress's fabric is
+// its bodice's; its parts are looked up as `drape pattern` looks them up (the designs among the
+// assets, or paths).
+sim::Result<sim::Garment> sewn_dress(const XrAppOptions& opt, const sim::DressForm& form,
+                                     sim::FabricParams& fabric) {
+  std::ifstream in(opt.garment, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  auto d = sim::parse_dress_design(text.str(), opt.garment, asset("designs").string());
+  if (!d) return sim::make_error("--garment", d.error());
+  auto f = garment_fabric(opt, d->bodice.fabric);
+  if (!f) return sim::Error{f.error()};
+  fabric = *f;
+  const std::string what = "--garment " + opt.garment;
+  auto b = sim::drape_bodice(d->bodice, form);
+  if (!b) return sim::make_error(what, b.error());
+  auto skirt = sim::run_pattern_pipeline(d->skirt, form, fabric);
+  if (!skirt) return sim::make_error(what, skirt.error());
+  auto g = sim::dress_garment(b->garment, skirt->garment);
+  if (!g) return sim::make_error(what, g.error());
+  return g;
+}
+
 // The design's sewn garment on `form` (the pipeline writes no files).
 sim::Result<sim::Garment> sewn_garment(const XrAppOptions& opt, const sim::DressForm& form,
                                        sim::FabricParams& fabric) {
   auto type = sim::design_type(opt.garment);
   if (!type) return sim::make_error("--garment", type.error());
   if (*type == "bodice") return sewn_bodice(opt, form, fabric);
-  if (*type != "skirt")
-    return sim::make_error("--garment " + opt.garment,
-                           "a " + *type + " design; the live garment takes skirts and the bodice");
+  if (*type == "dress") return sewn_dress(opt, form, fabric);
   auto d = sim::load_design(opt.garment);
   if (!d) return sim::make_error("--garment", d.error());
   auto f = garment_fabric(opt, d->fabric);

@@ -21,9 +21,9 @@ namespace drape::app {
 // correction (its lattice knows no ties), as simulate_garment runs it.
 std::unique_ptr<sim::XpbdSolver> make_garment_solver(std::vector<sim::xpbd::Tie> ties);
 
-// The World of a garment session: opt.garment (a skirt or bodice design file) made into its sewn
-// garment on the form of opt.form_* in the fabric opt.garment_fabric (from opt.fabrics_path; "" =
-// the design's), the floor, the form's friction, and the solver above. A cut that changes the
+// The World of a garment session: opt.garment (a skirt, bodice or dress design file) made into its
+// sewn garment on the form of opt.form_* in the fabric opt.garment_fabric (from opt.fabrics_path;
+// "" = the design's), the floor, the form's friction, and the solver above. A cut that changes the
 // cloth's vertices drops the ties (their indices name the old vertices) and says so in the
 // World's messages. Errors name the option and the file ("--garment <file>: ...").
 sim::Result<sim::World> make_garment_world(const XrAppOptions& opt);

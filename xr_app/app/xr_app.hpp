@@ -45,9 +45,9 @@ struct XrAppOptions {
   // sim/energy/self_collision.hpp).
   bool self_collision = true;
   std::string form_size = "9AR", form_measurements, form_mesh, forms_dir;
-  // The sewn garment of a skirt or bodice design file instead of the panel (garment_scene.hpp: the
-  // design's pattern sewn on the form, simulated with its seams as ties); "" = none. Its fabric
-  // is garment_fabric ("" = the design's), from fabrics_path.
+  // The sewn garment of a skirt, bodice or dress design file instead of the panel
+  // (garment_scene.hpp: the design's pattern sewn on the form, simulated with its seams as ties);
+  // "" = none. Its fabric is garment_fabric ("" = the design's), from fabrics_path.
   std::string garment, garment_fabric;
   // The sim's messages get the cloth's state hash before and after each operation's outcome
   // (tests: an undo restores the hash from before the operation).

@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include "sim/draping/bodice.hpp"
@@ -57,9 +59,14 @@ TEST(GarmentSimBodice, BodiceRestsClosedOnTheForm) {
   ASSERT_TRUE(d.ok()) << d.error();
   auto b = drape_bodice(*d, *form);
   ASSERT_TRUE(b.ok()) << b.error();
-  // Every vertex has a flat point; the seams are ties.
+  // Every vertex has a flat point; the seams are ties, none repeated (the nodes of a collapsed
+  // row are one vertex, tied once).
   ASSERT_EQ(b->garment.material.size(), b->garment.x.size());
   EXPECT_GT(b->garment.ties.size(), 100u);
+  std::set<std::array<double, 4>> seen;
+  for (const SeamTie& t : b->garment.ties)
+    EXPECT_TRUE(seen.insert({double(t.a), double(t.b0), double(t.b1), t.t}).second)
+        << "tie " << t.a << " -> " << t.b0 << ", " << t.b1 << " repeated";
   auto fabric = load_fabric(kAssets + "fabrics.json", "muslin");
   ASSERT_TRUE(fabric.ok()) << fabric.error();
   const MappingSurface surf(*form, d->ease, true);
