@@ -554,8 +554,7 @@ struct ClothBuild {
   Garment g;
   std::set<std::pair<int, int>> tied;  // (vertex, the vertex it is tied onto)
   // Ties `v` onto `onto` once: the nodes of a collapsed row are one vertex, and a tie per node
-  // would repeat the same tie (28 times at the back's neck point, where the repeated ties made
-  // that vertex shake at 1-4 m/s for good in the live solver).
+  // would repeat the same tie (28 times at the back's neck point), projected as many times.
   void tie(int v, int onto) {
     if (tied.emplace(v, onto).second) g.ties.push_back({v, onto, onto, 0.0});
   }
