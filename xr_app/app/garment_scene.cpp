@@ -34,14 +34,19 @@ sim::Result<sim::FabricParams> garment_fabric(const XrAppOptions& opt, const std
   return f;
 }
 
+// The whole text of the design file opt.garment (xr_launch checked that it exists).
+std::string design_text(const XrAppOptions& opt) {
+  std::ifstream in(opt.garment, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 // The bodice design's sewn bodice on `form`: its zones' flat pattern as rest, its darts' legs,
 // side and shoulder seams as ties (drape_bodice).
 sim::Result<sim::Garment> sewn_bodice(const XrAppOptions& opt, const sim::DressForm& form,
                                       sim::FabricParams& fabric) {
-  std::ifstream in(opt.garment, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  auto d = sim::parse_bodice_design(text.str(), opt.garment);
+  auto d = sim::parse_bodice_design(design_text(opt), opt.garment);
   if (!d) return sim::make_error("--garment", d.error());
   auto f = garment_fabric(opt, d->fabric);
   if (!f) return sim::Error{f.error()};
@@ -58,10 +63,7 @@ sim::Result<sim::Garment> sewn_bodice(const XrAppOptions& opt, const sim::DressF
 // assets, or paths).
 sim::Result<sim::Garment> sewn_dress(const XrAppOptions& opt, const sim::DressForm& form,
                                      sim::FabricParams& fabric) {
-  std::ifstream in(opt.garment, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  auto d = sim::parse_dress_design(text.str(), opt.garment, asset("designs").string());
+  auto d = sim::parse_dress_design(design_text(opt), opt.garment, asset("designs").string());
   if (!d) return sim::make_error("--garment", d.error());
   auto f = garment_fabric(opt, d->bodice.fabric);
   if (!f) return sim::Error{f.error()};
