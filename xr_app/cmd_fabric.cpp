@@ -91,10 +91,10 @@ int write_runs(const drape::sim::DrapeSeries& s, const DrapeTestOptions& o, cons
 
 void print_series(const drape::sim::DrapeSeries& s) {
   std::printf(
-      "mean over %zu drapes: DC %.4f (sd %.4f)  nodes %.2f (sd %.2f)  R_min %.1f mm  "
-      "R_max %.1f mm\n",
-      s.runs.size(), s.dc_mean, s.dc_sd, s.nodes_mean, s.nodes_sd, s.rmin_mean * 1e3,
-      s.rmax_mean * 1e3);
+      "mean over %zu drapes: DC %.4f (sd %.4f)  nodes %.2f (sd %.2f; median %g, %d-%d)  "
+      "R_min %.1f mm  R_max %.1f mm\n",
+      s.runs.size(), s.dc_mean, s.dc_sd, s.nodes_mean, s.nodes_sd, s.nodes_median, s.nodes_min,
+      s.nodes_max, s.rmin_mean * 1e3, s.rmax_mean * 1e3);
   std::printf(
       "face up / face down: not simulated apart. The cloth model has no term that tells "
       "the faces apart (no rest curvature, no curl), so a specimen turned over drapes as "

@@ -243,6 +243,13 @@ Result<DrapeSeries> run_drape_series(const FabricParams& fabric, const DrapeTest
   double sd_unused = 0;
   mean_sd(dc, series.dc_mean, series.dc_sd);
   mean_sd(nodes, series.nodes_mean, series.nodes_sd);
+  if (!nodes.empty()) {
+    std::sort(nodes.begin(), nodes.end());
+    const size_t h = nodes.size() / 2;
+    series.nodes_median = nodes.size() % 2 ? nodes[h] : 0.5 * (nodes[h - 1] + nodes[h]);
+    series.nodes_min = static_cast<int>(nodes.front());
+    series.nodes_max = static_cast<int>(nodes.back());
+  }
   mean_sd(rmin, series.rmin_mean, sd_unused);
   mean_sd(rmax, series.rmax_mean, sd_unused);
   series.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -68,6 +68,9 @@ Result<DrapeTestResult> run_drape_test(const FabricParams& fabric, const DrapeTe
 struct DrapeSeries {
   std::vector<DrapeTestResult> runs;  // one per seed: seed, seed + 1, ...
   double dc_mean = 0, dc_sd = 0, nodes_mean = 0, nodes_sd = 0;
+  // The node count's median and range: a drape test reports the median of its integer counts.
+  double nodes_median = 0;
+  int nodes_min = 0, nodes_max = 0;
   double rmin_mean = 0, rmax_mean = 0;  // m
   double seconds = 0;                   // wall time of the whole series
 };

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "sim/fabric_test/calibrate.hpp"
@@ -79,6 +80,23 @@ TEST(DrapeTester, SeriesOfSeedsGivesASpread) {
   EXPECT_NE(s->runs[0].measures.dc, s->runs[1].measures.dc);  // different perturbations
   EXPECT_GT(s->dc_sd, 0);
   EXPECT_LT(s->dc_sd, 0.1);
+  // The node count's median of two drapes is the mean of the two; min and max are theirs.
+  const int n0 = s->runs[0].measures.nodes, n1 = s->runs[1].measures.nodes;
+  EXPECT_DOUBLE_EQ(s->nodes_median, 0.5 * (n0 + n1));
+  EXPECT_EQ(s->nodes_min, std::min(n0, n1));
+  EXPECT_EQ(s->nodes_max, std::max(n0, n1));
+}
+
+// Three drapes: the median is the middle count.
+TEST(DrapeTester, NodeMedianIsTheMiddleDrapes) {
+  auto s = run_drape_series(with_bending(5e-6), small(), 3, 2);
+  ASSERT_TRUE(s) << s.error();
+  std::vector<int> n;
+  for (const auto& r : s->runs) n.push_back(r.measures.nodes);
+  std::sort(n.begin(), n.end());
+  EXPECT_DOUBLE_EQ(s->nodes_median, n[1]);
+  EXPECT_EQ(s->nodes_min, n[0]);
+  EXPECT_EQ(s->nodes_max, n[2]);
 }
 
 TEST(DrapeTester, BadOptionsAreRefused) {
@@ -178,6 +196,19 @@ TEST(DrapeCalibration, FitsTheWarpWeftRatioToTheFoldDepth) {
   EXPECT_NEAR(std::log(cal->ratio / 4.0), 0, std::log(1.6)) << trace;
   EXPECT_LT(std::abs(cal->residual), 0.03) << trace;
   EXPECT_LT(std::abs(cal->depth_residual), std::abs(alone_miss)) << trace;
+  // The fit is the evaluation of its ratio nearest both targets (DC and depth, each in units of
+  // its tolerance), not only the one nearest the DC.
+  const auto miss = [&](double d, double dep) {
+    return std::abs(d - dc) / o.dc_tolerance + std::abs(dep - depth) / o.depth_tolerance;
+  };
+  const double chosen = miss(cal->series.dc_mean, cal->series.rmax_mean - cal->series.rmin_mean);
+  int at_ratio = 0;
+  for (const auto& st : cal->steps)
+    if (std::abs(st.ratio - cal->ratio) < 1e-9 * cal->ratio) {
+      ++at_ratio;
+      EXPECT_GE(miss(st.dc, st.depth), chosen - 1e-9) << trace;
+    }
+  EXPECT_GE(at_ratio, 1) << trace;
 }
 
 }  // namespace
