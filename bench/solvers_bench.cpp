@@ -1004,14 +1004,16 @@ void thread_rows(int max_res, const ThreadRowsConfig& tr, std::optional<int> fra
 void self_rows(const std::vector<int>& resolutions, int rounds, std::optional<int> frames_cap) {
   std::ofstream sc("out/bench/solvers_self.csv");
   sc << "scene,solver,resolution,threads,self_collision,rounds,ms_per_frame,p99_ms,ratio,"
-        "self_pairs_end,self_pairs_max,regions_tested_pct\n";
-  std::printf("self     %6s %4s %10s %10s %8s %12s %12s %10s\n", "res", "self", "ms/frame",
-              "p99 ms", "ratio", "pairs (end)", "pairs (max)", "regions %");
+        "self_pairs_end,self_pairs_max,regions_tested_pct,detections_per_frame,self_detections_per_"
+        "frame,collision_ms_per_frame\n";
+  std::printf("self     %6s %4s %10s %10s %8s %12s %12s %10s %8s %8s %8s\n", "res", "self",
+              "ms/frame", "p99 ms", "ratio", "pairs (end)", "pairs (max)", "regions %", "det/fr",
+              "self/fr", "coll ms");
   for (const int res : resolutions) {
     struct Run {
       double mean, p99;
       size_t pairs_end, pairs_max;
-      double tested;
+      double tested, detections, self_detections, collision_ms;  // per frame
     };
     std::vector<Run> runs[2];
     for (int round = 0; round < rounds; ++round)
@@ -1029,9 +1031,10 @@ void self_rows(const std::vector<int>& resolutions, int rounds, std::optional<in
         std::vector<double> ms;
         size_t most = 0;
         double tested = 0;  // sum over frames of the share of regions the last detection tested
+        double collision_ms = 0;
         for (int f = 0; f < frames; ++f) {
           const auto t0 = std::chrono::steady_clock::now();
-          solver.value()->step(t.cloth, t.objects, 1.0 / 90);
+          collision_ms += solver.value()->step(t.cloth, t.objects, 1.0 / 90).collision_ms;
           ms.push_back(
               std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                   .count());
@@ -1043,9 +1046,11 @@ void self_rows(const std::vector<int>& resolutions, int rounds, std::optional<in
         double sum = 0;
         for (double m : ms) sum += m;
         std::sort(ms.begin(), ms.end());
-        runs[self].push_back({sum / frames, ms[std::min(ms.size() - 1, ms.size() * 99 / 100)],
-                              xs ? xs->self_collision().contacts().size() : 0, most,
-                              100 * tested / frames});
+        runs[self].push_back(
+            {sum / frames, ms[std::min(ms.size() - 1, ms.size() * 99 / 100)],
+             xs ? xs->self_collision().contacts().size() : 0, most, 100 * tested / frames,
+             xs ? double(xs->contact_detections()) / frames : 0.0,
+             xs ? double(xs->self_detections()) / frames : 0.0, collision_ms / frames});
       }
     auto median = [](std::vector<Run> v, double Run::*f) {
       std::sort(v.begin(), v.end(), [f](const Run& a, const Run& b) { return a.*f < b.*f; });
@@ -1055,12 +1060,15 @@ void self_rows(const std::vector<int>& resolutions, int rounds, std::optional<in
     for (int self = 0; self < 2; ++self) {
       const double mean = median(runs[self], &Run::mean), p99 = median(runs[self], &Run::p99);
       const Run& last = runs[self].back();
-      std::printf("self     %4d^2 %4s %10.3f %10.3f %7.2fx %12zu %12zu %10.1f\n", res,
-                  self ? "on" : "off", mean, p99, mean / off, last.pairs_end, last.pairs_max,
-                  last.tested);
+      const double det = median(runs[self], &Run::detections),
+                   self_det = median(runs[self], &Run::self_detections),
+                   coll = median(runs[self], &Run::collision_ms);
+      std::printf("self     %4d^2 %4s %10.3f %10.3f %7.2fx %12zu %12zu %10.1f %8.2f %8.2f %8.3f\n",
+                  res, self ? "on" : "off", mean, p99, mean / off, last.pairs_end, last.pairs_max,
+                  last.tested, det, self_det, coll);
       sc << "form," << kDefaultSolver << "," << res << ",2," << self << "," << rounds << "," << mean
          << "," << p99 << "," << mean / off << "," << last.pairs_end << "," << last.pairs_max << ","
-         << last.tested << std::endl;
+         << last.tested << "," << det << "," << self_det << "," << coll << std::endl;
     }
   }
 }

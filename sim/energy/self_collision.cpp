@@ -62,10 +62,10 @@ void SelfCollision::build_regions(const Cloth& cloth) {
   const int nt = static_cast<int>(tris.size()), n = cloth.num_vertices();
   region_version_ = cloth.topology_version;
   region_tris_ = nt;
-  // Grid cells 8 edges wide (an edge: the mean of each triangle's shortest material edge, the
-  // grid spacing of a panel), from the lowest material coordinates: on a panel the cells' sides
-  // run along grid lines, so that the regions of neighbouring cells share vertices, corners too.
-  // A triangle belongs to the cell of its centroid.
+  // Grid cells kRegionEdges edges wide (an edge: the mean of each triangle's shortest material
+  // edge, the grid spacing of a panel), from the lowest material coordinates: on a panel the cells'
+  // sides run along grid lines, so that the regions of neighbouring cells share vertices, corners
+  // too. A triangle belongs to the cell of its centroid.
   double edge = 0;
   Vec2 origin = Vec2::Constant(std::numeric_limits<double>::infinity());
   for (const auto& t : tris) {
@@ -103,6 +103,9 @@ void SelfCollision::build_regions(const Cloth& cloth) {
     if (id[r] < 0) id[r] = regions++;
     region_of_[t] = id[r];
   }
+  vertex_region_.assign(n, -1);
+  for (int v = 0; v < n; ++v)
+    if (fan_lo[v] < fan_lo[v + 1]) vertex_region_[v] = region_of_[fan[fan_lo[v]]];
   region_lo_.assign(regions + 1, 0);
   for (int t = 0; t < nt; ++t) ++region_lo_[region_of_[t] + 1];
   for (int r = 0; r < regions; ++r) region_lo_[r + 1] += region_lo_[r];
@@ -111,24 +114,157 @@ void SelfCollision::build_regions(const Cloth& cloth) {
   for (int t = 0; t < nt; ++t) region_tri_[fill[region_of_[t]]++] = t;
   // Adjacent regions: two regions with a common vertex, or with the two ends of one edge (a
   // region of a mesh that is not a grid can meet its diagonal neighbour across one triangle).
-  region_adjacent_.clear();
+  std::vector<uint64_t> adjacent;  // (a << 32 | b), a < b: regions sharing a vertex
   auto join = [&](int u, int v) {
     for (int i = fan_lo[u]; i < fan_lo[u + 1]; ++i)
       for (int j = fan_lo[v]; j < fan_lo[v + 1]; ++j) {
         const int a = region_of_[fan[i]], b = region_of_[fan[j]];
-        if (a != b)
-          region_adjacent_.push_back((uint64_t(std::min(a, b)) << 32) | uint64_t(std::max(a, b)));
+        if (a != b) adjacent.push_back((uint64_t(std::min(a, b)) << 32) | uint64_t(std::max(a, b)));
       }
   };
   for (int v = 0; v < n; ++v) join(v, v);
   for (const auto& t : tris)
     for (int k = 0; k < 3; ++k) join(t[k], t[(k + 1) % 3]);
-  std::sort(region_adjacent_.begin(), region_adjacent_.end());
-  region_adjacent_.erase(std::unique(region_adjacent_.begin(), region_adjacent_.end()),
-                         region_adjacent_.end());
+  std::sort(adjacent.begin(), adjacent.end());
+  adjacent.erase(std::unique(adjacent.begin(), adjacent.end()), adjacent.end());
+  // The same both ways, per region (CSR: adj_lo_, adj_).
+  adj_lo_.assign(regions + 1, 0);
+  for (const uint64_t p : adjacent) {
+    ++adj_lo_[(p >> 32) + 1];
+    ++adj_lo_[(p & 0xffffffffu) + 1];
+  }
+  for (int r = 0; r < regions; ++r) adj_lo_[r + 1] += adj_lo_[r];
+  adj_.resize(adj_lo_[regions]);
+  std::vector<int32_t> put(adj_lo_.begin(), adj_lo_.end() - 1);
+  for (const uint64_t p : adjacent) {
+    const int a = static_cast<int>(p >> 32), b = static_cast<int>(p & 0xffffffffu);
+    adj_[put[a]++] = b;
+    adj_[put[b]++] = a;
+  }
+  adj_together_.assign(adj_.size(), 0);
 }
 
-void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double reach) {
+// Region r's box (its vertices' bounds grown by the reach) and the cone of its triangles'
+// normals about their mean (box_[r]; pi: not flat). Each region writes only its own entries.
+void SelfCollision::region_box(const Cloth& cloth, const std::vector<Vec3>& x, double reach,
+                               int r) {
+  const auto& tris = cloth.topo.triangles;
+  Box& b = box_[r];
+  b.lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  b.hi = -b.lo;
+  Vec3 sum = Vec3::Zero();
+  for (int k = region_lo_[r]; k < region_lo_[r + 1]; ++k) {
+    const auto& T = tris[region_tri_[k]];
+    for (const int v : T) {
+      b.lo = b.lo.cwiseMin(x[v]);
+      b.hi = b.hi.cwiseMax(x[v]);
+    }
+    region_n_[k] = (x[T[1]] - x[T[0]]).cross(x[T[2]] - x[T[0]]);
+    sum += region_n_[k];
+  }
+  b.lo.array() -= reach;
+  b.hi.array() += reach;
+  b.cone = 3.14159265358979323846;
+  const double len = sum.norm();
+  if (!(len > 0)) return;
+  b.axis = sum / len;
+  double cmin = 1;
+  for (int k = region_lo_[r]; k < region_lo_[r + 1]; ++k) {
+    const Vec3& N = region_n_[k];
+    const double nn = N.norm();
+    cmin = std::min(cmin, nn > 0 ? N.dot(b.axis) / nn : -1.0);
+  }
+  b.cone = std::acos(std::clamp(cmin, -1.0, 1.0));
+}
+
+// Regions a and b are adjacent and flat together (at the last cull).
+bool SelfCollision::flat_together(int a, int b) const {
+  for (int k = adj_lo_[a]; k < adj_lo_[a + 1]; ++k)
+    if (adj_[k] == b) return adj_together_[k] != 0;
+  return false;
+}
+
+// Every region's box and cone (region_box), whether it is flat, and which of its adjacent
+// regions are flat together with it, on the pool.
+void SelfCollision::region_shapes(const Cloth& cloth, const std::vector<Vec3>& x, double reach,
+                                  ThreadPool* pool) {
+  const int R = regions();
+  box_.resize(R);
+  region_flat_.resize(R);
+  region_n_.resize(region_tri_.size());
+  auto boxes = [&](int rb, int re, int) {
+    for (int r = rb; r < re; ++r) region_box(cloth, x, reach, r);
+  };
+  // Adjacent regions flat together: the smallest cone about one axis that holds both regions'
+  // cones (its axis on the arc between theirs, as far from each: half the sum of both cones and
+  // the angle between the axes; or the wider cone when that holds the other) is flat.
+  auto together = [&](int rb, int re, int) {
+    for (int a = rb; a < re; ++a) {
+      const Box& A = box_[a];
+      region_flat_[a] = A.cone < kFlatCone;
+      for (int k = adj_lo_[a]; k < adj_lo_[a + 1]; ++k) {
+        const Box& B = box_[adj_[k]];
+        adj_together_[k] = 0;
+        if (!(A.cone < kFlatCone && B.cone < kFlatCone)) continue;
+        const double between = std::acos(std::clamp(A.axis.dot(B.axis), -1.0, 1.0));
+        adj_together_[k] =
+            std::max({A.cone, B.cone, 0.5 * (A.cone + B.cone + between)}) < kFlatCone;
+      }
+    }
+  };
+  if (pool) {
+    pool->parallel_for(R, boxes);
+    pool->parallel_for(R, together);
+  } else {
+    boxes(0, R, 0);
+    together(0, R, 0);
+  }
+}
+
+// Sweep along x over the boxes sorted by their low end: each overlapping pair either is two
+// adjacent regions flat together (no pair between them) or makes both active and is listed
+// both ways (conflict_, with its CSR conflict_lo_). A region that is not flat is active too.
+void SelfCollision::find_conflicts(std::vector<char>& active) {
+  const int R = regions();
+  const std::vector<Box>& box = box_;
+  active.assign(R, 0);
+  for (int r = 0; r < R; ++r) active[r] = !region_flat_[r];
+  std::vector<int32_t> order(R);
+  for (int r = 0; r < R; ++r) order[r] = r;
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return box[a].lo.x() < box[b].lo.x(); });
+  conflict_.clear();
+  for (int i = 0; i < R; ++i) {
+    const Box& A = box[order[i]];
+    for (int j = i + 1; j < R && box[order[j]].lo.x() <= A.hi.x(); ++j) {
+      const Box& B = box[order[j]];
+      if (B.lo.y() > A.hi.y() || A.lo.y() > B.hi.y() || B.lo.z() > A.hi.z() || A.lo.z() > B.hi.z())
+        continue;
+      const int a = order[i], b = order[j];
+      if (flat_together(a, b)) continue;
+      active[a] = active[b] = 1;
+      conflict_.push_back((uint64_t(a) << 32) | uint64_t(b));
+      conflict_.push_back((uint64_t(b) << 32) | uint64_t(a));
+    }
+  }
+  std::sort(conflict_.begin(), conflict_.end());
+  conflict_lo_.assign(R + 1, 0);
+  for (const uint64_t p : conflict_) ++conflict_lo_[(p >> 32) + 1];
+  for (int r = 0; r < R; ++r) conflict_lo_[r + 1] += conflict_lo_[r];
+}
+
+// A point (or box lo..hi) of flat region r can be within reach of another region's triangle
+// only inside the box of a region r meets otherwise (those boxes are grown by the reach).
+bool SelfCollision::meets(int r, const Vec3& lo, const Vec3& hi) const {
+  for (int k = conflict_lo_[r]; k < conflict_lo_[r + 1]; ++k) {
+    const Box& B = box_[conflict_[k] & 0xffffffffu];
+    if ((lo.array() <= B.hi.array()).all() && (B.lo.array() <= hi.array()).all()) return true;
+  }
+  return false;
+}
+
+void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double reach,
+                         ThreadPool* pool) {
   const auto& tris = cloth.topo.triangles;
   const int nt = static_cast<int>(tris.size()), n = cloth.num_vertices();
   if (!region_cull_) {
@@ -136,94 +272,51 @@ void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double 
     vertex_active_.assign(n, 1);
     active_regions_ = regions();
     active_tris_ = nt;
+    region_flat_.assign(regions(), 0);
+    adj_together_.assign(adj_.size(), 0);
+    conflict_.clear();
+    conflict_lo_.assign(regions() + 1, 0);
     return;
   }
   if (region_version_ != cloth.topology_version || region_tris_ != nt) build_regions(cloth);
-  const int R = regions();
-  struct Box {
-    Vec3 lo, hi, axis;
-    double cone;  // half-angle of the normals about the axis (pi: not flat)
-  };
-  std::vector<Box> box(R);
-  region_n_.resize(region_tri_.size());
-  for (int r = 0; r < R; ++r) {
-    Box& b = box[r];
-    b.lo = Vec3::Constant(std::numeric_limits<double>::infinity());
-    b.hi = -b.lo;
-    Vec3 sum = Vec3::Zero();
-    for (int k = region_lo_[r]; k < region_lo_[r + 1]; ++k) {
-      const auto& T = tris[region_tri_[k]];
-      for (const int v : T) {
-        b.lo = b.lo.cwiseMin(x[v]);
-        b.hi = b.hi.cwiseMax(x[v]);
-      }
-      region_n_[k] = (x[T[1]] - x[T[0]]).cross(x[T[2]] - x[T[0]]);
-      sum += region_n_[k];
-    }
-    b.lo.array() -= reach;
-    b.hi.array() += reach;
-    b.cone = 3.14159265358979323846;
-    const double len = sum.norm();
-    if (!(len > 0)) continue;
-    b.axis = sum / len;
-    double cmin = 1;
-    for (int k = region_lo_[r]; k < region_lo_[r + 1]; ++k) {
-      const Vec3& N = region_n_[k];
-      const double nn = N.norm();
-      cmin = std::min(cmin, nn > 0 ? N.dot(b.axis) / nn : -1.0);
-    }
-    b.cone = std::acos(std::clamp(cmin, -1.0, 1.0));
-  }
-  std::vector<char> active(R);
-  for (int r = 0; r < R; ++r) active[r] = !(box[r].cone < kFlatCone);
-  // Sweep along x over the boxes sorted by their low end: each overlapping pair either is two
-  // adjacent regions flat together (no pair between them) or makes both active.
-  std::vector<int32_t> order(R);
-  for (int r = 0; r < R; ++r) order[r] = r;
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return box[a].lo.x() < box[b].lo.x(); });
-  for (int i = 0; i < R; ++i) {
-    const Box& A = box[order[i]];
-    for (int j = i + 1; j < R && box[order[j]].lo.x() <= A.hi.x(); ++j) {
-      const Box& B = box[order[j]];
-      if (B.lo.y() > A.hi.y() || A.lo.y() > B.hi.y() || B.lo.z() > A.hi.z() || A.lo.z() > B.hi.z())
-        continue;
-      const int a = std::min(order[i], order[j]), b = std::max(order[i], order[j]);
-      const bool adjacent = std::binary_search(region_adjacent_.begin(), region_adjacent_.end(),
-                                               (uint64_t(a) << 32) | uint64_t(b));
-      if (adjacent && A.cone < kFlatCone && B.cone < kFlatCone) {
-        const double between = std::acos(std::clamp(A.axis.dot(B.axis), -1.0, 1.0));
-        if (std::max(A.cone, B.cone + between) < kFlatCone) continue;
-      }
-      active[a] = active[b] = 1;
-    }
-  }
+  region_shapes(cloth, x, reach, pool);
+  std::vector<char> active;
+  find_conflicts(active);
+  // Tested: the triangles of a folded region, and those of a flat one within reach of a region
+  // it meets (no vertex of its own or of a region flat together with it pairs with them); the
+  // vertices whose home region is folded, or flat and inside such a box (a vertex pairs only
+  // with a triangle of a region its home meets otherwise: see the tests' skip in detect()).
   tri_active_.assign(nt, 0);
   vertex_active_.assign(n, 0);
   active_regions_ = active_tris_ = 0;
-  for (int r = 0; r < R; ++r) {
+  for (int r = 0; r < regions(); ++r) {
     if (!active[r]) continue;
     ++active_regions_;
     for (int k = region_lo_[r]; k < region_lo_[r + 1]; ++k) {
       const int t = region_tri_[k];
+      if (region_flat_[r]) {
+        const Vec3& a = x[tris[t][0]];
+        const Vec3& b = x[tris[t][1]];
+        const Vec3& c = x[tris[t][2]];
+        if (!meets(r, a.cwiseMin(b).cwiseMin(c).array() - reach,
+                   a.cwiseMax(b).cwiseMax(c).array() + reach))
+          continue;
+      }
       tri_active_[t] = 1;
       ++active_tris_;
-      for (const int v : tris[t]) vertex_active_[v] = 1;
     }
+  }
+  for (int v = 0; v < n; ++v) {
+    const int h = vertex_region_[v];
+    vertex_active_[v] = h >= 0 && active[h] && (!region_flat_[h] || meets(h, x[v], x[v]));
   }
 }
 
-int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double thickness,
-                          double margin, ThreadPool* pool) {
-  pairs_.clear();
+// The hash of the tested triangles' grown boxes (table_start_, entries_, spheres_; cells of
+// 1 / hash_ic_, buckets masked by hash_mask_).
+void SelfCollision::build_hash(const Cloth& cloth, const std::vector<Vec3>& x, double reach) {
   const auto& tris = cloth.topo.triangles;
   const int nt = static_cast<int>(tris.size());
-  const int n = cloth.num_vertices();
-  if (nt == 0) return 0;
-  const auto& flags = cloth.state.flags;
-  const double reach = thickness + margin;
-  cull(cloth, x, reach);
-  if (active_tris_ == 0) return 0;
   // Cell size: the mean edge length plus twice the reach, so that a triangle's grown box spans
   // at most two cells per axis. On fine meshes the reach dominates the cell, so a vertex's
   // bucket holds ~170 triangles at 128^2; the bounding-sphere test below rejects most of them
@@ -232,12 +325,12 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
   for (int t = 0; t < nt; ++t)
     if (tri_active_[t]) edge += (x[tris[t][1]] - x[tris[t][0]]).norm();
   const double cell = edge / active_tris_ + 2 * reach;
-  const double ic = 1.0 / cell;
+  const double ic = hash_ic_ = 1.0 / cell;
   auto coord = [&](double v) { return static_cast<int>(std::floor(v * ic)); };
   // Table size: a power of two >= 2 x the tested triangles' count.
   uint32_t size = 1;
   while (size < 2u * static_cast<uint32_t>(active_tris_)) size <<= 1;
-  const uint32_t mask = size - 1;
+  const uint32_t mask = hash_mask_ = size - 1;
   table_start_.assign(size + 1, 0);
   // Calls fn(cell key) for each cell triangle t's bounding box, grown by the reach, overlaps
   // (at most 3 per axis when the cell is >= the mean edge plus twice the reach; a triangle
@@ -282,6 +375,23 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
       spheres_[q] = sp;
     });
   }
+}
+
+int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double thickness,
+                          double margin, ThreadPool* pool) {
+  pairs_.clear();
+  const auto& tris = cloth.topo.triangles;
+  const int nt = static_cast<int>(tris.size());
+  const int n = cloth.num_vertices();
+  if (nt == 0) return 0;
+  const auto& flags = cloth.state.flags;
+  const double reach = thickness + margin;
+  cull(cloth, x, reach, pool);
+  if (active_tris_ == 0) return 0;
+  build_hash(cloth, x, reach);
+  const double ic = hash_ic_;
+  const uint32_t mask = hash_mask_;
+  auto coord = [&](double v) { return static_cast<int>(std::floor(v * ic)); };
   // Per triangle its first corner a, unit normal n and the vectors g1, g2 with barycentric
   // coordinates b1 = g1 . (p - a), b2 = g2 . (p - a) of p's projection (g = 0: degenerate):
   // each candidate then costs three dot products.
@@ -312,9 +422,13 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
   auto fixed = [&](int v) {
     return (flags[v] & (kFlagPinned | kFlagPinched | kFlagKinematic)) != 0;
   };
+  // A vertex of a flat region skips the triangles of that region and of the regions it is flat
+  // together with (the cull's reason: no pair lies there).
   auto test = [&](int vb, int ve, std::vector<SelfContact>& out) {
     for (int v = vb; v < ve; ++v) {
       if (!vertex_active_[v] || (flags[v] & (kFlagNoCollide | kFlagKinematic))) continue;
+      const int home = region_cull_ ? vertex_region_[v] : -1;
+      const bool flat = home >= 0 && region_flat_[home];
       const Vec3& p = x[v];
       const uint32_t bk = bucket(pack(coord(p.x()), coord(p.y()), coord(p.z())), mask);
       const int32_t* e = entries_.data();
@@ -325,6 +439,7 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
         const float dx = px - sq.x, dy = py - sq.y, dz = pz - sq.z;
         if (sphere_test_ && dx * dx + dy * dy + dz * dz > sq.r * sq.r) continue;  // out of reach
         const int t = e[q];
+        if (flat && (home == region_of_[t] || flat_together(home, region_of_[t]))) continue;
         const auto& T = tris[t];
         if (T[0] == v || T[1] == v || T[2] == v) continue;
         const TriFrame& f = pre_[t];

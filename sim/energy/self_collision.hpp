@@ -66,31 +66,57 @@ class SelfCollision {
   std::vector<std::vector<SelfContact>> part_pairs_;  // per pool part (detect with a pool)
   // The hash: table_start_[b] .. table_start_[b + 1] index entries_ (triangle ids).
   std::vector<int32_t> table_start_, entries_, fill_;
+  double hash_ic_ = 1;  // 1 / the cell's side
+  uint32_t hash_mask_ = 0;
+  void build_hash(const Cloth& cloth, const std::vector<Vec3>& x, double reach);
   struct Sphere {
     float x, y, z, r;  // an entry's triangle: bounding sphere centre, radius + reach (padded)
   };
   std::vector<Sphere> spheres_;  // parallel to entries_
   bool sphere_test_ = true;
   // The region cull: the cloth is split once per topology into regions (the triangles of one
-  // cell of a material-space grid 8 edges wide that are connected to each other). At each
+  // cell of a material-space grid 6 edges wide that are connected to each other). At each
   // detection a region whose triangle normals lie within kFlatCone of their mean is flat (a
   // height field over that axis: none of its vertices is within reach above one of its own
   // triangles); a flat region whose box, grown by the reach, meets no other region's, or meets
   // only adjacent regions that are flat together with it, has no pair and is left out of the
   // hash and the vertex tests. Only the regions that fold, or that lie against another layer,
-  // are tested.
+  // are tested, and of a flat one only the triangles and vertices inside the box of a region
+  // it meets.
   bool region_cull_ = true;
   uint64_t region_version_ = 0;
   int region_tris_ = -1;
-  std::vector<int32_t> region_of_;         // per triangle
-  std::vector<int32_t> region_lo_;         // per region: its first entry in region_tri_
-  std::vector<int32_t> region_tri_;        // triangles grouped by region
-  std::vector<uint64_t> region_adjacent_;  // (a << 32 | b), a < b: regions sharing a vertex
+  std::vector<int32_t> region_of_;   // per triangle
+  std::vector<int32_t> region_lo_;   // per region: its first entry in region_tri_
+  std::vector<int32_t> region_tri_;  // triangles grouped by region
+  // A vertex's home region (that of the first triangle around it; -1: in none). A vertex of a
+  // flat region tests no triangle of its home region nor of a region flat together with it.
+  std::vector<int32_t> vertex_region_;
   std::vector<char> tri_active_, vertex_active_;
   std::vector<Vec3> region_n_;  // per entry of region_tri_: its triangle's area normal (cull)
+  struct Box {
+    Vec3 lo, hi, axis;
+    double cone;  // half-angle of the normals about the axis (pi: not flat)
+  };
+  std::vector<Box> box_;  // per region, at the last detection
+  std::vector<char> region_flat_;
+  // Per region its adjacent regions (CSR: adj_lo_, adj_; per topology) and whether each is flat
+  // together with it (per detection).
+  std::vector<int32_t> adj_lo_, adj_;
+  std::vector<char> adj_together_;
+  // Pairs of regions whose boxes meet and that are not flat together, both ways ((a << 32) | b,
+  // sorted), and per region a its first pair (CSR).
+  std::vector<uint64_t> conflict_;
+  std::vector<int32_t> conflict_lo_;
+  bool flat_together(int a, int b) const;
   int active_regions_ = 0, active_tris_ = 0;
   void build_regions(const Cloth& cloth);
-  void cull(const Cloth& cloth, const std::vector<Vec3>& x, double reach);
+  void region_box(const Cloth& cloth, const std::vector<Vec3>& x, double reach, int r);
+  void region_shapes(const Cloth& cloth, const std::vector<Vec3>& x, double reach,
+                     ThreadPool* pool);
+  void find_conflicts(std::vector<char>& active);
+  bool meets(int r, const Vec3& lo, const Vec3& hi) const;
+  void cull(const Cloth& cloth, const std::vector<Vec3>& x, double reach, ThreadPool* pool);
   struct TriFrame {
     Vec3 a, n, g1, g2;  // corner, unit normal, barycentric gradients (detect())
   };

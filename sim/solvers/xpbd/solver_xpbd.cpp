@@ -57,6 +57,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
   };
   auto t = Clock::now();
   CookStats st;
+  x_self_.clear();  // the self-collision pairs name triangles of the last topology
   // XPBD projects the bending rows and never evaluates P (EnergyOptions::bending_matrix).
   EnergyOptions eo = opt_.energy;
   eo.bending_matrix = false;
@@ -442,13 +443,11 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
     return false;
   }
   fresh_penetration_ = energy_.detect_contacts(cloth, scene, pool_.get());
-  if (scene.self_collision)
-    self_.detect(cloth, cloth.state.x, scene.offset, energy_.options().contact_margin, pool_.get());
   ++detections_;           // (x_det_ is taken at the end, after the snap)
   contacts_fresh_ = true;  // the first substep reuses them (same positions)
   const bool all_frozen = rest_.wake(cloth, energy_);
-  if (scene.self_collision) rest_.skip_rest_of_self_touching(cloth, self_.contacts());
   snap_to_contacts(cloth);
+  if (scene.self_collision) detect_self(cloth, scene, cloth.state.x);
   x_det_ = cloth.state.x;
   return all_frozen;
 }
@@ -541,6 +540,7 @@ struct XpbdSolver::Step {
   bool fused = false;      // the substep runs as one sweep (sweep())
   bool retest = false;     // the sweep tests moved vertices for contact again
   bool test_moved = false;
+  bool self_watch = false;    // the velocity loops take the box of motion for self_due()
   bool settle_check = false;  // some piece settles
   bool bending() const { return s % be == be - 1 || s == ns - 1; }
 };
@@ -653,7 +653,11 @@ void XpbdSolver::substep(Step& c) {
     for (int p = 0; p < tie_passes_; ++p) xpbd::project_ties(ties_, c.x, c.w, nullptr);
     ++c.st.iterations;
   }
-  if (!c.fused) pool_->parallel_for(c.n, [&](int b, int e, int wk) { velocities(c, b, e, wk); });
+  if (!c.fused)
+    pool_->parallel_for(c.n, [&](int b, int e, int wk) {
+      velocities(c, b, e, wk);
+      if (c.self_watch) self_motion(c, b, e, wk);
+    });
   update_pieces(c);
   schedule_rest(c);
   c.S.time += c.h;
@@ -671,22 +675,77 @@ void XpbdSolver::detect_contacts(Step& c) {
     detect = false;
     for (char m : moved_part_) detect = detect || m;
   }
-  if (!detect) return;
-  c.fresh = true;
+  // Self-collision pairs are found at a frame's start and then only once the cloth has deformed
+  // by half the margin (self_due): the contacts with the form are tested again vertex by vertex.
+  const bool self =
+      c.scene.self_collision && (c.s == 0 ? !contacts_fresh_ : !opt_.reuse_contacts || self_due(c));
+  if (!detect && !self) return;
   const auto t0 = std::chrono::steady_clock::now();
-  c.st.max_penetration =
-      std::max(c.st.max_penetration, energy_.detect_contacts(c.cloth, c.scene, pool_.get()));
-  if (c.scene.self_collision) {
-    self_.detect(c.cloth, c.x, c.scene.offset, c.margin, pool_.get());
-    rest_.skip_rest_of_self_touching(c.cloth, self_.contacts());
+  if (detect) {
+    c.fresh = true;
+    c.st.max_penetration =
+        std::max(c.st.max_penetration, energy_.detect_contacts(c.cloth, c.scene, pool_.get()));
+    rest_.unsettle_pushed(c.x, energy_);
+    snap_to_contacts(c.cloth);
+    x_det_.resize(c.n);
+    c.copy_det = true;  // x_det_ = x, in the prediction
+    ++detections_;
   }
-  rest_.unsettle_pushed(c.x, energy_);
-  snap_to_contacts(c.cloth);
-  x_det_.resize(c.n);
-  c.copy_det = true;  // x_det_ = x, in the prediction
-  ++detections_;
+  if (self) detect_self(c.cloth, c.scene, c.x);
   c.st.collision_ms +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Self-collision pairs at positions x, which are kept (x_self_) for self_due().
+void XpbdSolver::detect_self(const Cloth& cloth, const SceneObjects& scene,
+                             const std::vector<Vec3>& x) {
+  self_.detect(cloth, x, scene.offset, energy_.options().contact_margin, pool_.get());
+  rest_.skip_rest_of_self_touching(cloth, self_.contacts());
+  x_self_ = x;
+  ++self_detections_;
+}
+
+// The cloth deformed enough since its self-collision pairs were found that a pair not found
+// could come within the thickness. Only relative motion brings a vertex and a triangle closer:
+// with d_i each vertex's displacement since then, a triangle's points move by convex
+// combinations of its corners' d, so a vertex's distance to a triangle changes by at most the
+// diagonal of the box around all d_i, and by at most twice the largest |d_i|. The pairs were
+// found within thickness + margin: they stay complete while the smaller bound is at most the
+// margin (a cloth that falls or is carried whole keeps them). The box is taken by the previous
+// substep's velocity loops (self_motion) and after its projections.
+bool XpbdSolver::self_due(const Step& c) const {
+  if (x_self_.size() != static_cast<size_t>(c.n) || self_box_.empty()) return true;
+  SelfBox all;
+  for (const SelfBox& B : self_box_) all.add(B);
+  return std::min((all.hi - all.lo).squaredNorm(), 4 * all.most2) > c.margin * c.margin;
+}
+
+// Vertices [b, e) into slot's box of displacements since the self-collision pairs were found.
+void XpbdSolver::self_motion(const Step& c, int b, int e, int slot) {
+  const double* x = reinterpret_cast<const double*>(c.x.data());
+  const double* x0 = reinterpret_cast<const double*>(x_self_.data());
+  double lo[3], hi[3], most2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = self_box_[slot].lo[k];
+    hi[k] = self_box_[slot].hi[k];
+  }
+  for (int i = 3 * b; i < 3 * e; i += 3) {
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = x[i + k] - x0[i + k];
+      lo[k] = std::min(lo[k], d);
+      hi[k] = std::max(hi[k], d);
+      d2 += d * d;
+    }
+    most2 = std::max(most2, d2);
+  }
+  self_box_[slot].add(SelfBox{Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2]), most2});
+}
+
+// The same for vertices a projection after the sweep moved (repeats are harmless).
+void XpbdSolver::self_motion_of(const Step& c, const std::vector<int>& moved) {
+  if (!c.self_watch) return;
+  for (const int i : moved) self_box_[0].add(c.x[i] - x_self_[i]);
 }
 
 // w = the unscaled inverse mass (w0: 0 when not free or frozen) / the piece's settling scale.
@@ -793,13 +852,14 @@ void XpbdSolver::plan_substep(Step& c) {
   // since its own last test (a detection of all vertices happens only at a frame's start);
   // otherwise such a vertex makes the next substep detect all of them again. (Only when every
   // substep runs the sweep, bending_every = 1: a substep outside it projects the energy's
-  // contact list, which lists the tested contacts only at the step's end. Not with
-  // self-collision either: its pairs are found only by a detection of all vertices.)
-  c.retest = c.fused && c.be == 1 && opt_.reuse_contacts && opt_.retest_contacts &&
-             !c.scene.self_collision && c.s + 1 < c.ns;
+  // contact list, which lists the tested contacts only at the step's end.)
+  c.retest = c.fused && c.be == 1 && opt_.reuse_contacts && opt_.retest_contacts && c.s + 1 < c.ns;
   c.test_moved = opt_.reuse_contacts && c.s + 1 < c.ns && !c.retest;
+  c.self_watch = c.scene.self_collision && opt_.reuse_contacts && c.s + 1 < c.ns &&
+                 x_self_.size() == static_cast<size_t>(c.n);
   const int slots = std::max(pool_->size(), scratch_slots_);  // pool threads or sweep slots
   moved_part_.assign(slots, 0);
+  self_box_.assign(c.self_watch ? slots : 0, SelfBox{});
   if (c.retest) {
     retest_part_.assign(slots, RetestPart{});
     unsettle_mark_.assign(static_cast<size_t>(slots) * rest_.num_pieces(), 0);
@@ -1015,6 +1075,7 @@ void XpbdSolver::project_self_after_sweep(Step& c) {
   self_moved_.clear();
   self_.project(c.cloth, c.x, c.w, c.scene.offset, &self_moved_);
   refresh_velocities(c, self_moved_);
+  self_motion_of(c, self_moved_);
 }
 
 // The velocities of free vertices moved after the element sweep, computed again from their
@@ -1033,6 +1094,7 @@ void XpbdSolver::project_ties_after_sweep(Step& c) {
   tie_moved_.clear();
   for (int p = 0; p < tie_passes_; ++p) xpbd::project_ties(ties_, c.x, c.w, &tie_moved_);
   refresh_velocities(c, tie_moved_);
+  self_motion_of(c, tie_moved_);
 }
 
 void XpbdSolver::project_hinges(const Step& c, int b, int e) {
@@ -1196,6 +1258,7 @@ void XpbdSolver::sweep_items(const Step& c, const xpbd::SweepPlan::Phase& P, int
         block_velocities(c, k, vb, ve, slot);
         if (opt_.settle || opt_.freeze) block_motion(c, k, vb, ve);
         if (c.retest) retest_moved(c, vb, ve, slot);
+        if (c.self_watch) self_motion(c, vb, ve, slot);
       }
   }
 }

@@ -14,8 +14,10 @@
 // sleep, settling, coarse correction and finish are xpbd::RestScheduler's (xpbd_rest.hpp).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -73,6 +75,8 @@ class XpbdSolver : public Solver {
   const std::vector<xpbd::Tie>& ties() const { return ties_; }
   int tie_passes() const { return tie_passes_; }
   int contact_detections() const { return detections_; }
+  // Self-collision detections so far (found at a frame's start and once the cloth deforms).
+  int self_detections() const { return self_detections_; }
   // Single precision: how many times the anchors were renewed (XpbdOptions::single_precision).
   long anchor_renewals() const { return anchor_renewals_; }
   // Element sweeps run on several threads, and those in which a thread took over the share of
@@ -161,6 +165,10 @@ class XpbdSolver : public Solver {
   std::string read_state(ByteReader& in, const Cloth& cloth);
   void substep(Step& c);
   void detect_contacts(Step& c);
+  void detect_self(const Cloth& cloth, const SceneObjects& scene, const std::vector<Vec3>& x);
+  bool self_due(const Step& c) const;
+  void self_motion(const Step& c, int b, int e, int slot);
+  void self_motion_of(const Step& c, const std::vector<int>& moved);
   void set_masses(Step& c);  // w and the bending blocks' inverses
   void plan_substep(Step& c);
   void predict(const Step& c, int b, int e);
@@ -310,6 +318,25 @@ class XpbdSolver : public Solver {
   bool contacts_fresh_ = false;  // wake() detected contacts at the frame's start positions
   std::vector<Vec3> x_det_;      // each vertex's position at its last contact test
   SelfCollision self_;
+  std::vector<Vec3> x_self_;  // the positions the self-collision pairs were found at
+  // The box of displacements since x_self_ and the largest squared displacement, per sweep slot
+  // or pool thread (self_due).
+  struct SelfBox {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    double most2 = 0;
+    void add(const Vec3& d) {
+      lo = lo.cwiseMin(d);
+      hi = hi.cwiseMax(d);
+      most2 = std::max(most2, d.squaredNorm());
+    }
+    void add(const SelfBox& o) {
+      lo = lo.cwiseMin(o.lo);
+      hi = hi.cwiseMax(o.hi);
+      most2 = std::max(most2, o.most2);
+    }
+  };
+  std::vector<SelfBox> self_box_;
+  int self_detections_ = 0;
   std::vector<int> self_moved_;  // vertices the last self-collision projection moved
   std::vector<xpbd::Tie> ties_;
   int tie_passes_ = 2;
