@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "sim/core/cloth.hpp"
@@ -48,6 +49,9 @@ class SelfCollision {
   double project(const Cloth& cloth, std::vector<Vec3>& x, const double* w, double thickness,
                  std::vector<int>* moved = nullptr) const;
   const std::vector<SelfContact>& contacts() const { return pairs_; }
+  // Puts pairs found earlier back (a solver's saved state); clear() forgets them.
+  void set_contacts(std::vector<SelfContact> pairs) { pairs_ = std::move(pairs); }
+  void clear() { pairs_.clear(); }
   // The per-entry bounding-sphere rejection (on by default; off only to measure it: the same
   // pairs are found either way).
   void set_sphere_test(bool on) { sphere_test_ = on; }

@@ -58,6 +58,7 @@ void XpbdSolver::cook(const Cloth& cloth) {
   auto t = Clock::now();
   CookStats st;
   x_self_.clear();  // the self-collision pairs name triangles of the last topology
+  self_.clear();
   // XPBD projects the bending rows and never evaluates P (EnergyOptions::bending_matrix).
   EnergyOptions eo = opt_.energy;
   eo.bending_matrix = false;
@@ -447,7 +448,8 @@ bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
   contacts_fresh_ = true;  // the first substep reuses them (same positions)
   const bool all_frozen = rest_.wake(cloth, energy_);
   snap_to_contacts(cloth);
-  if (scene.self_collision) detect_self(cloth, scene, cloth.state.x);
+  // (A cloth that sleeps on needs no pairs: the frame computes nothing.)
+  if (scene.self_collision && !all_frozen) start_self(cloth, scene);
   x_det_ = cloth.state.x;
   return all_frozen;
 }
@@ -675,11 +677,12 @@ void XpbdSolver::detect_contacts(Step& c) {
     detect = false;
     for (char m : moved_part_) detect = detect || m;
   }
-  // Self-collision pairs are found at a frame's start and then only once the cloth has deformed
-  // by half the margin (self_due): the contacts with the form are tested again vertex by vertex.
-  const bool self =
-      c.scene.self_collision && (c.s == 0 ? !contacts_fresh_ : !opt_.reuse_contacts || self_due(c));
-  if (!detect && !self) return;
+  // Self-collision pairs are found again only once the cloth has deformed by half the margin
+  // (start_self at a frame's start, self_due in it); the contacts with the form are tested again
+  // vertex by vertex.
+  const bool frame_self = c.s == 0 && !contacts_fresh_ && c.scene.self_collision;
+  const bool self = c.scene.self_collision && c.s > 0 && (!opt_.reuse_contacts || self_due(c));
+  if (!detect && !self && !frame_self) return;
   const auto t0 = std::chrono::steady_clock::now();
   if (detect) {
     c.fresh = true;
@@ -691,18 +694,58 @@ void XpbdSolver::detect_contacts(Step& c) {
     c.copy_det = true;  // x_det_ = x, in the prediction
     ++detections_;
   }
-  if (self) detect_self(c.cloth, c.scene, c.x);
+  if (frame_self)
+    start_self(c.cloth, c.scene);
+  else if (self)
+    detect_self(c.cloth, c.scene, c.x);
   c.st.collision_ms +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Self-collision pairs at positions x, which are kept (x_self_) for self_due().
+// Self-collision pairs at positions x, which are kept (x_self_, with the vertices' flags that
+// decide which are tested: self_flags_) for self_due() and start_self().
 void XpbdSolver::detect_self(const Cloth& cloth, const SceneObjects& scene,
                              const std::vector<Vec3>& x) {
   self_.detect(cloth, x, scene.offset, energy_.options().contact_margin, pool_.get());
   rest_.skip_rest_of_self_touching(cloth, self_.contacts());
   x_self_ = x;
+  self_flags_.resize(x.size());
+  for (size_t i = 0; i < x.size(); ++i) self_flags_[i] = cloth.state.flags[i] & kSelfFlags;
   ++self_detections_;
+}
+
+// A frame's start: the pairs are found again when the cloth deformed since they were found
+// (self_due's bound over every vertex, with what moved between frames: hands, moves), when a
+// vertex was pinned, let go or made kinematic or not colliding (which pairs exist), or after a
+// cook; otherwise the last frame's pairs go on (their pieces still skip the coarse correction and
+// the finish). The pairs carried from frame to frame are part of the solver's saved state.
+void XpbdSolver::start_self(const Cloth& cloth, const SceneObjects& scene) {
+  const int n = cloth.num_vertices();
+  const auto& x = cloth.state.x;
+  bool due = x_self_.size() != static_cast<size_t>(n) || self_flags_.size() != x_self_.size();
+  if (!due) {
+    const int parts = pool_->size();
+    self_box_.assign(parts, SelfBox{});
+    self_flags_changed_.assign(parts, 0);
+    pool_->parallel_parts(n, [&](int b, int e, int part) {
+      SelfBox& B = self_box_[part];
+      for (int i = b; i < e; ++i) {
+        B.add(x[i] - x_self_[i]);
+        if ((cloth.state.flags[i] & kSelfFlags) != self_flags_[i]) self_flags_changed_[part] = 1;
+      }
+    });
+    SelfBox all;
+    for (int p = 0; p < parts; ++p) {
+      all.add(self_box_[p]);
+      due = due || self_flags_changed_[p];
+    }
+    const double margin = energy_.options().contact_margin;
+    due = due || std::min((all.hi - all.lo).squaredNorm(), 4 * all.most2) > margin * margin;
+  }
+  if (due)
+    detect_self(cloth, scene, x);
+  else
+    rest_.skip_rest_of_self_touching(cloth, self_.contacts());
 }
 
 // The cloth deformed enough since its self-collision pairs were found that a pair not found

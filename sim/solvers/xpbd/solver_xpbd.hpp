@@ -163,9 +163,11 @@ class XpbdSolver : public Solver {
   void renew_anchors(Step& c);  // single precision: new anchors once a vertex left its own
   void anchor_terms();          // the elements' terms at the anchors (anchors_)
   std::string read_state(ByteReader& in, const Cloth& cloth);
+  std::string read_self_state(ByteReader& in, const Cloth& cloth);
   void substep(Step& c);
   void detect_contacts(Step& c);
   void detect_self(const Cloth& cloth, const SceneObjects& scene, const std::vector<Vec3>& x);
+  void start_self(const Cloth& cloth, const SceneObjects& scene);
   bool self_due(const Step& c) const;
   void self_motion(const Step& c, int b, int e, int slot);
   void self_motion_of(const Step& c, const std::vector<int>& moved);
@@ -319,6 +321,11 @@ class XpbdSolver : public Solver {
   std::vector<Vec3> x_det_;      // each vertex's position at its last contact test
   SelfCollision self_;
   std::vector<Vec3> x_self_;  // the positions the self-collision pairs were found at
+  // The flags that decide which pairs are tested (SelfCollision::detect), per vertex then.
+  static constexpr uint8_t kSelfFlags =
+      kFlagPinned | kFlagPinched | kFlagKinematic | kFlagNoCollide;
+  std::vector<uint8_t> self_flags_;
+  std::vector<char> self_flags_changed_;  // per pool part (start_self)
   // The box of displacements since x_self_ and the largest squared displacement, per sweep slot
   // or pool thread (self_due).
   struct SelfBox {

@@ -8,7 +8,8 @@ namespace drape::sim {
 
 namespace {
 constexpr uint32_t kStateMagic = 0x44505258;  // "XRPD" little-endian
-constexpr uint32_t kStateVersion = 1;
+// 2: the self-collision pairs carried from frame to frame (version 1 states still load).
+constexpr uint32_t kStateVersion = 2;
 }  // namespace
 
 std::vector<unsigned char> XpbdSolver::save_state(const Cloth& cloth) const {
@@ -36,6 +37,17 @@ std::vector<unsigned char> XpbdSolver::save_state(const Cloth& cloth) const {
   lambdas(lambda_spring_, 1);
   o.array(anchors_.data(), anchors_.size());
   rest_.save(o);
+  // The self-collision pairs, where they were found and the flags then (start_self).
+  const bool self = x_self_.size() == static_cast<size_t>(cloth.num_vertices());
+  o.array(reinterpret_cast<const double*>(x_self_.data()), self ? x_self_.size() : 0, 3);
+  o.array(self_flags_.data(), self ? self_flags_.size() : 0);
+  const auto& pairs = self_.contacts();
+  o.u32(static_cast<uint32_t>(self ? pairs.size() : 0));
+  for (size_t k = 0; self && k < pairs.size(); ++k) {
+    o.i32(pairs[k].vertex);
+    o.i32(pairs[k].triangle);
+    o.u8(pairs[k].side > 0 ? 1 : 0);
+  }
   return std::move(o.b);
 }
 
@@ -55,8 +67,9 @@ std::string XpbdSolver::restore_state(const std::vector<unsigned char>& bytes, c
 
 std::string XpbdSolver::read_state(ByteReader& in, const Cloth& cloth) {
   if (in.u32() != kStateMagic) return "not an XPBD solver's state";
-  if (const uint32_t v = in.u32(); v != kStateVersion)
-    return "version " + std::to_string(v) + " (this program reads " +
+  const uint32_t version = in.u32();
+  if (version != 1 && version != kStateVersion)
+    return "version " + std::to_string(version) + " (this program reads 1 and " +
            std::to_string(kStateVersion) + ")";
   const bool f32 = in.u8() != 0;
   const int n = in.i32(), slots = in.i32();
@@ -89,6 +102,37 @@ std::string XpbdSolver::read_state(ByteReader& in, const Cloth& cloth) {
     return "the anchors do not fit the cloth";
   if (anchored) anchor_terms();
   if (!rest_.restore(in)) return "the pieces' rest state does not fit the cloth";
+  if (version >= 2) return read_self_state(in, cloth);
+  return "";
+}
+
+// The self-collision pairs of a version 2 state (save_state), checked against the cloth.
+std::string XpbdSolver::read_self_state(ByteReader& in, const Cloth& cloth) {
+  const int n = cloth.num_vertices();
+  const int nt = static_cast<int>(cloth.topo.triangles.size());
+  in.array<double>(x_self_, 3);
+  in.array<uint8_t>(self_flags_);
+  const uint32_t count = in.count(9);  // a pair: vertex, triangle, side
+  if (!in.ok ||
+      (!x_self_.empty() &&
+       (x_self_.size() != static_cast<size_t>(n) || self_flags_.size() != x_self_.size())) ||
+      !all_finite(reinterpret_cast<const double*>(x_self_.data()), 3 * x_self_.size()) ||
+      (x_self_.empty() && (count > 0 || !self_flags_.empty()))) {
+    x_self_.clear();
+    return "the self-collision pairs' positions do not fit the cloth";
+  }
+  std::vector<SelfContact> pairs(count);
+  for (SelfContact& c : pairs) {
+    c.vertex = in.i32();
+    c.triangle = in.i32();
+    const uint8_t side = in.u8();
+    if (!in.ok || c.vertex < 0 || c.vertex >= n || c.triangle < 0 || c.triangle >= nt || side > 1) {
+      x_self_.clear();
+      return "a self-collision pair names no vertex or triangle of the cloth";
+    }
+    c.side = side ? 1.0 : -1.0;
+  }
+  self_.set_contacts(std::move(pairs));
   return "";
 }
 
