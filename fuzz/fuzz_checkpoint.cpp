@@ -6,7 +6,8 @@
 // solver (XPBD cooking cuts ahead) with the checkpoint's cloth, when the cloth is small
 // (restoring cooks it): its readers (sim/solvers/cook_ahead.cpp, sim/solvers/xpbd/xpbd_state.cpp)
 // must reject what does not fit with an error, and the solver must then step (without the
-// scene's objects: the solver's state is what is fuzzed).
+// scene's objects but with self-collision, whose pairs the state carries: the solver's state is
+// what is fuzzed).
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -55,7 +56,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         o, drape::sim::CookAheadOptions{
                .ticks = 8, .idle_priority = false, .worker_threads = 1, .spare_energy = false});
     (void)solver.restore_state(c.solver_state, c.cloth);
-    solver.step(c.cloth, drape::sim::SceneObjects{}, 1.0 / 90);
+    drape::sim::SceneObjects scene;
+    scene.self_collision = true;
+    solver.step(c.cloth, scene, 1.0 / 90);
   }
   return 0;
 }
