@@ -739,8 +739,7 @@ void XpbdSolver::start_self(const Cloth& cloth, const SceneObjects& scene) {
       all.add(self_box_[p]);
       due = due || self_flags_changed_[p];
     }
-    const double margin = energy_.options().contact_margin;
-    due = due || std::min((all.hi - all.lo).squaredNorm(), 4 * all.most2) > margin * margin;
+    due = due || all.beyond(energy_.options().contact_margin);
   }
   if (due)
     detect_self(cloth, scene, x);
@@ -760,29 +759,14 @@ bool XpbdSolver::self_due(const Step& c) const {
   if (x_self_.size() != static_cast<size_t>(c.n) || self_box_.empty()) return true;
   SelfBox all;
   for (const SelfBox& B : self_box_) all.add(B);
-  return std::min((all.hi - all.lo).squaredNorm(), 4 * all.most2) > c.margin * c.margin;
+  return all.beyond(c.margin);
 }
 
 // Vertices [b, e) into slot's box of displacements since the self-collision pairs were found.
 void XpbdSolver::self_motion(const Step& c, int b, int e, int slot) {
-  const double* x = reinterpret_cast<const double*>(c.x.data());
-  const double* x0 = reinterpret_cast<const double*>(x_self_.data());
-  double lo[3], hi[3], most2 = 0;
-  for (int k = 0; k < 3; ++k) {
-    lo[k] = self_box_[slot].lo[k];
-    hi[k] = self_box_[slot].hi[k];
-  }
-  for (int i = 3 * b; i < 3 * e; i += 3) {
-    double d2 = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double d = x[i + k] - x0[i + k];
-      lo[k] = std::min(lo[k], d);
-      hi[k] = std::max(hi[k], d);
-      d2 += d * d;
-    }
-    most2 = std::max(most2, d2);
-  }
-  self_box_[slot].add(SelfBox{Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2]), most2});
+  SelfBox B;  // (a local box: the loop keeps it in registers)
+  for (int i = b; i < e; ++i) B.add(c.x[i] - x_self_[i]);
+  self_box_[slot].add(B);
 }
 
 // The same for vertices a projection after the sweep moved (repeats are harmless).

@@ -341,6 +341,10 @@ class XpbdSolver : public Solver {
       hi = hi.cwiseMax(o.hi);
       most2 = std::max(most2, o.most2);
     }
+    // The bound on how much closer a vertex and a triangle came (self_due) exceeds the margin.
+    bool beyond(double margin) const {
+      return std::min((hi - lo).squaredNorm(), 4 * most2) > margin * margin;
+    }
   };
   std::vector<SelfBox> self_box_;
   int self_detections_ = 0;
