@@ -88,8 +88,13 @@ int colour_elements(int num_vertices, const std::vector<int>& elem_offsets,
   return colours;
 }
 
-ThreadPool::ThreadPool(int threads) : threads_(std::max(1, threads)) {
-  for (int w = 1; w < threads_; ++w) workers_.emplace_back([this, w] { worker_main(w); });
+ThreadPool::ThreadPool(int threads, const TickGate* gate)
+    : threads_(std::max(1, threads)), gate_(gate) {
+  for (int w = 1; w < threads_; ++w)
+    workers_.emplace_back([this, w] {
+      set_thread_gate(gate_);
+      worker_main(w);
+    });
 }
 
 ThreadPool::~ThreadPool() {
@@ -119,8 +124,12 @@ void ThreadPool::run(int n, Thunk thunk, void* ctx, int chunks) {
   generation_.store(gen, std::memory_order_release);
   generation_.notify_all();
   work(gen, 0);
+  // (Kept off the ticks: the wait for a worker's chunk sleeps at the closed gate too.)
   for (int spin = 0; done_.load(std::memory_order_acquire) != chunks; ++spin)
-    if (spin > 64) std::this_thread::yield();
+    if (gate_ && gate_->closed())
+      gate_->pass();
+    else if (spin > 64)
+      std::this_thread::yield();
 }
 
 // Chunk k's start: each half of the range is split in chunks that halve toward the middle
@@ -140,6 +149,7 @@ int ThreadPool::chunk_start(int k) const {
 void ThreadPool::work(uint64_t gen, int w) {
   const bool from_back = w % 2 == 1;
   for (;;) {
+    if (gate_) gate_->pass();
     uint64_t cur = next_.load(std::memory_order_acquire);
     int k;
     uint64_t claimed;
@@ -175,6 +185,7 @@ void ThreadPool::worker_main(int w) {
     if (g == seen) {
       const auto t0 = std::chrono::steady_clock::now();
       for (int spin = 0; g == seen; ++spin) {
+        if (gate_ && gate_->closed()) gate_->pass();  // (no spinning while the ticks run)
         if ((spin & 255) == 255 && std::chrono::steady_clock::now() - t0 > kSpinBeforeSleep) {
           idle_sleeps_.fetch_add(1, std::memory_order_relaxed);
           generation_.wait(seen, std::memory_order_acquire);

@@ -80,6 +80,7 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt, ThreadPool
   const auto& M = topo.material;
   if (opt_.model == EnergyOptions::Model::kFem) {
     for (const auto& t : topo.triangles) {
+      if ((tri_v_.size() & 1023) == 0) pause_point();
       Eigen::Matrix2d Dm;
       Dm.col(0) = M[t[1]] - M[t[0]];
       Dm.col(1) = M[t[2]] - M[t[0]];
@@ -91,6 +92,7 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt, ThreadPool
       tri_D_.push_back(B * Dm.inverse());
       tri_area_.push_back(0.5 * std::abs(det));
     }
+    pause_point();  // (a cook ahead waits here while a tick runs: TickGate)
     // Hinges: interior edges shared by exactly two triangles.
     if (opt_.bending) {
       // Edges seen so far, listed at their lower vertex (a vertex has a handful: a walk of its
@@ -103,6 +105,7 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt, ThreadPool
       std::vector<EdgeSeen> edges_seen;
       edges_seen.reserve(3 * tri_v_.size());
       for (int ti = 0; ti < static_cast<int>(tri_v_.size()); ++ti) {
+        if ((ti & 1023) == 0) pause_point();
         const auto& t = tri_v_[ti];
         for (int k = 0; k < 3; ++k) {
           int a = t[k], b = t[(k + 1) % 3], o = t[(k + 2) % 3];
@@ -151,6 +154,7 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt, ThreadPool
         }
       }
     }
+    pause_point();
     if (opt_.bending && opt_.bending_model == EnergyOptions::Bending::kTensor)
       build_tensor_bending(cloth, pool);
   } else {
@@ -197,6 +201,7 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt, ThreadPool
     Dm.col(1) = M[t[2]] - M[t[0]];
     for (int k = 0; k < 3; ++k) vertex_area_[t[k]] += std::abs(Dm.determinant()) / 6.0;
   }
+  pause_point();
   contact_index_.assign(num_vertices_, -1);
   contacts_.clear();
   contacts_.reserve(num_vertices_);
@@ -273,6 +278,7 @@ bool ClothEnergy::mark_changed(const Cloth& cloth, const EnergyOptions& opt) {
   need_local_.assign(nt, 0);
   int changed = 0;
   for (int t = 0; t < nt; ++t) {
+    if ((t & 1023) == 0) pause_point();
     const auto& tv = T[t];
     bool c = tv != tri_v_[t];
     for (int k = 0; k < 3 && !c; ++k) c = tv[k] >= n_old || M[tv[k]] != built_material_[tv[k]];
@@ -496,6 +502,7 @@ void splice_rows(RowBlender&& blend, const std::vector<char>& need, const std::v
   Gk.col.reserve(old_col.size() + 1024);
   Gk.val.reserve(old_val.size() + 1024);
   for (int t = 0; t < nt; ++t) {
+    if ((t & 1023) == 0) pause_point();
     if (need[t]) {
       for (int c = 0; c < 3; ++c) blend.row(3 * t + c, Gk);
       continue;
@@ -592,12 +599,14 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
                !cloth.is_free(tv[2]);
   }
   built_rigid_ = rigid;
+  pause_point();
   // update(): only the hinges of the triangles whose local estimates the rows made again read
   // (need_local_) are needed; the others' L, Nn, len and Km rows are left empty (unread).
   if (reuse_rows_) widen_reach();
   std::vector<Eigen::Vector3d> L(nh), Nn(nh);
   std::vector<double> len(nh);
   hinge_vectors(M, rigid, L, Nn, len);
+  pause_point();
   // Hinges and deformable edge-neighbours per triangle.
   std::vector<std::array<int, 3>> th(nt, {-1, -1, -1}), tn(nt, {-1, -1, -1});
   for (int h = 0; h < nh; ++h)
@@ -618,6 +627,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   std::vector<Eigen::Matrix3d> mloc(nt, Eigen::Matrix3d::Zero());
   auto local = [&](int t0, int t1) {
     for (int t = t0; t < t1; ++t) {
+      if ((t & 255) == 0) pause_point();
       const int k = tri_nh_[t];
       if (k == 0 || (reuse_rows_ && !need_local_[t])) continue;
       Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
@@ -643,12 +653,14 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   }
   Csr Gloc, Gdiv;  // rows 3t + c, columns hinges (the same pattern)
   Gloc.reset(3 * nt);
+  pause_point();
   Gdiv.reset(3 * nt);
   for (Csr* G : {&Gloc, &Gdiv}) {
     G->col.reserve(9 * static_cast<size_t>(nt));
     G->val.reserve(9 * static_cast<size_t>(nt));
   }
   for (int t = 0; t < nt; ++t) {
+    if ((t & 1023) == 0) pause_point();
     const int k = tri_nh_[t];
     if (k > 0 && (!reuse_rows_ || need_local_[t])) {
       const Eigen::Matrix3d& Mloc = mloc[t];
@@ -669,6 +681,7 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   }
   // Km: hinge -> its 4 vertices with weights K (S rows over vertices: Gk = Gs Km).
   Csr Km;
+  pause_point();
   Km.reset(nh);
   for (int h = 0; h < nh; ++h) {
     for (int k = 0; k < 4 && hinge_needed(h); ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
@@ -733,10 +746,12 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
     return;
   }
   transpose(Gk, n, GkT);
+  pause_point();
   std::vector<double> ad(3 * nt);
   for (int t = 0; t < nt; ++t)
     for (int c = 0; c < 3; ++c) ad[3 * t + c] = tri_area_[t] * bend_D_[c];
   spgemm(GkT, Gk, n, P, &ad, pool);
+  pause_point();
   // CSR with the diagonal always present.
   bend_off_.assign(n + 1, 0);
   bend_diag_.assign(n, 0.0);

@@ -34,10 +34,46 @@ void copy_without_incidence(const Cloth& from, Cloth& to) {
   to.incidence = ClothIncidence{};
 }
 
+// Single precision: the anchors of `base`'s vertices (3 each, then its scratch vertices' zeros)
+// for the n vertices of a cloth that map onto them (src), with as many scratch vertices; none
+// when the base has none.
+std::vector<double> mapped_anchors(const XpbdSolver& base, int nb, const std::vector<int32_t>& src,
+                                   int n) {
+  const std::vector<double>& a = base.anchors();
+  if (a.size() < 3 * static_cast<size_t>(nb) || static_cast<int>(src.size()) < n) return {};
+  std::vector<double> m(a.size() - 3 * static_cast<size_t>(nb) + 3 * static_cast<size_t>(n), 0.0);
+  for (int j = 0; j < n; ++j)
+    for (int k = 0; k < 3; ++k) m[3 * j + k] = a[3 * static_cast<size_t>(src[j]) + k];
+  return m;
+}
+
+// The cores this process may run on.
+int usable_cores() {
+#if defined(__linux__)
+  cpu_set_t set;
+  if (sched_getaffinity(0, sizeof set, &set) == 0) return CPU_COUNT(&set);
+#endif
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// A thread that only runs on a core nothing else wants (Linux SCHED_IDLE; any user may choose
+// it) and yields it at once: work off the ticks that must not stretch them.
+void idle_priority() {
+#if defined(__linux__)
+  sched_param none{};
+  pthread_setschedparam(pthread_self(), SCHED_IDLE, &none);
+#endif
+}
+
 }  // namespace
 
 CookAheadSolver::CookAheadSolver(XpbdOptions xpbd, CookAheadOptions opt)
-    : opt_(opt), active_(std::make_unique<XpbdSolver>(xpbd)) {}
+    : opt_(opt), active_(std::make_unique<XpbdSolver>(xpbd)) {
+  using K = CookAheadOptions::KeepOff;
+  keep_off_ = opt_.keep_off_steps == K::kAlways ||
+              (opt_.keep_off_steps == K::kAuto &&
+               usable_cores() < std::max(1, xpbd.threads) + std::max(1, opt_.worker_threads));
+}
 
 CookAheadSolver::~CookAheadSolver() {
   join();
@@ -45,7 +81,8 @@ CookAheadSolver::~CookAheadSolver() {
 }
 
 void CookAheadSolver::join() {
-  release();  // a worker not yet released would wait forever
+  release();     // a worker not yet released would wait forever
+  gate_.open();  // and one held at the gate
   if (worker_.joinable()) worker_.join();
 }
 
@@ -101,17 +138,11 @@ void CookAheadSolver::launch(std::function<void(ThreadPool&)> job) {
     // Not during the step that launched it: the cook's memory traffic would slow that step,
     // which already carries the edit (measured: 7-11 ms instead of 5 at 128^2 on two cores).
     released_.wait(false, std::memory_order_acquire);
-#if defined(__linux__)
-    // SCHED_IDLE (any user may choose it): the thread runs only on a core nothing else wants
-    // and yields it at once, so the ticks do not stretch. The pool made below inherits it.
-    if (opt_.idle_priority) {
-      sched_param none{};
-      pthread_setschedparam(pthread_self(), SCHED_IDLE, &none);
-    }
-#endif
+    if (opt_.idle_priority) idle_priority();  // (the pool made below inherits it)
+    set_thread_gate(&gate_);
     if (opt_.worker_delay_ms > 0)
       std::this_thread::sleep_for(std::chrono::milliseconds(opt_.worker_delay_ms));
-    ThreadPool pool(std::max(1, opt_.worker_threads));
+    ThreadPool pool(std::max(1, opt_.worker_threads), &gate_);
     job(pool);
   });
 }
@@ -121,19 +152,27 @@ void CookAheadSolver::release() {
   released_.notify_all();
 }
 
-void CookAheadSolver::start(const Cloth& cloth, int steps) {
+void CookAheadSolver::start(const Cloth& cloth, int steps, double dt) {
   copy_without_incidence(cloth, next_cloth_);
   next_ = std::make_unique<XpbdSolver>(active_->options());
+  // The swap's step starts from the base's anchors then (adopt()): the worker makes the element
+  // terms at its anchors now, which serve when the base keeps them until the swap.
+  next_src_ = src_;
+  next_src_.resize(cloth.num_vertices());
+  std::vector<double> anchors =
+      mapped_anchors(*active_, base_.num_vertices(), next_src_, cloth.num_vertices());
   // The base steps as it was cooked: a vertex let go in the window (pinned when the base was
   // kept) has its own inverse mass; the step reads it only for free vertices.
   ClothState& B = base_.state;
   for (int i = 0; i < base_.num_vertices(); ++i)
     B.inv_mass[i] = B.mass[i] > 0 ? 1.0 / B.mass[i] : 0.0;
   done_.store(false, std::memory_order_relaxed);
-  launch([this, spare = opt_.spare_energy](ThreadPool& pool) {
+  launch([this, spare = opt_.spare_energy, dt, anchors = std::move(anchors)](ThreadPool& pool) {
     if (spare_) next_->seed_energy(std::move(*spare_));
     spare_.reset();
     next_->prepare(next_cloth_, &pool);
+    // The first step's masses, blocks and anchor terms, off the swap's step.
+    if (opt_.warm) next_->warm(next_cloth_, dt, anchors, &pool);
     // The next edit's cook starts from this topology's energy: a copy made here, before the
     // cooked solver steps, instead of a second build after the swap.
     if (spare) spare_ = std::make_unique<ClothEnergy>(next_->energy());
@@ -158,6 +197,9 @@ void CookAheadSolver::adopt() {
   join();
   next_->options() = active_->options();
   next_->set_ties(active_->ties(), active_->tie_passes());
+  // The new vertices start from their base vertices' anchors, as they start from their positions.
+  next_->take_anchors(
+      mapped_anchors(*active_, base_.num_vertices(), next_src_, next_cloth_.num_vertices()));
   std::unique_ptr<XpbdSolver> old = std::move(active_);
   active_ = std::move(next_);
   base_ = std::move(next_cloth_);
@@ -166,7 +208,10 @@ void CookAheadSolver::adopt() {
   pending_ = false;
   steps_left_ = 0;
   if (reaper_.joinable()) reaper_.join();
-  reaper_ = std::thread([p = std::move(old)]() mutable { p.reset(); });
+  reaper_ = std::thread([p = std::move(old), idle = opt_.idle_priority]() mutable {
+    if (idle) idle_priority();
+    p.reset();
+  });
 }
 
 void CookAheadSolver::keep_base(const Cloth& cloth) {
@@ -176,6 +221,20 @@ void CookAheadSolver::keep_base(const Cloth& cloth) {
 }
 
 StepStats CookAheadSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
+  // The worker's threads wait while the step runs (TickGate), unless the steps leave no time
+  // between them (they overran their period): the worker then cooks beside them, at SCHED_IDLE.
+  using Clock = std::chrono::steady_clock;
+  const bool close = opt_.keep_off_steps == CookAheadOptions::KeepOff::kAlways ||
+                     (keep_off_ && Clock::now() - last_step_end_ >= std::chrono::milliseconds(1));
+  struct Closed {
+    TickGate* g;
+    Clock::time_point& end;
+    ~Closed() {
+      if (g) g->open();
+      end = Clock::now();
+    }
+  } closed{close ? &gate_ : nullptr, last_step_end_};
+  if (close) gate_.close();
   if (pending_) {
     const bool edited_again = cloth.topology_version != next_cloth_.topology_version ||
                               cloth.num_vertices() != next_cloth_.num_vertices();
@@ -188,7 +247,7 @@ StepStats CookAheadSolver::step(Cloth& cloth, const SceneObjects& scene, double 
   }
   if (!active_->cooked_for(cloth) && mapped(cloth)) {
     ++edits_ahead_;
-    start(cloth, ticks_for(cloth) - 1);
+    start(cloth, ticks_for(cloth) - 1, dt);
     const StepStats st = step_base(cloth, scene, dt);
     release();  // the worker starts once the edit's own step is done (see launch())
     return st;
@@ -315,7 +374,7 @@ std::string CookAheadSolver::restore_state(const std::vector<unsigned char>& byt
     return fail(e);
   }
   active_->prepare(base_);
-  start(cloth, steps);
+  start(cloth, steps, 0.0);  // (the frame's length is not saved: the swap's step makes the blocks)
   release();
   return "";
 }

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -27,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "sim/core/thread_pool.hpp"
 #include "sim/solvers/solver.hpp"
 #include "sim/solvers/xpbd/solver_xpbd.hpp"
 
@@ -42,6 +44,17 @@ struct CookAheadOptions {
   // worker copies the energy it cooked, and a topology cooked in a step has its energy built on
   // a worker; false: that cook builds it whole.
   bool spare_energy = true;
+  // The worker also makes the first step's inverse masses, bending blocks and single-precision
+  // anchor terms (XpbdSolver::warm), so that the swap's step costs what any step does.
+  bool warm = true;
+  // The worker's threads wait while a step runs (TickGate): kAuto when the machine has fewer
+  // cores than the solver's and the worker's threads together, where a thread at SCHED_IDLE
+  // alone still takes slices of a core a step needs (measured on two cores: 2-4 ms inside a
+  // 5 ms step). On more cores the worker runs beside the steps, and so it does beside steps
+  // that follow one another without a pause (they overran their period: no time is left
+  // between them). kAlways: every step (tests).
+  enum class KeepOff { kAuto, kAlways, kNever };
+  KeepOff keep_off_steps = KeepOff::kAuto;
   // Tests: the worker sleeps this long before it cooks (a slow or loaded machine; the result
   // must not change, only the due step waits).
   int worker_delay_ms = 0;
@@ -78,9 +91,9 @@ class CookAheadSolver : public Solver {
   // vertex with its origin and (bit for bit) its position; false when one does not (the edit
   // is then cooked in the step).
   bool map_onto_base(const Cloth& cloth);
-  bool mapped(const Cloth& cloth);            // map_onto_base once per topology of the cloth
-  void start(const Cloth& cloth, int steps);  // the worker cooks `cloth`
-  void adopt();                               // the worker's solver becomes the active one
+  bool mapped(const Cloth& cloth);  // map_onto_base once per topology of the cloth
+  void start(const Cloth& cloth, int steps, double dt);  // the worker cooks `cloth`
+  void adopt();  // the worker's solver becomes the active one
   StepStats step_base(Cloth& cloth, const SceneObjects& scene, double dt);
   void keep_base(const Cloth& cloth);  // the cloth the active solver is cooked for
   void join();
@@ -99,9 +112,15 @@ class CookAheadSolver : public Solver {
   bool pending_ = false;
   int steps_left_ = 0;
   Cloth next_cloth_;
+  std::vector<int32_t> next_src_;  // its vertices' base vertices
   std::thread worker_;
   std::atomic<bool> done_{false};      // the worker has cooked
   std::atomic<bool> released_{false};  // the worker may start (release())
+  // Closed while a step runs (keep_off_: kAuto's cores rule) that began 1 ms or more after the
+  // last one ended: the worker's threads wait at their pause points.
+  TickGate gate_;
+  bool keep_off_ = false;
+  std::chrono::steady_clock::time_point last_step_end_{};
   // The energy of the base's topology, built by a worker after each new base (only workers
   // touch it, one after the other): the next edit's cook updates it for the triangles the edit
   // reached instead of building it whole.

@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <thread>
 
@@ -49,7 +50,10 @@ void apply_order(std::vector<T>& items, const std::vector<int>& order) {
 void XpbdSolver::cook(const Cloth& cloth) {
   // Each part's wall time (last_cook(): what a re-cook after a cut costs, and where).
   using Clock = std::chrono::steady_clock;
+  // Between its parts a cook waits while its thread's gate is closed (a cook ahead: the ticks
+  // run meanwhile), counted in the part before.
   auto since = [](Clock::time_point& t) {
+    pause_point();
     const auto now = Clock::now();
     const double ms = std::chrono::duration<double, std::milli>(now - t).count();
     t = now;
@@ -107,6 +111,7 @@ void XpbdSolver::cook_triangles(const Cloth& cloth) {
   std::vector<int> order;
   tris_.clear();
   for (int t = 0; t < energy_.num_triangles(); ++t) {
+    if ((t & 1023) == 0) pause_point();
     Tri T{};
     const auto& D = energy_.tri_D(t);
     for (int a = 0; a < 3; ++a) {
@@ -188,6 +193,7 @@ void XpbdSolver::assemble_blocks(bool incremental) {
   blk_off_.reserve(nb + 1);
   blk_ik_.reserve(3 * nb);
   for (int bk = 0; bk < nb; ++bk) {
+    if ((bk & 1023) == 0) pause_point();
     if (reuse && !rebuilt[bk]) {
       blk_col_.insert(blk_col_.end(), old_col.begin() + old_off[bk],
                       old_col.begin() + old_off[bk + 1]);
@@ -282,7 +288,9 @@ void XpbdSolver::cook_bending(int n, bool incremental) {
   const std::vector<double>& bval = blk_val_;
   const std::vector<double>& bik = blk_ik_;
   std::vector<int> order_b, col;
+  pause_point();
   colour_elements(n, boff, bcol, order_b, col);
+  pause_point();
   row_cols_ = col.empty() ? std::vector<int>(1, 0) : col;
   row_off_.assign(1, 0);
   row_colv_.clear();
@@ -293,6 +301,7 @@ void XpbdSolver::cook_bending(int n, bool incremental) {
   row_ik_.reserve(bik.size());
   row_off_.reserve(boff.size());
   for (int bk : order_b) {
+    if ((row_off_.size() & 1023) == 0) pause_point();
     row_colv_.insert(row_colv_.end(), bcol.begin() + boff[bk], bcol.begin() + boff[bk + 1]);
     row_val_.insert(row_val_.end(), bval.begin() + 3 * boff[bk], bval.begin() + 3 * boff[bk + 1]);
     row_off_.push_back(static_cast<int>(row_colv_.size()));
@@ -304,6 +313,7 @@ void XpbdSolver::cook_bending(int n, bool incremental) {
   rpack_col_.assign(1, 0);
   rpack8_col_.assign(1, 0);
   for (size_t c = 0; c + 1 < row_cols_.size(); ++c) {
+    pause_point();
     if (cooked_f32_) {
       row_packs8_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
                          row_cols_[c], row_cols_[c + 1], n, S);
@@ -562,6 +572,36 @@ void XpbdSolver::prepare(const Cloth& cloth, ThreadPool* cook_pool) {
   cook_pool_ = nullptr;
 }
 
+void XpbdSolver::warm(const Cloth& cloth, double dt, std::vector<double> anchors,
+                      ThreadPool* pool) {
+  if (!cooked_for(cloth)) return;
+  const double* scale = rest_.scales().data();
+  const int* piece_of = rest_.piece_of().data();
+  take_masses(cloth, scale, piece_of);
+  if (dt > 0) {
+    // 1/(be h^2) with Step's arithmetic.
+    const double h = dt / std::max(1, opt_.substeps);
+    const double ih2 = 1.0 / (h * h);
+    row_inverses(ih2 / std::max(1, opt_.bending_every), scale, piece_of, pool);
+  }
+  warm_anchors_.clear();
+  if (cooked_f32_ &&
+      anchors.size() == 3 * static_cast<size_t>(cloth.num_vertices() + scratch_slots_)) {
+    anchor_terms(anchors, pool);
+    warm_anchors_ = std::move(anchors);
+  }
+}
+
+void XpbdSolver::take_anchors(std::vector<double> anchors) {
+  if (!cooked_f32_ || anchors.size() != 3 * (w_.size() + scratch_slots_)) return;
+  const bool made =
+      warm_anchors_.size() == anchors.size() &&
+      std::memcmp(warm_anchors_.data(), anchors.data(), sizeof(double) * anchors.size()) == 0;
+  anchors_ = std::move(anchors);
+  warm_anchors_.clear();
+  if (!made) anchor_terms(anchors_, pool_.get());
+}
+
 StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   prepare(cloth);
   rest_.mark_masses_dirty();  // pins, releases, wakes and finishes happen between frames
@@ -615,22 +655,23 @@ void XpbdSolver::renew_anchors(Step& c) {
   if (!renew) return;
   anchors_.assign(xd, xd + 3 * n);
   anchors_.resize(3 * (n + scratch_slots_), 0.0);  // the scratch vertices (their P4f: 0)
-  anchor_terms();
+  anchor_terms(anchors_, pool_.get());
   ++anchor_renewals_;
 }
 
-void XpbdSolver::anchor_terms() {
+// The elements' terms at `anchors` (tri_anchor8_, row_anchor8_), on `pool`.
+void XpbdSolver::anchor_terms(const std::vector<double>& anchors, ThreadPool* pool) {
   const xpbd::Kernels& K = *kern_;
   const bool wide = tlanes_ == 16;
-  pool_->parallel_for(float_tri_packs(), [&](int b, int e, int) {
+  pool->parallel_for(float_tri_packs(), [&](int b, int e, int) {
     if (wide)
-      K.anchor_triangles16(tri_packs16_.data(), b, e, anchors_.data(), tri_anchor8_.data());
+      K.anchor_triangles16(tri_packs16_.data(), b, e, anchors.data(), tri_anchor8_.data());
     else
-      K.anchor_triangles(tri_packs8_.data(), b, e, anchors_.data(), tri_anchor8_.data());
+      K.anchor_triangles(tri_packs8_.data(), b, e, anchors.data(), tri_anchor8_.data());
   });
   const xpbd::RowPacksT<float> rp8 = row_packs8_.view();
-  pool_->parallel_for(row_packs8_.packs(), [&](int b, int e, int) {
-    K.anchor_rows(rp8, b, e, anchors_.data(), row_anchor8_.data());
+  pool->parallel_for(row_packs8_.packs(), [&](int b, int e, int) {
+    K.anchor_rows(rp8, b, e, anchors.data(), row_anchor8_.data());
   });
 }
 
@@ -780,32 +821,46 @@ void XpbdSolver::self_motion_of(const Step& c, const std::vector<int>& moved) {
 // sums over their stencils again; a change of scale alone does not (build_row_inverses()).
 void XpbdSolver::set_masses(Step& c) {
   if (rest_.masses_dirty()) {
-    const auto& S = c.S;
-    for (int i = 0; i < c.n; ++i) {
-      const double w0 = c.cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
-      const double wi = w0 > 0 ? w0 / c.scale[c.piece_of[i]] : 0.0;
-      if (wi != w_[i]) w_changed_ = true;
-      if (w0 != w0_[i]) w0_changed_ = true;
-      w_[i] = wi;
-      w0_[i] = w0;
-    }
+    take_masses(c.cloth, c.scale, c.piece_of);
     rest_.masses_set();
   }
-  if (!row_ik_.empty() && (w_changed_ || c.ihb != row_ai_h_)) {
-    row_b_.resize(row_ik_.size() * 2);  // 6 per block (3 rows)
-    pool_->parallel_for(static_cast<int>(row_ik_.size() / 3),
-                        [&](int b, int e, int) { build_row_inverses(c, b, e); });
-    row_ai_h_ = c.ihb;
-    w_changed_ = false;
-    w0_changed_ = false;
+  row_inverses(c.ihb, c.scale, c.piece_of, pool_.get());
+}
+
+// w_ and w0_ from the cloth's state, pieces' scales `scale` (vertex i's piece: piece_of[i]);
+// notes which changed.
+void XpbdSolver::take_masses(const Cloth& cloth, const double* scale, const int* piece_of) {
+  const ClothState& S = cloth.state;
+  const int n = cloth.num_vertices();
+  for (int i = 0; i < n; ++i) {
+    const double w0 = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
+    const double wi = w0 > 0 ? w0 / scale[piece_of[i]] : 0.0;
+    if (wi != w_[i]) w_changed_ = true;
+    if (w0 != w0_[i]) w0_changed_ = true;
+    w_[i] = wi;
+    w0_[i] = w0;
   }
+}
+
+// The bending blocks' inverses for substeps with 1/(be h^2) = ihb, made again when w or ihb
+// changed since they were made.
+void XpbdSolver::row_inverses(double ihb, const double* scale, const int* piece_of,
+                              ThreadPool* pool) {
+  if (row_ik_.empty() || (!w_changed_ && ihb == row_ai_h_)) return;
+  row_b_.resize(row_ik_.size() * 2);  // 6 per block (3 rows)
+  pool->parallel_for(static_cast<int>(row_ik_.size() / 3),
+                     [&](int b, int e, int) { build_row_inverses(ihb, scale, piece_of, b, e); });
+  row_ai_h_ = ihb;
+  w_changed_ = false;
+  w0_changed_ = false;
 }
 
 // The bending blocks' inverse system matrices (in row_packs_), for the current w and h:
 // A = sum_j w_j v_j v_j^T + alpha / (be h^2). A block's stencil lies in one piece, so
 // w_j = w0_j / scale and A = B / scale + alpha with B = sum_j w0_j v_j v_j^T, kept per block
 // (row_b_) and summed again only when w0 changed.
-void XpbdSolver::build_row_inverses(const Step& c, int b, int e) {
+void XpbdSolver::build_row_inverses(double ihb, const double* scale, const int* piece_of, int b,
+                                    int e) {
   for (int r = b; r < e; ++r) {
     double* B = &row_b_[6 * r];  // 00 01 02 11 12 22
     if (w0_changed_) {
@@ -823,7 +878,7 @@ void XpbdSolver::build_row_inverses(const Step& c, int b, int e) {
       }
     }
     const double is =
-        row_off_[r + 1] > row_off_[r] ? 1.0 / c.scale[c.piece_of[row_colv_[row_off_[r]]]] : 1.0;
+        row_off_[r + 1] > row_off_[r] ? 1.0 / scale[piece_of[row_colv_[row_off_[r]]]] : 1.0;
     double A[6];
     for (int m = 0; m < 6; ++m) A[m] = B[m] * is;
     double ai[6] = {0, 0, 0, 0, 0, 0};
@@ -839,9 +894,9 @@ void XpbdSolver::build_row_inverses(const Step& c, int b, int e) {
       store();
       continue;
     }
-    A[0] += c.ihb * row_ik_[3 * r];
-    A[3] += c.ihb * row_ik_[3 * r + 1];
-    A[5] += c.ihb * row_ik_[3 * r + 2];
+    A[0] += ihb * row_ik_[3 * r];
+    A[3] += ihb * row_ik_[3 * r + 1];
+    A[5] += ihb * row_ik_[3 * r + 2];
     // Closed-form inverse of the symmetric positive definite 3x3 A.
     const double c00 = A[3] * A[5] - A[4] * A[4];
     const double c01 = A[2] * A[4] - A[1] * A[5];

@@ -48,6 +48,20 @@ class XpbdSolver : public Solver {
   void prepare(const Cloth& cloth) { prepare(cloth, pool_.get()); }
   void prepare(const Cloth& cloth, ThreadPool* cook_pool);
   bool cooked_for(const Cloth& cloth) const;
+  // The work of a cooked solver's first step done ahead, on `pool` (CookAheadSolver's worker,
+  // after prepare): the inverse masses and the bending blocks' inverses for the cloth's pins
+  // and frozen vertices and frames of length dt (0: not made), and single precision's element
+  // terms at
+  // `anchors` (3 per vertex, then the scratch vertices'; none: not made). The step keeps what
+  // still holds when it comes (the same masses and substep; take_anchors with the same anchors)
+  // and makes the rest again: no result depends on whether or when warm ran.
+  void warm(const Cloth& cloth, double dt, std::vector<double> anchors, ThreadPool* pool);
+  // The anchors the next step starts from instead of new ones at its positions (a solver taking
+  // over from another: CookAheadSolver's swap); their element terms are made here unless warm
+  // made them for the same anchors. Ignored unless single precision and the cooked cloth's size.
+  void take_anchors(std::vector<double> anchors);
+  // Single precision: the anchors (empty before the first step).
+  const std::vector<double>& anchors() const { return anchors_; }
   // The energy a solver not yet stepped starts from: its first cook updates it for the cloth
   // (XpbdOptions::incremental_cook: only the triangles the change reached) instead of building
   // it whole. CookAheadSolver seeds the solver it cooks with the energy of the last one.
@@ -161,7 +175,7 @@ class XpbdSolver : public Solver {
   // The step's phases, in the order step() and substep() run them.
   bool begin_frame(Step& c);    // wake, finish, settling checks; false: everything sleeps
   void renew_anchors(Step& c);  // single precision: new anchors once a vertex left its own
-  void anchor_terms();          // the elements' terms at the anchors (anchors_)
+  void anchor_terms(const std::vector<double>& anchors, ThreadPool* pool);
   std::string read_state(ByteReader& in, const Cloth& cloth);
   std::string read_self_state(ByteReader& in, const Cloth& cloth);
   void substep(Step& c);
@@ -172,6 +186,8 @@ class XpbdSolver : public Solver {
   void self_motion(const Step& c, int b, int e, int slot);
   void self_motion_of(const Step& c, const std::vector<int>& moved);
   void set_masses(Step& c);  // w and the bending blocks' inverses
+  void take_masses(const Cloth& cloth, const double* scale, const int* piece_of);
+  void row_inverses(double ihb, const double* scale, const int* piece_of, ThreadPool* pool);
   void plan_substep(Step& c);
   void predict(const Step& c, int b, int e);
   void warm_start(Step& c);
@@ -187,7 +203,7 @@ class XpbdSolver : public Solver {
   void schedule_rest(Step& c);  // settling and sleep
 
   // The phases' loops over items [b, e): vertices, vertex blocks k, elements or packs.
-  void build_row_inverses(const Step& c, int b, int e);
+  void build_row_inverses(double ihb, const double* scale, const int* piece_of, int b, int e);
   void block_predict(const Step& c, int k, int b, int e);
   void warm_tris(const Step& c, int b, int e);
   void warm_hinges(const Step& c, int b, int e);
@@ -306,7 +322,8 @@ class XpbdSolver : public Solver {
   // Shares of a colour's packs, each with its scratch vertex of padding (xpbd::share_begin: n,
   // n + 1, ...): the sweep's shares, one per thread of the pool (at least two).
   int scratch_slots_ = 2;
-  std::vector<double> anchors_;  // 3 per vertex, and the scratch vertices' (0)
+  std::vector<double> anchors_;       // 3 per vertex, and the scratch vertices' (0)
+  std::vector<double> warm_anchors_;  // the anchors warm() made the terms at
   std::vector<float> tri_anchor8_, row_anchor8_;
   static constexpr double kAnchorReach = 0.05;  // m (a float resolves 3.7e-9 m there)
   long anchor_renewals_ = 0;

@@ -100,7 +100,7 @@ std::string XpbdSolver::read_state(ByteReader& in, const Cloth& cloth) {
   if (!in.ok || (!anchors_.empty() && (!anchored || !cooked_f32_)) ||
       !all_finite(anchors_.data(), anchors_.size()))
     return "the anchors do not fit the cloth";
-  if (anchored) anchor_terms();
+  if (anchored) anchor_terms(anchors_, pool_.get());
   if (!rest_.restore(in)) return "the pieces' rest state does not fit the cloth";
   if (version >= 2) return read_self_state(in, cloth);
   return "";

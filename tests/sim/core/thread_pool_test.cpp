@@ -1,6 +1,7 @@
 // sim/core/thread_pool.hpp: the thread pool runs every index exactly once, keeps each thread on its
-// own end of the range, and element colouring gives colours whose elements share no vertex. The
-// file name contains "thread": it also runs in the TSan build.
+// own end of the range, holds work made with a closed gate at its pause points, and element
+// colouring gives colours whose elements share no vertex. The file name contains "thread": it
+// also runs in the TSan build.
 #include "sim/core/thread_pool.hpp"
 
 #include <gtest/gtest.h>
@@ -118,6 +119,34 @@ TEST(ThreadPool, AnIdleWorkerSleepsAfterSpinning) {
     EXPECT_GT(pool.idle_sleeps(), before) << "rep " << rep;
   }
   EXPECT_EQ(sum.load(), 3 * 64);
+}
+
+// Work kept off the ticks (TickGate): while the gate is closed neither a pool made with it nor a
+// pause point of a thread given it gets past the next chunk or point; opened, all of it runs.
+TEST(ThreadPool, AClosedGateHoldsTheWorkAtItsPausePoints) {
+  TickGate gate;
+  gate.close();
+  std::atomic<int> chunks{0}, points{0};
+  std::atomic<bool> finished{false};
+  std::thread held([&] {
+    set_thread_gate(&gate);
+    ThreadPool pool(2, &gate);
+    pool.set_min_parallel(0);
+    pool.parallel_for(64, [&](int, int, int) { ++chunks; });
+    for (int k = 0; k < 3; ++k) {
+      pause_point();
+      ++points;
+    }
+    finished = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_EQ(chunks.load(), 0) << "a chunk ran past the closed gate";
+  EXPECT_EQ(points.load(), 0);
+  gate.open();
+  held.join();
+  EXPECT_TRUE(finished.load());
+  EXPECT_EQ(points.load(), 3);
+  EXPECT_EQ(chunks.load(), 8) << "64 items in 4 chunks per thread";
 }
 
 TEST(Colouring, ElementsOfOneColourShareNoVertex) {

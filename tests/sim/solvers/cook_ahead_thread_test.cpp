@@ -48,16 +48,19 @@ struct CutRun {
   int waits = 0, edits_ahead = 0, edits_in_step = 0;
   int adopted_at = -1;  // steps after the cut's until the solver stepped the cut topology
   double gap_at_swap = -1, gap_after = -1;
+  long anchor_renewals = -1;  // by the solver adopted at the swap, in its first step
 };
 
 // The form drape cut across at half its height after 30 steps and stepped 40 more; with
 // second_cut, cut again at a quarter of its height after the first cut's step (inside its
 // window). The gaps are those of the last cut.
-CutRun run(int worker_delay_ms, bool second_cut = false) {
+CutRun run(int worker_delay_ms, bool second_cut = false, CookAheadOptions o = {},
+           int frames_before = 30) {
   Testbed sc = make_scene("form", kRes);
-  CookAheadSolver s(options(sc),
-                    CookAheadOptions{.ticks = kTicks, .worker_delay_ms = worker_delay_ms});
-  for (int f = 0; f < 30; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  o.ticks = kTicks;
+  o.worker_delay_ms = worker_delay_ms;
+  CookAheadSolver s(options(sc), o);
+  for (int f = 0; f < frames_before; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
   int before = sc.cloth.num_vertices();
   EXPECT_TRUE(cut_across(sc.cloth));
   // The second cut's window opens when the first cut's topology is adopted.
@@ -69,7 +72,10 @@ CutRun run(int worker_delay_ms, bool second_cut = false) {
       EXPECT_TRUE(cut_across(sc.cloth, 0.25));
     }
     s.step(sc.cloth, sc.objects, 1.0 / 90);
-    if (r.adopted_at < 0 && !s.pending()) r.adopted_at = f;
+    if (r.adopted_at < 0 && !s.pending()) {
+      r.adopted_at = f;
+      r.anchor_renewals = s.xpbd().anchor_renewals();
+    }
     if (f == swap - 1) r.gap_at_swap = largest_gap(sc.cloth, before);  // the window's last
   }
   r.gap_after = largest_gap(sc.cloth, before);
@@ -92,6 +98,33 @@ TEST(CookAhead, TheCutLandsAtTheSameStepWhateverTheWorker) {
   EXPECT_EQ(fast.adopted_at, kTicks);
   EXPECT_EQ(slow.adopted_at, kTicks);
   EXPECT_EQ(fast.hash, slow.hash);
+}
+
+// What the worker does beyond the cook changes when things run, not what they give: its warm-up
+// of the first step (XpbdSolver::warm; the swap's step takes over the base's anchors either way)
+// and its waits while the steps run (TickGate).
+TEST(CookAhead, TheWarmUpAndTheGateChangeNoResult) {
+  using K = CookAheadOptions::KeepOff;
+  // Cut while falling (the swap's step renews the anchors) and after the drape has come to rest
+  // on the form (the swap's step keeps the base's anchors).
+  for (const int frames : {30, 300}) {
+    SCOPED_TRACE(frames);
+    const CutRun plain = run(0, false, {.warm = false, .keep_off_steps = K::kNever}, frames);
+    const CutRun warm = run(0, false, {.warm = true, .keep_off_steps = K::kNever}, frames);
+    const CutRun gated = run(0, false, {.warm = true, .keep_off_steps = K::kAlways}, frames);
+    const CutRun slow = run(50, false, {.warm = true, .keep_off_steps = K::kAlways}, frames);
+    EXPECT_EQ(plain.adopted_at, kTicks);
+    EXPECT_EQ(gated.adopted_at, kTicks);
+    EXPECT_EQ(warm.hash, plain.hash);
+    EXPECT_EQ(gated.hash, plain.hash);
+    EXPECT_EQ(slow.hash, plain.hash);
+    EXPECT_GE(slow.waits, 1);
+    std::printf("cut after %d frames: the swap's step renewed the anchors: %s\n", frames,
+                warm.anchor_renewals ? "yes" : "no");
+    if (frames == 300) {
+      EXPECT_EQ(warm.anchor_renewals, 0) << "the base's anchors were not kept";
+    }
+  }
 }
 
 TEST(CookAhead, TheSidesStayTogetherUntilTheSwapAndPartAfter) {
