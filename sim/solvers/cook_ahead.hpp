@@ -5,13 +5,16 @@
 // index and moves the triangles on one side onto the duplicates. The solver cooked for the cloth
 // before the edit (the base) is therefore still a valid model of that cloth with the edit not
 // yet made. When a step finds the topology changed that way, CookAheadSolver
-//   * copies the cloth and cooks a second XpbdSolver for it on a worker thread;
+//   * copies the cloth and cooks a second XpbdSolver for it on a worker thread, which also makes
+//     the new solver's first-step work (XpbdSolver::warm) and, on a machine short of cores,
+//     waits while each step runs (TickGate);
 //   * for the next `ticks` steps steps the base instead: each step copies the cloth's state of
 //     the base's vertices into the base cloth, steps it with the cooked solver and copies the
 //     result back; each new vertex follows the base vertex it was duplicated from (a hand,
 //     pin or move acting on a new vertex acts on that vertex);
 //   * at the step `ticks` after the edit adopts the new solver (waiting for the worker if it
-//     has not finished) and steps the cloth as it is.
+//     has not finished), which starts from the base's single-precision anchors, and steps the
+//     cloth as it is.
 // The physical effect of the edit lands `ticks` steps late, always at the same step, whatever
 // the worker's speed: runs, replays and resumed checkpoints give the same result bit for bit.
 // `ticks` grows with the cloth (CookAheadOptions::ticks per 32 768 triangles) so the cook has
