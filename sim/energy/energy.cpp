@@ -651,9 +651,9 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
   } else {
     local(0, nt);
   }
+  pause_point();
   Csr Gloc, Gdiv;  // rows 3t + c, columns hinges (the same pattern)
   Gloc.reset(3 * nt);
-  pause_point();
   Gdiv.reset(3 * nt);
   for (Csr* G : {&Gloc, &Gdiv}) {
     G->col.reserve(9 * static_cast<size_t>(nt));
@@ -680,8 +680,8 @@ void ClothEnergy::build_tensor_bending(const Cloth& cloth, ThreadPool* pool) {
     }
   }
   // Km: hinge -> its 4 vertices with weights K (S rows over vertices: Gk = Gs Km).
-  Csr Km;
   pause_point();
+  Csr Km;
   Km.reset(nh);
   for (int h = 0; h < nh; ++h) {
     for (int k = 0; k < 4 && hinge_needed(h); ++k) Km.push(hinge_v_[h][k], hinge_k_[h][k]);
