@@ -254,10 +254,13 @@ struct CutTicks {
   int res = 0, threads = 0, ticks = 0;
   Cook cook_mode = Cook::kIncremental;
   double p50 = 0, p99 = 0, max = 0, cut_tick = 0, before_p50 = 0;
-  double before_max = 0;       // the slowest of the 15 ticks before the cut (the machine's noise)
-  int max_at = 0;              // the slowest tick, counted from the cut's (0)
-  int swap_at = -1;            // ahead: the first tick that stepped the cut topology
-  int waits = 0;               // ahead: ticks that waited for the worker's cook
+  double before_max = 0;  // the slowest of the 15 ticks before the cut (the machine's noise)
+  int max_at = 0;         // the slowest tick, counted from the cut's (0)
+  int swap_at = -1;       // ahead: the first tick that stepped the cut topology
+  int waits = 0;          // ahead: ticks that waited for the worker's cook
+  // ahead: wall ms from the worker's start to the cut topology's solver ready, and to the end of
+  // its spare energy copy (-1: not ended when the run ended)
+  double ready_ms = -1, spare_ms = -1;
   XpbdSolver::CookStats cook;  // the cook of the cut topology (ahead: on the worker)
   // Every tick in order (the cut's at index kTicksBefore): wall ms, the stepping thread's CPU
   // ms (below the wall: it was off its core; above the pool's share: it waited for a worker)
@@ -325,7 +328,11 @@ CutTicks bench_cut_ticks(int res, int threads, Cook mode, int ahead_ticks) {
   r.each = ticks;
   r.cut_tick = ticks[kBefore];
   r.cook = xpbd()->last_cook();
-  if (ahead) r.waits = ahead->waits();
+  if (ahead) {
+    r.waits = ahead->waits();
+    r.ready_ms = ahead->ready_ms();
+    r.spare_ms = ahead->spare_ms();
+  }
   r.max_at =
       static_cast<int>(std::max_element(ticks.begin(), ticks.end()) - ticks.begin()) - kBefore;
   r.before_p50 = median(std::vector<double>(ticks.begin(), ticks.begin() + kBefore));
@@ -437,7 +444,7 @@ int main(int argc, char** argv) {
       << "resolution,threads,cook,ticks,p50_ms,p99_ms,max_ms,max_tick_after_cut,cut_tick_ms,"
          "p50_before_cut_ms,max_before_cut_ms,swap_tick_after_cut,waits,recook_ms,recook_energy_ms,"
          "recook_triangles_ms,recook_bending_ms,recook_sweep_ms,recook_other_ms,"
-         "recook_triangles_made\n";
+         "recook_triangles_made,worker_ready_ms,worker_spare_ms\n";
   std::printf(
       "\nticks around a cut (form drape, XPBD; 15 ticks, the cut, 39 more), wall ms; the cut\n"
       "topology cooked in the cut's tick (incremental, full) or ahead on a worker (swap: the\n"
@@ -476,12 +483,19 @@ int main(int argc, char** argv) {
              << t.p99 << ',' << t.max << ',' << t.max_at << ',' << t.cut_tick << ',' << t.before_p50
              << ',' << t.before_max << ',' << t.swap_at << ',' << t.waits << ',' << k.total_ms
              << ',' << k.energy_ms << ',' << k.triangles_ms << ',' << k.bending_ms << ','
-             << k.sweep_ms << ',' << k.other_ms << ',' << k.rebuilt_triangles << '\n';
+             << k.sweep_ms << ',' << k.other_ms << ',' << k.rebuilt_triangles << ',' << t.ready_ms
+             << ',' << t.spare_ms << '\n';
         std::printf(
             "          the cook of the cut topology%s: %.2f ms (energy %.2f, triangles %.2f, "
             "bending %.2f, sweep plan %.2f, other %.2f; rows of %d triangles made)\n",
             mode == Cook::kAhead ? " (on the worker)" : " in the cut's tick", k.total_ms,
             k.energy_ms, k.triangles_ms, k.bending_ms, k.sweep_ms, k.other_ms, k.rebuilt_triangles);
+        if (mode == Cook::kAhead)
+          std::printf(
+              "          the worker (from the end of the cut's tick; the swap's tick starts "
+              "%.1f ms later): the new solver ready at %.2f ms, its spare energy copied at %.2f "
+              "ms\n",
+              1000.0 / 90 * (t.swap_at - 1), t.ready_ms, t.spare_ms);
       }
     if (!ahead_only)
       std::printf(

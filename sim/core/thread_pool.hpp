@@ -134,9 +134,10 @@ class ThreadPool {
   int min_parallel_ = 64;
   std::vector<std::thread> workers_;
   std::atomic<uint64_t> generation_{0};
-  std::atomic<uint64_t> next_{0};  // generation << 32 | back << 16 | front (see run())
-  std::atomic<int> done_{0};       // chunks finished in this generation
-  std::atomic<int> chunks_{0};     // chunks of this generation
+  std::atomic<uint64_t> next_{0};      // generation << 32 | back << 16 | front (see run())
+  std::atomic<int> done_{0};           // chunks finished in this generation
+  std::atomic<int> caller_asleep_{0};  // run() sleeps on done_ (the last chunk wakes it)
+  std::atomic<int> chunks_{0};         // chunks of this generation
   std::atomic<bool> stop_{false};
   std::atomic<long> idle_sleeps_{0};
   Thunk thunk_ = nullptr;

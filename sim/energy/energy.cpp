@@ -224,6 +224,42 @@ void ClothEnergy::note_built(const Cloth& cloth) {
 
 namespace {
 
+// to = from, in parts of 64 Ki items with a pause point before each.
+template <class T>
+void copy_in_parts(const std::vector<T>& from, std::vector<T>& to) {
+  constexpr size_t kPart = size_t{1} << 16;
+  to.clear();
+  to.reserve(from.size());
+  for (size_t b = 0; b < from.size(); b += kPart) {
+    pause_point();
+    to.insert(to.end(), from.begin() + static_cast<std::ptrdiff_t>(b),
+              from.begin() + static_cast<std::ptrdiff_t>(std::min(from.size(), b + kPart)));
+  }
+}
+
+}  // namespace
+
+ClothEnergy ClothEnergy::spare_copy() const {
+  // update()'s eligibility and mark_changed() read these; its build() clears and remakes the rest.
+  ClothEnergy c;
+  c.opt_ = opt_;
+  c.built_version_ = built_version_;
+  c.num_vertices_ = num_vertices_;
+  c.tensor_ = tensor_;
+  c.built_fabric_ = built_fabric_;
+  c.built_all_triangles_ = built_all_triangles_;
+  copy_in_parts(tri_v_, c.tri_v_);
+  copy_in_parts(hinge_t_, c.hinge_t_);
+  copy_in_parts(built_material_, c.built_material_);
+  copy_in_parts(built_rigid_, c.built_rigid_);
+  copy_in_parts(tri_S_off_, c.tri_S_off_);
+  copy_in_parts(tri_S_col_, c.tri_S_col_);
+  copy_in_parts(tri_S_val_, c.tri_S_val_);
+  return c;
+}
+
+namespace {
+
 // The options and fabric values the tensor bending rows are made of (update(): equal, or a full
 // build).
 bool same_bending_cook(const EnergyOptions& a, const EnergyOptions& b) {
@@ -848,6 +884,12 @@ void ClothEnergy::add_spring(int a, int b, double k, double rest) {
 }
 
 void ClothEnergy::build_vertex_lists() {
+  // Only vertex_force_hessian() reads them, which an energy of tensor bending without P refuses
+  // (XPBD's): none are made for it (~13 M instructions of a cut's re-cook at 128^2).
+  if (tensor_ && bend_col_.empty()) {
+    for (auto* v : {&vt_off_, &vt_, &vh_off_, &vh_, &vs_off_, &vs_}) v->clear();
+    return;
+  }
   const int n = num_vertices_;
   auto csr = [n](std::vector<int>& off, std::vector<int>& items, int count, int arity,
                  auto&& vert) {
@@ -1538,6 +1580,8 @@ void ClothEnergy::gradient(const std::vector<Vec3>& x, const std::vector<double>
 
 void ClothEnergy::vertex_force_hessian(int i, const std::vector<Vec3>& x, double mass, Vec3& f,
                                        Mat3& H) const {
+  if (tensor_bending() && !has_bending_matrix())
+    throw std::logic_error("ClothEnergy::vertex_force_hessian: built with bending_matrix = false");
   f = external_force(i, x[i], mass);
   {
     Vec3 g = Vec3::Zero();
@@ -1552,9 +1596,6 @@ void ClothEnergy::vertex_force_hessian(int i, const std::vector<Vec3>& x, double
     H << h[0], h[1], h[2], h[1], h[4], h[5], h[2], h[5], h[8];
   }
   if (tensor_bending()) {
-    if (!has_bending_matrix())
-      throw std::logic_error(
-          "ClothEnergy::vertex_force_hessian: built with bending_matrix = false");
     // Constant P: g_i = sum_j P_ij x_j, H_ii = P_ii I (exact, PSD).
     Vec3 g = Vec3::Zero();
     for (int k = bend_off_[i]; k < bend_off_[i + 1]; ++k) g += bend_val_[k] * x[bend_col_[k]];

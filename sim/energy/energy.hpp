@@ -107,6 +107,13 @@ class ClothEnergy {
   // matrix P, with the same options and fabric and the same triangle count, no triangle
   // degenerate in material space, and at most an eighth of the triangles changed.
   bool update(const Cloth& cloth, const EnergyOptions& opt, ThreadPool* pool = nullptr);
+  // What a later update() of this energy reads: the last build's triangles, their hinges'
+  // triangles, tensor bending rows and inputs (update() or build() on the copy makes the same
+  // elements and rows as on this energy; the rest, contacts, friction and the contact stiffness
+  // included, is left at its defaults). It reads nothing a step writes, so one thread may make it
+  // while another steps with this energy; the large arrays are copied in parts with a pause
+  // point before each (TickGate).
+  ClothEnergy spare_copy() const;
   // Per triangle: 1 when the last build or update made its bending rows, 0 when it kept them.
   const std::vector<char>& rebuilt_triangles() const { return rebuilt_; }
   bool up_to_date(const Cloth& cloth) const {

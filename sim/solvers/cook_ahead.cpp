@@ -84,6 +84,7 @@ void CookAheadSolver::join() {
   release();     // a worker not yet released would wait forever
   gate_.open();  // and one held at the gate
   if (worker_.joinable()) worker_.join();
+  copying_ = nullptr;
 }
 
 int CookAheadSolver::ticks_for(const Cloth& cloth) const {
@@ -167,16 +168,27 @@ void CookAheadSolver::start(const Cloth& cloth, int steps, double dt) {
   for (int i = 0; i < base_.num_vertices(); ++i)
     B.inv_mass[i] = B.mass[i] > 0 ? 1.0 / B.mass[i] : 0.0;
   done_.store(false, std::memory_order_relaxed);
-  launch([this, spare = opt_.spare_energy, dt, anchors = std::move(anchors)](ThreadPool& pool) {
-    if (spare_) next_->seed_energy(std::move(*spare_));
+  copying_ = next_.get();
+  launch([this, s = next_.get(), spare = opt_.spare_energy, dt,
+          anchors = std::move(anchors)](ThreadPool& pool) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    auto ms = [t0] { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); };
+    ready_ms_.store(-1, std::memory_order_relaxed);
+    spare_ms_.store(-1, std::memory_order_relaxed);
+    if (spare_) s->seed_energy(std::move(*spare_));
     spare_.reset();
-    next_->prepare(next_cloth_, &pool);
+    s->prepare(next_cloth_, &pool);
     // The first step's masses, blocks and anchor terms, off the swap's step.
-    if (opt_.warm) next_->warm(next_cloth_, dt, anchors, &pool);
-    // The next edit's cook starts from this topology's energy: a copy made here, before the
-    // cooked solver steps, instead of a second build after the swap.
-    if (spare) spare_ = std::make_unique<ClothEnergy>(next_->energy());
+    if (opt_.warm) s->warm(next_cloth_, dt, anchors, &pool);
+    ready_ms_.store(ms(), std::memory_order_relaxed);
     done_.store(true, std::memory_order_release);
+    done_.notify_all();
+    // The next edit's cook starts from this topology's energy: a copy of what it reads, made
+    // after the swap may take the solver (it reads nothing the steps write; a step that cooks
+    // again joins this worker first), instead of a second build after the swap.
+    if (spare) spare_ = std::make_unique<ClothEnergy>(s->energy().spare_copy());
+    spare_ms_.store(ms(), std::memory_order_relaxed);
   });
   pending_ = true;
   steps_left_ = steps;
@@ -188,30 +200,50 @@ void CookAheadSolver::start_spare(const Cloth& cloth) {
   launch([this, copy, o = active_->options()](ThreadPool& pool) {
     XpbdSolver s(o);
     s.prepare(*copy, &pool);
-    spare_ = std::make_unique<ClothEnergy>(s.energy());
+    spare_ = std::make_unique<ClothEnergy>(s.energy().spare_copy());
   });
 }
 
 void CookAheadSolver::adopt() {
-  if (!done_.load(std::memory_order_acquire)) ++waits_;
-  join();
+  // The worker may still be copying the spare energy after it has cooked: it is joined later
+  // (the next launch, a cook in a step, a restore, the destructor).
+  if (!done_.load(std::memory_order_acquire)) {
+    ++waits_;
+    release();
+    with_gate_open([this] { done_.wait(false, std::memory_order_acquire); });
+  }
   next_->options() = active_->options();
   next_->set_ties(active_->ties(), active_->tie_passes());
   // The new vertices start from their base vertices' anchors, as they start from their positions.
   next_->take_anchors(
       mapped_anchors(*active_, base_.num_vertices(), next_src_, next_cloth_.num_vertices()));
   std::unique_ptr<XpbdSolver> old = std::move(active_);
+  auto old_base = std::make_unique<Cloth>(std::move(base_));
   active_ = std::move(next_);
   base_ = std::move(next_cloth_);
   next_cloth_ = Cloth{};
   mapped_version_ = 0;
   pending_ = false;
   steps_left_ = 0;
-  if (reaper_.joinable()) reaper_.join();
-  reaper_ = std::thread([p = std::move(old), idle = opt_.idle_priority]() mutable {
+  // The retired solver and base cloth are freed on a thread of their own once this step has
+  // ended (the gate): their memory's release (unmaps, the pool's joins) stays off the steps.
+  if (reaper_.joinable()) with_gate_open([this] { reaper_.join(); });
+  reaper_ = std::thread([p = std::move(old), b = std::move(old_base), idle = opt_.idle_priority,
+                         gate = &gate_]() mutable {
     if (idle) idle_priority();
+    gate->pass();
     p.reset();
+    b.reset();
   });
+}
+
+void CookAheadSolver::with_gate_open(const std::function<void()>& wait) {
+  // The worker's threads and the reaper wait at the gate: they pass it while the step waits for
+  // them, and it closes again after.
+  const bool closed = gate_.closed();
+  gate_.open();
+  wait();
+  if (closed) gate_.close();
 }
 
 void CookAheadSolver::keep_base(const Cloth& cloth) {
@@ -252,7 +284,11 @@ StepStats CookAheadSolver::step(Cloth& cloth, const SceneObjects& scene, double 
     release();  // the worker starts once the edit's own step is done (see launch())
     return st;
   }
-  if (have_base_ && !active_->cooked_for(cloth)) ++edits_in_step_;
+  if (!active_->cooked_for(cloth)) {
+    if (have_base_) ++edits_in_step_;
+    // A worker copying the active solver's energy (start()) ends before the cook changes it.
+    if (copying_ == active_.get()) with_gate_open([this] { join(); });
+  }
   StepStats st = active_->step(cloth, scene, dt);
   // A new base cooked in the step: the next edit's cook starts from its energy, built on a
   // worker. An adopted base is no new base here: the worker that cooked it kept a copy of its

@@ -7,7 +7,8 @@
 // yet made. When a step finds the topology changed that way, CookAheadSolver
 //   * copies the cloth and cooks a second XpbdSolver for it on a worker thread, which also makes
 //     the new solver's first-step work (XpbdSolver::warm) and, on a machine short of cores,
-//     waits while each step runs (TickGate);
+//     waits while each step runs (TickGate); once the solver is ready it copies what the next
+//     edit's cook reads of its energy (ClothEnergy::spare_copy), beside the steps that use it;
 //   * for the next `ticks` steps steps the base instead: each step copies the cloth's state of
 //     the base's vertices into the base cloth, steps it with the cooked solver and copies the
 //     result back; each new vertex follows the base vertex it was duplicated from (a hand,
@@ -86,6 +87,10 @@ class CookAheadSolver : public Solver {
   int edits_in_step() const { return edits_in_step_; }
   // Steps at which the worker had not finished when its topology was due (the step waited).
   int waits() const { return waits_; }
+  // The last edit taken ahead: wall ms from the worker's start to the new solver ready, and to
+  // the end of its spare energy copy (-1 until then).
+  double ready_ms() const { return ready_ms_.load(std::memory_order_relaxed); }
+  double spare_ms() const { return spare_ms_.load(std::memory_order_relaxed); }
   // Steps from an edit of this cloth to its first step with the new topology.
   int ticks_for(const Cloth& cloth) const;
 
@@ -117,25 +122,30 @@ class CookAheadSolver : public Solver {
   Cloth next_cloth_;
   std::vector<int32_t> next_src_;  // its vertices' base vertices
   std::thread worker_;
-  std::atomic<bool> done_{false};      // the worker has cooked
-  std::atomic<bool> released_{false};  // the worker may start (release())
+  std::atomic<bool> done_{false};        // the worker has cooked (it copies the spare energy after)
+  const XpbdSolver* copying_ = nullptr;  // the solver whose energy that copy reads
+  std::atomic<bool> released_{false};    // the worker may start (release())
   // Closed while a step runs (keep_off_: kAuto's cores rule) that began 1 ms or more after the
   // last one ended: the worker's threads wait at their pause points.
   TickGate gate_;
   bool keep_off_ = false;
   std::chrono::steady_clock::time_point last_step_end_{};
-  // The energy of the base's topology, built by a worker after each new base (only workers
-  // touch it, one after the other): the next edit's cook updates it for the triangles the edit
-  // reached instead of building it whole.
+  // What the next edit's cook reads of the base's energy (ClothEnergy::spare_copy), made by a
+  // worker after each new base (only workers touch it, one after the other): that cook updates
+  // it for the triangles the edit reached instead of building it whole.
   std::unique_ptr<ClothEnergy> spare_;
   void start_spare(const Cloth& cloth);  // a worker builds spare_ for a topology cooked in a step
   // Starts `job` on a new worker thread (after the one before it ends), at idle priority, with a
   // pool of its own.
   void launch(std::function<void(ThreadPool&)> job);
   void release();  // the step that launched the worker is done: it may start
-  // A solver retired by a swap is destroyed off the step (its threads are joined there).
+  // Runs `wait` (a step's wait for a thread that waits at the gate) with the gate open.
+  void with_gate_open(const std::function<void()>& wait);
+  // A solver and base cloth retired by a swap are destroyed off the step, after it (its threads
+  // are joined there).
   std::thread reaper_;
   int edits_ahead_ = 0, edits_in_step_ = 0, waits_ = 0;
+  std::atomic<double> ready_ms_{-1}, spare_ms_{-1};
 };
 
 }  // namespace drape::sim

@@ -1,7 +1,7 @@
 // sim/core/thread_pool.hpp: the thread pool runs every index exactly once, keeps each thread on its
-// own end of the range, holds work made with a closed gate at its pause points, and element
-// colouring gives colours whose elements share no vertex. The file name contains "thread": it
-// also runs in the TSan build.
+// own end of the range, sleeps while it waits long for a worker, holds work made with a closed
+// gate at its pause points, and element colouring gives colours whose elements share no vertex.
+// The file name contains "thread": it also runs in the TSan build.
 #include "sim/core/thread_pool.hpp"
 
 #include <gtest/gtest.h>
@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -119,6 +120,44 @@ TEST(ThreadPool, AnIdleWorkerSleepsAfterSpinning) {
     EXPECT_GT(pool.idle_sleeps(), before) << "rep " << rep;
   }
   EXPECT_EQ(sum.load(), 3 * 64);
+}
+
+// A caller whose worker runs a long chunk sleeps until it ends (a futex the chunk's end wakes)
+// instead of spinning or yielding its core all along: a yield hands the core to any runnable
+// thread, an idle-priority cook ahead's too, until the next scheduler tick.
+TEST(ThreadPool, ACallerWaitingForALongChunkSleeps) {
+  auto thread_cpu_ms = [] {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+  };
+  using Clock = std::chrono::steady_clock;
+  ThreadPool pool(2);
+  std::atomic<bool> worker_in{false};
+  std::atomic<int> slots{0};
+  double cpu0 = 0;
+  Clock::time_point t0{};
+  pool.parallel_slots([&](int slot, int w) {
+    ++slots;
+    if (w == 1) {
+      worker_in = true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(40));
+      return;
+    }
+    if (slot != 0) return;  // (the worker came late: the caller ran its slot)
+    // The caller's slot ends once the worker has taken its own (5 s for a loaded machine).
+    const auto until = Clock::now() + std::chrono::seconds(5);
+    while (!worker_in && Clock::now() < until) std::this_thread::yield();
+    cpu0 = thread_cpu_ms();
+    t0 = Clock::now();
+  });
+  ASSERT_TRUE(worker_in.load()) << "the worker never took its slot";
+  const double cpu = thread_cpu_ms() - cpu0;
+  const double wall = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  std::printf("the caller waited %.1f ms for the worker's chunk on %.2f ms of CPU\n", wall, cpu);
+  EXPECT_EQ(slots.load(), 2);
+  EXPECT_GT(wall, 20.0);
+  EXPECT_LT(cpu, 0.25 * wall) << "the caller spun through the worker's chunk";
 }
 
 // Work kept off the ticks (TickGate): while the gate is closed neither a pool made with it nor a

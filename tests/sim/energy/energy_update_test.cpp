@@ -1,7 +1,8 @@
 // ClothEnergy::update: after a topology change the tensor bending rows of the triangles the
 // change did not reach are kept, the others made again; the rows must be those of a full build
 // bit for bit (after a cut across, its undo, the cut again, a slit, and pins that make triangles
-// rigid), and the cases update() does not serve must fall back to a full build.
+// rigid), also when made on a spare copy of the energy, and the cases update() does not serve
+// must fall back to a full build.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -80,6 +81,39 @@ TEST(EnergyUpdate, RowsAfterACutASlitAndPinsEqualAFullBuild) {
     for (int i = 0; i < n / 3; ++i) c.state.flags[j * n + i] |= kFlagPinned;
   c.topology_changed();
   expect_rows_equal(e, c, "pinned corner");
+}
+
+// A spare copy (what update() reads) updates to the energy that update() of the original and
+// a full build give: the same triangles, hinges and rows.
+TEST(EnergyUpdate, ASpareCopyUpdatesAsTheEnergyItWasCopiedFrom) {
+  const int n = 40;
+  Cloth c = panel(n);
+  ClothEnergy e;
+  e.build(c, row_options());
+  ClothEnergy spare = e.spare_copy();
+  EXPECT_EQ(spare.num_triangles(), e.num_triangles());
+  EXPECT_EQ(spare.bending_row_values(), e.bending_row_values());
+  EXPECT_EQ(spare.num_hinges(), 0) << "what update() remakes is not copied";
+  const double dv = 0.4 / (n - 1);
+  ASSERT_TRUE(
+      cut_along_material(c, {Vec2(-0.01, 0.2 + 0.25 * dv), Vec2(0.41, 0.2 + 0.25 * dv)}).ok);
+  expect_rows_equal(spare, c, "spare copy, cut across");
+  ASSERT_TRUE(e.update(c, row_options()));
+  EXPECT_EQ(spare.rebuilt_triangles(), e.rebuilt_triangles());
+  ASSERT_EQ(spare.num_hinges(), e.num_hinges());
+  for (int h = 0; h < e.num_hinges(); ++h) {
+    ASSERT_EQ(spare.hinge(h), e.hinge(h));
+    ASSERT_EQ(spare.hinge_K(h), e.hinge_K(h));
+    ASSERT_EQ(spare.hinge_w(h), e.hinge_w(h));
+  }
+  for (int t = 0; t < e.num_triangles(); ++t) {
+    ASSERT_EQ(spare.tri(t), e.tri(t));
+    ASSERT_EQ(spare.tri_D(t), e.tri_D(t));
+    ASSERT_EQ(spare.rest_area(t), e.rest_area(t));
+  }
+  EXPECT_EQ(spare.bending_row_offsets(), e.bending_row_offsets());
+  EXPECT_EQ(spare.bending_row_columns(), e.bending_row_columns());
+  EXPECT_EQ(spare.bending_row_values(), e.bending_row_values());
 }
 
 TEST(EnergyUpdate, FallsBackToAFullBuildItDoesNotServe) {

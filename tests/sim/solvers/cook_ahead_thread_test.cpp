@@ -206,9 +206,12 @@ TEST(CookAhead, AnUndoOfTheCutIsCookedInTheStep) {
 // A second cut inside the window maps onto the same base: the base steps on until the first
 // cut's topology is adopted, whose window then opens again for the second. Both land ahead (no
 // cook in a step), the second's sides stay together until its own swap, and the result does not
-// depend on the worker's speed.
+// depend on the worker's speed, nor on whether the second cook starts from the spare energy the
+// first one copied beside the steps (ClothEnergy::spare_copy) or builds its energy whole.
 TEST(CookAhead, ASecondCutInTheWindowLandsAheadToo) {
   const CutRun fast = run(0, true), slow = run(200, true);
+  const CutRun whole = run(0, true, {.spare_energy = false});
+  EXPECT_EQ(whole.hash, fast.hash);
   std::printf("second cut: gap %.3g mm at its window's last step, %.1f mm after; adopted at %d\n",
               1e3 * fast.gap_at_swap, 1e3 * fast.gap_after, fast.adopted_at);
   EXPECT_EQ(fast.edits_ahead, 2);
