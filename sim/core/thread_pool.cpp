@@ -152,10 +152,10 @@ void ThreadPool::run(int n, Thunk thunk, void* ctx, int chunks) {
   generation_.notify_all();
   work(gen, 0);
   // The wait for the chunks workers run: a spin, then (a worker off its core for kSpinBeforeSleep)
-  // a sleep until the last of them ends (work() wakes it). Not a yield: a yield hands the core to
-  // any runnable thread, an idle-priority cook ahead's too, until the next scheduler tick (4 ms
-  // at 250 Hz; measured inside the ticks of a cut's window on two cores), while a sleeper's wake
-  // takes the core back from such a thread at once. (Kept off the ticks: the wait of a pool
+  // a sleep until they end (work() wakes it at each chunk's end). Not a yield: a yield hands the
+  // core to any runnable thread, an idle-priority cook ahead's too, until the next scheduler tick
+  // (4 ms at 250 Hz; measured inside the ticks of a cut's window on two cores), while a sleeper's
+  // wake takes the core back from such a thread at once. (Kept off the ticks: the wait of a pool
   // with a gate sleeps at the closed gate too.)
   constexpr auto kSpinBeforeSleep = std::chrono::microseconds(50);
   std::chrono::steady_clock::time_point t0{};

@@ -136,7 +136,7 @@ class ThreadPool {
   std::atomic<uint64_t> generation_{0};
   std::atomic<uint64_t> next_{0};      // generation << 32 | back << 16 | front (see run())
   std::atomic<int> done_{0};           // chunks finished in this generation
-  std::atomic<int> caller_asleep_{0};  // run() sleeps on done_ (the last chunk wakes it)
+  std::atomic<int> caller_asleep_{0};  // run() sleeps on done_ (a chunk's end wakes it)
   std::atomic<int> chunks_{0};         // chunks of this generation
   std::atomic<bool> stop_{false};
   std::atomic<long> idle_sleeps_{0};

@@ -885,7 +885,7 @@ void ClothEnergy::add_spring(int a, int b, double k, double rest) {
 
 void ClothEnergy::build_vertex_lists() {
   // Only vertex_force_hessian() reads them, which an energy of tensor bending without P refuses
-  // (XPBD's): none are made for it (~13 M instructions of a cut's re-cook at 128^2).
+  // (XPBD's): none are made for it (~5 M instructions of a cut's re-cook at 128^2).
   if (tensor_ && bend_col_.empty()) {
     for (auto* v : {&vt_off_, &vt_, &vh_off_, &vh_, &vs_off_, &vs_}) v->clear();
     return;
