@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "sim/core/stopwatch.hpp"
 #include "sim/ops/cut.hpp"
 #include "sim/ops/operation_controller.hpp"
 #include "sim/runtime/sim_thread.hpp"
@@ -56,13 +57,6 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// CPU time of this thread (ms): the machine is shared, wall time would count other processes.
-double cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
 // A hand stroke across the whole cloth at 90 Hz (1 s), with 3 mm tracking noise.
 std::vector<Vec3> stroke_across(double size) {
   std::mt19937 rng(5);
@@ -90,22 +84,22 @@ void bench_cut(int n, std::vector<Row>& rows) {
   for (int rep = 0; rep < 25; ++rep) {
     Cloth c = base;
     prepare_for_cuts(c);
-    double t0 = cpu_ms();
+    double t0 = thread_cpu_ms();
     last = cut_along(c, stroke);
-    t_full.push_back(cpu_ms() - t0);
+    t_full.push_back(thread_cpu_ms() - t0);
     if (!last.ok) {
       std::fprintf(stderr, "cut failed: %s\n", last.reason.c_str());
       return;
     }
     Cloth c2 = base;
     prepare_for_cuts(c2);
-    t0 = cpu_ms();
+    t0 = thread_cpu_ms();
     cut_path(c2, last.path);
-    t_split.push_back(cpu_ms() - t0);
+    t_split.push_back(thread_cpu_ms() - t0);
     Cloth c3 = base;
-    t0 = cpu_ms();
+    t0 = thread_cpu_ms();
     cut_along(c3, stroke);
-    t_cold.push_back(cpu_ms() - t0);
+    t_cold.push_back(thread_cpu_ms() - t0);
   }
   // The whole command through the controller (undo copy of the cloth + cut), on a World whose
   // cloth the operations prepared in the previous tick (after_step).
@@ -116,9 +110,9 @@ void bench_cut(int n, std::vector<Row>& rows) {
     OperationController oc;
     oc.install(w);
     w.after_step(w, 1.0 / 90);
-    const double t0 = cpu_ms();
+    const double t0 = thread_cpu_ms();
     oc.cut_stroke(w, 0, stroke);
-    t_cmd.push_back(cpu_ms() - t0);
+    t_cmd.push_back(thread_cpu_ms() - t0);
   }
   rows.push_back({"cut", n, median(t_full), -1});
   rows.push_back({"cut_command", n, median(t_cmd), -1});
@@ -174,9 +168,9 @@ void bench_latency(int n, std::vector<Row>& rows) {
                      std::function<bool(const SceneSnapshot&)> effect) {
     auto ms = std::make_shared<double>(0);
     sim.post([op, ms](World& world) {
-      const double t0 = cpu_ms();  // on the sim thread: its CPU time
+      const double t0 = thread_cpu_ms();  // on the sim thread: its CPU time
       op(world);
-      *ms = cpu_ms() - t0;
+      *ms = thread_cpu_ms() - t0;
     });
     int ticks = 0;
     do {
@@ -269,11 +263,6 @@ struct CutTicks {
   std::vector<long> each_preempted;
 };
 
-double thread_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
 long involuntary_switches() {
   rusage u{};
   getrusage(RUSAGE_THREAD, &u);

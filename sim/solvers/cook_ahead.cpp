@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "sim/core/cloth_io.hpp"
+#include "sim/core/stopwatch.hpp"
 #include "sim/core/thread_pool.hpp"
 
 namespace drape::sim {
@@ -171,9 +172,7 @@ void CookAheadSolver::start(const Cloth& cloth, int steps, double dt) {
   copying_ = next_.get();
   launch([this, s = next_.get(), spare = opt_.spare_energy, dt,
           anchors = std::move(anchors)](ThreadPool& pool) {
-    using Clock = std::chrono::steady_clock;
-    const auto t0 = Clock::now();
-    auto ms = [t0] { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); };
+    const auto t0 = std::chrono::steady_clock::now();
     ready_ms_.store(-1, std::memory_order_relaxed);
     spare_ms_.store(-1, std::memory_order_relaxed);
     if (spare_) s->seed_energy(std::move(*spare_));
@@ -181,14 +180,14 @@ void CookAheadSolver::start(const Cloth& cloth, int steps, double dt) {
     s->prepare(next_cloth_, &pool);
     // The first step's masses, blocks and anchor terms, off the swap's step.
     if (opt_.warm) s->warm(next_cloth_, dt, anchors, &pool);
-    ready_ms_.store(ms(), std::memory_order_relaxed);
+    ready_ms_.store(ms_since(t0), std::memory_order_relaxed);
     done_.store(true, std::memory_order_release);
     done_.notify_all();
     // The next edit's cook starts from this topology's energy: a copy of what it reads, made
     // after the swap may take the solver (it reads nothing the steps write; a step that cooks
     // again joins this worker first), instead of a second build after the swap.
     if (spare) spare_ = std::make_unique<ClothEnergy>(s->energy().spare_copy());
-    spare_ms_.store(ms(), std::memory_order_relaxed);
+    spare_ms_.store(ms_since(t0), std::memory_order_relaxed);
   });
   pending_ = true;
   steps_left_ = steps;

@@ -10,12 +10,13 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <memory>
 #include <mutex>
 #include <set>
 #include <thread>
 #include <vector>
+
+#include "sim/core/stopwatch.hpp"
 
 namespace drape::sim {
 namespace {
@@ -126,11 +127,6 @@ TEST(ThreadPool, AnIdleWorkerSleepsAfterSpinning) {
 // instead of spinning or yielding its core all along: a yield hands the core to any runnable
 // thread, an idle-priority cook ahead's too, until the next scheduler tick.
 TEST(ThreadPool, ACallerWaitingForALongChunkSleeps) {
-  auto thread_cpu_ms = [] {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-  };
   using Clock = std::chrono::steady_clock;
   ThreadPool pool(2);
   std::atomic<bool> worker_in{false};
