@@ -62,6 +62,7 @@ void SelfCollision::build_regions(const Cloth& cloth) {
   const int nt = static_cast<int>(tris.size()), n = cloth.num_vertices();
   region_version_ = cloth.topology_version;
   region_tris_ = nt;
+  ++region_builds_;
   // Grid cells kRegionEdges edges wide (an edge: the mean of each triangle's shortest material
   // edge, the grid spacing of a panel), from the lowest material coordinates: on a panel the cells'
   // sides run along grid lines, so that the regions of neighbouring cells share vertices, corners
@@ -80,6 +81,8 @@ void SelfCollision::build_regions(const Cloth& cloth) {
     cell[t] = (static_cast<int64_t>(std::floor(c.x() * ic)) << 32) ^
               static_cast<int64_t>(static_cast<uint32_t>(std::floor(c.y() * ic)));
   }
+  // (A cook ahead builds the regions on a worker: pause points between the parts, TickGate.)
+  pause_point();
   // Triangles of one cell that share a vertex are joined (union-find over each vertex's fan).
   std::vector<int32_t> fan_lo(n + 1, 0), fan, parent(nt);
   for (const auto& t : tris)
@@ -90,6 +93,7 @@ void SelfCollision::build_regions(const Cloth& cloth) {
   for (int t = 0; t < nt; ++t)
     for (const int v : tris[t]) fan[at[v]++] = t;
   for (int t = 0; t < nt; ++t) parent[t] = t;
+  pause_point();
   for (int v = 0; v < n; ++v)
     for (int i = fan_lo[v]; i < fan_lo[v + 1]; ++i)
       for (int j = i + 1; j < fan_lo[v + 1]; ++j)
@@ -114,17 +118,32 @@ void SelfCollision::build_regions(const Cloth& cloth) {
   for (int t = 0; t < nt; ++t) region_tri_[fill[region_of_[t]]++] = t;
   // Adjacent regions: two regions with a common vertex, or with the two ends of one edge (a
   // region of a mesh that is not a grid can meet its diagonal neighbour across one triangle).
+  // Each vertex's distinct regions first (one inside a region, a few on its border), so that a
+  // vertex or an edge pairs a handful of regions rather than every two triangles of its fans.
+  pause_point();
+  std::vector<int32_t> vreg_lo(n + 1, 0), vreg;
+  vreg.reserve(fan.size());
+  for (int v = 0; v < n; ++v) {
+    const size_t first = vreg.size();
+    for (int i = fan_lo[v]; i < fan_lo[v + 1]; ++i) {
+      const int r = region_of_[fan[i]];
+      if (std::find(vreg.begin() + first, vreg.end(), r) == vreg.end()) vreg.push_back(r);
+    }
+    vreg_lo[v + 1] = static_cast<int32_t>(vreg.size());
+  }
   std::vector<uint64_t> adjacent;  // (a << 32 | b), a < b: regions sharing a vertex
   auto join = [&](int u, int v) {
-    for (int i = fan_lo[u]; i < fan_lo[u + 1]; ++i)
-      for (int j = fan_lo[v]; j < fan_lo[v + 1]; ++j) {
-        const int a = region_of_[fan[i]], b = region_of_[fan[j]];
+    for (int i = vreg_lo[u]; i < vreg_lo[u + 1]; ++i)
+      for (int j = vreg_lo[v]; j < vreg_lo[v + 1]; ++j) {
+        const int a = vreg[i], b = vreg[j];
         if (a != b) adjacent.push_back((uint64_t(std::min(a, b)) << 32) | uint64_t(std::max(a, b)));
       }
   };
+  pause_point();
   for (int v = 0; v < n; ++v) join(v, v);
   for (const auto& t : tris)
     for (int k = 0; k < 3; ++k) join(t[k], t[(k + 1) % 3]);
+  pause_point();
   std::sort(adjacent.begin(), adjacent.end());
   adjacent.erase(std::unique(adjacent.begin(), adjacent.end()), adjacent.end());
   // The same both ways, per region (CSR: adj_lo_, adj_).
@@ -142,6 +161,12 @@ void SelfCollision::build_regions(const Cloth& cloth) {
     adj_[put[b]++] = a;
   }
   adj_together_.assign(adj_.size(), 0);
+}
+
+void SelfCollision::prepare(const Cloth& cloth) {
+  if (region_cull_ && (region_version_ != cloth.topology_version ||
+                       region_tris_ != static_cast<int>(cloth.topo.triangles.size())))
+    build_regions(cloth);
 }
 
 // Region r's box (its vertices' bounds grown by the reach) and the cone of its triangles'
@@ -278,7 +303,7 @@ void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double 
     conflict_lo_.assign(regions() + 1, 0);
     return;
   }
-  if (region_version_ != cloth.topology_version || region_tris_ != nt) build_regions(cloth);
+  prepare(cloth);
   region_shapes(cloth, x, reach, pool);
   std::vector<char> active;
   find_conflicts(active);

@@ -49,6 +49,10 @@ class SelfCollision {
   double project(const Cloth& cloth, std::vector<Vec3>& x, const double* w, double thickness,
                  std::vector<int>* moved = nullptr) const;
   const std::vector<SelfContact>& contacts() const { return pairs_; }
+  // The cloth's split into regions (per topology: see below), made ahead of the first detection
+  // on it (CookAheadSolver's worker); the detection makes it otherwise.
+  void prepare(const Cloth& cloth);
+  int region_builds() const { return region_builds_; }  // splits made (one per topology)
   // Puts pairs found earlier back (a solver's saved state); clear() forgets them.
   void set_contacts(std::vector<SelfContact> pairs) { pairs_ = std::move(pairs); }
   void clear() { pairs_.clear(); }
@@ -90,6 +94,7 @@ class SelfCollision {
   bool region_cull_ = true;
   uint64_t region_version_ = 0;
   int region_tris_ = -1;
+  int region_builds_ = 0;
   std::vector<int32_t> region_of_;   // per triangle
   std::vector<int32_t> region_lo_;   // per region: its first entry in region_tri_
   std::vector<int32_t> region_tri_;  // triangles grouped by region

@@ -170,7 +170,7 @@ void CookAheadSolver::start(const Cloth& cloth, int steps, double dt) {
     B.inv_mass[i] = B.mass[i] > 0 ? 1.0 / B.mass[i] : 0.0;
   done_.store(false, std::memory_order_relaxed);
   copying_ = next_.get();
-  launch([this, s = next_.get(), spare = opt_.spare_energy, dt,
+  launch([this, s = next_.get(), spare = opt_.spare_energy, dt, self = self_collision_,
           anchors = std::move(anchors)](ThreadPool& pool) {
     const auto t0 = std::chrono::steady_clock::now();
     ready_ms_.store(-1, std::memory_order_relaxed);
@@ -179,7 +179,7 @@ void CookAheadSolver::start(const Cloth& cloth, int steps, double dt) {
     spare_.reset();
     s->prepare(next_cloth_, &pool);
     // The first step's masses, blocks and anchor terms, off the swap's step.
-    if (opt_.warm) s->warm(next_cloth_, dt, anchors, &pool);
+    if (opt_.warm) s->warm(next_cloth_, dt, anchors, self, &pool);
     ready_ms_.store(ms_since(t0), std::memory_order_relaxed);
     done_.store(true, std::memory_order_release);
     done_.notify_all();
@@ -266,6 +266,7 @@ StepStats CookAheadSolver::step(Cloth& cloth, const SceneObjects& scene, double 
     }
   } closed{close ? &gate_ : nullptr, last_step_end_};
   if (close) gate_.close();
+  self_collision_ = scene.self_collision;
   if (pending_) {
     const bool edited_again = cloth.topology_version != next_cloth_.topology_version ||
                               cloth.num_vertices() != next_cloth_.num_vertices();

@@ -121,6 +121,7 @@ class CookAheadSolver : public Solver {
   int steps_left_ = 0;
   Cloth next_cloth_;
   std::vector<int32_t> next_src_;  // its vertices' base vertices
+  bool self_collision_ = false;    // the last step's scene has self-collision (the worker warms it)
   std::thread worker_;
   std::atomic<bool> done_{false};        // the worker has cooked (it copies the spare energy after)
   const XpbdSolver* copying_ = nullptr;  // the solver whose energy that copy reads

@@ -573,7 +573,7 @@ void XpbdSolver::prepare(const Cloth& cloth, ThreadPool* cook_pool) {
 }
 
 void XpbdSolver::warm(const Cloth& cloth, double dt, std::vector<double> anchors,
-                      ThreadPool* pool) {
+                      bool self_collision, ThreadPool* pool) {
   if (!cooked_for(cloth)) return;
   const double* scale = rest_.scales().data();
   const int* piece_of = rest_.piece_of().data();
@@ -589,6 +589,10 @@ void XpbdSolver::warm(const Cloth& cloth, double dt, std::vector<double> anchors
       anchors.size() == 3 * static_cast<size_t>(cloth.num_vertices() + scratch_slots_)) {
     anchor_terms(anchors, pool);
     warm_anchors_ = std::move(anchors);
+  }
+  if (self_collision) {
+    pause_point();
+    self_.prepare(cloth);
   }
 }
 
@@ -687,6 +691,7 @@ void XpbdSolver::substep(Step& c) {
     sweep(c);
     ++c.st.iterations;
   }
+  retest_listed(c);
   if (c.fused && c.scene.self_collision) project_self_after_sweep(c);
   if (c.fused) project_ties_after_sweep(c);
   collect_retests(c);
@@ -944,6 +949,11 @@ void XpbdSolver::plan_substep(Step& c) {
   self_box_.assign(c.self_watch ? slots : 0, SelfBox{});
   if (c.retest) {
     retest_part_.assign(slots, RetestPart{});
+    retest_list_.resize(slots);
+    for (std::vector<int>& listed : retest_list_) {
+      listed.clear();
+      listed.reserve(c.n);
+    }
     unsettle_mark_.assign(static_cast<size_t>(slots) * rest_.num_pieces(), 0);
   }
   c.settle_check = opt_.settle && rest_.settle_scale() > 1.0;
@@ -1223,26 +1233,67 @@ bool XpbdSolver::moved_beyond(const Step& c, int i) const {
   return m2 > c.moved_lim && m2 > energy_.clearance2(i);
 }
 
-// Vertices [b, e) that moved beyond their last test are tested again as contact detection tests
-// them; then as after a detection, a settling piece pushed more than kUnsettleDepth into a fresh
-// plane ends its settling (unsettle_mark_), a vertex up to contact_snap_depth inside it is put
-// on it, and the test's position is kept (x_det_).
-void XpbdSolver::retest_moved(const Step& c, int b, int e, int slot) {
-  RetestPart& rp = retest_part_[slot];
-  const int pieces = rest_.num_pieces();
+// Vertices [b, e) that moved beyond their last test are listed (retest_list_[slot], in vertex
+// order) for retest_listed, which tests them after the sweep; the self-collision watch takes the
+// motion of the others now and theirs once tested (a test may move a vertex onto its plane).
+void XpbdSolver::list_moved(const Step& c, int b, int e, int slot) {
+  std::vector<int>& listed = retest_list_[slot];
+  int from = b;  // the watch's next stretch of unlisted vertices
   for (int i = b; i < e; ++i) {
     if (!moved_beyond(c, i)) continue;
-    rp.deepest = std::max(rp.deepest, energy_.retest_contact(c.cloth, c.scene, i));
-    ++rp.count;
-    const Contact& ct = energy_.tested_contact(i);
-    if (ct.vertex >= 0) {
-      if (c.settle_check && ct.n.dot(c.x[i] - ct.p) < -xpbd::kUnsettleDepth &&
-          c.scale[c.piece_of[i]] > 1.0)
-        unsettle_mark_[static_cast<size_t>(slot) * pieces + c.piece_of[i]] = 1;
-      snap_onto(c.cloth, ct);
-    }
-    x_det_[i] = c.x[i];
+    listed.push_back(i);  // (no allocation: reserved for every vertex)
+    if (c.self_watch) self_motion(c, from, i, slot);
+    from = i + 1;
   }
+  if (c.self_watch) self_motion(c, from, e, slot);
+}
+
+// The vertices list_moved listed are tested again as contact detection tests them; then as after
+// a detection, a settling piece pushed more than kUnsettleDepth into a fresh plane ends its
+// settling (unsettle_mark_), a vertex up to contact_snap_depth inside it is put on it, and the
+// test's position is kept (x_det_). A vertex's test reads and writes that vertex alone, so the
+// tests run in any order after the sweep, on the whole pool: the vertices that move (a flap
+// falling after a cut) often lie in one slot's strip, and tested in the sweep they kept that
+// slot's thread busy while the others waited at its border.
+void XpbdSolver::retest_listed(const Step& c) {
+  if (!c.retest) return;
+  const int slots = static_cast<int>(retest_list_.size());
+  retest_off_.assign(slots + 1, 0);
+  for (int t = 0; t < slots; ++t)
+    retest_off_[t + 1] = retest_off_[t] + static_cast<int>(retest_list_[t].size());
+  const int listed = retest_off_[slots];
+  if (listed == 0) return;
+  const int pieces = rest_.num_pieces();
+  // Entries [b, e) of the slots' lists one after the other.
+  auto test = [&](int b, int e, int wk) {
+    RetestPart& rp = retest_part_[wk];
+    double deepest = 0;
+    int t = static_cast<int>(std::upper_bound(retest_off_.begin(), retest_off_.end(), b) -
+                             retest_off_.begin()) -
+            1;
+    for (int k = b; k < e; ++k) {
+      while (k >= retest_off_[t + 1]) ++t;
+      const int i = retest_list_[t][k - retest_off_[t]];
+      deepest = std::max(deepest, energy_.retest_contact(c.cloth, c.scene, i));
+      const Contact& ct = energy_.tested_contact(i);
+      if (ct.vertex >= 0) {
+        if (c.settle_check && ct.n.dot(c.x[i] - ct.p) < -xpbd::kUnsettleDepth &&
+            c.scale[c.piece_of[i]] > 1.0)
+          unsettle_mark_[static_cast<size_t>(wk) * pieces + c.piece_of[i]] = 1;
+        snap_onto(c.cloth, ct);
+      }
+      x_det_[i] = c.x[i];
+      if (c.self_watch) self_box_[wk].add(c.x[i] - x_self_[i]);
+    }
+    rp.count += e - b;
+    rp.deepest = std::max(rp.deepest, deepest);
+  };
+  // A few tests do not pay for waking the pool.
+  constexpr int kRetestsOnPool = 64;
+  if (listed < kRetestsOnPool)
+    test(0, listed, 0);
+  else
+    pool_->parallel_for(listed, test);
 }
 
 // The contact-reuse test: some vertex of [b, e) moved beyond its last test (moved_part_, per
@@ -1339,8 +1390,10 @@ void XpbdSolver::sweep_items(const Step& c, const xpbd::SweepPlan::Phase& P, int
         energy_.project_tested_contacts(c.x, &c.S.x_prev, c.scene.friction, vb, ve);
         block_velocities(c, k, vb, ve, slot);
         if (opt_.settle || opt_.freeze) block_motion(c, k, vb, ve);
-        if (c.retest) retest_moved(c, vb, ve, slot);
-        if (c.self_watch) self_motion(c, vb, ve, slot);
+        if (c.retest)
+          list_moved(c, vb, ve, slot);  // (and the self-collision watch)
+        else if (c.self_watch)
+          self_motion(c, vb, ve, slot);
       }
   }
 }

@@ -51,11 +51,13 @@ class XpbdSolver : public Solver {
   // The work of a cooked solver's first step done ahead, on `pool` (CookAheadSolver's worker,
   // after prepare): the inverse masses and the bending blocks' inverses for the cloth's pins
   // and frozen vertices and frames of length dt (0: not made), and single precision's element
-  // terms at
-  // `anchors` (3 per vertex, then the scratch vertices'; none: not made). The step keeps what
-  // still holds when it comes (the same masses and substep; take_anchors with the same anchors)
-  // and makes the rest again: no result depends on whether or when warm ran.
-  void warm(const Cloth& cloth, double dt, std::vector<double> anchors, ThreadPool* pool);
+  // terms at `anchors` (3 per vertex, then the scratch vertices'; none: not made), and with
+  // `self_collision` the cloth's split into self-collision regions (SelfCollision::prepare).
+  // The step keeps what still holds when it comes (the same masses and substep; take_anchors with
+  // the same anchors; the regions of the same topology) and makes the rest again: no result
+  // depends on whether or when warm ran.
+  void warm(const Cloth& cloth, double dt, std::vector<double> anchors, bool self_collision,
+            ThreadPool* pool);
   // The anchors the next step starts from instead of new ones at its positions (a solver taking
   // over from another: CookAheadSolver's swap); their element terms are made here unless warm
   // made them for the same anchors. Ignored unless single precision and the cooked cloth's size.
@@ -217,7 +219,8 @@ class XpbdSolver : public Solver {
   void block_velocities(const Step& c, int k, int b, int e, int wk);
   void block_motion(const Step& c, int k, int b, int e);
   bool moved_beyond(const Step& c, int i) const;
-  void retest_moved(const Step& c, int b, int e, int slot);
+  void list_moved(const Step& c, int b, int e, int slot);
+  void retest_listed(const Step& c);
   void test_moved_part(const Step& c, int b, int e, int wk);
   // Runs fn(b, e, worker) over each colour's items (offsets off), colour after colour; the packs'
   // version gives each share of a colour's packs to its own thread (xpbd::share_begin).
@@ -314,6 +317,10 @@ class XpbdSolver : public Solver {
     double deepest = 0;
   };
   std::vector<RetestPart> retest_part_;
+  // Per sweep slot: the vertices its share found moved beyond their last test in this substep;
+  // retest_off_: where each slot's list starts when they are laid one after the other.
+  std::vector<std::vector<int>> retest_list_;
+  std::vector<int> retest_off_;
   // Contacts tested again in the sweep and not yet in the energy's contact list (the sweep
   // projects the tested ones, ClothEnergy::project_tested_contacts): listed at the step's end.
   bool contacts_unlisted_ = false;

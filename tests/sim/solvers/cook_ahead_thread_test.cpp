@@ -49,14 +49,16 @@ struct CutRun {
   int adopted_at = -1;  // steps after the cut's until the solver stepped the cut topology
   double gap_at_swap = -1, gap_after = -1;
   long anchor_renewals = -1;  // by the solver adopted at the swap, in its first step
+  int region_builds = -1;     // the self-collision splits the solver at the end has made
 };
 
 // The form drape cut across at half its height after 30 steps and stepped 40 more; with
 // second_cut, cut again at a quarter of its height after the first cut's step (inside its
-// window). The gaps are those of the last cut.
+// window). The gaps are those of the last cut. self_collision: the scene's.
 CutRun run(int worker_delay_ms, bool second_cut = false, CookAheadOptions o = {},
-           int frames_before = 30) {
+           int frames_before = 30, bool self_collision = false) {
   Testbed sc = make_scene("form", kRes);
+  sc.objects.self_collision = self_collision;
   o.ticks = kTicks;
   o.worker_delay_ms = worker_delay_ms;
   CookAheadSolver s(options(sc), o);
@@ -80,6 +82,7 @@ CutRun run(int worker_delay_ms, bool second_cut = false, CookAheadOptions o = {}
   }
   r.gap_after = largest_gap(sc.cloth, before);
   r.hash = state_hash(sc.cloth);
+  r.region_builds = s.xpbd().self_collision().region_builds();
   r.waits = s.waits();
   r.edits_ahead = s.edits_ahead();
   r.edits_in_step = s.edits_in_step();
@@ -125,6 +128,19 @@ TEST(CookAhead, TheWarmUpAndTheGateChangeNoResult) {
       EXPECT_EQ(warm.anchor_renewals, 0) << "the base's anchors were not kept";
     }
   }
+}
+
+// With self-collision on, the worker's warm-up also splits the cut cloth into self-collision
+// regions (the swap's first detection otherwise does): the same cloth, bit for bit.
+TEST(CookAhead, SelfCollisionRegionsMadeAheadChangeNoResult) {
+  using K = CookAheadOptions::KeepOff;
+  const CutRun plain = run(0, false, {.warm = false, .keep_off_steps = K::kNever}, 30, true);
+  const CutRun warm = run(0, false, {.warm = true, .keep_off_steps = K::kNever}, 30, true);
+  const CutRun slow = run(50, false, {.warm = true, .keep_off_steps = K::kAlways}, 30, true);
+  EXPECT_EQ(warm.adopted_at, kTicks);
+  EXPECT_EQ(warm.hash, plain.hash);
+  EXPECT_EQ(slow.hash, plain.hash);
+  EXPECT_EQ(warm.region_builds, 1) << "the adopted solver split the cut cloth once";
 }
 
 TEST(CookAhead, TheSidesStayTogetherUntilTheSwapAndPartAfter) {
