@@ -203,8 +203,13 @@ void ClothEnergy::build(const Cloth& cloth, const EnergyOptions& opt, ThreadPool
   }
   pause_point();
   contact_index_.assign(num_vertices_, -1);
+  // The contact tests' arrays sized and written here, so that the cook (on a cook ahead's worker)
+  // takes their page faults rather than the first step's detection.
+  contacts_.assign(num_vertices_, Contact{});
   contacts_.clear();
-  contacts_.reserve(num_vertices_);
+  candidate_.assign(num_vertices_, Contact{});
+  has_candidate_.assign(num_vertices_, 0);
+  clearance2_.assign(num_vertices_, 0.0f);
   build_vertex_lists();
   note_built(cloth);
 }
