@@ -1236,9 +1236,9 @@ bool XpbdSolver::moved_beyond(const Step& c, int i) const {
   return m2 > c.moved_lim && m2 > energy_.clearance2(i);
 }
 
-// Vertices [b, e) that moved beyond their last test are listed (retest_list_[slot], in vertex
-// order) for retest_listed, which tests them after the sweep; the self-collision watch takes the
-// motion of the others now and theirs once tested (a test may move a vertex onto its plane).
+// Vertices [b, e) that moved beyond their last test are listed (retest_list_[slot]) for
+// retest_listed, which tests them after the sweep; the self-collision watch takes the motion of
+// the others now and theirs once tested (a test may move a vertex onto its plane).
 void XpbdSolver::list_moved(const Step& c, int b, int e, int slot) {
   std::vector<int>& listed = retest_list_[slot];
   int from = b;  // the watch's next stretch of unlisted vertices

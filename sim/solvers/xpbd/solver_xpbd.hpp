@@ -310,8 +310,8 @@ class XpbdSolver : public Solver {
   static constexpr int kSweepBlock = 256;
   xpbd::SweepPlan sweep_;
   long sweeps_ = 0, sweep_takeovers_ = 0, contact_retests_ = 0;
-  // Per sweep slot: vertices tested again for contact and their deepest penetration; pieces a
-  // test ends the settling of (slot * pieces + piece).
+  // Per pool thread of the retests (retest_listed): vertices tested again for contact and their
+  // deepest penetration; pieces a test ends the settling of (thread * pieces + piece).
   struct RetestPart {
     long count = 0;
     double deepest = 0;
@@ -321,7 +321,7 @@ class XpbdSolver : public Solver {
   // retest_off_: where each slot's list starts when they are laid one after the other.
   std::vector<std::vector<int>> retest_list_;
   std::vector<int> retest_off_;
-  // Contacts tested again in the sweep and not yet in the energy's contact list (the sweep
+  // Contacts tested again after a sweep and not yet in the energy's contact list (the sweep
   // projects the tested ones, ClothEnergy::project_tested_contacts): listed at the step's end.
   bool contacts_unlisted_ = false;
   std::vector<char> unsettle_mark_;
