@@ -213,6 +213,7 @@ void CookAheadSolver::adopt() {
   }
   next_->options() = active_->options();
   next_->set_ties(active_->ties(), active_->tie_passes());
+  next_->trade_pool(*active_);
   // The new vertices start from their base vertices' anchors, as they start from their positions.
   next_->take_anchors(
       mapped_anchors(*active_, base_.num_vertices(), next_src_, next_cloth_.num_vertices()));

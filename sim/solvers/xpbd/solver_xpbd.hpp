@@ -41,6 +41,14 @@ class XpbdSolver : public Solver {
   std::string name() const override { return "xpbd"; }
   StepStats step(Cloth& cloth, const SceneObjects& scene, double dt) override;
   ThreadPool* pool() override { return pool_.get(); }
+  // Trades thread pools with `other` when both have as many threads: a solver taking over from
+  // another (CookAheadSolver's swap) steps on the threads that stepped that one, awake and on their
+  // cores, rather than on its own, asleep since it was made (measured: a pool woken for the swap's
+  // step could miss the whole step, its share run by the stepping thread). Results do not depend
+  // on which threads run a step.
+  void trade_pool(XpbdSolver& other) {
+    if (pool_->size() == other.pool_->size()) std::swap(pool_, other.pool_);
+  }
   // Cooks the element data of the cloth's topology unless they are cooked already (the first
   // step does it otherwise): CookAheadSolver cooks a cut's topology this way on a worker thread
   // while another solver steps on. Reads only the cloth's topology, fabric and masses. The
