@@ -50,6 +50,7 @@ struct CutRun {
   double gap_at_swap = -1, gap_after = -1;
   long anchor_renewals = -1;  // by the solver adopted at the swap, in its first step
   int region_builds = -1;     // the self-collision splits the solver at the end has made
+  bool same_pool = false;     // the adopted solver steps on the threads that stepped the base
 };
 
 // The form drape cut across at half its height after 30 steps and stepped 40 more; with
@@ -63,6 +64,7 @@ CutRun run(int worker_delay_ms, bool second_cut = false, CookAheadOptions o = {}
   o.worker_delay_ms = worker_delay_ms;
   CookAheadSolver s(options(sc), o);
   for (int f = 0; f < frames_before; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+  const ThreadPool* base_pool = s.pool();
   int before = sc.cloth.num_vertices();
   EXPECT_TRUE(cut_across(sc.cloth));
   // The second cut's window opens when the first cut's topology is adopted.
@@ -76,6 +78,7 @@ CutRun run(int worker_delay_ms, bool second_cut = false, CookAheadOptions o = {}
     s.step(sc.cloth, sc.objects, 1.0 / 90);
     if (r.adopted_at < 0 && !s.pending()) {
       r.adopted_at = f;
+      r.same_pool = s.pool() == base_pool;
       r.anchor_renewals = s.xpbd().anchor_renewals();
     }
     if (f == swap - 1) r.gap_at_swap = largest_gap(sc.cloth, before);  // the window's last
@@ -101,6 +104,7 @@ TEST(CookAhead, TheCutLandsAtTheSameStepWhateverTheWorker) {
   EXPECT_EQ(fast.adopted_at, kTicks);
   EXPECT_EQ(slow.adopted_at, kTicks);
   EXPECT_EQ(fast.hash, slow.hash);
+  EXPECT_TRUE(fast.same_pool) << "the adopted solver steps on the base's awake threads";
 }
 
 // What the worker does beyond the cook changes when things run, not what they give: its warm-up
