@@ -591,7 +591,7 @@ void XpbdSolver::warm(const Cloth& cloth, double dt, std::vector<double> anchors
     warm_anchors_ = std::move(anchors);
   }
   // The positions of the contacts' last tests, written (their pages faulted) here rather than in
-  // the first step's prediction; that step's detection sets them all.
+  // the first step's prediction, which copies every position into them after its detection.
   x_det_.assign(cloth.num_vertices(), Vec3::Zero());
   if (self_collision) {
     pause_point();
