@@ -131,6 +131,16 @@ void SelfCollision::build_regions(const Cloth& cloth) {
     }
     vreg_lo[v + 1] = static_cast<int32_t>(vreg.size());
   }
+  // Each region's vertices (those of its triangles, once each: CSR region_vlo_, region_vert_).
+  region_vlo_.assign(regions + 1, 0);
+  for (const int32_t r : vreg) ++region_vlo_[r + 1];
+  for (int r = 0; r < regions; ++r) region_vlo_[r + 1] += region_vlo_[r];
+  region_vert_.resize(vreg.size());
+  {
+    std::vector<int32_t> put(region_vlo_.begin(), region_vlo_.end() - 1);
+    for (int v = 0; v < n; ++v)
+      for (int i = vreg_lo[v]; i < vreg_lo[v + 1]; ++i) region_vert_[put[vreg[i]]++] = v;
+  }
   std::vector<uint64_t> adjacent;  // (a << 32 | b), a < b: regions sharing a vertex
   auto join = [&](int u, int v) {
     for (int i = vreg_lo[u]; i < vreg_lo[u + 1]; ++i)
@@ -167,6 +177,13 @@ void SelfCollision::prepare(const Cloth& cloth) {
   if (region_cull_ && (region_version_ != cloth.topology_version ||
                        region_tris_ != static_cast<int>(cloth.topo.triangles.size())))
     build_regions(cloth);
+  // The detection's arrays per triangle and per vertex, sized and written here (on a cook-ahead
+  // worker) rather than page-faulted in the first detection on the topology (3 MB at 128^2).
+  const size_t nt = cloth.topo.triangles.size(), n = static_cast<size_t>(cloth.num_vertices());
+  if (pre_.size() != nt) pre_.assign(nt, {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
+  if (region_n_.size() != region_tri_.size()) region_n_.assign(region_tri_.size(), Vec3::Zero());
+  active_tri_.reserve(nt);
+  active_vert_.reserve(n);
 }
 
 // Region r's box (its vertices' bounds grown by the reach) and the cone of its triangles'
@@ -175,30 +192,47 @@ void SelfCollision::region_box(const Cloth& cloth, const std::vector<Vec3>& x, d
                                int r) {
   const auto& tris = cloth.topo.triangles;
   Box& b = box_[r];
-  b.lo = Vec3::Constant(std::numeric_limits<double>::infinity());
-  b.hi = -b.lo;
+  double lo[3], hi[3];  // (plain arrays: the loop keeps them in registers)
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::numeric_limits<double>::infinity();
+    hi[a] = -lo[a];
+  }
+  for (int k = region_vlo_[r]; k < region_vlo_[r + 1]; ++k) {
+    const Vec3& p = x[region_vert_[k]];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], p[a]);
+      hi[a] = std::max(hi[a], p[a]);
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    b.lo[a] = lo[a] - reach;
+    b.hi[a] = hi[a] + reach;
+  }
   Vec3 sum = Vec3::Zero();
   for (int k = region_lo_[r]; k < region_lo_[r + 1]; ++k) {
     const auto& T = tris[region_tri_[k]];
-    for (const int v : T) {
-      b.lo = b.lo.cwiseMin(x[v]);
-      b.hi = b.hi.cwiseMax(x[v]);
-    }
     region_n_[k] = (x[T[1]] - x[T[0]]).cross(x[T[2]] - x[T[0]]);
     sum += region_n_[k];
   }
-  b.lo.array() -= reach;
-  b.hi.array() += reach;
   b.cone = 3.14159265358979323846;
   const double len = sum.norm();
   if (!(len > 0)) return;
   b.axis = sum / len;
-  double cmin = 1;
+  // The smallest cosine of a normal to the axis, as the signed square c |c| = d |d| / |N|^2
+  // (d = N . axis), kept as a fraction num / den: no root or division per triangle.
+  double num = 1, den = 1;
   for (int k = region_lo_[r]; k < region_lo_[r + 1]; ++k) {
     const Vec3& N = region_n_[k];
-    const double nn = N.norm();
-    cmin = std::min(cmin, nn > 0 ? N.dot(b.axis) / nn : -1.0);
+    const double nn = N.squaredNorm(), d = N.dot(b.axis);
+    const double sq = nn > 0 ? d * std::abs(d) : -1.0;
+    const double q = nn > 0 ? nn : 1.0;
+    if (sq * den < num * q) {
+      num = sq;
+      den = q;
+    }
   }
+  const double c2 = num / den;
+  const double cmin = c2 >= 0 ? std::sqrt(c2) : -std::sqrt(-c2);
   b.cone = std::acos(std::clamp(cmin, -1.0, 1.0));
 }
 
@@ -254,18 +288,33 @@ void SelfCollision::find_conflicts(std::vector<char>& active) {
   const std::vector<Box>& box = box_;
   active.assign(R, 0);
   for (int r = 0; r < R; ++r) active[r] = !region_flat_[r];
-  std::vector<int32_t> order(R);
-  for (int r = 0; r < R; ++r) order[r] = r;
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return box[a].lo.x() < box[b].lo.x(); });
+  // The sweep runs along the axis of the boxes' widest spread (a draped cloth hangs: most of
+  // its boxes overlap in x and z, few in y), over (low end, region) pairs sorted by low end.
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (int r = 0; r < R; ++r) {
+    lo = lo.cwiseMin(box[r].lo);
+    hi = hi.cwiseMax(box[r].hi);
+  }
+  int ax = 0;
+  for (int a = 1; a < 3; ++a)
+    if (hi[a] - lo[a] > hi[ax] - lo[ax]) ax = a;
+  const int ay = (ax + 1) % 3, az = (ax + 2) % 3;
+  order_.resize(R);
+  for (int r = 0; r < R; ++r) order_[r] = {box[r].lo[ax], r};
+  std::sort(order_.begin(), order_.end());
+  // The boxes in that order, their sweep axis first (the inner loop reads them in sequence).
+  sweep_.resize(R);
+  for (int i = 0; i < R; ++i) {
+    const Box& B = box[order_[i].second];
+    sweep_[i] = {{B.lo[ax], B.hi[ax], B.lo[ay], B.hi[ay], B.lo[az], B.hi[az]}, order_[i].second};
+  }
   conflict_.clear();
   for (int i = 0; i < R; ++i) {
-    const Box& A = box[order[i]];
-    for (int j = i + 1; j < R && box[order[j]].lo.x() <= A.hi.x(); ++j) {
-      const Box& B = box[order[j]];
-      if (B.lo.y() > A.hi.y() || A.lo.y() > B.hi.y() || B.lo.z() > A.hi.z() || A.lo.z() > B.hi.z())
-        continue;
-      const int a = order[i], b = order[j];
+    const SweepBox& A = sweep_[i];
+    for (int j = i + 1; j < R && sweep_[j].b[0] <= A.b[1]; ++j) {
+      const SweepBox& B = sweep_[j];
+      if (B.b[2] > A.b[3] || A.b[2] > B.b[3] || B.b[4] > A.b[5] || A.b[4] > B.b[5]) continue;
+      const int a = A.r, b = B.r;
       if (flat_together(a, b)) continue;
       active[a] = active[b] = 1;
       conflict_.push_back((uint64_t(a) << 32) | uint64_t(b));
@@ -293,8 +342,10 @@ void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double 
   const auto& tris = cloth.topo.triangles;
   const int nt = static_cast<int>(tris.size()), n = cloth.num_vertices();
   if (!region_cull_) {
-    tri_active_.assign(nt, 1);
-    vertex_active_.assign(n, 1);
+    active_tri_.resize(nt);
+    for (int t = 0; t < nt; ++t) active_tri_[t] = t;
+    active_vert_.resize(n);
+    for (int v = 0; v < n; ++v) active_vert_[v] = v;
     active_regions_ = regions();
     active_tris_ = nt;
     region_flat_.assign(regions(), 0);
@@ -305,15 +356,17 @@ void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double 
   }
   prepare(cloth);
   region_shapes(cloth, x, reach, pool);
+  pause_point();
   std::vector<char> active;
   find_conflicts(active);
   // Tested: the triangles of a folded region, and those of a flat one within reach of a region
   // it meets (no vertex of its own or of a region flat together with it pairs with them); the
   // vertices whose home region is folded, or flat and inside such a box (a vertex pairs only
   // with a triangle of a region its home meets otherwise: see the tests' skip in detect()).
-  tri_active_.assign(nt, 0);
-  vertex_active_.assign(n, 0);
-  active_regions_ = active_tris_ = 0;
+  // Both lists in ascending order, as the hash and the tests take them (the pairs' order).
+  active_tri_.clear();
+  active_vert_.clear();
+  active_regions_ = 0;
   for (int r = 0; r < regions(); ++r) {
     if (!active[r]) continue;
     ++active_regions_;
@@ -327,28 +380,29 @@ void SelfCollision::cull(const Cloth& cloth, const std::vector<Vec3>& x, double 
                    a.cwiseMax(b).cwiseMax(c).array() + reach))
           continue;
       }
-      tri_active_[t] = 1;
-      ++active_tris_;
+      active_tri_.push_back(t);
+    }
+    for (int k = region_vlo_[r]; k < region_vlo_[r + 1]; ++k) {
+      const int v = region_vert_[k];
+      if (vertex_region_[v] == r && (!region_flat_[r] || meets(r, x[v], x[v])))
+        active_vert_.push_back(v);
     }
   }
-  for (int v = 0; v < n; ++v) {
-    const int h = vertex_region_[v];
-    vertex_active_[v] = h >= 0 && active[h] && (!region_flat_[h] || meets(h, x[v], x[v]));
-  }
+  std::sort(active_tri_.begin(), active_tri_.end());
+  std::sort(active_vert_.begin(), active_vert_.end());
+  active_tris_ = static_cast<int>(active_tri_.size());
 }
 
 // The hash of the tested triangles' grown boxes (table_start_, entries_, spheres_; cells of
 // 1 / hash_ic_, buckets masked by hash_mask_).
 void SelfCollision::build_hash(const Cloth& cloth, const std::vector<Vec3>& x, double reach) {
   const auto& tris = cloth.topo.triangles;
-  const int nt = static_cast<int>(tris.size());
   // Cell size: the mean edge length plus twice the reach, so that a triangle's grown box spans
   // at most two cells per axis. On fine meshes the reach dominates the cell, so where a whole
   // sheet is hashed a vertex's bucket holds ~190 triangles at 128^2 (18 mm cells); the
   // bounding-sphere test below rejects most of them from the entry alone.
   double edge = 0;
-  for (int t = 0; t < nt; ++t)
-    if (tri_active_[t]) edge += (x[tris[t][1]] - x[tris[t][0]]).norm();
+  for (const int t : active_tri_) edge += (x[tris[t][1]] - x[tris[t][0]]).norm();
   const double cell = edge / active_tris_ + 2 * reach;
   const double ic = hash_ic_ = 1.0 / cell;
   auto coord = [&](double v) { return static_cast<int>(std::floor(v * ic)); };
@@ -374,9 +428,8 @@ void SelfCollision::build_hash(const Cloth& cloth, const std::vector<Vec3>& x, d
         for (int k = 0; k <= ez; ++k) fn(pack(x0 + i, y0 + j, z0 + k));
   };
   // Counting sort of (bucket, triangle): counts, prefix sums, fill.
-  for (int t = 0; t < nt; ++t)
-    if (tri_active_[t])
-      for_cells(t, [&](uint32_t cell) { ++table_start_[bucket(cell, mask) + 1]; });
+  for (const int t : active_tri_)
+    for_cells(t, [&](uint32_t cell) { ++table_start_[bucket(cell, mask) + 1]; });
   for (uint32_t b = 0; b < size; ++b) table_start_[b + 1] += table_start_[b];
   entries_.resize(table_start_[size]);
   fill_.assign(table_start_.begin(), table_start_.end() - 1);
@@ -385,8 +438,7 @@ void SelfCollision::build_hash(const Cloth& cloth, const std::vector<Vec3>& x, d
   // triangle (most of a bucket's candidates: the bucket spans 18 mm at 128^2, the reach sphere
   // 7 mm + the triangle).
   spheres_.resize(entries_.size());
-  for (int t = 0; t < nt; ++t) {
-    if (!tri_active_[t]) continue;
+  for (const int t : active_tri_) {
     const Vec3& a = x[tris[t][0]];
     const Vec3& b = x[tris[t][1]];
     const Vec3& c = x[tris[t][2]];
@@ -407,13 +459,14 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
   pairs_.clear();
   const auto& tris = cloth.topo.triangles;
   const int nt = static_cast<int>(tris.size());
-  const int n = cloth.num_vertices();
   if (nt == 0) return 0;
   const auto& flags = cloth.state.flags;
   const double reach = thickness + margin;
   cull(cloth, x, reach, pool);
   if (active_tris_ == 0) return 0;
+  pause_point();  // (a detection on a cook-ahead worker waits here while a tick runs)
   build_hash(cloth, x, reach);
+  pause_point();
   const double ic = hash_ic_;
   const uint32_t mask = hash_mask_;
   auto coord = [&](double v) { return static_cast<int>(std::floor(v * ic)); };
@@ -422,8 +475,8 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
   // each candidate then costs three dot products.
   pre_.resize(nt);
   auto frames = [&](int b, int e, int) {
-    for (int t = b; t < e; ++t) {
-      if (!tri_active_[t]) continue;
+    for (int i = b; i < e; ++i) {
+      const int t = active_tri_[i];
       TriFrame& f = pre_[t];
       f.a = x[tris[t][0]];
       const Vec3 e1 = x[tris[t][1]] - f.a, e2 = x[tris[t][2]] - f.a, N = e1.cross(e2);
@@ -438,9 +491,10 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
     }
   };
   if (pool)
-    pool->parallel_for(nt, frames);
+    pool->parallel_for(active_tris_, frames);
   else
-    frames(0, nt, 0);
+    frames(0, active_tris_, 0);
+  pause_point();
   // Pass 2: each vertex against the triangles of its cell's bucket. With a pool the vertices run
   // in one contiguous part per thread, each into its own list, joined in part order: the pairs
   // of one thread in the same order.
@@ -449,9 +503,10 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
   };
   // A vertex of a flat region skips the triangles of that region and of the regions it is flat
   // together with (the cull's reason: no pair lies there).
-  auto test = [&](int vb, int ve, std::vector<SelfContact>& out) {
-    for (int v = vb; v < ve; ++v) {
-      if (!vertex_active_[v] || (flags[v] & (kFlagNoCollide | kFlagKinematic))) continue;
+  auto test = [&](int ib, int ie, std::vector<SelfContact>& out) {
+    for (int i = ib; i < ie; ++i) {
+      const int v = active_vert_[i];
+      if (flags[v] & (kFlagNoCollide | kFlagKinematic)) continue;
       const int home = region_cull_ ? vertex_region_[v] : -1;
       const bool flat = home >= 0 && region_flat_[home];
       const Vec3& p = x[v];
@@ -483,10 +538,10 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
     }
   };
   if (!pool || pool->size() < 2) {
-    test(0, n, pairs_);
+    test(0, static_cast<int>(active_vert_.size()), pairs_);
   } else {
     part_pairs_.resize(pool->size());
-    pool->parallel_parts(n, [&](int vb, int ve, int part) {
+    pool->parallel_parts(static_cast<int>(active_vert_.size()), [&](int vb, int ve, int part) {
       part_pairs_[part].clear();
       test(vb, ve, part_pairs_[part]);
     });

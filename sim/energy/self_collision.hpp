@@ -95,13 +95,15 @@ class SelfCollision {
   uint64_t region_version_ = 0;
   int region_tris_ = -1;
   int region_builds_ = 0;
-  std::vector<int32_t> region_of_;   // per triangle
-  std::vector<int32_t> region_lo_;   // per region: its first entry in region_tri_
-  std::vector<int32_t> region_tri_;  // triangles grouped by region
+  std::vector<int32_t> region_of_;                 // per triangle
+  std::vector<int32_t> region_lo_;                 // per region: its first entry in region_tri_
+  std::vector<int32_t> region_tri_;                // triangles grouped by region
+  std::vector<int32_t> region_vlo_, region_vert_;  // per region its vertices (CSR)
   // A vertex's home region (that of the first triangle around it; -1: in none). A vertex of a
   // flat region tests no triangle of its home region nor of a region flat together with it.
   std::vector<int32_t> vertex_region_;
-  std::vector<char> tri_active_, vertex_active_;
+  // The triangles and vertices the last detection tested (ascending).
+  std::vector<int32_t> active_tri_, active_vert_;
   std::vector<Vec3> region_n_;  // per entry of region_tri_: its triangle's area normal (cull)
   struct Box {
     Vec3 lo, hi, axis;
@@ -117,6 +119,14 @@ class SelfCollision {
   // sorted), and per region a its first pair (CSR).
   std::vector<uint64_t> conflict_;
   std::vector<int32_t> conflict_lo_;
+  // find_conflicts' boxes sorted by their low end on the sweep axis: (low end, region), and the
+  // boxes in that order (lo, hi on the sweep axis, then on the other two).
+  std::vector<std::pair<double, int32_t>> order_;
+  struct SweepBox {
+    double b[6];
+    int32_t r;
+  };
+  std::vector<SweepBox> sweep_;
   bool flat_together(int a, int b) const;
   int active_regions_ = 0, active_tris_ = 0;
   void build_regions(const Cloth& cloth);
