@@ -63,6 +63,7 @@ void SelfCollision::build_regions(const Cloth& cloth) {
   region_version_ = cloth.topology_version;
   region_tris_ = nt;
   ++region_builds_;
+  shapes_found_ = false;
   // Grid cells kRegionEdges edges wide (an edge: the mean of each triangle's shortest material
   // edge, the grid spacing of a panel), from the lowest material coordinates: on a panel the cells'
   // sides run along grid lines, so that the regions of neighbouring cells share vertices, corners
@@ -457,12 +458,14 @@ void SelfCollision::build_hash(const Cloth& cloth, const std::vector<Vec3>& x, d
 int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double thickness,
                           double margin, ThreadPool* pool) {
   pairs_.clear();
+  shapes_found_ = false;
   const auto& tris = cloth.topo.triangles;
   const int nt = static_cast<int>(tris.size());
   if (nt == 0) return 0;
   const auto& flags = cloth.state.flags;
   const double reach = thickness + margin;
   cull(cloth, x, reach, pool);
+  shapes_found_ = region_cull_;
   if (active_tris_ == 0) return 0;
   pause_point();  // (a detection on a cook-ahead worker waits here while a tick runs)
   build_hash(cloth, x, reach);
@@ -548,6 +551,74 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
     for (const auto& part : part_pairs_) pairs_.insert(pairs_.end(), part.begin(), part.end());
   }
   return static_cast<int>(pairs_.size());
+}
+
+bool SelfCollision::keeps_pairs(const Cloth& cloth, const std::vector<Vec3>& x,
+                                const std::vector<Vec3>& x0, double thickness, double margin,
+                                ThreadPool* pool) {
+  if (!region_cull_ || x.size() != x0.size() ||
+      x.size() != static_cast<size_t>(cloth.num_vertices()))
+    return false;
+  if (!shapes_found_ || region_version_ != cloth.topology_version ||
+      region_tris_ != static_cast<int>(cloth.topo.triangles.size())) {
+    // Pairs put back (a saved state): the regions' shapes at x0, as the detection that found
+    // them made them.
+    prepare(cloth);
+    region_shapes(cloth, x0, thickness + margin, pool);
+    std::vector<char> active;
+    find_conflicts(active);
+    shapes_found_ = true;
+  }
+  const int R = regions();
+  motion_.resize(R);
+  auto regions_moved = [&](int rb, int re, int) {
+    for (int r = rb; r < re; ++r) {
+      double lo[3], hi[3], most2 = 0;  // (registers)
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::numeric_limits<double>::infinity();
+        hi[a] = -lo[a];
+      }
+      for (int k = region_vlo_[r]; k < region_vlo_[r + 1]; ++k) {
+        const int v = region_vert_[k];
+        const Vec3 d = x[v] - x0[v];
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::min(lo[a], d[a]);
+          hi[a] = std::max(hi[a], d[a]);
+        }
+        most2 = std::max(most2, d.squaredNorm());
+      }
+      motion_[r] = {Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2]), most2};
+    }
+  };
+  if (pool)
+    pool->parallel_for(R, regions_moved);
+  else
+    regions_moved(0, R, 0);
+  // A vertex and a triangle came closer by at most the smaller of the diagonal of their regions'
+  // displacement box and twice their largest displacement (XpbdSolver::self_due's bound).
+  auto beyond = [](const Motion& A, const Motion& B, double limit) {
+    const Vec3 lo = A.lo.cwiseMin(B.lo), hi = A.hi.cwiseMax(B.hi);
+    return std::min((hi - lo).squaredNorm(), 4 * std::max(A.most2, B.most2)) > limit * limit;
+  };
+  Motion all = {Vec3::Constant(std::numeric_limits<double>::infinity()),
+                Vec3::Constant(-std::numeric_limits<double>::infinity()), 0.0};
+  for (int r = 0; r < R; ++r) {
+    if (region_vlo_[r] == region_vlo_[r + 1]) continue;
+    if (beyond(motion_[r], motion_[r], margin)) return false;  // within one region
+    all = {all.lo.cwiseMin(motion_[r].lo), all.hi.cwiseMax(motion_[r].hi),
+           std::max(all.most2, motion_[r].most2)};
+  }
+  if (R > 0 && beyond(all, all, thickness + 2 * margin)) return false;
+  // Regions whose grown boxes met: adjacent ones, and the others listed by the cull.
+  for (int a = 0; a < R; ++a) {
+    for (int k = adj_lo_[a]; k < adj_lo_[a + 1]; ++k)
+      if (adj_[k] > a && beyond(motion_[a], motion_[adj_[k]], margin)) return false;
+    for (int k = conflict_lo_[a]; k < conflict_lo_[a + 1]; ++k) {
+      const int b = static_cast<int>(conflict_[k] & 0xffffffffu);
+      if (b > a && beyond(motion_[a], motion_[b], margin)) return false;
+    }
+  }
+  return true;
 }
 
 double SelfCollision::project(const Cloth& cloth, std::vector<Vec3>& x, const double* w,

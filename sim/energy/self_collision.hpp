@@ -54,8 +54,23 @@ class SelfCollision {
   void prepare(const Cloth& cloth);
   int region_builds() const { return region_builds_; }  // splits made (one per topology)
   // Puts pairs found earlier back (a solver's saved state); clear() forgets them.
-  void set_contacts(std::vector<SelfContact> pairs) { pairs_ = std::move(pairs); }
-  void clear() { pairs_.clear(); }
+  void set_contacts(std::vector<SelfContact> pairs) {
+    pairs_ = std::move(pairs);
+    shapes_found_ = false;
+  }
+  void clear() {
+    pairs_.clear();
+    shapes_found_ = false;
+  }
+  // Whether the pairs the last detection found (at x0, with this thickness and margin) are still
+  // all the pairs that can be within `thickness` at x, by region: the displacements since x0
+  // bound how much closer a vertex and a triangle came, per pair of regions whose boxes met at
+  // x0 (within the margin, as the solver's bound over the whole cloth) and over the whole cloth
+  // for regions that were farther apart (within thickness + 2 margin: their boxes grown by the
+  // reach did not meet). x0 must be the positions the pairs were found at; pairs put back by
+  // set_contacts() have the regions' shapes made at x0 here. False without the region cull.
+  bool keeps_pairs(const Cloth& cloth, const std::vector<Vec3>& x, const std::vector<Vec3>& x0,
+                   double thickness, double margin, ThreadPool* pool = nullptr);
   // The per-entry bounding-sphere rejection (on by default; off only to measure it: the same
   // pairs are found either way).
   void set_sphere_test(bool on) { sphere_test_ = on; }
@@ -128,6 +143,13 @@ class SelfCollision {
   };
   std::vector<SweepBox> sweep_;
   bool flat_together(int a, int b) const;
+  // The region shapes (box_, conflict_) are those of the detection that found pairs_.
+  bool shapes_found_ = false;
+  struct Motion {  // a region's displacements since x0: their box and largest squared length
+    Vec3 lo, hi;
+    double most2;
+  };
+  std::vector<Motion> motion_;  // per region (keeps_pairs)
   int active_regions_ = 0, active_tris_ = 0;
   void build_regions(const Cloth& cloth);
   void region_box(const Cloth& cloth, const std::vector<Vec3>& x, double reach, int r);

@@ -788,7 +788,9 @@ void XpbdSolver::start_self(const Cloth& cloth, const SceneObjects& scene) {
       all.add(self_box_[p]);
       due = due || self_flags_changed_[p];
     }
-    due = due || all.beyond(energy_.options().contact_margin);
+    const double margin = energy_.options().contact_margin;
+    due = due || (all.beyond(margin) &&
+                  !self_.keeps_pairs(cloth, x, x_self_, scene.offset, margin, pool_.get()));
   }
   if (due)
     detect_self(cloth, scene, x);
@@ -803,12 +805,16 @@ void XpbdSolver::start_self(const Cloth& cloth, const SceneObjects& scene) {
 // diagonal of the box around all d_i, and by at most twice the largest |d_i|. The pairs were
 // found within thickness + margin: they stay complete while the smaller bound is at most the
 // margin (a cloth that falls or is carried whole keeps them). The box is taken by the previous
-// substep's velocity loops (self_motion) and after its projections.
-bool XpbdSolver::self_due(const Step& c) const {
+// substep's velocity loops (self_motion) and after its projections. Beyond it, the same bound
+// region by region (SelfCollision::keeps_pairs) can still keep them: parts of the cloth that
+// move against each other but lie apart (a hand lifting one edge, a flap swinging) need no
+// detection.
+bool XpbdSolver::self_due(const Step& c) {
   if (x_self_.size() != static_cast<size_t>(c.n) || self_box_.empty()) return true;
   SelfBox all;
   for (const SelfBox& B : self_box_) all.add(B);
-  return all.beyond(c.margin);
+  return all.beyond(c.margin) &&
+         !self_.keeps_pairs(c.cloth, c.x, x_self_, c.scene.offset, c.margin, pool_.get());
 }
 
 // Vertices [b, e) into slot's box of displacements since the self-collision pairs were found.

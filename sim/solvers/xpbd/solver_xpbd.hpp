@@ -192,7 +192,7 @@ class XpbdSolver : public Solver {
   void detect_contacts(Step& c);
   void detect_self(const Cloth& cloth, const SceneObjects& scene, const std::vector<Vec3>& x);
   void start_self(const Cloth& cloth, const SceneObjects& scene);
-  bool self_due(const Step& c) const;
+  bool self_due(const Step& c);
   void self_motion(const Step& c, int b, int e, int slot);
   void self_motion_of(const Step& c, const std::vector<int>& moved);
   void set_masses(Step& c);  // w and the bending blocks' inverses
