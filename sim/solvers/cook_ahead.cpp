@@ -88,9 +88,10 @@ void CookAheadSolver::join() {
   copying_ = nullptr;
 }
 
-int CookAheadSolver::ticks_for(const Cloth& cloth) const {
+int CookAheadSolver::ticks_for(const Cloth& cloth, bool self_collision) const {
   const int per = (cloth.topo.num_triangles() + kTrianglesPerTicks - 1) / kTrianglesPerTicks;
-  return std::max(1, opt_.ticks * std::max(1, per));
+  const int ticks = opt_.ticks * std::max(1, per);
+  return std::max(1, self_collision ? (ticks * opt_.self_collision_percent + 99) / 100 : ticks);
 }
 
 bool CookAheadSolver::map_onto_base(const Cloth& cloth) {
@@ -280,7 +281,7 @@ StepStats CookAheadSolver::step(Cloth& cloth, const SceneObjects& scene, double 
   }
   if (!active_->cooked_for(cloth) && mapped(cloth)) {
     ++edits_ahead_;
-    start(cloth, ticks_for(cloth) - 1, dt);
+    start(cloth, ticks_for(cloth, scene.self_collision) - 1, dt);
     const StepStats st = step_base(cloth, scene, dt);
     release();  // the worker starts once the edit's own step is done (see launch())
     return st;
@@ -391,7 +392,8 @@ std::string CookAheadSolver::restore_state(const std::vector<unsigned char>& byt
                                bytes.begin() + static_cast<long>(in.i + len));
   in.i += len;
   if (in.i != in.n) return fail("its bytes are malformed");
-  if (steps < 0 || steps > ticks_for(cloth)) return fail("steps left out of range");
+  if (steps < 0 || steps > std::max(ticks_for(cloth, false), ticks_for(cloth, true)))
+    return fail("steps left out of range");
   if (const std::string e = base.validate(); !e.empty()) return fail("base cloth: " + e);
   const int nb = base.num_vertices();
   if (static_cast<int>(src.size()) != cloth.num_vertices() || nb > cloth.num_vertices())

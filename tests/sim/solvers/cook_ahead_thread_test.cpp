@@ -141,7 +141,8 @@ TEST(CookAhead, SelfCollisionRegionsMadeAheadChangeNoResult) {
   const CutRun plain = run(0, false, {.warm = false, .keep_off_steps = K::kNever}, 30, true);
   const CutRun warm = run(0, false, {.warm = true, .keep_off_steps = K::kNever}, 30, true);
   const CutRun slow = run(50, false, {.warm = true, .keep_off_steps = K::kAlways}, 30, true);
-  EXPECT_EQ(warm.adopted_at, kTicks);
+  // (self-collision's costlier steps: half as many ticks again for the worker)
+  EXPECT_EQ(warm.adopted_at, kTicks * CookAheadOptions{}.self_collision_percent / 100);
   EXPECT_EQ(warm.hash, plain.hash);
   EXPECT_EQ(slow.hash, plain.hash);
   EXPECT_EQ(warm.region_builds, 1) << "the adopted solver split the cut cloth once";
@@ -160,6 +161,9 @@ TEST(CookAhead, TicksGrowWithTheCloth) {
   Testbed small = make_scene("form", 128), large = make_scene("form", 256);
   EXPECT_EQ(s.ticks_for(small.cloth), 8);   // 32 258 triangles
   EXPECT_EQ(s.ticks_for(large.cloth), 32);  // 130 050 triangles
+  // With self-collision its steps cost more: the worker gets more of them.
+  EXPECT_EQ(s.ticks_for(small.cloth, true), 12);
+  EXPECT_EQ(s.ticks_for(large.cloth, true), 48);
 }
 
 // A checkpoint in the window (the base stepping, the worker cooking) resumes bit for bit.
