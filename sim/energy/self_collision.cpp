@@ -506,6 +506,8 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
   };
   // A vertex of a flat region skips the triangles of that region and of the regions it is flat
   // together with (the cull's reason: no pair lies there).
+  const int32_t* origin =
+      cloth.topo.vertex_origin.size() == x.size() ? cloth.topo.vertex_origin.data() : nullptr;
   auto test = [&](int ib, int ie, std::vector<SelfContact>& out) {
     for (int i = ib; i < ie; ++i) {
       const int v = active_vert_[i];
@@ -525,6 +527,11 @@ int SelfCollision::detect(const Cloth& cloth, const std::vector<Vec3>& x, double
         if (flat && (home == region_of_[t] || flat_together(home, region_of_[t]))) continue;
         const auto& T = tris[t];
         if (T[0] == v || T[1] == v || T[2] == v) continue;
+        // A vertex and a corner made from one vertex (the two sides of a cut or slit, which
+        // coincide where it was made): they are one point of the cloth, with no side to keep.
+        if (origin &&
+            (origin[T[0]] == origin[v] || origin[T[1]] == origin[v] || origin[T[2]] == origin[v]))
+          continue;
         const TriFrame& f = pre_[t];
         const Vec3 r = p - f.a;
         const double d = f.n.dot(r);

@@ -4,7 +4,8 @@
 //
 // Detection: every triangle is entered in the hash cells its bounding box, grown by the reach
 // (thickness + margin), overlaps; each vertex looks up its own cell and tests the triangles
-// there that do not contain it: the pair is kept when the vertex is within the reach of the
+// there that do not contain it (nor a vertex made from the same one: a cut's other side): the
+// pair is kept when the vertex is within the reach of the
 // triangle's plane and projects inside the triangle. The side (sign of the distance) is taken
 // then, from a state assumed free of intersections, and kept until the next detection. A pair
 // farther than the reach cannot come within `thickness` before any vertex has moved margin / 2,
@@ -14,8 +15,10 @@
 // the correction), inverse-mass weighted, one Gauss-Seidel pass.
 // Limits (docs/solvers.md): vertex-face pairs only (no edge-edge test: two layers can still
 // cross where edges pass each other between vertices, on meshes much coarser than the
-// thickness); the side is not repaired once a layer has passed through; a triangle stretched over
-// more than 8 hash cells per axis is entered in the first 8 only.
+// thickness); a vertex over a convex layer's edge or vertex projects into no triangle (no pair
+// until it slides over one and the next detection); the side is not repaired once a layer has
+// passed through; a triangle stretched over more than 8 hash cells per axis is entered in the
+// first 8 only.
 #pragma once
 
 #include <algorithm>

@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "sim/ops/cut.hpp"
 #include "sim/solvers/xpbd/solver_xpbd.hpp"
 #include "sim/testbeds/testbed.hpp"
 
@@ -260,6 +261,28 @@ double distance_to_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 }
 
 }  // namespace
+
+// A cut's two sides coincide where it was made (each vertex of its path and its duplicate): no
+// pair joins them (no side to keep a point on against itself), so a flat panel cut across has
+// no pair, and the solver does not push the sides apart out of the plane.
+TEST(SelfCollision, NoPairJoinsTheTwoSidesOfACut) {
+  const double thick = 0.002, margin = 0.005;
+  Cloth c = test_panel(41, 21);
+  const int before = c.num_vertices();
+  ASSERT_TRUE(prepare_for_cuts(c));
+  ASSERT_TRUE(cut_across_material(c, 0.5 + 0.25 / 20).ok);
+  ASSERT_GT(c.num_vertices(), before);
+  SelfCollision sc;
+  const int pairs = sc.detect(c, c.state.x, thick, margin);
+  std::printf("panel 41 x 21 cut across: %d new vertices, %d pairs\n", c.num_vertices() - before,
+              pairs);
+  EXPECT_EQ(pairs, 0);
+  // Without the vertices' origins (as if the sides were two pieces laid edge to edge) the
+  // duplicates sit on the corners of the other side's triangles: pairs with an arbitrary side.
+  Cloth pieces = c;
+  for (int v = 0; v < pieces.num_vertices(); ++v) pieces.topo.vertex_origin[v] = v;
+  EXPECT_GT(sc.detect(pieces, pieces.state.x, thick, margin), 0);
+}
 
 // Curved layers: the rolled panel's regions bend (~20 deg within one) and are flat together
 // with their neighbours, only those where the turns overlap lie within reach of another: the
