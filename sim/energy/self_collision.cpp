@@ -289,8 +289,8 @@ void SelfCollision::find_conflicts(std::vector<char>& active) {
   const std::vector<Box>& box = box_;
   active.assign(R, 0);
   for (int r = 0; r < R; ++r) active[r] = !region_flat_[r];
-  // The sweep runs along the axis of the boxes' widest spread (a draped cloth hangs: most of
-  // its boxes overlap in x and z, few in y), over (low end, region) pairs sorted by low end.
+  // The sweep runs along the axis of the boxes' widest spread, over (low end, region) pairs
+  // sorted by low end.
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (int r = 0; r < R; ++r) {
     lo = lo.cwiseMin(box[r].lo);

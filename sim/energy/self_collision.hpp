@@ -5,11 +5,12 @@
 // Detection: every triangle is entered in the hash cells its bounding box, grown by the reach
 // (thickness + margin), overlaps; each vertex looks up its own cell and tests the triangles
 // there that do not contain it (nor a vertex made from the same one: a cut's other side): the
-// pair is kept when the vertex is within the reach of the
-// triangle's plane and projects inside the triangle. The side (sign of the distance) is taken
-// then, from a state assumed free of intersections, and kept until the next detection. A pair
-// farther than the reach cannot come within `thickness` before any vertex has moved margin / 2,
-// which is when the solver detects again (XpbdSolver's contact reuse rule).
+// pair is kept when the vertex is within the reach of the triangle's plane and projects inside
+// the triangle. The side (sign of the distance) is taken then, from a state assumed free of
+// intersections, and kept until the next detection. A pair farther than the reach cannot come
+// within `thickness` before the vertex and the triangle have come `margin` closer, which the
+// solver bounds from the displacements since the detection (XpbdSolver::self_due, keeps_pairs
+// below) to detect again in time.
 // Projection: C = side n . (x_v - sum_k b_k x_k) - thickness >= 0 (n the triangle's unit
 // normal, b the barycentric coordinates of the vertex's projection, both taken as constant in
 // the correction), inverse-mass weighted, one Gauss-Seidel pass.
