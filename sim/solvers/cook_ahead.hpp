@@ -20,8 +20,8 @@
 // the worker's speed: runs, replays and resumed checkpoints give the same result bit for bit.
 // `ticks` grows with the cloth (CookAheadOptions::ticks per 32 768 triangles), and by half with
 // self-collision on (costlier steps), so the cook has time to end on a machine as loaded as the
-// one it ran on. Other edits (an undo that removes
-// vertices, a new cloth) are cooked in the step, as plain XPBD does.
+// one it ran on. Other edits (an undo that removes vertices, a new cloth) are cooked in the
+// step, as plain XPBD does.
 #pragma once
 
 #include <atomic>
