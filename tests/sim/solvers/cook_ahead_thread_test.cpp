@@ -196,7 +196,8 @@ TEST(CookAhead, MalformedStateIsRefusedWithAReason) {
   ASSERT_TRUE(s.pending());
   const std::vector<unsigned char> bytes = s.save_state(sc.cloth);
   CookAheadSolver r(options(sc), CookAheadOptions{kTicks});
-  // Cut short, a wrong version, and a base that does not fit a cloth without the cut.
+  // Cut short, a wrong version, a base that does not fit a cloth without the cut, and steps left
+  // out of range.
   std::vector<unsigned char> shortened(bytes.begin(), bytes.begin() + bytes.size() / 2);
   EXPECT_NE(r.restore_state(shortened, sc.cloth).find("cook-ahead state: its bytes are malformed"),
             std::string::npos);
@@ -205,6 +206,14 @@ TEST(CookAhead, MalformedStateIsRefusedWithAReason) {
   EXPECT_NE(r.restore_state(version, sc.cloth).find("version 9"), std::string::npos);
   Testbed uncut = make_scene("form", kRes);
   EXPECT_NE(r.restore_state(bytes, uncut.cloth).find("does not fit"), std::string::npos);
+  // Steps left below zero or beyond the longer window (self-collision's); after the magic and
+  // the version, as a little-endian int32.
+  for (const int32_t steps : {-1, 1000}) {
+    std::vector<unsigned char> far = bytes;
+    for (int k = 0; k < 4; ++k) far[8 + k] = static_cast<unsigned char>(uint32_t(steps) >> (8 * k));
+    EXPECT_NE(r.restore_state(far, sc.cloth).find("steps left out of range"), std::string::npos)
+        << steps;
+  }
   // The refused solver steps on as a fresh one.
   EXPECT_FALSE(r.pending());
   r.step(sc.cloth, sc.objects, 1.0 / 90);
