@@ -468,6 +468,9 @@ std::shared_ptr<Window> open_window(Session* s, std::string* why) {
   return w;
 }
 
+// The surface depth's step (m).
+constexpr float kDepthStep = 1e-4f;
+
 float depth_to_distance(float d, float min_depth, float max_depth, float near_z, float far_z) {
   const float inf = std::numeric_limits<float>::infinity();
   float t = (d - min_depth) / (max_depth - min_depth);
@@ -794,7 +797,10 @@ void window_end_frame(Session* s, const XrCompositionLayerProjection* layer) {
   float z = depth_to_distance(dv, d->minDepth, d->maxDepth, d->nearZ, d->farZ);
   if (!std::isfinite(z)) return;
   w->hit_valid = true;
-  w->hit_z = z;
+  // In steps of kDepthStep: renderers differ in the depth's last bits (a CPU rasterizer's code is
+  // made for the CPU it runs on), which must not move the hand, and with it a session played
+  // from input events, from one machine to another.
+  w->hit_z = std::round(z / kDepthStep) * kDepthStep;
   w->hit_eye = eye;
 }
 
