@@ -77,8 +77,8 @@ class ThreadPool {
   ThreadPool& operator=(const ThreadPool&) = delete;
   int size() const { return threads_; }
 
-  // Runs fn(begin, end, worker) over [0, n) split in up to 4 size() contiguous chunks (halving
-  // in size toward the middle of the range: thread_pool.cpp, chunk_start) claimed
+  // Runs fn(begin, end, worker) over [0, n) split in up to chunks_for() contiguous chunks
+  // (shrinking toward the middle of the range: thread_pool.cpp, chunk_start) claimed
   // by whichever thread is free (the caller included; fn may be called several times per
   // thread, `worker` is the calling thread's index); returns when all are done. fn must be
   // callable as void(int, int, int). No allocation.
@@ -88,8 +88,13 @@ class ThreadPool {
       fn(0, n, 0);
       return;
     }
-    run(n, &invoke<std::remove_reference_t<Fn>>, &fn, std::min(n, threads_ * 4));
+    run(n, &invoke<std::remove_reference_t<Fn>>, &fn, std::min(n, chunks_for(threads_)));
   }
+  // parallel_for's chunks on `threads` threads: 4 per thread up to two threads, 12 beyond (the
+  // chunks shrink by 1/threads of what is left: with more threads more chunks keep the last
+  // ones small, e^-6 of the half), and the first item of chunk k of m over [0, n).
+  static int chunks_for(int threads) { return threads <= 2 ? 4 * threads : 12 * threads; }
+  static int chunk_start(int64_t n, int m, int threads, int k);
   // Runs fn(slot, worker) once for each slot in [0, size()), every slot claimed by one thread
   // (the caller takes slot 0 first; a worker that arrives late may find its slot taken by the
   // caller, which then runs it after its own). fn may wait for another slot only if it can take

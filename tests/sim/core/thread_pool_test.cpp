@@ -59,6 +59,40 @@ TEST(ThreadPool, ChunksHalveTowardTheMiddleOfTheRange) {
   EXPECT_EQ(got, want);
 }
 
+// On any thread count the chunks tile the range, none is more than a thread's share of its half,
+// and threads claiming them as the pool does (even threads from the front, odd ones from the
+// back, each the next chunk when it is free) finish a loop of equal items within 10 % of
+// n / threads (halving from half of each half, as with two threads, would make the caller's
+// first chunk a quarter of the loop on any count).
+TEST(ThreadPool, ChunksLetEveryThreadShareOnManyThreads) {
+  const int64_t n = 100000;
+  for (int threads : {2, 3, 4, 6, 8, 12, 16}) {
+    const int m = ThreadPool::chunks_for(threads);
+    std::vector<int64_t> at(m + 1);
+    for (int k = 0; k <= m; ++k) at[k] = ThreadPool::chunk_start(n, m, threads, k);
+    ASSERT_EQ(at[0], 0);
+    ASSERT_EQ(at[m], n);
+    for (int k = 0; k < m; ++k) {
+      ASSERT_LE(at[k], at[k + 1]) << threads << " threads, chunk " << k;
+      EXPECT_LE(at[k + 1] - at[k], n / 2 / threads + 1) << threads << " threads, chunk " << k;
+    }
+    // Greedy claiming, one item one unit of time.
+    std::vector<int64_t> free_at(threads, 0);
+    int front = 0, back = m;
+    while (front < back) {
+      const int w =
+          static_cast<int>(std::min_element(free_at.begin(), free_at.end()) - free_at.begin());
+      const int k = w % 2 ? --back : front++;
+      free_at[w] += at[k + 1] - at[k];
+    }
+    const int64_t span = *std::max_element(free_at.begin(), free_at.end());
+    EXPECT_LE(span, 1.1 * n / threads) << threads << " threads";
+  }
+  // Two threads: the halving of ChunksHalveTowardTheMiddleOfTheRange.
+  EXPECT_EQ(ThreadPool::chunk_start(4096, 8, 2, 1), 1024);
+  EXPECT_EQ(ThreadPool::chunk_start(4096, 8, 2, 3), 1792);
+}
+
 // parallel_slots: every slot once, each on one thread.
 TEST(ThreadPool, RunsEverySlotExactlyOnce) {
   for (int threads : {1, 2, 3}) {
