@@ -14,6 +14,10 @@
 #       With a baseline: its probe (--probe form RES xpbd 10 1 --no-polish --no-ref --frames 270)
 #       at --base-res x --base-threads (--base-res "" skips it), OUT/baseline.log. --two-cores:
 #       also 128^2 on two threads pinned to two cores (taskset), both builds, OUT/two_cores.log.
+#       --split: this build's probe at --base-res x --base-threads, each frame's wall time
+#       split into the element sweeps and the rest of the step (OUT/split.log), and the sweep
+#       model (solvers_bench --sweep-model: the sweep's plan timed on one thread, replayed on
+#       8 and 16; OUT/solvers_sweep_model.csv).
 set -euo pipefail
 mode="${1:-}"
 case "$mode" in
@@ -39,12 +43,13 @@ case "$mode" in
     dir="$(cd "$2" && pwd)"
     out="$3"
     shift 3
-    base_res="128 256" base_threads="1 2 4 8 16" two_cores=""
+    base_res="128 256" base_threads="1 2 4 8 16" two_cores="" split=""
     while [ $# -gt 0 ]; do
       case "$1" in
         --base-res) base_res="$2"; shift 2 ;;
         --base-threads) base_threads="$2"; shift 2 ;;
         --two-cores) two_cores=1; shift ;;
+        --split) split=1; shift ;;
         --) shift; break ;;
         *) echo "device_threads.sh: unknown option '$1' (solvers_bench flags go after --)" >&2; exit 2 ;;
       esac
@@ -65,14 +70,26 @@ case "$mode" in
     cd "$work"
     run_bin "$dir/solvers_bench" --threads-only --threads-default-only "$@" 2>&1 | tee "$out/threads.log"
     cp out/bench/solvers_threads.csv "$out/"
-    if [ -x "$dir/solvers_bench_base" ] && [ -n "$base_res" ]; then
+    # probe_rows NAME BIN PATTERN: BIN's probe at --base-res x --base-threads, the lines that
+    # match PATTERN.
+    probe_rows() {
       for res in $base_res; do
         for t in $base_threads; do
-          echo "== baseline $res^2, $t threads"
-          run_bin "$dir/solvers_bench_base" --probe form "$res" xpbd 10 1 --no-polish --no-ref \
-            --frames 270 --threads "$t" 2>&1 | grep -E '^form .* wall'
+          echo "== $1 $res^2, $t threads"
+          run_bin "$2" --probe form "$res" xpbd 10 1 --no-polish --no-ref --frames 270 \
+            --threads "$t" 2>&1 | grep -E "$3"
         done
-      done 2>&1 | tee "$out/baseline.log"
+      done
+    }
+    if [ -x "$dir/solvers_bench_base" ] && [ -n "$base_res" ]; then
+      probe_rows baseline "$dir/solvers_bench_base" '^form .* wall' 2>&1 | tee "$out/baseline.log"
+    fi
+    if [ -n "$split" ]; then
+      probe_rows split "$dir/solvers_bench" '^form .* wall|element sweeps' 2>&1 |
+        tee "$out/split.log"
+      run_bin "$dir/solvers_bench" --sweep-model --thread-res 128,256 --thread-counts 8,16 \
+        2>&1 | tee -a "$out/split.log"
+      cp out/bench/solvers_sweep_model.csv "$out/"
     fi
     # Two cores of the machine (taskset), 128^2 on two threads, this build and the baseline.
     if command -v taskset >/dev/null && [ -n "$two_cores" ]; then
@@ -85,7 +102,7 @@ case "$mode" in
     fi
     ;;
   *)
-    sed -n '2,16p' "$0"
+    sed -n '2,/^set -euo/p' "$0" | sed '$d'
     exit 2
     ;;
 esac

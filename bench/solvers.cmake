@@ -29,13 +29,17 @@ if(TARGET bullet_peer_bench)
            WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
   set_tests_properties(bench_bullet_peer_smoke PROPERTIES LABELS "bench")
 endif()
-# Smoke check of the thread rows (ctest, label "bench"): a tiny drape on 1 and 3 threads writes
-# out/bench/solvers_threads.csv with the columns and rows the many-core figures use
-# (bench/checks/thread_rows.cmake).
+# Smoke checks of the thread rows and of the sweep model (ctest, label "bench"): a tiny drape on 1
+# and 3 threads writes out/bench/solvers_threads.csv with the columns and rows the many-core
+# figures use (bench/checks/thread_rows.cmake); its sweep planned for 2 and 3 threads, timed on
+# one and replayed, writes out/bench/solvers_sweep_model.csv with bounded figures
+# (bench/checks/sweep_model.cmake).
 if(TARGET solvers_bench)
-  add_test(NAME bench_solvers_thread_rows_smoke
-           COMMAND ${CMAKE_COMMAND} -DBIN=$<TARGET_FILE:solvers_bench>
-                   -DDIR=${CMAKE_BINARY_DIR}/bench_thread_rows -P
-                   ${CMAKE_CURRENT_SOURCE_DIR}/checks/thread_rows.cmake)
-  set_tests_properties(bench_solvers_thread_rows_smoke PROPERTIES LABELS "bench")
+  foreach(check thread_rows sweep_model)
+    add_test(NAME bench_solvers_${check}_smoke
+             COMMAND ${CMAKE_COMMAND} -DBIN=$<TARGET_FILE:solvers_bench>
+                     -DDIR=${CMAKE_BINARY_DIR}/bench_${check} -P
+                     ${CMAKE_CURRENT_SOURCE_DIR}/checks/${check}.cmake)
+    set_tests_properties(bench_solvers_${check}_smoke PROPERTIES LABELS "bench")
+  endforeach()
 endif()

@@ -61,6 +61,7 @@
 #include <vector>
 
 #include "bench/bullet_peer.hpp"
+#include "sim/core/stopwatch.hpp"
 #include "sim/form/dress_form.hpp"
 #include "sim/rest/coarse_correction.hpp"
 #include "sim/rest/equilibrium_finisher.hpp"
@@ -110,7 +111,8 @@ struct ThreadRowsConfig {
 // value, or one that depends on where the knob is used.
 struct Knobs {
   // The benchmark grid (and the probe, where they apply).
-  bool quick = false, sleep_only = false, threads_only = false, self_only = false;
+  bool quick = false, sleep_only = false, threads_only = false, self_only = false,
+       sweep_model = false;
   ThreadRowsConfig thread_rows;
   int max_res = 64;
   std::optional<int> threads;    // solver threads: grid 1, probe 2, the probe's --finish pool 1
@@ -548,10 +550,12 @@ int probe(const Knobs& kn) {
     const bool f32 = xp->options().single_precision;
     std::printf(
         "xpbd: %.2f contact detections and %.0f vertices tested again per frame, %ld anchor "
-        "renewals in %d frames%s; kernels %s (%d triangles, %d bending blocks per pack)\n",
+        "renewals in %d frames%s; kernels %s (%d triangles, %d bending blocks per pack); "
+        "element sweeps %.3f ms/frame wall, the rest of the steps %.3f\n",
         double(xp->contact_detections()) / frames, double(xp->contact_retests()) / frames,
         xp->anchor_renewals(), frames, f32 ? "" : " (double precision)", xp->kernels().name,
-        f32 ? xp->kernels().tri_lanes : 4, f32 ? 8 : 4);
+        f32 ? xp->kernels().tri_lanes : 4, f32 ? 8 : 4, frames ? xp->sweep_ms() / frames : 0.0,
+        frames ? (wall - xp->sweep_ms()) / frames : 0.0);
     if (xp->options().coarse_factor > 0) {
       const CoarseStats& c = xp->last_coarse();
       std::printf(
@@ -994,6 +998,72 @@ void thread_rows(int max_res, const ThreadRowsConfig& tr, std::optional<int> fra
   }
 }
 
+// The element sweep's plan on many threads, measured on one: the default solver on the form drape
+// (the thread rows' scene) on a pool of one thread, its sweep planned for S slots
+// (XpbdOptions::sweep_slots: the same results), each sweep's runs timed and replayed as S
+// threads would run them (XpbdSolver::sweep_profile, xpbd::SweepPlan::schedule): the sweep's
+// span on S threads that never wait for a time slice nor share caches or memory bandwidth, and
+// what the slots spend idle (waiting for another slot before a run, after their last phase),
+// beside the same runs replayed with a phase gate (gated_efficiency: no slot two phases ahead of
+// another, what a plan whose waits name only the phase before needs). With
+// the step's time outside the sweeps on one thread (the frame's and substeps' other work) it
+// brackets the frame on S cores: that work serial, or divided by S. The MB of the arrays a sweep
+// streams (XpbdSolver::sweep_megabytes) give the memory traffic a measured frame implies. CSV
+// out/bench/solvers_sweep_model.csv.
+void sweep_model_rows(const ThreadRowsConfig& tr, std::optional<int> frames_cap) {
+  std::ofstream mc("out/bench/solvers_sweep_model.csv");
+  mc << "scene,solver,resolution,slots,frames,frame_ms,sweep_ms,other_ms,work_ms,span_ms,"
+        "span_handover_ms,sweep_speedup,sweep_efficiency,wait_pct,tail_pct,"
+        "handover_efficiency,gated_efficiency,frame_ms_other_serial,frame_ms_other_divided,"
+        "sweep_mb\n";
+  std::printf("model    %5s %5s %9s %9s %9s %9s %9s %8s %6s %6s %6s %7s %7s %10s %10s\n", "res",
+              "slots", "frame ms", "sweep ms", "other ms", "work ms", "span ms", "speedup", "eff",
+              "wait", "tail", "eff+ho", "gated", "fr serial", "fr divided");
+  for (int res : tr.res)
+    for (int slots : tr.counts) {
+      if (slots < 2) continue;
+      Testbed sc = make_scene("form", res);
+      SolverConfig cfg;
+      cfg.substeps = 10;
+      cfg.threads = 1;
+      cfg.air_drag = sc.air_drag;
+      auto made = make_solver("default", cfg);
+      XpbdSolver* xp = xpbd_of(made->get());
+      if (!xp) return;
+      xp->options().sweep_slots = slots;
+      xp->options().sweep_profile = true;
+      const int frames =
+          std::max(2, frames_cap.value_or(static_cast<int>(std::lround(sc.duration * 90))));
+      const auto w0 = std::chrono::steady_clock::now();
+      for (int f = 0; f < frames; ++f) (*made)->step(sc.cloth, sc.objects, 1.0 / 90);
+      const double frame = ms_since(w0) / frames, sweep = xp->sweep_ms() / frames;
+      const auto& P = xp->sweep_profile();
+      const double work = P.ideal.work_ns * 1e-6 / frames, span = P.ideal.span_ns * 1e-6 / frames;
+      const double span_ho = P.handover.span_ns * 1e-6 / frames, other = frame - sweep;
+      const double slot_ns = slots * P.ideal.span_ns;
+      auto pct = [&](double ns) { return slot_ns > 0 ? 100 * ns / slot_ns : 0.0; };
+      const double eff = span > 0 ? work / (slots * span) : 0.0;
+      const double eff_ho = span_ho > 0 ? work / (slots * span_ho) : 0.0;
+      const double span_gated = P.gated.span_ns * 1e-6 / frames;
+      const double eff_gated = span_gated > 0 ? work / (slots * span_gated) : 0.0;
+      std::printf(
+          "model    %5d %5d %9.3f %9.3f %9.3f %9.3f %9.3f %7.2fx %5.0f%% %5.1f%% %5.1f%% %6.0f%% "
+          "%6.0f%% %10.3f %10.3f\n",
+          res, slots, frame, sweep, other, work, span, span > 0 ? work / span : 0.0, 100 * eff,
+          pct(P.ideal.border_ns), pct(P.ideal.tail_ns), 100 * eff_ho, 100 * eff_gated, other + span,
+          other / slots + span);
+      std::printf("model    %5d %5d the sweep's arrays %.1f MB (%d sweeps a frame)\n", res, slots,
+                  xp->sweep_megabytes(sc.cloth.num_vertices()),
+                  static_cast<int>(std::lround(double(P.sweeps) / frames)));
+      mc << "form," << kDefaultSolver << "," << res << "," << slots << "," << frames << "," << frame
+         << "," << sweep << "," << other << "," << work << "," << span << "," << span_ho << ","
+         << (span > 0 ? work / span : 0.0) << "," << eff << "," << pct(P.ideal.border_ns) << ","
+         << pct(P.ideal.tail_ns) << "," << eff_ho << "," << eff_gated << "," << other + span << ","
+         << other / slots + span << "," << xp->sweep_megabytes(sc.cloth.num_vertices())
+         << std::endl;
+    }
+}
+
 // Self-collision in the app's scene: the live session's solver (the default, pieces at rest
 // sleeping, the static finish one cycle per tick as in a lock-step session, two threads) on the
 // form drape (the muslin panel falling from the chest line, 3 s) with self-collision off and on,
@@ -1102,6 +1172,10 @@ void add_knobs(CLI::App& app, Knobs& kn, std::string& simd) {
   app.add_flag("--self-only", kn.self_only,
                "only the self-collision rows: the app's scene with it off and on, 64^2 and "
                "--max-res (out/bench/solvers_self.csv)");
+  app.add_flag("--sweep-model", kn.sweep_model,
+               "only the sweep model: the element sweep planned for each --thread-counts count "
+               "above 1, timed on one thread and replayed on that many, at each --thread-res "
+               "(out/bench/solvers_sweep_model.csv)");
   app.add_option("--thread-counts", kn.thread_rows.counts,
                  "the thread rows' thread counts (the default configuration; 1,2,4)")
       ->delimiter(',')
@@ -1304,6 +1378,10 @@ int main(int argc, char** argv) {
   }
   if (kn.self_only) {  // the self-collision rows alone (out/bench/solvers_self.csv)
     self_rows({64, std::max(max_res, 128)}, kn.thread_rows.rounds.value_or(3), kn.frames);
+    return 0;
+  }
+  if (kn.sweep_model) {  // the sweep's plan on many threads, measured on one
+    sweep_model_rows(kn.thread_rows, kn.frames);
     return 0;
   }
   if (kn.threads_only) {  // the thread and precision rows alone (out/bench/solvers_threads.csv)

@@ -2,44 +2,18 @@
 # (16^2, 1 and 3 threads, 5 frames) in DIR and checks out/bench/solvers_threads.csv: its header
 # names resolution, threads, cores and ms_per_frame, and it holds one row per thread count with
 # the machine's core count and a positive time. Arguments: -DBIN=solvers_bench -DDIR=scratch.
-file(REMOVE_RECURSE "${DIR}")
-file(MAKE_DIRECTORY "${DIR}")
-execute_process(
-  COMMAND "${BIN}" --threads-only --threads-default-only --thread-res 16 --thread-counts 1,3
-          --thread-rounds 1 --frames 5
-  WORKING_DIRECTORY "${DIR}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "solvers_bench --threads-only failed (${rc}):\n${out}")
-endif()
-set(csv "${DIR}/out/bench/solvers_threads.csv")
-if(NOT EXISTS "${csv}")
-  message(FATAL_ERROR "no ${csv} written")
-endif()
-file(STRINGS "${csv}" lines)
-list(LENGTH lines n)
-if(NOT n EQUAL 3)
-  message(FATAL_ERROR "${csv}: ${n} lines, expected a header and 2 rows:\n${lines}")
-endif()
-list(GET lines 0 header)
-string(REPLACE "," ";" cols "${header}")
-foreach(name resolution threads cores ms_per_frame)
-  list(FIND cols ${name} i_${name})
-  if(i_${name} LESS 0)
-    message(FATAL_ERROR "${csv}: no column '${name}' in '${header}'")
-  endif()
-endforeach()
+include(${CMAKE_CURRENT_LIST_DIR}/bench_csv.cmake)
+set(BENCH_ARGS --threads-only --threads-default-only --thread-res 16 --thread-counts 1,3
+               --thread-rounds 1 --frames 5)
+bench_csv(out/bench/solvers_threads.csv 2 resolution threads cores ms_per_frame)
 cmake_host_system_information(RESULT cores QUERY NUMBER_OF_LOGICAL_CORES)
 set(expected 1 3)
 foreach(k 1 2)
-  list(GET lines ${k} row)
-  string(REPLACE "," ";" f "${row}")
-  list(GET f ${i_resolution} res)
-  list(GET f ${i_threads} threads)
-  list(GET f ${i_cores} c)
-  list(GET f ${i_ms_per_frame} ms)
+  bench_csv_row(${k})
   math(EXPR j "${k} - 1")
   list(GET expected ${j} want)
-  if(NOT res EQUAL 16 OR NOT threads EQUAL want OR NOT c EQUAL cores OR NOT ms GREATER 0)
+  if(NOT v_resolution EQUAL 16 OR NOT v_threads EQUAL want OR NOT v_cores EQUAL cores
+     OR NOT v_ms_per_frame GREATER 0)
     message(FATAL_ERROR "${csv} row ${k}: '${row}' (want 16^2, ${want} threads, ${cores} cores, "
                         "ms > 0)")
   endif()

@@ -9,6 +9,8 @@
 #include <limits>
 #include <thread>
 
+#include "sim/core/stopwatch.hpp"
+
 namespace drape::sim {
 
 XpbdSolver::XpbdSolver(XpbdOptions opt)
@@ -130,7 +132,8 @@ void XpbdSolver::cook_triangles(const Cloth& cloth) {
   // (sim/solvers/xpbd/xpbd_kernels.hpp); padding lanes use the scratch vertices n, n + 1, ...: one
   // per share of a colour's packs, the shares the threads run (by_colour_packs, the sweep's
   // halves).
-  scratch_slots_ = std::max(2, pool_->size());
+  scratch_slots_ = std::clamp(opt_.sweep_slots > 0 ? opt_.sweep_slots : pool_->size(), 2,
+                              xpbd::SweepPlan::kMaxSlots);
   const int S = scratch_slots_;
   cooked_f32_ = opt_.single_precision;
   cooked_kernels_ = opt_.kernels;
@@ -450,7 +453,7 @@ void XpbdSolver::build_sweep(int n) {
 
 bool XpbdSolver::wake(Cloth& cloth, const SceneObjects& scene) {
   if (!rest_.any_frozen()) {  // also clears flags left by a cut (re-cook) or by another solver
-    rest_.thaw(cloth);
+    rest_.thaw(cloth, pool_.get());
     return false;
   }
   fresh_penetration_ = energy_.detect_contacts(cloth, scene, pool_.get());
@@ -577,7 +580,7 @@ void XpbdSolver::warm(const Cloth& cloth, double dt, std::vector<double> anchors
   if (!cooked_for(cloth)) return;
   const double* scale = rest_.scales().data();
   const int* piece_of = rest_.piece_of().data();
-  take_masses(cloth, scale, piece_of);
+  take_masses(cloth, scale, piece_of, pool);
   if (dt > 0) {
     // 1/(be h^2) with Step's arithmetic.
     const double h = dt / std::max(1, opt_.substeps);
@@ -627,7 +630,7 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
 bool XpbdSolver::begin_frame(Step& c) {
   contacts_fresh_ = false;
   if (!opt_.freeze) {
-    rest_.thaw(c.cloth);
+    rest_.thaw(c.cloth, pool_.get());
   } else if (wake(c.cloth, c.scene)) {
     // Every piece sleeps and nothing disturbed it: nothing to compute this frame but the static
     // finish of pieces that have just fallen asleep.
@@ -639,7 +642,7 @@ bool XpbdSolver::begin_frame(Step& c) {
   } else {
     rest_.finish_sleeping(c.cloth, c.scene, pool_.get());  // pieces asleep while others move
   }
-  rest_.check_fixed(c.cloth);
+  rest_.check_fixed(c.cloth, pool_.get());
   return true;
 }
 
@@ -655,10 +658,20 @@ void XpbdSolver::renew_anchors(Step& c) {
   const auto& x = c.x;
   const double* xd = reinterpret_cast<const double*>(x.data());
   bool renew = anchors_.size() != static_cast<size_t>(3 * (n + scratch_slots_));
-  const double reach2 = kAnchorReach * kAnchorReach;
-  for (int i = 0; i < n && !renew; ++i)
-    renew = (x[i] - Vec3(anchors_[3 * i], anchors_[3 * i + 1], anchors_[3 * i + 2])).squaredNorm() >
+  if (!renew) {
+    // Some vertex beyond the reach (on the pool: a flag per thread).
+    const double reach2 = kAnchorReach * kAnchorReach;
+    changed_part_.assign(pool_->size(), 0);
+    pool_->parallel_for(n, [&](int b, int e, int wk) {
+      bool far = false;
+      for (int i = b; i < e && !far; ++i)
+        far =
+            (x[i] - Vec3(anchors_[3 * i], anchors_[3 * i + 1], anchors_[3 * i + 2])).squaredNorm() >
             reach2;
+      if (far) changed_part_[wk] = 1;
+    });
+    for (char f : changed_part_) renew = renew || f;
+  }
   if (!renew) return;
   anchors_.assign(xd, xd + 3 * n);
   anchors_.resize(3 * (n + scratch_slots_), 0.0);  // the scratch vertices (their P4f: 0)
@@ -835,24 +848,34 @@ void XpbdSolver::self_motion_of(const Step& c, const std::vector<int>& moved) {
 // sums over their stencils again; a change of scale alone does not (build_row_inverses()).
 void XpbdSolver::set_masses(Step& c) {
   if (rest_.masses_dirty()) {
-    take_masses(c.cloth, c.scale, c.piece_of);
+    take_masses(c.cloth, c.scale, c.piece_of, pool_.get());
     rest_.masses_set();
   }
   row_inverses(c.ihb, c.scale, c.piece_of, pool_.get());
 }
 
 // w_ and w0_ from the cloth's state, pieces' scales `scale` (vertex i's piece: piece_of[i]);
-// notes which changed.
-void XpbdSolver::take_masses(const Cloth& cloth, const double* scale, const int* piece_of) {
+// notes which changed. The vertices on `pool`.
+void XpbdSolver::take_masses(const Cloth& cloth, const double* scale, const int* piece_of,
+                             ThreadPool* pool) {
   const ClothState& S = cloth.state;
-  const int n = cloth.num_vertices();
-  for (int i = 0; i < n; ++i) {
-    const double w0 = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
-    const double wi = w0 > 0 ? w0 / scale[piece_of[i]] : 0.0;
-    if (wi != w_[i]) w_changed_ = true;
-    if (w0 != w0_[i]) w0_changed_ = true;
-    w_[i] = wi;
-    w0_[i] = w0;
+  changed_part_.assign(2 * static_cast<size_t>(pool->size()), 0);
+  pool->parallel_for(cloth.num_vertices(), [&](int b, int e, int wk) {
+    bool w_changed = false, w0_changed = false;
+    for (int i = b; i < e; ++i) {
+      const double w0 = cloth.is_free(i) && !(S.flags[i] & kFlagFrozen) ? S.inv_mass[i] : 0.0;
+      const double wi = w0 > 0 ? w0 / scale[piece_of[i]] : 0.0;
+      w_changed = w_changed || wi != w_[i];
+      w0_changed = w0_changed || w0 != w0_[i];
+      w_[i] = wi;
+      w0_[i] = w0;
+    }
+    if (w_changed) changed_part_[2 * wk] = 1;
+    if (w0_changed) changed_part_[2 * wk + 1] = 1;
+  });
+  for (size_t k = 0; k < changed_part_.size(); k += 2) {
+    w_changed_ = w_changed_ || changed_part_[k];
+    w0_changed_ = w0_changed_ || changed_part_[k + 1];
   }
 }
 
@@ -1408,19 +1431,51 @@ void XpbdSolver::sweep_items(const Step& c, const xpbd::SweepPlan::Phase& P, int
 }
 
 void XpbdSolver::sweep(const Step& c) {
+  const auto t0 = std::chrono::steady_clock::now();
   auto items = [&](const xpbd::SweepPlan::Phase& P, int b, int e, int slot) {
     sweep_items(c, P, b, e, slot);
   };
-  if (!sweep_parallel_) {
+  if (opt_.sweep_profile && pool_->size() == 1) {
+    profile_sweep(items);
+  } else if (!sweep_parallel_) {
     for (const auto& P : sweep_.phases()) items(P, P.b, P.e, 0);
-    return;
+  } else {
+    ++sweeps_;
+    // A pool thread other than the caller claims its share unless a test plays it absent.
+    auto claims = [&](int wk) {
+      return wk == 0 || (opt_.sweep_worker && wk != opt_.sweep_absent_worker);
+    };
+    if (sweep_.run(*pool_, items, claims)) ++sweep_takeovers_;
   }
-  ++sweeps_;
-  // A pool thread other than the caller claims its share unless a test plays it absent.
-  auto claims = [&](int wk) {
-    return wk == 0 || (opt_.sweep_worker && wk != opt_.sweep_absent_worker);
+  sweep_ms_ += ms_since(t0);
+}
+
+double XpbdSolver::sweep_megabytes(int n) const {
+  if (!cooked_f32_ || sweep_.empty()) return 0.0;
+  auto bytes = [](const auto& v) { return static_cast<double>(v.size() * sizeof(v[0])); };
+  const auto& rp = row_packs8_;
+  const double packs = bytes(tri_packs8_) + bytes(tri_packs16_) + bytes(tri_anchor8_) +
+                       bytes(rp.off) + bytes(rp.colv) + bytes(rp.val) + bytes(rp.ik) +
+                       bytes(rp.ai) + bytes(row_anchor8_);
+  const double per_vertex = sizeof(xpbd::P4f) + 4 * sizeof(Vec3) + sizeof(double);
+  return (packs + per_vertex * n) / (1 << 20);
+}
+
+template <class Items>
+void XpbdSolver::profile_sweep(Items& items) {
+  profile_ns_.assign(sweep_.num_runs(), 0.0);
+  sweep_.run_timed(items, profile_ns_);
+  auto add = [](xpbd::SweepPlan::Schedule& sum, const xpbd::SweepPlan::Schedule& s) {
+    sum.work_ns += s.work_ns;
+    sum.span_ns += s.span_ns;
+    sum.border_ns += s.border_ns;
+    sum.tail_ns += s.tail_ns;
   };
-  if (sweep_.run(*pool_, items, claims)) ++sweep_takeovers_;
+  add(profile_.ideal, sweep_.schedule(profile_ns_, 0));
+  add(profile_.handover, sweep_.schedule(profile_ns_, kProfileHandoverNs));
+  add(profile_.gated, sweep_.schedule(profile_ns_, 0, true));
+  profile_.slots = sweep_.slots();
+  ++profile_.sweeps;
 }
 
 // The sweep's contact retests: counted, their deepest penetration, the settling they end.

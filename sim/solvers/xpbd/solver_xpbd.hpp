@@ -107,6 +107,23 @@ class XpbdSolver : public Solver {
   // another (a worker had not claimed its share when it was needed).
   long sweeps() const { return sweeps_; }
   long sweep_takeovers() const { return sweep_takeovers_; }
+  // Wall ms spent in the element sweeps so far (the rest of a step is the per-substep and
+  // per-frame work around them).
+  double sweep_ms() const { return sweep_ms_; }
+  // XpbdOptions::sweep_profile: the sweeps' runs timed on one thread and replayed on the plan's
+  // slots (xpbd::SweepPlan::schedule), summed over the sweeps so far, with a hand-over of 0 and
+  // of kProfileHandoverNs per wait, and with a phase gate (SweepPlan::schedule, hand-over 0).
+  static constexpr double kProfileHandoverNs = 300;
+  struct SweepProfile {
+    long sweeps = 0;
+    int slots = 0;
+    xpbd::SweepPlan::Schedule ideal, handover, gated;
+  };
+  const SweepProfile& sweep_profile() const { return profile_; }
+  // MB of the arrays one single-precision sweep streams through at least once: the triangle
+  // and bending packs with their anchor terms, and per vertex the packed positions, positions,
+  // previous positions, velocities, inverse masses and anchors (0 when it has not cooked one).
+  double sweep_megabytes(int n) const;
   // Vertices tested again for contact in the sweep (XpbdOptions::retest_contacts).
   long contact_retests() const { return contact_retests_; }
   // The last cook of a topology (the first step, and the step after a cut, slit or sew): wall ms
@@ -196,12 +213,14 @@ class XpbdSolver : public Solver {
   void self_motion(const Step& c, int b, int e, int slot);
   void self_motion_of(const Step& c, const std::vector<int>& moved);
   void set_masses(Step& c);  // w and the bending blocks' inverses
-  void take_masses(const Cloth& cloth, const double* scale, const int* piece_of);
+  void take_masses(const Cloth& cloth, const double* scale, const int* piece_of, ThreadPool* pool);
   void row_inverses(double ihb, const double* scale, const int* piece_of, ThreadPool* pool);
   void plan_substep(Step& c);
   void predict(const Step& c, int b, int e);
   void warm_start(Step& c);
   void sweep(const Step& c);  // the whole substep as one element sweep (xpbd_sweep.hpp)
+  template <class Items>
+  void profile_sweep(Items& items);  // XpbdOptions::sweep_profile
   void collect_retests(Step& c);
   void project_triangles(const Step& c);  // and the bending blocks (packed alike)
   void project_bending_springs(Step& c);  // hinges, springs, contacts, self-collision
@@ -279,6 +298,8 @@ class XpbdSolver : public Solver {
   // The inverse masses without the settling scale (w0_) and whether they changed since the
   // bending blocks' sums row_b_ (6 per block: sum_j w0_j v_j v_j^T) were taken.
   std::vector<double> w0_, row_b_;
+  // Per pool thread: take_masses()' changed flags (w, w0), renew_anchors()' "beyond the reach".
+  std::vector<char> changed_part_;
   // Per pool thread: a vertex it updated in the substep moved more than half the contact margin
   // since the last detection (XpbdOptions::reuse_contacts).
   std::vector<char> moved_part_;
@@ -318,6 +339,9 @@ class XpbdSolver : public Solver {
   static constexpr int kSweepBlock = 256;
   xpbd::SweepPlan sweep_;
   long sweeps_ = 0, sweep_takeovers_ = 0, contact_retests_ = 0;
+  double sweep_ms_ = 0;
+  SweepProfile profile_;
+  std::vector<double> profile_ns_;  // per run of the plan: its duration in the last sweep
   // Per pool thread of the retests (retest_listed): vertices tested again for contact and their
   // deepest penetration; pieces a test ends the settling of (thread * pieces + piece).
   struct RetestPart {

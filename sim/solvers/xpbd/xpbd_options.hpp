@@ -32,6 +32,12 @@ struct XpbdOptions {
   // >= 1 does so for that one worker only, whose share the others take over (xpbd_sweep.hpp).
   bool sweep_worker = true;
   int sweep_absent_worker = -1;
+  // Benchmarks: the element sweep's shares (and the packs' padding shares) planned for this many
+  // threads whatever the pool's size (0: the pool's; results do not depend on it), and with
+  // sweep_profile on a pool of one thread each sweep's runs timed and replayed as that many
+  // threads would run them (XpbdSolver::sweep_profile(), xpbd::SweepPlan::schedule).
+  int sweep_slots = 0;
+  bool sweep_profile = false;
   // With reuse_contacts, in the element sweep: each vertex that moved more than half the margin
   // and its clearance (ClothEnergy::clearance2) since its own last contact test is tested again
   // there, instead of all vertices being tested again in the next substep (the frame's first

@@ -127,10 +127,15 @@ void RestScheduler::skip_rest_of_self_touching(const Cloth& cloth,
   }
 }
 
-void RestScheduler::thaw(Cloth& cloth) {
+void RestScheduler::thaw(Cloth& cloth, ThreadPool* pool) {
   auto& S = cloth.state;
-  const int n = cloth.num_vertices();
-  for (int i = 0; i < n; ++i) S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
+  auto clear = [&](int b, int e, int) {
+    for (int i = b; i < e; ++i) S.flags[i] &= static_cast<uint8_t>(~kFlagFrozen);
+  };
+  if (pool)
+    pool->parallel_for(cloth.num_vertices(), clear);
+  else
+    clear(0, cloth.num_vertices(), 0);
   std::fill(frozen_.begin(), frozen_.end(), 0);
   frozen_count_ = 0;
 }
@@ -187,20 +192,33 @@ bool RestScheduler::wake(Cloth& cloth, const ClothEnergy& energy) {
   return all_frozen;
 }
 
-void RestScheduler::check_fixed(const Cloth& cloth) {
+void RestScheduler::check_fixed(const Cloth& cloth, ThreadPool* pool) {
   if (!opt_.settle) {
     std::fill(scale_.begin(), scale_.end(), 1.0);
     return;
   }
   const auto& S = cloth.state;
-  const int n = cloth.num_vertices();
-  for (int i = 0; i < n; ++i) {
-    const bool fixed = !cloth.is_free(i);
-    if (scale_[piece_of_[i]] > 1.0 &&
-        ((fixed && (S.x[i] - S.x_prev[i]).squaredNorm() > 1e-18) || (fixed_prev_[i] && !fixed)))
-      unsettle(piece_of_[i]);
-    fixed_prev_[i] = fixed ? 1 : 0;
-  }
+  // Per pool thread and piece: whether a vertex of that piece ends its settling (applied after
+  // the loop: unsettle() writes the piece's state).
+  const int threads = pool ? pool->size() : 1;
+  unsettle_mark_.assign(static_cast<size_t>(threads) * num_pieces_, 0);
+  auto check = [&](int b, int e, int wk) {
+    char* mark = unsettle_mark_.data() + static_cast<size_t>(wk) * num_pieces_;
+    for (int i = b; i < e; ++i) {
+      const bool fixed = !cloth.is_free(i);
+      if (scale_[piece_of_[i]] > 1.0 &&
+          ((fixed && (S.x[i] - S.x_prev[i]).squaredNorm() > 1e-18) || (fixed_prev_[i] && !fixed)))
+        mark[piece_of_[i]] = 1;
+      fixed_prev_[i] = fixed ? 1 : 0;
+    }
+  };
+  if (pool)
+    pool->parallel_for(cloth.num_vertices(), check);
+  else
+    check(0, cloth.num_vertices(), 0);
+  for (int wk = 0; wk < threads; ++wk)
+    for (int p = 0; p < num_pieces_; ++p)
+      if (unsettle_mark_[static_cast<size_t>(wk) * num_pieces_ + p]) unsettle(p);
 }
 
 void RestScheduler::unsettle_pushed(const std::vector<Vec3>& x, const ClothEnergy& energy) {

@@ -63,16 +63,16 @@ class RestScheduler {
   // self pairs and could push one layer through another); the other pieces still do.
   void skip_rest_of_self_touching(const Cloth& cloth, const std::vector<SelfContact>& pairs);
 
-  // Frame start without freeze: every piece awake, no vertex frozen.
-  void thaw(Cloth& cloth);
+  // Frame start without freeze: every piece awake, no vertex frozen (the vertices on `pool`).
+  void thaw(Cloth& cloth, ThreadPool* pool = nullptr);
   bool any_frozen() const;
   // Frame start with freeze, after a fresh contact detection: wakes the sleeping pieces that
   // something disturbs (a fixed vertex moved, a vertex released, an object in the contact
   // shell) and resets the frozen flags; true when every piece still sleeps.
   bool wake(Cloth& cloth, const ClothEnergy& energy);
   // Frame start: a fixed vertex that moved since the last frame or was let go ends its piece's
-  // settling (without settle: every piece at its own mass).
-  void check_fixed(const Cloth& cloth);
+  // settling (without settle: every piece at its own mass). The vertices on `pool`.
+  void check_fixed(const Cloth& cloth, ThreadPool* pool = nullptr);
   // After a contact detection: something pushed into a settling piece (kUnsettleDepth).
   void unsettle_pushed(const std::vector<Vec3>& x, const ClothEnergy& energy);
 
@@ -132,6 +132,7 @@ class RestScheduler {
   std::vector<int> slow_;                // settling: slow substeps, then substeps since growing
   std::vector<int> full_;                // settling: substeps at the full scale
   std::vector<uint8_t> fixed_prev_;      // per vertex: fixed at the last step
+  std::vector<char> unsettle_mark_;      // check_fixed: per pool thread and piece
   std::vector<PieceMotion> motion_;      // this substep's motion per piece
   std::vector<int> group_;               // per vertex: its piece if corrected or finished, else -1
   // Coarse correction.
