@@ -6,20 +6,24 @@
 // (thickness + margin), overlaps; each vertex looks up its own cell and tests the triangles
 // there that do not contain it (nor a vertex made from the same one: a cut's other side): the
 // pair is kept when the vertex is within the reach of the triangle's plane and projects inside
-// the triangle. The side (sign of the distance) is taken then, from a state assumed free of
+// the triangle, or, projecting outside it (over an edge or a corner of a convex layer, between
+// the prisms of its triangles), is within the reach of the triangle and within 15 deg of its
+// normal from the triangle's nearest point (a vertex over a ridge pairs with the triangles on
+// both sides). The side (sign of the distance) is taken then, from a state assumed free of
 // intersections, and kept until the next detection. A pair farther than the reach cannot come
 // within `thickness` before the vertex and the triangle have come `margin` closer, which the
 // solver bounds from the displacements since the detection (XpbdSolver::self_due, keeps_pairs
 // below) to detect again in time.
 // Projection: C = side n . (x_v - sum_k b_k x_k) - thickness >= 0 (n the triangle's unit
 // normal, b the barycentric coordinates of the vertex's projection, both taken as constant in
-// the correction), inverse-mass weighted, one Gauss-Seidel pass.
+// the correction; outside the triangle b is clamped onto it), inverse-mass weighted, one
+// Gauss-Seidel pass.
 // Limits (docs/solvers.md): vertex-face pairs only (no edge-edge test: two layers can still
 // cross where edges pass each other between vertices, on meshes much coarser than the
-// thickness); a vertex over a convex layer's edge or vertex projects into no triangle (no pair
-// until it slides over one and the next detection); the side is not repaired once a layer has
-// passed through; a triangle stretched over more than 8 hash cells per axis is entered in the
-// first 8 only.
+// thickness); a vertex over a ridge that turns by more than 30 deg between two triangles is
+// paired with neither until it slides over one and the next detection; the side is not repaired
+// once a layer has passed through; a triangle stretched over more than 8 hash cells per axis is
+// entered in the first 8 only.
 #pragma once
 
 #include <algorithm>
@@ -103,8 +107,8 @@ class SelfCollision {
   bool sphere_test_ = true;
   // The region cull: the cloth is split once per topology into regions (the triangles of one
   // cell of a material-space grid 6 edges wide that are connected to each other). At each
-  // detection a region whose triangle normals lie within kFlatCone of their mean is flat (a
-  // height field over that axis: none of its vertices is within reach above one of its own
+  // detection a region whose triangle normals lie within kFlatCone (37 deg) of their mean is flat
+  // (a height field over that axis: none of its vertices is within reach above one of its own
   // triangles); a flat region whose box, grown by the reach, meets no other region's, or meets
   // only adjacent regions that are flat together with it, has no pair and is left out of the
   // hash and the vertex tests. Only the regions that fold, or that lie against another layer,
@@ -166,6 +170,13 @@ class SelfCollision {
     Vec3 a, n, g1, g2;  // corner, unit normal, barycentric gradients (detect())
   };
   std::vector<TriFrame> pre_;
+  // Per vertex the triangles around it (CSR; per topology), and whether a corner of triangle t
+  // is vertex v's neighbour in the mesh (or v itself).
+  std::vector<int32_t> fan_lo_, fan_;
+  uint64_t fans_version_ = 0;
+  int fans_tris_ = -1;
+  void build_fans(const Cloth& cloth);
+  bool near_in_mesh(const Cloth& cloth, int v, int t) const;
 };
 
 }  // namespace drape::sim
