@@ -1009,8 +1009,9 @@ void thread_rows(int max_res, const ThreadRowsConfig& tr, std::optional<int> fra
 // the step's time outside the sweeps on one thread (the frame's and substeps' other work) it
 // brackets the frame on S cores: that work serial, or divided by S. The MB of the arrays a sweep
 // streams (XpbdSolver::sweep_megabytes) give the memory traffic a measured frame implies. CSV
-// out/bench/solvers_sweep_model.csv.
-void sweep_model_rows(const ThreadRowsConfig& tr, std::optional<int> frames_cap) {
+// out/bench/solvers_sweep_model.csv. False (with the reason on stderr) when the default solver is
+// not XPBD: it has no sweep plan to model.
+bool sweep_model_rows(const ThreadRowsConfig& tr, std::optional<int> frames_cap) {
   std::ofstream mc("out/bench/solvers_sweep_model.csv");
   mc << "scene,solver,resolution,slots,frames,frame_ms,sweep_ms,other_ms,work_ms,span_ms,"
         "span_handover_ms,sweep_speedup,sweep_efficiency,wait_pct,tail_pct,"
@@ -1029,7 +1030,11 @@ void sweep_model_rows(const ThreadRowsConfig& tr, std::optional<int> frames_cap)
       cfg.air_drag = sc.air_drag;
       auto made = make_solver("default", cfg);
       XpbdSolver* xp = xpbd_of(made->get());
-      if (!xp) return;
+      if (!xp) {
+        std::fprintf(stderr, "sweep model: the default solver (%s) is not XPBD: no sweep plan\n",
+                     kDefaultSolver);
+        return false;
+      }
       xp->options().sweep_slots = slots;
       xp->options().sweep_profile = true;
       const int frames =
@@ -1052,16 +1057,16 @@ void sweep_model_rows(const ThreadRowsConfig& tr, std::optional<int> frames_cap)
           res, slots, frame, sweep, other, work, span, span > 0 ? work / span : 0.0, 100 * eff,
           pct(P.ideal.border_ns), pct(P.ideal.tail_ns), 100 * eff_ho, 100 * eff_gated, other + span,
           other / slots + span);
+      const double mb = xp->sweep_megabytes(sc.cloth.num_vertices());
       std::printf("model    %5d %5d the sweep's arrays %.1f MB (%d sweeps a frame)\n", res, slots,
-                  xp->sweep_megabytes(sc.cloth.num_vertices()),
-                  static_cast<int>(std::lround(double(P.sweeps) / frames)));
+                  mb, static_cast<int>(std::lround(double(P.sweeps) / frames)));
       mc << "form," << kDefaultSolver << "," << res << "," << slots << "," << frames << "," << frame
          << "," << sweep << "," << other << "," << work << "," << span << "," << span_ho << ","
          << (span > 0 ? work / span : 0.0) << "," << eff << "," << pct(P.ideal.border_ns) << ","
          << pct(P.ideal.tail_ns) << "," << eff_ho << "," << eff_gated << "," << other + span << ","
-         << other / slots + span << "," << xp->sweep_megabytes(sc.cloth.num_vertices())
-         << std::endl;
+         << other / slots + span << "," << mb << std::endl;
     }
+  return true;
 }
 
 // Self-collision in the app's scene: the live session's solver (the default, pieces at rest
@@ -1381,8 +1386,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (kn.sweep_model) {  // the sweep's plan on many threads, measured on one
-    sweep_model_rows(kn.thread_rows, kn.frames);
-    return 0;
+    return sweep_model_rows(kn.thread_rows, kn.frames) ? 0 : 1;
   }
   if (kn.threads_only) {  // the thread and precision rows alone (out/bench/solvers_threads.csv)
     thread_rows(std::max(max_res, 256), kn.thread_rows, kn.frames);
