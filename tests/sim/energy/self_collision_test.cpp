@@ -314,7 +314,7 @@ TEST(SelfCollision, RegionCullFindsThePlainTestsPairsOnCurvedLayers) {
 
 // A flat layer 4 mm over a ridge of the layer below: the vertices over the ridge project outside
 // the prisms of the sloped triangles on both sides. A ridge turning by 20 deg pairs each of them
-// with triangles on both sides (within 15 deg of their normals; before such pairs, none); one
+// with triangles on both sides (within 15 deg of their normals; without such pairs, none); one
 // turning by 40 deg with neither (the detector's limit).
 TEST(SelfCollision, PairsAVertexOverARidgeWithBothSides) {
   const double thick = 0.002, margin = 0.005, y0 = 0.1, gap = 0.004, ridge = 0.1;
