@@ -58,6 +58,7 @@ constexpr double kOverEdgeTan = 0.26794919243112270;  // tan 15 deg
 // allow 44 deg, which in the app's scene tests half the regions 37 deg does at 64^2.)
 constexpr double kFlatCone = 37.0 * kDegree;
 
+// Whether triangles a and b have a vertex in common.
 bool shares_corner(const std::array<int32_t, 3>& a, const std::array<int32_t, 3>& b) {
   for (const int32_t u : a)
     if (u == b[0] || u == b[1] || u == b[2]) return true;
@@ -222,10 +223,8 @@ void SelfCollision::build_fans(const Cloth& cloth) {
 
 bool SelfCollision::near_in_mesh(const Cloth& cloth, int v, int t) const {
   const auto& tris = cloth.topo.triangles;
-  const auto& T = tris[t];
   for (int i = fan_lo_[v]; i < fan_lo_[v + 1]; ++i)
-    for (const int c : tris[fan_[i]])
-      if (c == T[0] || c == T[1] || c == T[2]) return true;
+    if (shares_corner(tris[fan_[i]], tris[t])) return true;
   return false;
 }
 
