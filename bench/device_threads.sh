@@ -15,7 +15,8 @@
 #       at --base-res x --base-threads (--base-res "" skips it), OUT/baseline.log. --two-cores:
 #       also 128^2 on two threads pinned to two cores (taskset), both builds, OUT/two_cores.log.
 #       --split: this build's probe at --base-res x --base-threads, each frame's wall time
-#       split into the element sweeps and the rest of the step (OUT/split.log), and the sweep
+#       split into the element sweeps and the rest of the step, and into the step's parts
+#       (OUT/split.log; the thread rows print the parts too), and the sweep
 #       model (solvers_bench --sweep-model: the sweep's plan timed on one thread, replayed on
 #       8 and 16; OUT/solvers_sweep_model.csv).
 set -euo pipefail
@@ -85,7 +86,7 @@ case "$mode" in
       probe_rows baseline "$dir/solvers_bench_base" '^form .* wall' 2>&1 | tee "$out/baseline.log"
     fi
     if [ -n "$split" ]; then
-      probe_rows split "$dir/solvers_bench" '^form .* wall|element sweeps' 2>&1 |
+      probe_rows split "$dir/solvers_bench" '^form .* wall|element sweeps|step parts' 2>&1 |
         tee "$out/split.log"
       run_bin "$dir/solvers_bench" --sweep-model --thread-res 128,256 --thread-counts 8,16 \
         2>&1 | tee -a "$out/split.log"

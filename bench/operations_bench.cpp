@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "sim/core/memory.hpp"
 #include "sim/core/stopwatch.hpp"
 #include "sim/ops/cut.hpp"
 #include "sim/ops/operation_controller.hpp"
@@ -252,9 +253,12 @@ struct CutTicks {
   int max_at = 0;         // the slowest tick, counted from the cut's (0)
   int swap_at = -1;       // ahead: the first tick that stepped the cut topology
   int waits = 0;          // ahead: ticks that waited for the worker's cook
-  // ahead: wall ms from the worker's start to the cut topology's solver ready, and to the end of
-  // its spare energy copy (-1: not ended when the run ended)
-  double ready_ms = -1, spare_ms = -1;
+  // ahead: wall ms from the end of the cut's tick (the worker's release) to the worker's start
+  // (once the worker before it ended), to the cut topology's solver ready, and to the end of its
+  // spare energy copy (-1: not ended when the run ended)
+  double start_ms = -1, ready_ms = -1, spare_ms = -1;
+  long faults = -1;        // the process's page faults from the cut's tick to the swap's (its end)
+  long ready_faults = -1;  // ahead: those while the worker made the new solver ready
   XpbdSolver::CookStats cook;  // the cook of the cut topology (ahead: on the worker)
   // Every tick in order (the cut's at index kTicksBefore): wall ms, the stepping thread's CPU
   // ms (below the wall: it was off its core; above the pool's share: it waited for a worker)
@@ -300,7 +304,9 @@ CutTicks bench_cut_ticks(int res, int threads, Cook mode, int ahead_ticks, bool 
   r.threads = threads;
   r.cook_mode = mode;
   constexpr int kBefore = kTicksBefore, kAfter = 40;
+  long faults0 = 0;
   for (int k = 0; k < kBefore + kAfter; ++k) {
+    if (k == kBefore) faults0 = process_page_faults();
     std::this_thread::sleep_until(next);
     next += period;
     const double cpu0 = thread_cpu_ms();
@@ -314,7 +320,10 @@ CutTicks bench_cut_ticks(int res, int threads, Cook mode, int ahead_ticks, bool 
     r.each_cpu.push_back(thread_cpu_ms() - cpu0);
     r.each_preempted.push_back(involuntary_switches() - inv0);
     r.each_collision.push_back(st.collision_ms);
-    if (ahead && k >= kBefore && r.swap_at < 0 && !ahead->pending()) r.swap_at = k - kBefore;
+    if (ahead && k >= kBefore && r.swap_at < 0 && !ahead->pending()) {
+      r.swap_at = k - kBefore;
+      r.faults = process_page_faults() - faults0;
+    }
   }
   r.ticks = kBefore + kAfter;
   r.each = ticks;
@@ -322,7 +331,9 @@ CutTicks bench_cut_ticks(int res, int threads, Cook mode, int ahead_ticks, bool 
   r.cook = xpbd()->last_cook();
   if (ahead) {
     r.waits = ahead->waits();
+    r.start_ms = ahead->start_ms();
     r.ready_ms = ahead->ready_ms();
+    r.ready_faults = ahead->ready_faults();
     r.spare_ms = ahead->spare_ms();
   }
   r.max_at =
@@ -337,27 +348,55 @@ CutTicks bench_cut_ticks(int res, int threads, Cook mode, int ahead_ticks, bool 
 }
 
 // One cut's re-cook alone, for an instruction count (valgrind --tool=callgrind; docs/solvers.md,
-// section 3): the form drape at res^2 on one thread, two frames, the cut across of
-// bench_cut_ticks, one frame (the cook); prints the cook's parts. Every cook is a full one with
-// `full`.
-void cook_probe(int res, bool full) {
-  Testbed sc = make_scene("form", res);
-  XpbdOptions o;
-  o.air_drag = sc.air_drag;
-  o.threads = 1;
-  o.freeze = true;
-  o.incremental_cook = !full;
-  XpbdSolver s(o);
-  for (int f = 0; f < 2; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
-  if (!cut_across_material(sc.cloth, 0.5 + 0.25 / res).ok)
-    std::fprintf(stderr, "the cut across %d^2 failed\n", res);
-  s.step(sc.cloth, sc.objects, 1.0 / 90);
-  const auto& k = s.last_cook();
+// section 3) or its wall time on `threads` threads: the form drape at res^2, two frames, the cut
+// across of bench_cut_ticks, one frame (the cook); prints the cook's parts, their medians over
+// `repeat` runs. Every cook is a full one with `full`.
+void cook_probe(int res, bool full, int threads, int repeat) {
+  std::vector<XpbdSolver::CookStats> cooks;
+  std::vector<double> faults;  // the process's page faults in the cut's step (its cook with it)
+  for (int r = 0; r < repeat; ++r) {
+    Testbed sc = make_scene("form", res);
+    XpbdOptions o;
+    o.air_drag = sc.air_drag;
+    o.threads = threads;
+    o.freeze = true;
+    o.incremental_cook = !full;
+    XpbdSolver s(o);
+    for (int f = 0; f < 2; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
+    if (!cut_across_material(sc.cloth, 0.5 + 0.25 / res).ok)
+      std::fprintf(stderr, "the cut across %d^2 failed\n", res);
+    rusage u0{}, u1{};
+    getrusage(RUSAGE_SELF, &u0);
+    s.step(sc.cloth, sc.objects, 1.0 / 90);
+    getrusage(RUSAGE_SELF, &u1);
+    faults.push_back(static_cast<double>(u1.ru_minflt - u0.ru_minflt));
+    cooks.push_back(s.last_cook());
+  }
+  // Each part's median over the runs (a noisy machine: the runs' spread is printed too).
+  auto median = [&](double XpbdSolver::CookStats::*f) {
+    std::vector<double> v;
+    for (const auto& k : cooks) v.push_back(k.*f);
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  auto lo_hi = [&](double XpbdSolver::CookStats::*f) {
+    double lo = cooks[0].*f, hi = lo;
+    for (const auto& k : cooks) lo = std::min(lo, k.*f), hi = std::max(hi, k.*f);
+    return std::make_pair(lo, hi);
+  };
+  using K = XpbdSolver::CookStats;
+  const K& k = cooks.back();
+  const auto [lo, hi] = lo_hi(&K::total_ms);
   std::printf(
-      "%d^2, the cut's cook (%s): %.2f ms (energy %.2f, triangles %.2f, bending %.2f, sweep "
-      "plan %.2f, other %.2f; rows of %d triangles made)\n",
-      res, k.incremental ? "incremental" : "full", k.total_ms, k.energy_ms, k.triangles_ms,
-      k.bending_ms, k.sweep_ms, k.other_ms, k.rebuilt_triangles);
+      "%d^2, the cut's cook (%s, %d thread%s, median of %d): %.2f ms [%.2f - %.2f] (energy %.2f, "
+      "triangles %.2f, bending %.2f, sweep plan %.2f, other %.2f; rows of %d triangles made)\n",
+      res, k.incremental ? "incremental" : "full", threads, threads > 1 ? "s" : "", repeat,
+      median(&K::total_ms), lo, hi, median(&K::energy_ms), median(&K::triangles_ms),
+      median(&K::bending_ms), median(&K::sweep_ms), median(&K::other_ms), k.rebuilt_triangles);
+  std::sort(faults.begin(), faults.end());
+  std::printf(
+      "%d^2, the cut's step: %.0f page faults (median; 4 KiB each: %.1f MiB first touched)\n", res,
+      faults[faults.size() / 2], faults[faults.size() / 2] * 4096 / (1 << 20));
 }
 
 // The operations' cost and latency rows (out/bench/operations.csv) and their targets.
@@ -411,6 +450,11 @@ int main(int argc, char** argv) {
                  "only one cut's re-cook at this form resolution, on one thread (for callgrind)")
       ->check(CLI::Range(4, 1024));
   app.add_flag("--full-cook", full_cook, "with --cook-probe: a full cook instead");
+  int cook_threads = 1;
+  app.add_option("--cook-threads", cook_threads,
+                 "with --cook-probe: the solver's threads (the cook's pool)")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   bool ahead_only = false;
   app.add_flag("--ahead-only", ahead_only,
                "the ticks around a cut with the session's cook ahead only (no operation rows, no "
@@ -420,12 +464,13 @@ int main(int argc, char** argv) {
                "the ticks around a cut with self-collision on (the app's scene at 48^2 and up); "
                "the goal line then does not apply");
   int repeat = 1;
-  app.add_option("--repeat", repeat, "runs of the ticks around a cut, each its own row")
+  app.add_option("--repeat", repeat,
+                 "runs of the ticks around a cut, each its own row (with --cook-probe: cooks)")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (probe_res > 0) {
-    cook_probe(probe_res, full_cook);
+    cook_probe(probe_res, full_cook, cook_threads, repeat);
     return 0;
   }
   if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
@@ -440,7 +485,8 @@ int main(int argc, char** argv) {
       << "resolution,threads,cook,ticks,p50_ms,p99_ms,max_ms,max_tick_after_cut,cut_tick_ms,"
          "p50_before_cut_ms,max_before_cut_ms,swap_tick_after_cut,waits,recook_ms,recook_energy_ms,"
          "recook_triangles_ms,recook_bending_ms,recook_sweep_ms,recook_other_ms,"
-         "recook_triangles_made,worker_ready_ms,worker_spare_ms,self_collision\n";
+         "recook_triangles_made,worker_ready_ms,worker_spare_ms,self_collision,worker_start_ms,"
+         "page_faults_to_swap,worker_cook_page_faults\n";
   std::printf(
       "\nticks around a cut (form drape, XPBD; 15 ticks, the cut, 39 more), wall ms; the cut\n"
       "topology cooked in the cut's tick (incremental, full) or ahead on a worker (swap: the\n"
@@ -481,7 +527,8 @@ int main(int argc, char** argv) {
              << ',' << t.before_max << ',' << t.swap_at << ',' << t.waits << ',' << k.total_ms
              << ',' << k.energy_ms << ',' << k.triangles_ms << ',' << k.bending_ms << ','
              << k.sweep_ms << ',' << k.other_ms << ',' << k.rebuilt_triangles << ',' << t.ready_ms
-             << ',' << t.spare_ms << ',' << self_collision << '\n';
+             << ',' << t.spare_ms << ',' << self_collision << ',' << t.start_ms << ',' << t.faults
+             << ',' << t.ready_faults << '\n';
         std::printf(
             "          the cook of the cut topology%s: %.2f ms (energy %.2f, triangles %.2f, "
             "bending %.2f, sweep plan %.2f, other %.2f; rows of %d triangles made)\n",
@@ -490,9 +537,11 @@ int main(int argc, char** argv) {
         if (mode == Cook::kAhead)
           std::printf(
               "          the worker (from the end of the cut's tick; the swap's tick starts "
-              "%.1f ms later): the new solver ready at %.2f ms, its spare energy copied at %.2f "
-              "ms\n",
-              1000.0 / 90 * (t.swap_at - 1), t.ready_ms, t.spare_ms);
+              "%.1f ms later): started at %.2f ms, the new solver ready at %.2f ms, its spare "
+              "energy copied at %.2f ms; page faults %ld in the cook, %ld from the cut to the "
+              "swap\n",
+              1000.0 / 90 * (t.swap_at - 1), t.start_ms, t.ready_ms, t.spare_ms, t.ready_faults,
+              t.faults);
       }
     if (!ahead_only)
       std::printf(

@@ -44,6 +44,8 @@
 // solvers_bench --probe form 128 xpbd 10 1 --frames 270 --threads 2.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -556,6 +558,12 @@ int probe(const Knobs& kn) {
         xp->anchor_renewals(), frames, f32 ? "" : " (double precision)", xp->kernels().name,
         f32 ? xp->kernels().tri_lanes : 4, f32 ? 8 : 4, frames ? xp->sweep_ms() / frames : 0.0,
         frames ? (wall - xp->sweep_ms()) / frames : 0.0);
+    // The steps' parts (the cooks apart): on more threads, a part whose time does not fall is
+    // serial.
+    std::printf("xpbd step parts, wall ms/frame:");
+    for (int p = 0; p < XpbdSolver::kStepParts; ++p)
+      std::printf(" %s %.3f%s", XpbdSolver::part_name(p), frames ? xp->part_ms(p) / frames : 0.0,
+                  p + 1 < XpbdSolver::kStepParts ? "," : "\n");
     if (xp->options().coarse_factor > 0) {
       const CoarseStats& c = xp->last_coarse();
       std::printf(
@@ -902,6 +910,7 @@ std::string cpu_model() {
 struct ThreadRun {
   double wall = 0, cpu = 0, steady = 0, first = 0;
   std::string kernels;
+  std::array<double, XpbdSolver::kStepParts> parts{};  // XPBD: wall ms/frame of each step part
 };
 ThreadRun timed_drape(int res, int threads, bool dbl, const std::string& kernels,
                       std::optional<int> frames_cap) {
@@ -926,7 +935,10 @@ ThreadRun timed_drape(int res, int threads, bool dbl, const std::string& kernels
   auto ms = [](auto d) { return std::chrono::duration<double, std::milli>(d).count(); };
   ThreadRun r{ms(w2 - w0) / frames, (cpu_ms() - c0) / frames, ms(w2 - w1) / (frames - 1),
               ms(w1 - w0), ""};
-  if (auto* xp = xpbd_of(s->get())) r.kernels = xp->kernels().name;
+  if (auto* xp = xpbd_of(s->get())) {
+    r.kernels = xp->kernels().name;
+    for (int p = 0; p < XpbdSolver::kStepParts; ++p) r.parts[p] = xp->part_ms(p) / frames;
+  }
   return r;
 }
 
@@ -944,7 +956,16 @@ void thread_rows(int max_res, const ThreadRowsConfig& tr, std::optional<int> fra
   const std::string cpu = cpu_model();
   std::ofstream tc("out/bench/solvers_threads.csv");
   tc << "scene,solver,resolution,substeps,threads,cores,precision,kernels,runs,ms_per_frame,"
-        "cpu_ms_per_frame,steady_ms_per_frame,first_frame_ms,speedup,efficiency,cpu\n";
+        "cpu_ms_per_frame,steady_ms_per_frame,first_frame_ms,speedup,efficiency,cpu";
+  // Then each step part's wall ms per frame (XpbdSolver::StepPart; the first frame's cook is
+  // in first_frame_ms, not in a part).
+  for (int p = 0; p < XpbdSolver::kStepParts; ++p) {
+    std::string name = XpbdSolver::part_name(p);
+    std::replace_if(
+        name.begin(), name.end(), [](char ch) { return !std::isalnum(ch); }, '_');
+    tc << ",part_" << name << "_ms";
+  }
+  tc << "\n";
   std::printf("threads  machine: %u cores, %s\n", cores, cpu.c_str());
   struct Config {
     bool dbl;
@@ -971,6 +992,12 @@ void thread_rows(int max_res, const ThreadRowsConfig& tr, std::optional<int> fra
       std::sort(x.begin(), x.end());
       return x[x.size() / 2];
     };
+    auto median_part = [](const std::vector<ThreadRun>& v, int p) {
+      std::vector<double> x;
+      for (const ThreadRun& r : v) x.push_back(r.parts[p]);
+      std::sort(x.begin(), x.end());
+      return x[x.size() / 2];
+    };
     std::printf("threads  %4d^2 %s 10x1: %-7s %-6s %7s %10s %10s %10s %10s %8s %6s\n", res,
                 kDefaultSolver, "prec", "simd", "threads", "ms/frame", "CPU ms", "steady",
                 "first ms", "speedup", "eff");
@@ -991,9 +1018,27 @@ void thread_rows(int max_res, const ThreadRowsConfig& tr, std::optional<int> fra
         tc << "form," << kDefaultSolver << "," << res << ",10," << threads << "," << cores << ","
            << prec << "," << v[0].kernels << "," << rounds << "," << wall << ","
            << median(v, &ThreadRun::cpu) << "," << median(v, &ThreadRun::steady) << ","
-           << median(v, &ThreadRun::first) << "," << speedup << "," << eff << ",\"" << cpu << "\""
-           << std::endl;
+           << median(v, &ThreadRun::first) << "," << speedup << "," << eff << ",\"" << cpu << "\"";
+        for (int p = 0; p < XpbdSolver::kStepParts; ++p) tc << "," << median_part(v, p);
+        tc << std::endl;
       }
+    }
+    // The step's parts of the default configuration, each against its own time on one thread:
+    // a part that does not speed up is serial (what limits the frame on many cores).
+    std::printf("threads  %4d^2 step parts, wall ms/frame (speed-up against one thread):\n", res);
+    const auto& one = runs[{0, 1}];
+    for (int threads : configs[0].threads) {
+      const auto& v = runs[{0, threads}];
+      std::printf("threads  %4d^2 %3d:", res, threads);
+      const char* sep = " ";
+      for (int p = 0; p < XpbdSolver::kStepParts; ++p) {
+        const double ms = median_part(v, p), base = one.empty() ? 0.0 : median_part(one, p);
+        if (base < 0.005 && ms < 0.005) continue;  // (a part this scene does not run)
+        std::printf("%s%s %.3f", sep, XpbdSolver::part_name(p), ms);
+        if (base > 0 && ms > 0 && threads > 1) std::printf(" (%.2fx)", base / ms);
+        sep = ", ";
+      }
+      std::printf("\n");
     }
   }
 }

@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "sim/core/cloth_io.hpp"
+#include "sim/core/memory.hpp"
 #include "sim/core/stopwatch.hpp"
 #include "sim/core/thread_pool.hpp"
 
@@ -151,6 +152,9 @@ void CookAheadSolver::launch(std::function<void(ThreadPool&)> job) {
 }
 
 void CookAheadSolver::release() {
+  if (!released_.load(std::memory_order_relaxed))
+    released_at_.store(std::chrono::steady_clock::now().time_since_epoch().count(),
+                       std::memory_order_relaxed);
   released_.store(true, std::memory_order_release);
   released_.notify_all();
 }
@@ -173,14 +177,18 @@ void CookAheadSolver::start(const Cloth& cloth, int steps, double dt) {
   copying_ = next_.get();
   launch([this, s = next_.get(), spare = opt_.spare_energy, dt, self = self_collision_,
           anchors = std::move(anchors)](ThreadPool& pool) {
-    const auto t0 = std::chrono::steady_clock::now();
+    using Clock = std::chrono::steady_clock;
+    const Clock::time_point t0{Clock::duration{released_at_.load(std::memory_order_relaxed)}};
+    start_ms_.store(ms_since(t0), std::memory_order_relaxed);
     ready_ms_.store(-1, std::memory_order_relaxed);
     spare_ms_.store(-1, std::memory_order_relaxed);
     if (spare_) s->seed_energy(std::move(*spare_));
     spare_.reset();
+    const long faults0 = process_page_faults();
     s->prepare(next_cloth_, &pool);
     // The first step's masses, blocks and anchor terms, off the swap's step.
     if (opt_.warm) s->warm(next_cloth_, dt, anchors, self, &pool);
+    ready_faults_.store(process_page_faults() - faults0, std::memory_order_relaxed);
     ready_ms_.store(ms_since(t0), std::memory_order_relaxed);
     done_.store(true, std::memory_order_release);
     done_.notify_all();
@@ -197,10 +205,12 @@ void CookAheadSolver::start(const Cloth& cloth, int steps, double dt) {
 void CookAheadSolver::start_spare(const Cloth& cloth) {
   auto copy = std::make_shared<Cloth>();
   copy_without_incidence(cloth, *copy);
-  launch([this, copy, o = active_->options()](ThreadPool& pool) {
-    XpbdSolver s(o);
-    s.prepare(*copy, &pool);
-    spare_ = std::make_unique<ClothEnergy>(s.energy().spare_copy());
+  // The energy alone, as the solver's cook builds it (not the solver's packs and plan: a cut
+  // soon after would wait for them).
+  launch([this, copy, eo = XpbdSolver::cook_energy_options(active_->options())](ThreadPool& pool) {
+    ClothEnergy e;
+    e.build(*copy, eo, &pool);
+    spare_ = std::make_unique<ClothEnergy>(e.spare_copy());
   });
 }
 

@@ -92,10 +92,15 @@ class CookAheadSolver : public Solver {
   int edits_in_step() const { return edits_in_step_; }
   // Steps at which the worker had not finished when its topology was due (the step waited).
   int waits() const { return waits_; }
-  // The last edit taken ahead: wall ms from the worker's start to the new solver ready, and to
+  // The last edit taken ahead: wall ms from the end of the edit's step (the worker's release)
+  // to the worker's start (after the worker before it ended), to the new solver ready, and to
   // the end of its spare energy copy (-1 until then).
+  double start_ms() const { return start_ms_.load(std::memory_order_relaxed); }
   double ready_ms() const { return ready_ms_.load(std::memory_order_relaxed); }
   double spare_ms() const { return spare_ms_.load(std::memory_order_relaxed); }
+  // The process's page faults while the worker made the new solver ready (its cook's first
+  // touches of fresh memory; the steps beside it allocate nothing).
+  long ready_faults() const { return ready_faults_.load(std::memory_order_relaxed); }
   // Steps from an edit of this cloth to its first step with the new topology, in a scene with
   // self-collision or without.
   int ticks_for(const Cloth& cloth, bool self_collision = false) const;
@@ -152,7 +157,10 @@ class CookAheadSolver : public Solver {
   // are joined there).
   std::thread reaper_;
   int edits_ahead_ = 0, edits_in_step_ = 0, waits_ = 0;
-  std::atomic<double> ready_ms_{-1}, spare_ms_{-1};
+  std::atomic<double> start_ms_{-1}, ready_ms_{-1}, spare_ms_{-1};
+  std::atomic<long> ready_faults_{-1};
+  // When release() let the worker go: steady_clock ticks (the worker's times count from it).
+  std::atomic<std::chrono::steady_clock::rep> released_at_{0};
 };
 
 }  // namespace drape::sim

@@ -9,6 +9,7 @@
 #include <limits>
 #include <thread>
 
+#include "sim/core/memory.hpp"
 #include "sim/core/stopwatch.hpp"
 
 namespace drape::sim {
@@ -16,6 +17,9 @@ namespace drape::sim {
 XpbdSolver::XpbdSolver(XpbdOptions opt)
     : opt_(opt), pool_(std::make_unique<ThreadPool>(std::max(1, opt.threads))) {
   pool_->set_min_parallel(64);
+  // A cook's arrays reuse the memory the cook before it freed instead of fresh pages (a page
+  // fault each 4 KiB: a third of a cut's re-cook at 128^2 on a virtual machine).
+  retain_freed_memory();
 }
 XpbdSolver::~XpbdSolver() = default;
 
@@ -65,12 +69,10 @@ void XpbdSolver::cook(const Cloth& cloth) {
   CookStats st;
   x_self_.clear();  // the self-collision pairs name triangles of the last topology
   self_.clear();
-  // XPBD projects the bending rows and never evaluates P (EnergyOptions::bending_matrix).
-  EnergyOptions eo = opt_.energy;
-  eo.bending_matrix = false;
+  const EnergyOptions eo = cook_energy_options(opt_);
   // An incremental cook keeps the bending rows and blocks of the triangles the change did not
   // reach (ClothEnergy::update); everything else is cooked again as in a full cook.
-  ThreadPool* pool = cook_pool_ ? cook_pool_ : pool_.get();
+  ThreadPool* pool = cook_pool();
   if (opt_.incremental_cook)
     st.incremental = energy_.update(cloth, eo, pool);
   else
@@ -295,38 +297,37 @@ void XpbdSolver::cook_bending(int n, bool incremental) {
   colour_elements(n, boff, bcol, order_b, col);
   pause_point();
   row_cols_ = col.empty() ? std::vector<int>(1, 0) : col;
-  row_off_.assign(1, 0);
-  row_colv_.clear();
-  row_val_.clear();
-  row_ik_.clear();
-  row_colv_.reserve(bcol.size());
-  row_val_.reserve(bval.size());
-  row_ik_.reserve(bik.size());
-  row_off_.reserve(boff.size());
-  for (int bk : order_b) {
-    if ((row_off_.size() & 1023) == 0) pause_point();
-    row_colv_.insert(row_colv_.end(), bcol.begin() + boff[bk], bcol.begin() + boff[bk + 1]);
-    row_val_.insert(row_val_.end(), bval.begin() + 3 * boff[bk], bval.begin() + 3 * boff[bk + 1]);
-    row_off_.push_back(static_cast<int>(row_colv_.size()));
-    row_ik_.insert(row_ik_.end(), bik.begin() + 3 * bk, bik.begin() + 3 * bk + 3);
-  }
+  // The blocks in colour order (row_*): the offsets first, then each block's entries copied to
+  // its place on the cook's pool.
+  const int nb = static_cast<int>(order_b.size());
+  row_off_.resize(nb + 1);
+  row_off_[0] = 0;
+  for (int k = 0; k < nb; ++k)
+    row_off_[k + 1] = row_off_[k] + boff[order_b[k] + 1] - boff[order_b[k]];
+  row_colv_.resize(row_off_[nb]);
+  row_val_.resize(3 * static_cast<size_t>(row_off_[nb]));
+  row_ik_.resize(3 * static_cast<size_t>(nb));
+  ThreadPool* pool = cook_pool();
+  pool->parallel_for(nb, [&](int b, int e, int) {
+    for (int k = b; k < e; ++k) {
+      const int bk = order_b[k], len = boff[bk + 1] - boff[bk];
+      std::copy_n(bcol.begin() + boff[bk], len, row_colv_.begin() + row_off_[k]);
+      std::copy_n(bval.begin() + 3 * boff[bk], 3 * len, row_val_.begin() + 3 * row_off_[k]);
+      std::copy_n(bik.begin() + 3 * bk, 3, row_ik_.begin() + 3 * k);
+    }
+  });
+  pause_point();
   lambda_row_.assign(row_ik_.size(), Vec3::Zero());
   row_packs_.clear();
   row_packs8_.clear();
   rpack_col_.assign(1, 0);
   rpack8_col_.assign(1, 0);
-  for (size_t c = 0; c + 1 < row_cols_.size(); ++c) {
-    pause_point();
-    if (cooked_f32_) {
-      row_packs8_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
-                         row_cols_[c], row_cols_[c + 1], n, S);
-      rpack8_col_.push_back(row_packs8_.packs());
-    } else {
-      row_packs_.append(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
-                        row_cols_[c], row_cols_[c + 1], n, S);
-      rpack_col_.push_back(row_packs_.packs());
-    }
-  }
+  if (cooked_f32_)
+    row_packs8_.assign(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(),
+                       row_cols_, n, S, pool, rpack8_col_);
+  else
+    row_packs_.assign(row_off_.data(), row_colv_.data(), row_val_.data(), row_ik_.data(), row_cols_,
+                      n, S, pool, rpack_col_);
   row_ai_h_ = -1;
 }
 
@@ -617,14 +618,33 @@ StepStats XpbdSolver::step(Cloth& cloth, const SceneObjects& scene, double dt) {
   rest_.mark_masses_dirty();  // pins, releases, wakes and finishes happen between frames
   energy_.set_form(&scene);
   Step c(*this, cloth, scene, dt);
-  if (!begin_frame(c)) return c.st;
+  auto t = std::chrono::steady_clock::now();
+  const bool moving = begin_frame(c);
+  add_part(kPartFrame, t);
+  if (!moving) return c.st;
   renew_anchors(c);
+  add_part(kPartAnchors, t);
   for (c.s = 0; c.s < c.ns; ++c.s) substep(c);
+  t = std::chrono::steady_clock::now();
   if (contacts_unlisted_) {
     energy_.list_contacts(c.n, pool_.get());
     contacts_unlisted_ = false;
   }
+  add_part(kPartList, t);
   return c.st;
+}
+
+void XpbdSolver::add_part(int part, std::chrono::steady_clock::time_point& t) {
+  const auto now = std::chrono::steady_clock::now();
+  part_ms_[part] += std::chrono::duration<double, std::milli>(now - t).count();
+  t = now;
+}
+
+const char* XpbdSolver::part_name(int part) {
+  static const char* const names[kStepParts] = {"frame start", "anchors", "contacts",
+                                                "masses+plan", "sweep",   "retests",
+                                                "after sweep", "pieces",  "list"};
+  return part >= 0 && part < kStepParts ? names[part] : "?";
 }
 
 bool XpbdSolver::begin_frame(Step& c) {
@@ -696,21 +716,28 @@ void XpbdSolver::anchor_terms(const std::vector<double>& anchors, ThreadPool* po
 }
 
 void XpbdSolver::substep(Step& c) {
+  auto t = std::chrono::steady_clock::now();
   detect_contacts(c);
   if (c.s == 0) rest_.coarse_step(c.cloth, c.scene, energy_);
   contacts_fresh_ = false;
+  add_part(kPartContacts, t);
   set_masses(c);
   plan_substep(c);
+  add_part(kPartPlan, t);
   if (!c.fused) pool_->parallel_for(c.n, [&](int b, int e, int) { predict(c, b, e); });
   warm_start(c);
   for (int it = 0; it < opt_.iterations && c.fused; ++it) {
     sweep(c);
     ++c.st.iterations;
   }
+  add_part(kPartSweep, t);
   retest_listed(c);
+  add_part(kPartRetests, t);
   if (c.fused && c.scene.self_collision) project_self_after_sweep(c);
   if (c.fused) project_ties_after_sweep(c);
+  add_part(kPartAfter, t);
   collect_retests(c);
+  add_part(kPartRetests, t);
   for (int it = 0; it < opt_.iterations && !c.fused; ++it) {
     project_triangles(c);
     project_bending_springs(c);
@@ -722,8 +749,10 @@ void XpbdSolver::substep(Step& c) {
       velocities(c, b, e, wk);
       if (c.self_watch) self_motion(c, b, e, wk);
     });
+  add_part(kPartSweep, t);
   update_pieces(c);
   schedule_rest(c);
+  add_part(kPartPieces, t);
   c.S.time += c.h;
   ++c.st.substeps;
 }

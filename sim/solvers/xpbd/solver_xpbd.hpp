@@ -15,7 +15,9 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -76,6 +78,12 @@ class XpbdSolver : public Solver {
   // (XpbdOptions::incremental_cook: only the triangles the change reached) instead of building
   // it whole. CookAheadSolver seeds the solver it cooks with the energy of the last one.
   void seed_energy(ClothEnergy energy) { energy_ = std::move(energy); }
+  // The options the solver builds its energy with (its cook's; a seed is built with them).
+  static EnergyOptions cook_energy_options(const XpbdOptions& opt) {
+    EnergyOptions eo = opt.energy;
+    eo.bending_matrix = false;  // XPBD projects the bending rows and never evaluates P
+    return eo;
+  }
   // What carries from one step to the next (xpbd_state.cpp): the warm-start multipliers (with
   // warm_start > 0; else they start at zero in every substep), the last substep's length, the
   // single-precision anchors and the rest scheduler's state. The element data are cooked again
@@ -110,6 +118,22 @@ class XpbdSolver : public Solver {
   // Wall ms spent in the element sweeps so far (the rest of a step is the per-substep and
   // per-frame work around them).
   double sweep_ms() const { return sweep_ms_; }
+  // Wall ms spent so far in each part of the steps (the sweeps among them): which parts are
+  // serial, and which scale with the pool (the many-core cost outside the sweeps).
+  enum StepPart {
+    kPartFrame,     // the frame's start: wake, thaw, the static finish, the fixed vertices
+    kPartAnchors,   // the single-precision anchors' reach test and renewal
+    kPartContacts,  // contact and self-collision detection, the coarse correction
+    kPartPlan,      // the inverse masses (with the bending blocks' inverses) and the plan
+    kPartSweep,     // the element sweeps (fused substeps) or the coloured passes
+    kPartRetests,   // the contact retests after the sweep, counted
+    kPartAfter,     // the self-collision pairs and the ties after the sweep
+    kPartPieces,    // the pieces' motion sums, settling and sleep
+    kPartList,      // the contacts listed at the step's end
+    kStepParts
+  };
+  static const char* part_name(int part);
+  double part_ms(int part) const { return part_ms_[part]; }
   // XpbdOptions::sweep_profile: the sweeps' runs timed on one thread and replayed on the plan's
   // slots (xpbd::SweepPlan::schedule), summed over the sweeps so far, with a hand-over of 0 and
   // of kProfileHandoverNs per wait, and with a phase gate (SweepPlan::schedule, hand-over 0).
@@ -340,6 +364,9 @@ class XpbdSolver : public Solver {
   xpbd::SweepPlan sweep_;
   long sweeps_ = 0, sweep_takeovers_ = 0, contact_retests_ = 0;
   double sweep_ms_ = 0;
+  std::array<double, kStepParts> part_ms_{};
+  // Adds the wall ms since t to the part's sum and restarts t.
+  void add_part(int part, std::chrono::steady_clock::time_point& t);
   SweepProfile profile_;
   std::vector<double> profile_ns_;  // per run of the plan: its duration in the last sweep
   // Per pool thread of the retests (retest_listed): vertices tested again for contact and their
@@ -410,8 +437,9 @@ class XpbdSolver : public Solver {
   bool pieces_stale_ = false;   // the ties changed since the pieces were made
   std::vector<int> tie_moved_;  // vertices the last tie projection moved
   CookStats last_cook_;
-  ThreadPool* cook_pool_ = nullptr;  // cook() spreads the energy's build over it (null: pool_)
-  int detections_ = 0;               // contact detections so far (for tests and the bench)
+  ThreadPool* cook_pool_ = nullptr;  // cook() spreads its parallel parts over it (null: pool_)
+  ThreadPool* cook_pool() const { return cook_pool_ ? cook_pool_ : pool_.get(); }
+  int detections_ = 0;  // contact detections so far (for tests and the bench)
   double fresh_penetration_ = 0;
 };
 

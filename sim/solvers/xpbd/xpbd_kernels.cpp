@@ -49,48 +49,68 @@ void RowPackDataT<T, L>::clear() {
 }
 
 template <class T, int L>
-void RowPackDataT<T, L>::append(const int* boff, const int* bcol, const double* bval,
-                                const double* bik, int b, int e, int scratch, int shares) {
-  if (static_cast<int>(slot.size()) < e) slot.resize(e, -1);
-  const int cnt = (e - b + L - 1) / L;
-  // Sized once, then written in place (growing by push_back cost ~10 ms at 128^2).
-  size_t entries = 0;
-  for (int r0 = b; r0 < e; r0 += L) {
-    int len = 0;
-    for (int r = r0; r < std::min(e, r0 + L); ++r) len = std::max(len, boff[r + 1] - boff[r]);
-    entries += len;
+void RowPackDataT<T, L>::assign(const int* boff, const int* bcol, const double* bval,
+                                const double* bik, const std::vector<int>& col, int scratch,
+                                int shares, ThreadPool* pool, std::vector<int>& pack_col) {
+  // The packs first (their first block, their colour's end, their padding vertex) and their
+  // entries' offsets: a pass over the block offsets alone.
+  struct Pack {
+    int r0, e, pad;
+  };
+  std::vector<Pack> packs;
+  clear();
+  pack_col.assign(1, 0);
+  const int colours = static_cast<int>(col.size()) - 1;
+  const int blocks = colours > 0 ? col[colours] : 0;
+  packs.reserve(static_cast<size_t>(blocks / L + colours));
+  for (int c = 0; c < colours; ++c) {
+    pause_point();
+    const int b = col[c], e = col[c + 1], cnt = (e - b + L - 1) / L;
+    for (int r0 = b; r0 < e; r0 += L) {
+      int len = 0;
+      for (int r = r0; r < std::min(e, r0 + L); ++r) len = std::max(len, boff[r + 1] - boff[r]);
+      packs.push_back({r0, e, scratch + share_of((r0 - b) / L, cnt, shares)});
+      off.push_back(off.back() + len);
+    }
+    pack_col.push_back(static_cast<int>(packs.size()));
   }
-  const size_t e0 = colv.size(), p0 = blk.size() / L;
-  colv.resize(e0 + L * entries);
-  val.resize(3 * (e0 + L * entries));
-  ik.resize(3 * L * (p0 + cnt));
-  blk.resize(L * (p0 + cnt));
-  ai.resize(6 * L * (p0 + cnt), T(0));
-  size_t k = e0 / L;  // the next entry (L lanes each)
-  for (int r0 = b; r0 < e; r0 += L) {
-    const int p = packs();
-    const int lanes = std::min(L, e - r0);
-    const int pad = scratch + share_of((r0 - b) / L, cnt, shares);
-    int len = 0;
-    for (int l = 0; l < lanes; ++l) len = std::max(len, boff[r0 + l + 1] - boff[r0 + l]);
-    for (int i = 0; i < len; ++i, ++k) {
+  const int np = static_cast<int>(packs.size());
+  const size_t entries = static_cast<size_t>(off.back());
+  colv.resize(L * entries);
+  val.resize(3 * L * entries);
+  ik.resize(3 * static_cast<size_t>(L) * np);
+  blk.resize(static_cast<size_t>(L) * np);
+  ai.assign(6 * static_cast<size_t>(L) * np, T(0));
+  slot.assign(blocks, -1);
+  // Each pack as append() writes it; the packs write disjoint entries.
+  auto fill = [&](int pb, int pe) {
+    for (int p = pb; p < pe; ++p) {
+      const int r0 = packs[p].r0, lanes = std::min(L, packs[p].e - r0), pad = packs[p].pad;
+      const int len = off[p + 1] - off[p];
+      for (int i = 0; i < len; ++i) {
+        const size_t k = static_cast<size_t>(off[p]) + i;
+        for (int l = 0; l < L; ++l) {
+          const int r = r0 + l;
+          const bool real = l < lanes && i < boff[r + 1] - boff[r];
+          colv[L * k + l] = real ? bcol[boff[r] + i] : pad;
+          for (int a = 0; a < 3; ++a)
+            val[3 * L * k + L * a + l] = real ? static_cast<T>(bval[3 * (boff[r] + i) + a]) : T(0);
+        }
+      }
+      for (int a = 0; a < 3; ++a)
+        for (int l = 0; l < L; ++l)
+          ik[3 * L * static_cast<size_t>(p) + L * a + l] =
+              l < lanes ? static_cast<T>(bik[3 * (r0 + l) + a]) : T(0);
       for (int l = 0; l < L; ++l) {
-        const int r = r0 + l;
-        const bool real = l < lanes && i < boff[r + 1] - boff[r];
-        colv[L * k + l] = real ? bcol[boff[r] + i] : pad;
-        for (int a = 0; a < 3; ++a)
-          val[3 * L * k + L * a + l] = real ? static_cast<T>(bval[3 * (boff[r] + i) + a]) : T(0);
+        blk[L * static_cast<size_t>(p) + l] = l < lanes ? r0 + l : -1;
+        if (l < lanes) slot[r0 + l] = L * p + l;
       }
     }
-    off.push_back(off.back() + len);
-    for (int a = 0; a < 3; ++a)
-      for (int l = 0; l < L; ++l)
-        ik[3 * L * p + L * a + l] = l < lanes ? static_cast<T>(bik[3 * (r0 + l) + a]) : T(0);
-    for (int l = 0; l < L; ++l) {
-      blk[L * p + l] = l < lanes ? r0 + l : -1;
-      if (l < lanes) slot[r0 + l] = L * p + l;
-    }
-  }
+  };
+  if (pool)
+    pool->parallel_for(np, [&](int pb, int pe, int) { fill(pb, pe); });
+  else
+    fill(0, np);
 }
 template struct RowPackDataT<double, 4>;
 template struct RowPackDataT<float, 8>;

@@ -105,11 +105,14 @@ struct RowPackDataT {
   std::vector<T> val, ik, ai;
   std::vector<int> slot;  // per block: L * pack + lane
   void clear();
-  // Appends blocks [b, e) (one colour) of the CSR (boff, bcol, bval: 3 per entry; bik: 3 per
-  // block).
-  // Padding uses the scratch vertex of the pack's share (share_begin).
-  void append(const int* boff, const int* bcol, const double* bval, const double* bik, int b, int e,
-              int scratch, int shares = 1);
+  // Packs the blocks of the CSR (boff, bcol, bval: 3 per entry; bik: 3 per block), colour by
+  // colour (colour c: blocks [col[c], col[c + 1])), L blocks of one colour a pack, the packs of a
+  // colour in `shares` shares whose padding uses the share's scratch vertex (share_begin). The
+  // packs are filled on `pool` (null: on this thread; the same arrays either way). pack_col:
+  // each colour's first pack, and the packs in all (size colours + 1).
+  void assign(const int* boff, const int* bcol, const double* bval, const double* bik,
+              const std::vector<int>& col, int scratch, int shares, ThreadPool* pool,
+              std::vector<int>& pack_col);
   int packs() const { return static_cast<int>(off.size()) - 1; }
   // The inverse system matrix entry m of a block.
   T& ai_of(int block, int m) {

@@ -188,7 +188,9 @@ Packed pack_problem(const Problem& p) {
   k.xp[p.n] = P4{{0, 0, 0, 0}};
   pack_triangles(p.tris.data(), 0, static_cast<int>(p.tris.size()), p.n, k.tp);
   const int nb = static_cast<int>(p.off.size()) - 1;
-  k.rp.append(p.off.data(), p.colv.data(), p.val.data(), p.ik.data(), 0, nb, p.n);
+  std::vector<int> pack_col;
+  k.rp.assign(p.off.data(), p.colv.data(), p.val.data(), p.ik.data(), {0, nb}, p.n, 1, nullptr,
+              pack_col);
   for (int r = 0; r < nb; ++r)
     for (int m = 0; m < 6; ++m) k.rp.ai_of(r, m) = p.ai[6 * r + m];
   return k;
@@ -248,6 +250,77 @@ TEST(XpbdKernels, PacksProjectLikeOneElementAfterTheOther) {
 // kernels() returns the last (widest) of all_kernels(), which starts with the portable build;
 // DRAPE_XPBD_SIMD=0 leaves only that one, DRAPE_XPBD_SIMD=avx2 stops below AVX-512 (ctest runs
 // this test with both too: simd_off.*, simd_avx2.*).
+// Bending blocks of several colours packed in eights: on a pool of two threads the same arrays
+// as on one, and every block in its colour's packs with its own columns and values, the padding
+// on its share's scratch vertex.
+TEST(XpbdKernels, BendingPacksHoldEveryBlockOfEveryColourOnAPoolAsOnOneThread) {
+  constexpr int L = 8, kScratch = 500, kShares = 3;
+  std::mt19937 rng(7);
+  const std::vector<int> col{0, 37, 70, 71, 100};  // four colours, one of a single block
+  const int nb = col.back();
+  std::vector<int> boff{0}, bcol;
+  std::vector<double> bval, bik;
+  for (int r = 0; r < nb; ++r) {
+    const int len = 3 + static_cast<int>(rng() % 10);
+    for (int i = 0; i < len; ++i) {
+      bcol.push_back(static_cast<int>(rng() % kScratch));
+      for (int a = 0; a < 3; ++a) bval.push_back(std::ldexp(double(rng() % 1000) - 500, -7));
+    }
+    boff.push_back(static_cast<int>(bcol.size()));
+    for (int a = 0; a < 3; ++a) bik.push_back(1.0 + r + 0.25 * a);
+  }
+  RowPackData8 one, two;
+  std::vector<int> col_one, col_two;
+  one.assign(boff.data(), bcol.data(), bval.data(), bik.data(), col, kScratch, kShares, nullptr,
+             col_one);
+  drape::sim::ThreadPool pool(2);
+  two.assign(boff.data(), bcol.data(), bval.data(), bik.data(), col, kScratch, kShares, &pool,
+             col_two);
+  EXPECT_EQ(one.off, two.off);
+  EXPECT_EQ(one.colv, two.colv);
+  EXPECT_EQ(one.val, two.val);
+  EXPECT_EQ(one.ik, two.ik);
+  EXPECT_EQ(one.blk, two.blk);
+  EXPECT_EQ(one.ai, two.ai);
+  EXPECT_EQ(one.slot, two.slot);
+  EXPECT_EQ(col_one, col_two);
+  // Each colour's packs: ceil(size / 8), in order.
+  ASSERT_EQ(col_one.size(), col.size());
+  for (size_t c = 0; c + 1 < col.size(); ++c)
+    EXPECT_EQ(col_one[c + 1] - col_one[c], (col[c + 1] - col[c] + L - 1) / L) << "colour " << c;
+  for (size_t c = 0; c + 1 < col.size(); ++c) {
+    const int cnt = col_one[c + 1] - col_one[c];
+    for (int p = col_one[c]; p < col_one[c + 1]; ++p) {
+      const int pad = kScratch + share_of(p - col_one[c], cnt, kShares);
+      int longest = 0;  // the pack's entries: its longest block's
+      for (int r = col[c] + L * (p - col_one[c]);
+           r < std::min(col[c + 1], col[c] + L * (p + 1 - col_one[c])); ++r)
+        longest = std::max(longest, boff[r + 1] - boff[r]);
+      EXPECT_EQ(two.off[p + 1] - two.off[p], longest) << "pack " << p;
+      for (int l = 0; l < L; ++l) {
+        const int r = col[c] + L * (p - col_one[c]) + l;
+        const bool real = r < col[c + 1];
+        ASSERT_EQ(two.blk[L * p + l], real ? r : -1) << "pack " << p << " lane " << l;
+        if (real) {
+          EXPECT_EQ(two.slot[r], L * p + l);
+          for (int a = 0; a < 3; ++a)
+            EXPECT_EQ(two.ik[3 * L * p + L * a + l], static_cast<float>(bik[3 * r + a]));
+        }
+        const int len = real ? boff[r + 1] - boff[r] : 0;
+        for (int i = two.off[p]; i < two.off[p + 1]; ++i) {
+          const int e = i - two.off[p];
+          const bool entry = e < len;
+          EXPECT_EQ(two.colv[L * i + l], entry ? bcol[boff[r] + e] : pad)
+              << "pack " << p << " lane " << l << " entry " << e;
+          for (int a = 0; a < 3; ++a)
+            EXPECT_EQ(two.val[3 * L * i + L * a + l],
+                      entry ? static_cast<float>(bval[3 * (boff[r] + e) + a]) : 0.0f);
+        }
+      }
+    }
+  }
+}
+
 TEST(XpbdKernels, TheFastestBuildTheCpuRunsIsChosen) {
   const std::vector<const Kernels*> builds = all_kernels();
   ASSERT_FALSE(builds.empty());
@@ -334,7 +407,9 @@ PackedF<L> pack_problem_f(const Problem& p, const Kernels& K, const double* offs
   K.pack8(k.x.data(), p.w.data(), k.a.data(), k.xp.data(), 0, p.n);
   pack_triangles<float, L>(p.tris.data(), 0, static_cast<int>(p.tris.size()), p.n, k.tp);
   const int nb = static_cast<int>(p.off.size()) - 1;
-  k.rp.append(p.off.data(), p.colv.data(), p.val.data(), p.ik.data(), 0, nb, p.n);
+  std::vector<int> pack_col;
+  k.rp.assign(p.off.data(), p.colv.data(), p.val.data(), p.ik.data(), {0, nb}, p.n, 1, nullptr,
+              pack_col);
   for (int r = 0; r < nb; ++r)
     for (int m = 0; m < 6; ++m) k.rp.ai_of(r, m) = static_cast<float>(p.ai[6 * r + m]);
   k.fa.resize(6 * L * k.tp.size());
