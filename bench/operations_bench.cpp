@@ -365,11 +365,9 @@ void cook_probe(int res, bool full, int threads, int repeat) {
     for (int f = 0; f < 2; ++f) s.step(sc.cloth, sc.objects, 1.0 / 90);
     if (!cut_across_material(sc.cloth, 0.5 + 0.25 / res).ok)
       std::fprintf(stderr, "the cut across %d^2 failed\n", res);
-    rusage u0{}, u1{};
-    getrusage(RUSAGE_SELF, &u0);
+    const long faults0 = process_page_faults();
     s.step(sc.cloth, sc.objects, 1.0 / 90);
-    getrusage(RUSAGE_SELF, &u1);
-    faults.push_back(static_cast<double>(u1.ru_minflt - u0.ru_minflt));
+    faults.push_back(static_cast<double>(process_page_faults() - faults0));
     cooks.push_back(s.last_cook());
   }
   // Each part's median over the runs (a noisy machine: the runs' spread is printed too).
@@ -447,7 +445,8 @@ int main(int argc, char** argv) {
   int probe_res = 0;
   bool full_cook = false;
   app.add_option("--cook-probe", probe_res,
-                 "only one cut's re-cook at this form resolution, on one thread (for callgrind)")
+                 "only one cut's re-cook at this form resolution (one thread unless "
+                 "--cook-threads: for callgrind), its parts and page faults")
       ->check(CLI::Range(4, 1024));
   app.add_flag("--full-cook", full_cook, "with --cook-probe: a full cook instead");
   int cook_threads = 1;
